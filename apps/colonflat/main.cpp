@@ -1,0 +1,11 @@
+// The `colonflat` dispatcher: every command is a library function (pipeline/dispatch.h).
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "colonflat/pipeline/dispatch.h"
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  return cf::colonflat_main(args, std::cout, std::cerr);
+}

@@ -1,0 +1,55 @@
+# Helpers shared by every module.
+#
+#   colonflat_module(NAME <name> SOURCES ... DEPS ...)
+#     builds static library colonflat_<name> from modules/<name>/src, public include dir
+#     modules/<name>/include.
+#   colonflat_tests(NAME <name> SOURCES ... DEPS ... [LABELS ...])
+#     builds <name>_tests from the given test sources and registers every GoogleTest case with ctest.
+#   colonflat_register_tool(FACTORY <fn> HEADER <header>)
+#     adds a `colonflat <tool>` command (a function returning std::unique_ptr<cf::Tool>).
+#   colonflat_register_stage(FACTORY <fn> HEADER <header>)
+#     adds a pipeline stage (a function returning std::unique_ptr<cf::Stage>); it is also a command.
+
+set(COLONFLAT_WARNINGS -Wall -Wextra -Wno-unused-parameter)
+
+function(colonflat_module)
+  cmake_parse_arguments(M "" "NAME" "SOURCES;DEPS" ${ARGN})
+  add_library(colonflat_${M_NAME} STATIC ${M_SOURCES})
+  target_include_directories(colonflat_${M_NAME} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(colonflat_${M_NAME} PUBLIC ${M_DEPS})
+  target_compile_options(colonflat_${M_NAME} PRIVATE ${COLONFLAT_WARNINGS})
+  set_property(GLOBAL APPEND PROPERTY COLONFLAT_MODULE_LIBS colonflat_${M_NAME})
+endfunction()
+
+function(colonflat_tests)
+  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  if(NOT COLONFLAT_BUILD_TESTS)
+    return()
+  endif()
+  add_executable(${T_NAME}_tests ${T_SOURCES})
+  target_link_libraries(${T_NAME}_tests PRIVATE ${T_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
+  target_include_directories(${T_NAME}_tests PRIVATE ${PROJECT_SOURCE_DIR}/modules/core/test/support)
+  target_compile_definitions(${T_NAME}_tests PRIVATE
+    COLONFLAT_SHARED_DIR="${COLONFLAT_SHARED_DIR}"
+    COLONFLAT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 300)
+  endif()
+  include(GoogleTest)
+  gtest_discover_tests(${T_NAME}_tests
+    WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}
+    PROPERTIES LABELS "${T_NAME};${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    DISCOVERY_TIMEOUT 60)
+endfunction()
+
+function(colonflat_register_tool)
+  cmake_parse_arguments(R "" "FACTORY;HEADER" "" ${ARGN})
+  set_property(GLOBAL APPEND PROPERTY COLONFLAT_TOOL_FACTORIES "${R_FACTORY}")
+  set_property(GLOBAL APPEND PROPERTY COLONFLAT_TOOL_HEADERS "${R_HEADER}")
+endfunction()
+
+function(colonflat_register_stage)
+  cmake_parse_arguments(R "" "FACTORY;HEADER" "" ${ARGN})
+  set_property(GLOBAL APPEND PROPERTY COLONFLAT_STAGE_FACTORIES "${R_FACTORY}")
+  set_property(GLOBAL APPEND PROPERTY COLONFLAT_TOOL_HEADERS "${R_HEADER}")
+endfunction()

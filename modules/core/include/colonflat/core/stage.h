@@ -1,0 +1,122 @@
+#pragma once
+// A pipeline stage (VMTK-style): one class declaring its inputs, outputs and parameters. From the
+// declaration come the stand-alone command `colonflat <stage> IN -o OUT [--param ...]`, its
+// --help, range checks, --params-in/--params-out JSON, and the in-memory chaining in
+// `colonflat run`. Alone or chained, a stage runs the same run() on the same data.
+#include <any>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/params.h"
+#include "colonflat/core/tool.h"
+
+namespace cf {
+
+// A kind of data passed between stages, with its file reader and writer.
+struct ArtifactType {
+  std::string name;         // "mesh", "volume", "mask", "loops", "flat", "image"
+  std::string description;  // for --help: "triangle mesh (.vtp .vtk .off .obj .ply .stl)"
+  // Reads a file into a value; throws InputError.
+  std::function<std::any(const std::filesystem::path&)> read;
+  // Writes a value to `tmp` (a temporary path with the target's extension); `target` names the
+  // final file for messages. The caller renames tmp -> target when every output is written.
+  std::function<void(const std::any&, const std::filesystem::path& tmp, const std::filesystem::path& target)> write;
+};
+
+struct Port {
+  std::string name;           // key in the artifact bag, and CLI option name for secondary ports
+  const ArtifactType* type;   // never null
+  std::string help;
+  std::string file_name;      // default file name in run and debug folders, e.g. "surface.vtp"
+  bool required = true;       // inputs: must be given; outputs: always produced
+};
+
+struct StageSpec {
+  std::string name;     // "denoise"
+  std::string summary;  // one line
+  std::vector<Port> inputs, outputs;
+};
+
+// Named values flowing between stages.
+class ArtifactBag {
+ public:
+  bool has(const std::string& name) const { return items_.count(name) != 0; }
+  void put(const std::string& name, std::any value) { items_[name] = std::move(value); }
+  const std::any& raw(const std::string& name) const;
+  template <class T>
+  const T& get(const std::string& name) const {
+    const T* p = std::any_cast<T>(&raw(name));
+    if (!p) throw Error("artifact '" + name + "' has an unexpected type");
+    return *p;
+  }
+  template <class T>
+  T take(const std::string& name) {
+    T v = std::move(const_cast<T&>(get<T>(name)));
+    items_.erase(name);
+    return v;
+  }
+  void erase(const std::string& name) { items_.erase(name); }
+
+ private:
+  std::map<std::string, std::any> items_;
+};
+
+// What a running stage may use: a progress stream and its report (counts, timings).
+struct RunContext {
+  std::ostream* log = nullptr;  // progress lines; null = quiet
+  nlohmann::json report = nlohmann::json::object();
+  void progress(const std::string& line) const {
+    if (log) *log << line << std::endl;
+  }
+};
+
+class Stage {
+ public:
+  virtual ~Stage() = default;
+  virtual const StageSpec& spec() const = 0;
+  virtual std::vector<ParamInfo> params() const = 0;
+  virtual void add_cli_options(CLI::App& app) = 0;
+  virtual nlohmann::json params_json() const = 0;
+  virtual void set_params_json(const nlohmann::json& j, const std::string& where) = 0;
+  virtual void validate_params() const = 0;
+  // Reads spec().inputs from `bag`, puts spec().outputs into it. Throws cf::Error.
+  virtual void run(ArtifactBag& bag, RunContext& ctx) = 0;
+};
+
+// Implements the parameter plumbing of Stage from a ParamTable over an Options struct.
+template <class O>
+class StageWithOptions : public Stage {
+ public:
+  O& options() { return opts_; }
+  const O& options() const { return opts_; }
+  std::vector<ParamInfo> params() const override { return table().info(); }
+  void add_cli_options(CLI::App& app) override { table().add_to(app, opts_); }
+  nlohmann::json params_json() const override { return table().to_json(opts_); }
+  void set_params_json(const nlohmann::json& j, const std::string& where) override {
+    table().from_json(j, opts_, where);
+  }
+  void validate_params() const override { table().validate(opts_); }
+
+ protected:
+  virtual const ParamTable<O>& table() const = 0;
+  O opts_{};
+};
+
+using StageFactory = std::function<std::unique_ptr<Stage>()>;
+
+// The stand-alone command of a stage: `colonflat <stage> INPUT -o OUTPUT [--<port> FILE]...
+// [--report FILE.json] [--params-in F] [--params-out F] [--quiet] [params]`.
+std::unique_ptr<Tool> make_stage_tool(StageFactory factory);
+
+// Reads a JSON file (InputError on failure).
+nlohmann::json read_json_file(const std::filesystem::path& path);
+
+}  // namespace cf

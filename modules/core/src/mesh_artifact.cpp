@@ -1,0 +1,104 @@
+#include "colonflat/core/mesh_artifact.h"
+
+#include <iomanip>
+#include <sstream>
+
+#include "colonflat/core/mesh_io.h"
+
+namespace cf {
+
+const ArtifactType& mesh_artifact() {
+  static const ArtifactType t{
+      "mesh", "triangle mesh (" + mesh_format_list() + "), LPS mm",
+      [](const std::filesystem::path& p) { return std::any(load_mesh(p).mesh); },
+      [](const std::any& v, const std::filesystem::path& tmp, const std::filesystem::path& target) {
+        // write_mesh renames atomically itself; the caller's transaction renames tmp later.
+        (void)target;
+        write_mesh(std::any_cast<const Mesh&>(v), tmp);
+      }};
+  return t;
+}
+
+namespace {
+nlohmann::json opt_int(const std::optional<int>& g) { return g ? nlohmann::json(*g) : nlohmann::json(nullptr); }
+}  // namespace
+
+nlohmann::json topology_to_json(const TopologyReport& t) {
+  nlohmann::json comps = nlohmann::json::array();
+  for (std::size_t i = 0; i < t.components.size(); ++i) {
+    const auto& c = t.components[i];
+    comps.push_back({{"id", i},
+                     {"vertices", c.vertices},
+                     {"edges", c.edges},
+                     {"faces", c.faces},
+                     {"boundary_edges", c.boundary_edges},
+                     {"boundary_loops", c.boundary_loops},
+                     {"euler_characteristic", c.euler},
+                     {"genus", opt_int(c.genus)},
+                     {"closed", c.closed},
+                     {"manifold", c.manifold},
+                     {"orientable", c.orientable}});
+  }
+  return {{"vertices", t.vertices},
+          {"edges", t.edges},
+          {"faces", t.faces},
+          {"unreferenced_vertices", t.unreferenced_vertices},
+          {"components", t.components.size()},
+          {"boundary_edges", t.boundary_edges},
+          {"boundary_loops", t.boundary_loops},
+          {"nonmanifold_edges", t.nonmanifold_edges},
+          {"nonmanifold_vertices", t.nonmanifold_vertices},
+          {"inconsistently_oriented_edges", t.inconsistent_edges},
+          {"euler_characteristic", t.euler},
+          {"genus", opt_int(t.genus)},
+          {"closed", t.closed},
+          {"manifold", t.manifold},
+          {"orientable", t.orientable},
+          {"bounding_box", {{"min", t.bbox_min}, {"max", t.bbox_max}}},
+          {"mean_edge_length", t.mean_edge_length},
+          {"per_component", comps},
+          {"conventions",
+           "chi = V - E + F over referenced vertices; per component g = (2 - chi - b) / 2 with b boundary loops; "
+           "total genus = sum over components; genus null where a component is non-manifold or non-orientable"}};
+}
+
+nlohmann::json diagnosis_to_json(const MeshDiagnosis& d) {
+  static const char* names[] = {"note", "repaired", "defect", "fatal"};
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& f : d.findings)
+    a.push_back({{"code", f.code}, {"severity", names[static_cast<int>(f.severity)]}, {"count", f.count}, {"message", f.message}});
+  return a;
+}
+
+std::string topology_to_text(const TopologyReport& t) {
+  std::ostringstream s;
+  auto yn = [](bool b) { return b ? "yes" : "no"; };
+  auto g = [](const std::optional<int>& x) { return x ? std::to_string(*x) : std::string("undefined"); };
+  s << "vertices        " << t.vertices;
+  if (t.unreferenced_vertices) s << " (+" << t.unreferenced_vertices << " unreferenced, not counted)";
+  s << "\nedges           " << t.edges << "\nfaces           " << t.faces
+    << "\ncomponents      " << t.components.size() << "\nboundary loops  " << t.boundary_loops
+    << " (" << t.boundary_edges << " boundary edges)"
+    << "\neuler char.     " << t.euler << "   (V - E + F)"
+    << "\ngenus           " << g(t.genus) << "   (sum over components of (2 - chi - b) / 2)"
+    << "\nclosed          " << yn(t.closed) << "\nmanifold        " << yn(t.manifold);
+  if (!t.manifold) s << " (" << t.nonmanifold_edges << " non-manifold edges, " << t.nonmanifold_vertices << " non-manifold vertices)";
+  s << "\norientable      " << yn(t.orientable);
+  if (t.orientable && t.inconsistent_edges) s << " (" << t.inconsistent_edges << " edges inconsistently oriented)";
+  s << std::setprecision(6) << "\nbounding box    [" << t.bbox_min[0] << ", " << t.bbox_min[1] << ", " << t.bbox_min[2]
+    << "] .. [" << t.bbox_max[0] << ", " << t.bbox_max[1] << ", " << t.bbox_max[2] << "]"
+    << "\nmean edge       " << t.mean_edge_length << "\n";
+  if (t.components.size() > 1) {
+    s << "per component (largest first):\n";
+    const std::size_t shown = std::min<std::size_t>(t.components.size(), 20);
+    for (std::size_t i = 0; i < shown; ++i) {
+      const auto& c = t.components[i];
+      s << "  #" << i << ": V=" << c.vertices << " E=" << c.edges << " F=" << c.faces << " chi=" << c.euler
+        << " b=" << c.boundary_loops << " genus=" << g(c.genus) << (c.manifold ? "" : " non-manifold") << "\n";
+    }
+    if (shown < t.components.size()) s << "  ... " << (t.components.size() - shown) << " more (see --json)\n";
+  }
+  return s.str();
+}
+
+}  // namespace cf

@@ -1,0 +1,342 @@
+#include "colonflat/core/validation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <sstream>
+
+#include "colonflat/core/error.h"
+
+namespace cf {
+namespace {
+
+std::string plural(std::size_t n, const std::string& one, const std::string& many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+template <class T, class F>
+std::string examples(const std::vector<T>& xs, F fmt) {
+  if (xs.empty()) return "";
+  std::ostringstream s;
+  s << " (e.g. ";
+  for (std::size_t i = 0; i < xs.size(); ++i) s << (i ? ", " : "") << fmt(xs[i]);
+  s << ")";
+  return s.str();
+}
+
+std::string edge_str(const std::array<int, 2>& e) {
+  return std::to_string(e[0]) + "-" + std::to_string(e[1]);
+}
+
+}  // namespace
+
+bool MeshDiagnosis::has(const std::string& code) const { return find(code) != nullptr; }
+
+const Finding* MeshDiagnosis::find(const std::string& code) const {
+  for (const auto& f : findings)
+    if (f.code == code) return &f;
+  return nullptr;
+}
+
+bool MeshDiagnosis::has_at_least(Severity s) const {
+  for (const auto& f : findings)
+    if (f.severity >= s) return true;
+  return false;
+}
+
+std::string MeshDiagnosis::summary(Severity s) const {
+  std::string out;
+  for (const auto& f : findings) {
+    if (f.severity < s) continue;
+    if (!out.empty()) out += "; ";
+    out += f.message;
+  }
+  return out;
+}
+
+MeshDiagnosis diagnose_soup(const PolygonSoup& soup) {
+  MeshDiagnosis d;
+  const std::size_t P = soup.points.size();
+  const std::size_t F = soup.num_faces();
+  if (F == 0) {
+    d.findings.push_back({"empty", Severity::kFatal, 0,
+                          P == 0 ? "empty mesh: no vertices and no faces"
+                                 : "empty mesh: " + plural(P, "vertex", "vertices") + " but no faces"});
+    return d;
+  }
+  {  // Non-finite coordinates.
+    std::vector<std::size_t> bad;
+    std::size_t n = 0;
+    for (std::size_t v = 0; v < P; ++v) {
+      const auto& p = soup.points[v];
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        ++n;
+        if (bad.size() < 5) bad.push_back(v);
+      }
+    }
+    if (n)
+      d.findings.push_back({"nonfinite_coordinates", Severity::kFatal, n,
+                            plural(n, "vertex", "vertices") + " with NaN or infinite coordinates" +
+                                examples(bad, [](std::size_t v) { return "v" + std::to_string(v); })});
+  }
+  std::size_t out_of_range = 0, too_small = 0, polygons = 0, repeated = 0;
+  std::vector<std::string> ex_range, ex_small, ex_poly, ex_rep;
+  std::vector<std::uint8_t> used(P, 0);
+  for (std::size_t f = 0; f < F; ++f) {
+    const std::size_t n = soup.face_size(f);
+    const std::int64_t* ids = soup.face(f);
+    bool in_range = true;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (ids[k] < 0 || static_cast<std::size_t>(ids[k]) >= P) {
+        in_range = false;
+        if (ex_range.size() < 5)
+          ex_range.push_back("face " + std::to_string(f) + " -> " + std::to_string(ids[k]));
+      } else {
+        used[ids[k]] = 1;
+      }
+    }
+    if (!in_range) ++out_of_range;
+    if (n < 3) {
+      ++too_small;
+      if (ex_small.size() < 5) ex_small.push_back("face " + std::to_string(f));
+      continue;
+    }
+    if (n > 3) {
+      ++polygons;
+      if (ex_poly.size() < 5) ex_poly.push_back("face " + std::to_string(f) + " has " + std::to_string(n));
+    }
+    bool rep = false;
+    for (std::size_t a = 0; a < n && !rep; ++a)
+      for (std::size_t b = a + 1; b < n && !rep; ++b) rep = ids[a] == ids[b];
+    if (rep) {
+      ++repeated;
+      if (ex_rep.size() < 5) ex_rep.push_back("face " + std::to_string(f));
+    }
+  }
+  auto ex = [](const std::vector<std::string>& v) { return examples(v, [](const std::string& s) { return s; }); };
+  if (out_of_range)
+    d.findings.push_back({"index_out_of_range", Severity::kFatal, out_of_range,
+                          plural(out_of_range, "face references", "faces reference") +
+                              " vertex ids outside 0.." + std::to_string(P == 0 ? 0 : P - 1) + ex(ex_range)});
+  if (too_small)
+    d.findings.push_back({"faces_too_small", Severity::kDefect, too_small,
+                          plural(too_small, "face has", "faces have") + " fewer than 3 vertices" + ex(ex_small)});
+  if (polygons)
+    d.findings.push_back({"non_triangle_faces", Severity::kRepaired, polygons,
+                          plural(polygons, "face is a polygon", "faces are polygons") +
+                              " with more than 3 vertices, fan-triangulated" + ex(ex_poly)});
+  if (repeated)
+    d.findings.push_back({"degenerate_faces", Severity::kDefect, repeated,
+                          plural(repeated, "degenerate face repeats", "degenerate faces repeat") +
+                              " a vertex id" + ex(ex_rep)});
+  if (out_of_range) return d;  // the checks below index points
+
+  {  // Duplicate faces: same vertex set (either orientation).
+    std::vector<std::pair<std::vector<std::int64_t>, std::size_t>> keys;
+    keys.reserve(F);
+    for (std::size_t f = 0; f < F; ++f) {
+      std::vector<std::int64_t> k(soup.face(f), soup.face(f) + soup.face_size(f));
+      std::sort(k.begin(), k.end());
+      keys.emplace_back(std::move(k), f);
+    }
+    std::sort(keys.begin(), keys.end());
+    std::size_t dup = 0;
+    std::vector<std::string> ex_dup;
+    for (std::size_t i = 1; i < keys.size(); ++i) {
+      if (keys[i].first == keys[i - 1].first) {
+        ++dup;
+        if (ex_dup.size() < 5)
+          ex_dup.push_back("face " + std::to_string(keys[i].second) + " = face " +
+                           std::to_string(keys[i - 1].second));
+      }
+    }
+    if (dup)
+      d.findings.push_back({"duplicate_faces", Severity::kDefect, dup,
+                            plural(dup, "duplicate face uses", "duplicate faces use") +
+                                " the same vertices as another face" + ex(ex_dup)});
+  }
+  {  // Unreferenced vertices.
+    std::size_t n = 0;
+    std::vector<std::string> exv;
+    for (std::size_t v = 0; v < P; ++v)
+      if (!used[v]) {
+        ++n;
+        if (exv.size() < 5) exv.push_back("v" + std::to_string(v));
+      }
+    if (n)
+      d.findings.push_back({"unreferenced_vertices", Severity::kRepaired, n,
+                            plural(n, "vertex is", "vertices are") + " not used by any face (ignored)" + ex(exv)});
+  }
+  {  // Coincident points: distinct referenced vertices at exactly the same position.
+    std::vector<std::uint32_t> order;
+    order.reserve(P);
+    for (std::size_t v = 0; v < P; ++v)
+      if (used[v]) order.push_back(static_cast<std::uint32_t>(v));
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return soup.points[a] < soup.points[b] || (soup.points[a] == soup.points[b] && a < b);
+    });
+    std::size_t extra = 0;
+    std::vector<std::string> exc;
+    for (std::size_t i = 1; i < order.size(); ++i) {
+      if (soup.points[order[i]] == soup.points[order[i - 1]]) {
+        ++extra;
+        if (exc.size() < 5) exc.push_back("v" + std::to_string(order[i]) + " = v" + std::to_string(order[i - 1]));
+      }
+    }
+    if (extra)
+      d.findings.push_back({"coincident_vertices", Severity::kNote, extra,
+                            plural(extra, "vertex duplicates", "vertices duplicate") +
+                                " the position of another (an unwelded seam? weld them before use)" + ex(exc)});
+  }
+  return d;
+}
+
+void add_topology_findings(const TopologyReport& t, bool allow_boundary, MeshDiagnosis& d) {
+  if (t.nonmanifold_edges)
+    d.findings.push_back({"nonmanifold_edges", Severity::kDefect, t.nonmanifold_edges,
+                          plural(t.nonmanifold_edges, "non-manifold edge has", "non-manifold edges have") +
+                              " 3 or more faces" + examples(t.example_nonmanifold_edges, edge_str)});
+  if (t.nonmanifold_vertices)
+    d.findings.push_back({"nonmanifold_vertices", Severity::kDefect, t.nonmanifold_vertices,
+                          plural(t.nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices") +
+                              " (faces around them form more than one fan)" +
+                              examples(t.example_nonmanifold_vertices, [](int v) { return "v" + std::to_string(v); })});
+  if (t.boundary_edges)
+    d.findings.push_back({"boundary_edges", allow_boundary ? Severity::kNote : Severity::kDefect, t.boundary_edges,
+                          "open surface: " + plural(t.boundary_edges, "boundary edge", "boundary edges") + " in " +
+                              plural(t.boundary_loops, "boundary loop", "boundary loops") +
+                              examples(t.example_boundary_edges, edge_str)});
+  if (!t.orientable)
+    d.findings.push_back({"non_orientable", Severity::kDefect, 1, "the surface is not orientable"});
+  else if (t.inconsistent_edges)
+    d.findings.push_back({"inconsistent_orientation", Severity::kRepaired, t.inconsistent_edges,
+                          "inconsistent orientation: " +
+                              plural(t.inconsistent_edges, "edge is", "edges are") +
+                              " traversed the same way by both faces (faces re-oriented)" +
+                              examples(t.example_inconsistent_edges, edge_str)});
+  if (t.components.size() > 1)
+    d.findings.push_back({"several_components", Severity::kNote, t.components.size(),
+                          std::to_string(t.components.size()) + " connected components"});
+}
+
+TriangleList soup_to_triangles(const PolygonSoup& soup, const LoadPolicy& policy,
+                               const MeshDiagnosis& diag) {
+  for (const auto& f : diag.findings)
+    if (f.severity == Severity::kFatal) throw PreconditionError(f.message);
+  if (!policy.triangulate && diag.has("non_triangle_faces"))
+    throw PreconditionError(diag.find("non_triangle_faces")->message);
+  if (!policy.drop_degenerate && (diag.has("degenerate_faces") || diag.has("faces_too_small")))
+    throw PreconditionError(diag.summary(Severity::kDefect));
+  TriangleList t;
+  const std::size_t P = soup.points.size();
+  std::vector<int> remap(P, -1);
+  std::vector<std::uint8_t> used(P, 0);
+  auto keep_face = [&](const std::int64_t* ids, std::size_t n) {
+    if (n < 3) return false;
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = a + 1; b < n; ++b)
+        if (ids[a] == ids[b]) return false;
+    return true;
+  };
+  for (std::size_t f = 0; f < soup.num_faces(); ++f)
+    if (keep_face(soup.face(f), soup.face_size(f)))
+      for (std::size_t k = 0; k < soup.face_size(f); ++k) used[soup.face(f)[k]] = 1;
+  for (std::size_t v = 0; v < P; ++v) {
+    if (used[v] || !policy.drop_unreferenced) {
+      remap[v] = static_cast<int>(t.points.size());
+      t.points.push_back(soup.points[v]);
+    }
+  }
+  t.triangles.reserve(soup.num_faces());
+  for (std::size_t f = 0; f < soup.num_faces(); ++f) {
+    const std::int64_t* ids = soup.face(f);
+    const std::size_t n = soup.face_size(f);
+    if (!keep_face(ids, n)) continue;
+    for (std::size_t k = 1; k + 1 < n; ++k)
+      t.triangles.push_back({remap[ids[0]], remap[ids[k]], remap[ids[k + 1]]});
+  }
+  return t;
+}
+
+Mesh triangles_to_mesh(TriangleList t, const TopologyReport& topo, bool fix_orientation) {
+  if (!topo.manifold) {
+    MeshDiagnosis d;
+    add_topology_findings(topo, true, d);
+    throw PreconditionError("not a 2-manifold: " + d.summary(Severity::kDefect));
+  }
+  if (!topo.orientable) throw PreconditionError("the surface is not orientable");
+  if (topo.inconsistent_edges) {
+    if (!fix_orientation)
+      throw PreconditionError("inconsistent orientation on " + std::to_string(topo.inconsistent_edges) + " edges");
+    // Breadth-first re-orientation across manifold edges, one seed per component.
+    const std::size_t F = t.triangles.size();
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> recs;
+    recs.reserve(3 * F);
+    for (std::size_t f = 0; f < F; ++f)
+      for (int k = 0; k < 3; ++k) {
+        std::uint64_t a = t.triangles[f][k], b = t.triangles[f][(k + 1) % 3];
+        if (a > b) std::swap(a, b);
+        recs.emplace_back((a << 32) | b, static_cast<std::uint32_t>(f));
+      }
+    std::sort(recs.begin(), recs.end());
+    std::vector<std::uint32_t> adj_start(F + 1, 0), adj;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t i = 0; i + 1 < recs.size(); ++i)
+      if (recs[i].first == recs[i + 1].first) pairs.emplace_back(recs[i].second, recs[i + 1].second);
+    for (auto& p : pairs) {
+      ++adj_start[p.first + 1];
+      ++adj_start[p.second + 1];
+    }
+    for (std::size_t f = 0; f < F; ++f) adj_start[f + 1] += adj_start[f];
+    adj.resize(adj_start[F]);
+    std::vector<std::uint32_t> fill(adj_start.begin(), adj_start.end() - 1);
+    for (auto& p : pairs) {
+      adj[fill[p.first]++] = p.second;
+      adj[fill[p.second]++] = p.first;
+    }
+    std::vector<std::uint8_t> seen(F, 0);
+    auto directed = [&](std::uint32_t f, int a, int b) {
+      const auto& tr = t.triangles[f];
+      for (int k = 0; k < 3; ++k)
+        if (tr[k] == a && tr[(k + 1) % 3] == b) return true;
+      return false;
+    };
+    for (std::size_t s = 0; s < F; ++s) {
+      if (seen[s]) continue;
+      seen[s] = 1;
+      std::deque<std::uint32_t> q{static_cast<std::uint32_t>(s)};
+      while (!q.empty()) {
+        const std::uint32_t f = q.front();
+        q.pop_front();
+        for (std::uint32_t i = adj_start[f]; i < adj_start[f + 1]; ++i) {
+          const std::uint32_t g = adj[i];
+          if (seen[g]) continue;
+          seen[g] = 1;
+          // Shared edge: find it and make g traverse it opposite to f.
+          const auto& tf = t.triangles[f];
+          for (int k = 0; k < 3; ++k) {
+            const int a = tf[k], b = tf[(k + 1) % 3];
+            if (directed(g, a, b)) {
+              std::swap(t.triangles[g][1], t.triangles[g][2]);
+              break;
+            }
+            if (directed(g, b, a)) break;
+          }
+          q.push_back(g);
+        }
+      }
+    }
+  }
+  Mesh mesh;
+  mesh.reserve(t.points.size(), t.triangles.size() * 3 / 2, t.triangles.size());
+  for (const auto& p : t.points) mesh.add_vertex(Vec3(p[0], p[1], p[2]));
+  for (std::size_t f = 0; f < t.triangles.size(); ++f) {
+    const auto& tr = t.triangles[f];
+    auto fh = mesh.add_face(Mesh::VertexHandle(tr[0]), Mesh::VertexHandle(tr[1]), Mesh::VertexHandle(tr[2]));
+    if (!fh.is_valid())
+      throw PreconditionError("face " + std::to_string(f) + " could not be added to the halfedge mesh");
+  }
+  return mesh;
+}
+
+}  // namespace cf

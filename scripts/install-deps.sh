@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs every system dependency of ColonFlat from Debian 12 (bookworm) packages.
+# The README, .ci/run and docker/Dockerfile all call this one script.
+#   scripts/install-deps.sh            build + test + runtime dependencies
+#   scripts/install-deps.sh --runtime  only what the installed binary needs (Docker runtime stage)
+set -euo pipefail
+
+BUILD_PKGS=(
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  libvtk9-dev            # reconstruction (flying edges), .vtp/.vtk I/O, off-screen rendering, PNG
+  libinsighttoolkit5-dev # volume I/O (DICOM/GDCM, NRRD, NIfTI, MHA), filters
+  libeigen3-dev          # sparse linear algebra (flattening)
+  libopenmesh-dev        # halfedge mesh + OFF/OBJ/PLY/STL I/O
+  libgtest-dev libgmock-dev
+  libbenchmark-dev
+  libboost-graph-dev     # Boykov-Kolmogorov max-flow
+  libcli11-dev           # command-line parsing
+  nlohmann-json3-dev     # JSON reports
+  libcgal-dev            # tests only: independent self-intersection check
+  xvfb xauth             # off-screen rendering where there is no display
+  python3                # small test helpers
+)
+RUNTIME_PKGS=(
+  libvtk9.1 libinsighttoolkit5.2 libopenmesh9.0 xvfb xauth
+)
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO=sudo; fi
+export DEBIAN_FRONTEND=noninteractive
+
+if [ "${1:-}" = "--runtime" ]; then
+  PKGS=("${RUNTIME_PKGS[@]}")
+else
+  PKGS=("${BUILD_PKGS[@]}")
+fi
+
+# Skip the network entirely when everything is already installed.
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PKGS[@]} packages already installed"
+  exit 0
+fi
+echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
