@@ -1,0 +1,84 @@
+#pragma once
+// Lumen mask -> closed, manifold colon surface in LPS millimetres (docs/reconstruct.md).
+//
+//   cf::ReconstructStats st;
+//   cf::Mesh surface = cf::reconstruct_surface(mask.GetPointer(), cf::ReconstructOptions{}, &st);
+//
+// Guarantees on the returned mesh (checked after every step; a violation throws cf::Error):
+//   * closed (no boundary edge), 2-manifold, consistently oriented, normals pointing out of the
+//     lumen (signed volume of every outer surface > 0), whatever the sign of det(direction);
+//   * points are LPS mm: p = origin + direction * diag(spacing) * index (ITK's convention);
+//   * topology = the (6,18) digital topology of the mask: lumen voxels joined through faces,
+//     background voxels through faces and edges. Exactly, before decimation:
+//     chi(extracted surface) == 2 * mask_euler_characteristic_6_18(mask), before small components
+//     are dropped. Smoothing moves points only; decimation keeps every component's genus.
+//   * one surface component per 6-connected lumen component (plus one per enclosed background
+//     cavity), components enclosing less than min_component_volume mm^3 dropped and reported.
+#include <itkImage.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "colonflat/core/mesh.h"
+#include "colonflat/core/params.h"
+
+namespace cf {
+
+// Same alias as colonflat/volume/volume_io.h (0 outside, 1 lumen; any non-zero value is lumen).
+using MaskImage = itk::Image<unsigned char, 3>;
+
+struct ReconstructOptions {
+  std::string method = "flying-edges";  // flying-edges | discrete-flying-edges | marching-cubes
+  double min_component_volume = 500.0;  // mm^3; smaller surface components are dropped
+  int smoothing_iterations = 20;        // windowed-sinc iterations; 0 = no smoothing
+  double pass_band = 0.1;               // windowed-sinc pass band (smaller = smoother)
+  int target_faces = 0;                 // quadric decimation to this many triangles; 0 = none
+};
+
+// The one declaration of the options (names, units, help, ranges) used by the stage's command
+// line, --help, JSON and validate().
+const ParamTable<ReconstructOptions>& reconstruct_param_table();
+// Throws UsageError naming the first invalid option.
+void validate(const ReconstructOptions& o);
+
+struct ReconstructComponent {
+  std::size_t faces = 0;
+  double volume_mm3 = 0;  // signed: > 0 an outer surface, < 0 the wall of an enclosed cavity
+  double area_mm2 = 0;
+  int genus = 0;
+};
+
+struct ReconstructStats {
+  std::string method;
+  std::size_t lumen_voxels = 0;
+  std::array<std::size_t, 3> image_size{0, 0, 0};
+  std::array<std::size_t, 3> crop_size{0, 0, 0};  // lumen bounding box (before 1-voxel padding)
+  bool direction_flips_orientation = false;       // det(direction) < 0
+  std::size_t extracted_vertices = 0, extracted_faces = 0;
+  long long mask_euler_6_18 = 0;     // chi of the lumen, (6,18) topology
+  long long surface_euler = 0;       // chi of the extracted surface (== 2 * mask_euler_6_18)
+  std::size_t components_found = 0;
+  std::vector<ReconstructComponent> kept;     // largest |volume| first
+  std::vector<ReconstructComponent> dropped;  // below min_component_volume
+  bool smoothed = false, decimated = false;
+  std::size_t vertices = 0, faces = 0;
+  int genus = 0;  // total over kept components
+  double time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_decimate_s = 0, time_total_s = 0;
+  nlohmann::json to_json() const;
+};
+
+// The surface of the lumen (see the guarantees above). Throws PreconditionError for an empty
+// mask, a mask without a component above min_component_volume, or non-positive spacing;
+// UsageError for invalid options; cf::Error if a guarantee fails to hold.
+Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& options,
+                         ReconstructStats* stats = nullptr);
+
+// Euler characteristic of the lumen (non-zero voxels) in the (6,18) digital topology, i.e. of
+// the solid the marching-cubes surface bounds: #voxels - #face-adjacent pairs + #2x2 squares
+// - #2x2x2 blocks + #2x2x2 blocks with exactly two background voxels at opposite corners.
+long long mask_euler_characteristic_6_18(const MaskImage* mask);
+
+}  // namespace cf

@@ -1,0 +1,36 @@
+#include "colonflat/reconstruct/reconstruct_stage.h"
+
+#include <iomanip>
+#include <sstream>
+
+#include "colonflat/core/mesh_artifact.h"
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+
+const StageSpec& ReconstructStage::spec() const {
+  static const StageSpec s{
+      "reconstruct",
+      "lumen mask -> closed manifold colon surface (LPS mm, normals out of the lumen)",
+      {{"mask", &mask_artifact(), "lumen mask", "lumen_mask.nrrd"}},
+      {{"surface", &mesh_artifact(), "colon surface (LPS mm)", "surface.vtp"}}};
+  return s;
+}
+
+void ReconstructStage::run(ArtifactBag& bag, RunContext& ctx) {
+  const auto& mask = bag.get<MaskImage::Pointer>("mask");
+  ReconstructStats st;
+  Mesh surface = reconstruct_surface(mask.GetPointer(), opts_, &st);
+  ctx.report = st.to_json();
+  std::ostringstream line;
+  line << "  reconstruct: " << st.lumen_voxels << " lumen voxels -> " << st.extracted_faces << " triangles ("
+       << st.components_found << " components, " << st.dropped.size() << " dropped below "
+       << format_number(opts_.min_component_volume) << " mm^3) -> " << st.faces << " triangles, " << st.kept.size()
+       << " components, genus " << st.genus << std::fixed << std::setprecision(2) << ", " << st.time_total_s << " s";
+  ctx.progress(line.str());
+  bag.put("surface", std::move(surface));
+}
+
+std::unique_ptr<Stage> make_reconstruct_stage() { return std::make_unique<ReconstructStage>(); }
+
+}  // namespace cf
