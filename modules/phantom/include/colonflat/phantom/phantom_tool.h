@@ -1,0 +1,11 @@
+#pragma once
+// `colonflat phantom -o DIR [--seed N] [--size small|full] [--format nrrd|dicom] ...`
+#include <memory>
+
+#include "colonflat/core/tool.h"
+
+namespace cf {
+
+std::unique_ptr<Tool> make_phantom_tool();
+
+}  // namespace cf

@@ -1,0 +1,54 @@
+#pragma once
+// Colon lumen segmentation of a CT colonography volume (docs/segment.md): lumen = air and tagged
+// fluid inside the body; outside air, lungs and other gas removed; the colon kept as one or a few
+// segments; boundary refined by a graph cut (Boykov-Kolmogorov max-flow) on a narrow band with
+// partial-volume data terms and contrast-sensitive smoothness; the air/fluid partial-volume layer
+// is kept inside the lumen.
+//
+//   cf::SegmentStats stats;
+//   cf::MaskImage::Pointer mask = cf::segment_colon(ct, cf::SegmentOptions{}, &stats);
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+
+struct SegmentOptions {
+  double air_threshold = -600;        // HU; below: gas (seed of the lumen)
+  double fluid_threshold = 200;       // HU; above (and below fluid-max): tagged-fluid candidate
+  double fluid_max = 1400;            // HU; above: not fluid (metal, dense bone)
+  double interface_width = 3.0;       // mm; air/fluid layer thickness taken as lumen
+  double band_width = 2.0;            // mm; half-width of the graph-cut band around the initial boundary
+  double smoothness = 0.5;            // weight of the boundary (smoothness) term against the data term
+  double edge_sigma = 60;             // HU; contrast sensitivity of the smoothness term
+  double min_segment_volume = 20;     // mL; smaller gas/fluid bodies are not colon
+  double min_segment_fraction = 0.05; // fraction of the largest kept segment a further segment must reach
+  int max_segments = 6;               // at most this many colon segments kept
+  bool graph_cut = true;              // refine the boundary by graph cut (off: thresholds only)
+};
+
+struct SegmentStats {
+  int segments = 0;
+  std::vector<double> segment_volumes_ml;  // largest first
+  double lumen_volume_ml = 0;
+  double air_hu = 0, tissue_hu = 0, fluid_hu = 0;  // class means estimated from the image
+  double fluid_volume_ml = 0;
+  std::size_t band_voxels = 0, graph_edges = 0;
+  double flow = 0;
+  std::size_t removed_components = 0;
+  double time_s = 0, graph_cut_time_s = 0;
+  double peak_memory_mib = 0;
+  nlohmann::json to_json() const;
+};
+
+// Segments the colon lumen (1 = lumen). Throws UsageError for invalid options, PreconditionError
+// for a volume that is not CT-like, has absurd spacing, or in which no colon is found.
+MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts = {}, SegmentStats* stats = nullptr);
+
+// Checks the options (UsageError naming the first bad one).
+void validate(const SegmentOptions& opts);
+
+}  // namespace cf
