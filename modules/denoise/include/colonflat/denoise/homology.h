@@ -1,0 +1,77 @@
+#pragma once
+// Z2 homology of a surface mesh, from a tree-cotree decomposition (Eppstein; Erickson-Whittlesey).
+//
+// Each boundary loop is closed by a virtual polygon face, so the classes are those of the closed
+// surface M^ = M + disks; an edge cycle of M is non-separating in M exactly when its class in
+// H1(M^; Z2) is nonzero (equivalently: nonzero in H1(M, dM; Z2)).
+//
+// build() computes, per component: a spanning tree D of the dual graph (faces and virtual faces,
+// breadth-first from the component's first face), the cut graph G = primal edges not dual to D
+// (Algorithm 1 of the seed paper), a spanning tree T of G and the 2g leftover edges X. Each edge
+// gets an annotation a(e) in Z2^(2G), G = total genus: unit vectors on X, zero on T, and on the
+// dual-tree edges the value that makes every face's boundary sum to zero (leaf peeling). The
+// class of any edge cycle is the XOR of its edges' annotations.
+#include <cstdint>
+#include <vector>
+
+#include "colonflat/core/mesh.h"
+
+namespace cf {
+
+class HomologyBasis {
+ public:
+  // Precondition: `mesh` is a manifold (garbage-collected) triangle mesh.
+  void build(const Mesh& mesh);
+
+  int rank() const { return rank_; }    // 2 * total genus = |X|
+  int words() const { return words_; }  // 64-bit words per class vector
+  const std::uint64_t* edge_class(Mesh::EdgeHandle e) const { return &ann_[std::size_t(e.idx()) * words_]; }
+  // Sets the class of an edge created after build() (grows the table as needed).
+  void set_edge_class(Mesh::EdgeHandle e, const std::uint64_t* cls);
+
+  // Cut graph G (all its edges) and its pruned core (degree-1 vertices removed recursively), as
+  // flags indexed by edge / vertex id of the mesh given to build().
+  const std::vector<std::uint8_t>& cut_graph_edges() const { return cut_edge_; }
+  const std::vector<std::uint8_t>& pruned_cut_graph_edges() const { return pruned_edge_; }
+  std::vector<int> pruned_cut_graph_vertices() const;
+
+ private:
+  int rank_ = 0, words_ = 1;
+  std::vector<std::uint64_t> ann_;
+  std::vector<std::uint8_t> cut_edge_, pruned_edge_;
+  std::size_t n_vertices_ = 0;
+  std::vector<int> pruned_vertices_;
+};
+
+// A subspace of Z2^n kept in reduced echelon form (each pivot bit set in exactly one row).
+class Z2Span {
+ public:
+  explicit Z2Span(int words = 1) : words_(words) {}
+  void reset(int words) {
+    words_ = words;
+    rows_.clear();
+    pivots_.clear();
+  }
+  int dimension() const { return static_cast<int>(pivots_.size()); }
+  // Reduces v in place modulo the span; returns true if the result is zero (v in span).
+  bool reduce(std::uint64_t* v) const;
+  bool contains(const std::uint64_t* v) const;
+  // Adds v; returns false if it was already in the span.
+  bool insert(const std::uint64_t* v);
+
+ private:
+  int words_;
+  std::vector<std::vector<std::uint64_t>> rows_;
+  std::vector<int> pivots_;
+};
+
+inline bool is_zero(const std::uint64_t* v, int words) {
+  for (int i = 0; i < words; ++i)
+    if (v[i]) return false;
+  return true;
+}
+inline void xor_into(std::uint64_t* dst, const std::uint64_t* src, int words) {
+  for (int i = 0; i < words; ++i) dst[i] ^= src[i];
+}
+
+}  // namespace cf

@@ -1,0 +1,77 @@
+#pragma once
+// Bounded shortest-path searches for non-separating loops.
+//
+// FundamentalCycleSearch runs Dijkstra from a source s over the mesh (Euclidean edge lengths,
+// boundary vertices excluded) and examines the fundamental cycles of the shortest-path tree:
+// for a non-tree edge uv, the cycle path(s,u) + uv + path(v,s) of value d(u) + |uv| + d(v).
+// By Thomassen's 3-path argument (the property "class not in the span" is closed under the
+// 3-path condition), the shortest non-separating cycle through s is such a fundamental cycle,
+// so minimising over a vertex set that every non-separating cycle meets gives the global
+// shortest. Since d(u) + |uv| + d(v) >= 2 max(d(u), d(v)), cycles of value <= L involve only
+// vertices within L/2: the search stops at half the best value found (or of the limit).
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <vector>
+
+#include "colonflat/core/mesh.h"
+#include "colonflat/denoise/homology.h"
+
+namespace cf {
+
+struct CycleCandidate {
+  bool found = false;
+  double value = std::numeric_limits<double>::infinity();  // d(u) + |uv| + d(v)
+  Mesh::VertexHandle source, u, v;
+  bool truncated = false;  // the search stopped at the limit with vertices left unexplored
+};
+
+class FundamentalCycleSearch {
+ public:
+  using Accept = std::function<bool(const std::vector<Mesh::VertexHandle>& loop)>;
+  FundamentalCycleSearch(const Mesh& mesh, const HomologyBasis& homology, const Z2Span& cut_classes);
+
+  // Best fundamental cycle of value <= limit whose class is not in `cut_classes` (and that
+  // `accept` approves, when given). The search state is kept for extract().
+  CycleCandidate run(Mesh::VertexHandle s, double limit, const Accept* accept = nullptr);
+  // The simple cycle of a candidate from the last run() (the common stem from s is dropped).
+  std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
+  // Class of an edge cycle (XOR of edge classes), `words()` words.
+  std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
+  std::size_t last_settled() const { return settled_count_; }
+
+ private:
+  void grow();
+  bool settled(int v) const { return stamp_[v] == run_id_ && settled_flag_[v]; }
+  const Mesh& mesh_;
+  const HomologyBasis& hom_;
+  const Z2Span& span_;
+  int W_;
+  std::uint32_t run_id_ = 0;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<std::uint8_t> settled_flag_;
+  std::vector<double> dist_;
+  std::vector<int> parent_;  // parent halfedge (parent -> v) idx, -1 at the source
+  std::vector<int> slot_;    // row of acc_ holding the class of path(s, v)
+  std::vector<std::uint64_t> acc_;
+  std::vector<std::uint64_t> tmp_;
+  std::vector<std::uint32_t> mark_;
+  std::uint32_t mark_id_ = 0;
+  std::size_t settled_count_ = 0;
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap_;
+};
+
+// Euclidean length of a closed loop.
+double loop_length(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);
+
+// Handle or tunnel, relative to the solid the surface encloses (outward normals): a handle loop
+// bounds a disk inside the solid, a tunnel loop a disk outside. Decided from the sign of
+// sum_i n_i . (p_i - c) over the loop (n_i vertex normals, c the loop centroid): positive when
+// the surface around the loop faces away from its centre (a tube seen from outside: handle).
+enum class LoopType { kHandle, kTunnel };
+LoopType classify_loop(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);
+const char* loop_type_name(LoopType t);
+
+}  // namespace cf

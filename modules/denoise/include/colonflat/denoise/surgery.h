@@ -1,0 +1,39 @@
+#pragma once
+// Topological surgery along an edge loop (Algorithm 3 of the seed paper, with separated caps).
+//
+// cut_and_cap() slices the mesh along a simple edge cycle, which splits each loop vertex into a
+// left and a right copy and opens two boundary rings, then fills each ring with a fan to a new
+// vertex. Unlike the paper, whose two centroid fans coincide in space, each ring is first pulled
+// a fraction of the way into its own side (towards its own neighbours), and each cap vertex is the
+// centroid of its pulled ring, so the two caps are disjoint. Nothing is deleted: the input's
+// vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
+#include <cstdint>
+#include <vector>
+
+#include "colonflat/core/mesh.h"
+
+namespace cf {
+
+class HomologyBasis;
+
+struct SurgeryOptions {
+  double ring_pull = 0.25;  // fraction (0..0.5) of the way from a ring vertex to the centroid of
+                            // its same-side neighbours; 0 gives the paper's coincident caps
+};
+
+struct SurgeryResult {
+  std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
+  Mesh::VertexHandle left_cap, right_cap;                 // fan centres
+};
+
+// Preconditions (checked, PreconditionError otherwise): `loop` is a simple cycle of >= 3
+// vertices, consecutive vertices share an edge, and no loop vertex lies on the boundary.
+// When `homology` is given, new edges get classes consistent with it modulo the loop's class.
+SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts,
+                          HomologyBasis* homology = nullptr);
+
+// True when a and b are connected in the mesh graph (bidirectional breadth-first search, which
+// stops early when both sides meet: cheap for the small handles of denoising).
+bool vertices_connected(const Mesh& mesh, Mesh::VertexHandle a, Mesh::VertexHandle b);
+
+}  // namespace cf

@@ -1,0 +1,48 @@
+#pragma once
+// Internal to the denoise module: state shared by the exact and paper methods.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/denoise/denoise.h"
+#include "colonflat/denoise/homology.h"
+#include "colonflat/denoise/surgery.h"
+
+namespace cf::detail {
+
+struct Timers {
+  double homology = 0, search = 0, surgery = 0, verify = 0;
+};
+
+// The mesh being denoised and what is known of its vertices.
+struct DenoiseState {
+  Mesh mesh;
+  std::size_t n_input = 0;
+  std::vector<int> origin;      // vertex -> input vertex id, or -1 (cap centres)
+  std::vector<int> component;   // vertex -> input component id
+  std::vector<int> genus_left;  // per input component
+  std::vector<LoopRecord> loops;
+  Timers t;
+
+  // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others
+  // (caps) have no input id.
+  void extend_vertices(const std::vector<Mesh::VertexHandle>& copies_of, const std::vector<Mesh::VertexHandle>& copies,
+                       int comp);
+  LoopRecord& record(const std::vector<Mesh::VertexHandle>& loop, int iteration, bool separating);
+};
+
+// Vertices within graph distance `radius` of any seed (multi-source Dijkstra).
+std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius);
+
+// Surgery plus bookkeeping; returns whether the two sides stayed connected.
+bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
+              HomologyBasis* hb, SurgeryResult* out);
+
+// Both return the reason the method stopped; `stats` receives method-specific counters.
+std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
+                      double mean_edge, nlohmann::json& stats);
+std::string run_paper(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
+                      nlohmann::json& stats);
+
+}  // namespace cf::detail
