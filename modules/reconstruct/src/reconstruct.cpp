@@ -513,4 +513,69 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
   return mesh;
 }
 
+nlohmann::json BoundaryDistance::to_json() const {
+  return {{"max_mm", max_mm}, {"mean_mm", mean_mm}, {"vertices", vertices}, {"far", far}, {"max_spacing_mm", max_spacing_mm}};
+}
+
+BoundaryDistance distance_to_mask_boundary(const Mesh& surface, const MaskImage* mask) {
+  if (!mask) throw PreconditionError("no mask");
+  const auto region = mask->GetBufferedRegion();
+  const long n[3] = {long(region.GetSize()[0]), long(region.GetSize()[1]), long(region.GetSize()[2])};
+  const unsigned char* d = mask->GetBufferPointer();
+  const auto sp = mask->GetSpacing();
+  const auto org = mask->GetOrigin();
+  const auto dir = mask->GetDirection();
+  auto at = [&](long i, long j, long k) -> bool {
+    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return false;
+    return d[(k * n[1] + j) * n[0] + i] != 0;
+  };
+  BoundaryDistance out;
+  out.max_spacing_mm = std::max({sp[0], sp[1], sp[2]});
+  const int R = 3;
+  double sum = 0;
+  for (auto v : surface.vertices()) {
+    const auto& p = surface.point(v);
+    // Continuous buffer index: x = diag(1/s) D^T (p - origin) - start.
+    double x[3];
+    for (int a = 0; a < 3; ++a) {
+      double t = 0;
+      for (int r = 0; r < 3; ++r) t += dir(r, a) * (p[r] - org[r]);
+      x[a] = t / sp[a] - double(region.GetIndex()[a]);
+    }
+    const long c[3] = {std::lround(x[0]), std::lround(x[1]), std::lround(x[2])};
+    double best = kInf;
+    for (long k = c[2] - R; k <= c[2] + R; ++k)
+      for (long j = c[1] - R; j <= c[1] + R; ++j)
+        for (long i = c[0] - R; i <= c[0] + R; ++i) {
+          if (!at(i, j, k)) continue;
+          const long q[3] = {i, j, k};
+          for (int a = 0; a < 3; ++a)
+            for (int s = -1; s <= 1; s += 2) {
+              long nb[3] = {i, j, k};
+              nb[a] += s;
+              if (at(nb[0], nb[1], nb[2])) continue;
+              // The face between q and nb: plane x_a = q_a + s/2, the other two coordinates
+              // within half a voxel of q.
+              double d2 = 0;
+              for (int b = 0; b < 3; ++b) {
+                const double e = b == a ? x[b] - (double(q[b]) + 0.5 * s)
+                                        : std::max(0.0, std::abs(x[b] - double(q[b])) - 0.5);
+                d2 += (e * sp[b]) * (e * sp[b]);
+              }
+              best = std::min(best, d2);
+            }
+        }
+    ++out.vertices;
+    if (!std::isfinite(best)) {
+      ++out.far;
+      continue;
+    }
+    const double dd = std::sqrt(best);
+    out.max_mm = std::max(out.max_mm, dd);
+    sum += dd;
+  }
+  if (out.vertices > out.far) out.mean_mm = sum / double(out.vertices - out.far);
+  return out;
+}
+
 }  // namespace cf

@@ -81,4 +81,16 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
 // - #2x2x2 blocks + #2x2x2 blocks with exactly two background voxels at opposite corners.
 long long mask_euler_characteristic_6_18(const MaskImage* mask);
 
+// How far a surface lies from the mask's voxel boundary (the faces between lumen voxels and
+// background voxels, outside the image counting as background), in LPS mm. For accuracy checks
+// against a ground-truth mask (tests, benchmarks); assumes an orthonormal direction matrix.
+// Vertices farther than 3 voxels from any boundary face count as `far`.
+struct BoundaryDistance {
+  double max_mm = 0, mean_mm = 0;
+  std::size_t vertices = 0, far = 0;
+  double max_spacing_mm = 0;  // largest voxel spacing of the mask
+  nlohmann::json to_json() const;
+};
+BoundaryDistance distance_to_mask_boundary(const Mesh& surface, const MaskImage* mask);
+
 }  // namespace cf
