@@ -1,6 +1,7 @@
 #include "colonflat/reconstruct/reconstruct.h"
 
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/McDecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <vtkCellArray.h>
@@ -460,7 +461,7 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
   // tetrahedron collapse) keeps a closed manifold's topology; normal flips are refused.
   if (options.target_faces > 0 && mesh.n_faces() > std::size_t(options.target_faces)) {
     t.restart();
-    using Decimater = OpenMesh::Decimater::DecimaterT<Mesh>;
+    using Decimater = OpenMesh::Decimater::McDecimaterT<Mesh>;
     using Quadric = OpenMesh::Decimater::ModQuadricT<Mesh>::Handle;
     using NormalFlip = OpenMesh::Decimater::ModNormalFlippingT<Mesh>::Handle;
     mesh.request_face_normals();
@@ -472,6 +473,7 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
       dec.add(hq);
       dec.add(hn);
       dec.module(hn).set_max_normal_deviation(60.0);
+      dec.set_samples(8);
       if (!dec.initialize()) throw Error("decimation failed to initialise");
       dec.decimate_to_faces(0, std::size_t(options.target_faces));
     }

@@ -1,0 +1,1 @@
+// Shared meshes for the benchmark apps (compiled into each *_bench executable); empty for now.
