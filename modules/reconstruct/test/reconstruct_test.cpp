@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <algorithm>
 #include <queue>
 #include <random>
 
@@ -319,6 +320,33 @@ TEST(ReconstructTopology, TorusIsGenusOneWithEveryMethodAndStep) {
     EXPECT_LE(b.n_faces(), 820u);
     EXPECT_GT(signed_volume(b), 0);
   }
+}
+
+// The three VTK filters give the same surface (same faces and the same set of points).
+TEST(ReconstructTopology, MethodsAgree) {
+  MaskSpec s;
+  s.size = {24, 20, 18};
+  s.spacing = {0.9, 1.1, 1.4};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto m = rasterize(s, [&](const std::array<double, 3>& p) {
+    return dist(p, {10, 11, 12}) <= 7 || u(rng) < 0.08;  // a ball in noise
+  });
+  std::vector<std::vector<std::array<double, 3>>> points;
+  std::vector<std::size_t> faces;
+  for (const std::string method : {"flying-edges", "discrete-flying-edges", "marching-cubes"}) {
+    ReconstructOptions o = raw();
+    o.method = method;
+    const TriangleList t = to_triangle_list(reconstruct_surface(m, o));
+    auto p = t.points;
+    std::sort(p.begin(), p.end());
+    points.push_back(p);
+    faces.push_back(t.triangles.size());
+  }
+  EXPECT_EQ(faces[0], faces[1]);
+  EXPECT_EQ(faces[0], faces[2]);
+  EXPECT_EQ(points[0], points[1]);
+  EXPECT_EQ(points[0], points[2]);
 }
 
 // Adversarial masks: single voxels, voxels touching only along an edge or at a corner, 2x2x2
