@@ -41,6 +41,7 @@ struct SegmentStats {
   std::size_t removed_components = 0;
   double time_s = 0, graph_cut_time_s = 0;
   double peak_memory_mib = 0;
+  nlohmann::json timings;  // seconds per step
   nlohmann::json to_json() const;
 };
 
