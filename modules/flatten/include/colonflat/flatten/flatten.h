@@ -1,0 +1,87 @@
+#pragma once
+// Conformal flattening of a colon surface onto rectangles (one per colon segment).
+//
+// Per segment (connected component of genus 0): the two ends are found as geodesic extremes and
+// opened (a cap of geodesic radius `end_cut_radius` removed around each), giving an annulus; an
+// open tube is used as it is. On the annulus a harmonic function u (0 on one end, 1 on the other;
+// cotangent Laplacian) and its conjugate v (harmonic with zero normal derivative on both ends and
+// a period around the tube) form a holomorphic 1-form du + i dv (Hong et al. 2006, Zeng et al.
+// 2010). Integrating it and cutting along a line v = const maps the wall onto a rectangle:
+// x along the colon (mm, from end A to end B), y around it (mm). The scale makes the rectangle's
+// area equal the 3D wall area. Solvers: Eigen SimplicialLDLT.
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/mesh.h"
+#include "colonflat/core/soup.h"
+
+namespace cf {
+
+struct FlattenOptions {
+  double end_cut_radius = 15.0;        // mm; geodesic radius of the cap opened at each closed end
+  double min_segment_fraction = 0.02;  // components with fewer faces than this fraction of the largest are skipped
+  double segment_gap = 20.0;           // mm between the rectangles of several segments in the 2D layout
+  std::string weights = "auto";        // "cotan", "clamped" (negative cotangents clamped), "auto"
+};
+
+// Distortion of the 3D -> 2D map, per triangle.
+struct DistortionStats {
+  std::size_t faces = 0;
+  std::size_t flipped = 0;                        // triangles with non-positive 2D signed area
+  double qc_mean = 0, qc_p95 = 0, qc_max = 0;     // quasi-conformal ratio sigma1/sigma2 (1 = conformal)
+  double area_p05 = 0, area_median = 0, area_p95 = 0;  // 2D area / 3D area (area-preserving scale: mean ~1)
+  double area_log2_mean_abs = 0;                  // mean |log2(area ratio)|, area-weighted
+};
+
+struct FlatSegment {
+  int id = 0;               // segment index (0-based) = "segment_id" of its vertices
+  int component = 0;        // component of the input mesh it comes from
+  std::string input_kind;   // "closed", "one open end", "tube"
+  double x0 = 0, y0 = 0;    // rectangle origin in the 2D layout (mm)
+  double length = 0;        // mm along the colon (x), end A at x0, end B at x0 + length
+  double period = 0;        // mm around the colon (y); the map is periodic in y with this period
+  double area_3d = 0;       // mm^2 of wall mapped
+  std::size_t faces = 0, vertices = 0;   // of the flattened annulus (before the cut duplicates)
+  std::size_t removed_faces = 0;         // faces removed when opening the closed ends
+  std::array<double, 3> end_a{0, 0, 0}, end_b{0, 0, 0};  // LPS mm, centres of the end loops
+  double dirichlet_period_ratio = 1;     // period from u's energy / period from v's energy (1 = consistent)
+  std::string weights;      // weights used ("cotan" or "clamped")
+  DistortionStats stats;
+};
+
+// The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices
+// on the cut are duplicated), with the 3D correspondence per vertex.
+struct FlatMap {
+  std::vector<std::array<double, 2>> uv;        // 2D position (mm) in the layout
+  std::vector<std::array<double, 3>> position;  // 3D position, LPS mm
+  std::vector<std::array<double, 3>> normal;    // unit 3D normal pointing out of the lumen (into the wall)
+  std::vector<int> segment;                     // segment id per vertex
+  std::vector<int> source_vertex;               // vertex id in the flattened input mesh
+  std::vector<std::array<int, 3>> triangles;    // counter-clockwise in 2D
+  std::vector<FlatSegment> segments;
+  DistortionStats stats;                        // over all segments
+  std::size_t skipped_components = 0;           // small components not flattened
+  std::size_t input_vertices = 0, input_faces = 0;
+};
+
+// Flattens every colon segment of `mesh` (LPS mm). Throws PreconditionError when a segment has
+// genus > 0 ("run denoise first"), more than two boundary loops, or is not a manifold.
+FlatMap flatten_colon(const Mesh& mesh, const FlattenOptions& opts = {});
+FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts = {});
+
+// Distortion of a flat map's triangles (3D positions vs uv).
+DistortionStats distortion_stats(const FlatMap& flat, int segment = -1);
+
+// The 3D surface of a flat map: vertices merged back by source_vertex (the cut closed again).
+// `flat_to_3d` (optional) receives the 3D vertex of each flat vertex.
+TriangleList flat_to_surface(const FlatMap& flat, std::vector<int>* flat_to_3d = nullptr);
+
+nlohmann::json distortion_to_json(const DistortionStats& s);
+nlohmann::json segment_to_json(const FlatSegment& s);
+nlohmann::json flat_report(const FlatMap& f);
+
+}  // namespace cf

@@ -1,0 +1,58 @@
+#include "colonflat/flatten/flatten_stage.h"
+
+#include <iomanip>
+#include <sstream>
+
+#include "colonflat/core/mesh_artifact.h"
+#include "colonflat/core/run_stats.h"
+
+namespace cf {
+
+const StageSpec& FlattenStage::spec() const {
+  static const StageSpec s{
+      "flatten",
+      "conformal flattening of the colon wall onto rectangles (holomorphic 1-form)",
+      {{"denoised", &mesh_artifact(), "genus-0 colon surface (after denoise)", "denoised.vtp"}},
+      {{"flat", &flat_artifact(), "flat colon map", "flat.vtp"}}};
+  return s;
+}
+
+const ParamTable<FlattenOptions>& FlattenStage::table() const {
+  static const ParamTable<FlattenOptions> t = [] {
+    ParamTable<FlattenOptions> t;
+    t.real("end-cut-radius", &FlattenOptions::end_cut_radius, "mm",
+           "geodesic radius of the cap opened at each closed end (at most 10% of the segment length)", 0.0, 1000.0);
+    t.real("min-segment-fraction", &FlattenOptions::min_segment_fraction, "",
+           "skip components with fewer faces than this fraction of the largest", 0.0, 1.0);
+    t.real("segment-gap", &FlattenOptions::segment_gap, "mm", "gap between segment rectangles in the layout", 0.0,
+           1000.0);
+    t.choice("weights", &FlattenOptions::weights, {"auto", "cotan", "clamped"},
+             "Laplacian weights: cotan; clamped (negative cotangents clamped, never flips in practice); auto = "
+             "cotan, clamped if cotan flips a triangle");
+    return t;
+  }();
+  return t;
+}
+
+void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
+  const Mesh& mesh = bag.get<Mesh>("denoised");
+  Stopwatch sw;
+  FlatMap flat = flatten_colon(mesh, opts_);
+  ctx.report = flat_report(flat);
+  ctx.report["flatten_time_s"] = sw.seconds();
+  for (const auto& s : flat.segments) {
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1) << "flatten: segment " << s.id << " (" << s.input_kind << ", "
+         << s.faces << " faces): " << s.length << " x " << s.period << " mm, flipped " << s.stats.flipped
+         << ", quasi-conformal mean " << std::setprecision(3) << s.stats.qc_mean << " p95 " << s.stats.qc_p95
+         << " max " << s.stats.qc_max;
+    ctx.progress(line.str());
+  }
+  if (flat.stats.flipped > 0)
+    ctx.progress("flatten: warning: " + std::to_string(flat.stats.flipped) + " flipped triangles");
+  bag.put("flat", std::move(flat));
+}
+
+std::unique_ptr<Stage> make_flatten_stage() { return std::make_unique<FlattenStage>(); }
+
+}  // namespace cf
