@@ -256,6 +256,49 @@ typename TImage::Pointer read_dicom_series(const DicomChoice& c, const ScannedFo
 // ---------------------------------------------------------------------------------------------
 // Files
 
+// A NRRD header with per-axis "spacings" and a "space" field is not valid NRRD and teem (ITK's
+// NrrdIO) refuses it, yet such headers exist (VTK's headsq quarter.nhdr: "space: 3D-left-handed",
+// "spacings: 3.2 3.2 1.5", detached slices). The header is copied to a temporary file without its
+// "space" line (so the spacings are valid, with an identity direction) and with the data file path
+// made absolute, and that copy is read by ITK. Returns false when the header is not of this kind.
+bool sanitized_nrrd_header(const fs::path& p, fs::path& out) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return false;
+  std::string line, text;
+  bool has_space = false, has_spacings = false;
+  std::vector<std::string> lines;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;  // end of the header (attached data follows)
+    lines.push_back(line);
+    if (lines.size() > 200) return false;
+  }
+  if (lines.empty() || lines[0].rfind("NRRD", 0) != 0) return false;
+  for (const auto& l : lines) {
+    if (l.rfind("space:", 0) == 0) has_space = true;
+    if (l.rfind("spacings:", 0) == 0) has_spacings = true;
+  }
+  if (!(has_space && has_spacings)) return false;
+  const fs::path dir = fs::absolute(p).parent_path();
+  for (const auto& l : lines) {
+    if (l.rfind("space:", 0) == 0) continue;
+    if (l.rfind("data file:", 0) == 0 || l.rfind("datafile:", 0) == 0) {
+      std::string v = l.substr(l.find(':') + 1);
+      while (!v.empty() && v.front() == ' ') v.erase(v.begin());
+      if (v.rfind("LIST", 0) == 0) return false;
+      if (!v.empty() && v.front() != '/') v = (dir / v).string();
+      text += "data file: " + v + "\n";
+      continue;
+    }
+    text += l + "\n";
+  }
+  if (text.find("data file:") == std::string::npos) return false;  // attached data: cannot be split off
+  out = temp_sibling(fs::temp_directory_path() / "colonflat_header.nhdr");
+  std::ofstream o(out, std::ios::binary);
+  o << text;
+  return bool(o);
+}
+
 template <class TImage>
 typename TImage::Pointer read_image_file(const fs::path& p) {
   const std::string where = p.string();
@@ -267,6 +310,20 @@ typename TImage::Pointer read_image_file(const fs::path& p) {
   try {
     io->ReadImageInformation();
   } catch (const itk::ExceptionObject& e) {
+    fs::path fixed;
+    if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer()) && sanitized_nrrd_header(p, fixed)) {
+      struct Remove {
+        fs::path f;
+        ~Remove() {
+          std::error_code ec;
+          fs::remove(f, ec);
+        }
+      } remove{fixed};
+      try {
+        return read_image_file<TImage>(fixed);
+      } catch (const InputError&) {
+      }
+    }
     throw InputError(where, itk_message(e));
   }
   if (io->GetNumberOfDimensions() < 2 || io->GetNumberOfDimensions() > 3)
