@@ -1,0 +1,53 @@
+#pragma once
+// The 2D colon-wall image ("virtual dissection"): the flat map rasterised (VTK probe filter) at
+// `pixel_size` mm, one band per segment, x along the colon (end A left), y around it. Each pixel
+// is shaded from the 3D normal against a light tilted from the local large-scale wall normal
+// (Gaussian-smoothed normal image) towards the colon axis, so folds and polyps stand out in
+// relief. Optional colouring by shape index. Overlays: polyp candidates outlined with id and
+// size, known polyps (dashed), segment labels and a scale bar in mm (valid at the mean scale:
+// the map is conformal, area-preserving on average). Each band is rolled around the colon so that
+// its cut runs as far as possible from every marker.
+#include <string>
+#include <vector>
+
+#include "colonflat/flatten/flatten.h"
+#include "colonflat/render/artifacts.h"
+
+namespace cf {
+
+struct ColonImageOptions {
+  double pixel_size = 0.5;         // mm per pixel
+  std::string color = "shading";   // "shading" or "curvature"
+  double smooth_normal = 8.0;      // mm, sigma of the large-scale normal
+  double light_tilt = 0.7;         // tangent component of the light (relief strength)
+  int max_width = 12000;           // pixels; pixel_size grows if the colon would be wider
+  std::string title;               // top line (empty: automatic)
+};
+
+struct ImageMarker {
+  int id = 0;
+  int segment = 0;
+  double x = 0, y = 0;     // flat layout position (mm)
+  double radius_mm = 4;    // circle radius in the flat map (mm)
+  std::string label;       // e.g. "P1 8 mm"
+  bool known = false;      // known (ground-truth) polyp: dashed green; else candidate: yellow
+  // filled by render_colon_image: pixel position (column, row from the top)
+  double px = 0, py = 0;
+};
+
+struct ColonImage {
+  ImagePtr image;           // RGB unsigned char
+  double pixel_size = 0;    // mm per pixel actually used
+  int width = 0, height = 0;
+  std::vector<double> roll; // per segment: y offset of the cut (mm, in [y0, y0 + period))
+};
+
+// `shape_index`: per flat vertex (for color = "curvature"); may be empty.
+ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& shape_index,
+                              std::vector<ImageMarker>& markers, const ColonImageOptions& opts);
+
+// Draws `text` into an RGB image at column x, row-from-top y (top-left corner), with FreeType.
+void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_from_top, int font_size,
+               const double color[3], double background_opacity = 0.0);
+
+}  // namespace cf

@@ -1,0 +1,256 @@
+#include "colonflat/render/polyps.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/stage.h"
+
+namespace cf {
+namespace {
+
+using V3 = Eigen::Vector3d;
+
+struct Graph {
+  std::vector<int> start, nbr;
+};
+
+Graph vertex_graph(const TriangleList& s) {
+  const std::size_t nv = s.points.size();
+  std::vector<std::pair<int, int>> e;
+  e.reserve(6 * s.triangles.size());
+  for (const auto& t : s.triangles)
+    for (int k = 0; k < 3; ++k) {
+      e.push_back({t[k], t[(k + 1) % 3]});
+      e.push_back({t[(k + 1) % 3], t[k]});
+    }
+  std::sort(e.begin(), e.end());
+  e.erase(std::unique(e.begin(), e.end()), e.end());
+  Graph g;
+  g.start.assign(nv + 1, 0);
+  for (const auto& [a, b] : e) ++g.start[a + 1];
+  for (std::size_t i = 0; i < nv; ++i) g.start[i + 1] += g.start[i];
+  g.nbr.resize(e.size());
+  for (std::size_t i = 0; i < e.size(); ++i) g.nbr[i] = e[i].second;
+  return g;
+}
+
+V3 P(const TriangleList& s, int i) { return {s.points[i][0], s.points[i][1], s.points[i][2]}; }
+
+std::vector<double> vertex_areas(const TriangleList& s) {
+  std::vector<double> a(s.points.size(), 0.0);
+  for (const auto& t : s.triangles) {
+    const double ar = 0.5 * (P(s, t[1]) - P(s, t[0])).cross(P(s, t[2]) - P(s, t[0])).norm();
+    for (int v : t) a[v] += ar / 3;
+  }
+  return a;
+}
+
+// Vertices within Euclidean distance r of `c`, reached through edges (at least the 2-ring).
+void neighbourhood(const Graph& g, const TriangleList& s, int c, double r, std::vector<int>& stamp, int tag,
+                   std::vector<int>& out) {
+  out.clear();
+  out.push_back(c);
+  stamp[c] = tag;
+  const V3 pc = P(s, c);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const int v = out[k];
+    const bool near_ring = k == 0 || (P(s, v) - pc).norm() <= r;
+    if (!near_ring) continue;
+    for (int q = g.start[v]; q < g.start[v + 1]; ++q) {
+      const int w = g.nbr[q];
+      if (stamp[w] == tag) continue;
+      stamp[w] = tag;
+      if ((P(s, w) - pc).norm() <= r || k == 0) out.push_back(w);
+    }
+  }
+}
+
+}  // namespace
+
+Curvature surface_curvature(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
+                            double fit_radius) {
+  const int nv = int(s.points.size());
+  const Graph g = vertex_graph(s);
+  Curvature c;
+  c.k1.assign(nv, 0);
+  c.k2.assign(nv, 0);
+  c.si.assign(nv, 0);
+  c.cv.assign(nv, 0);
+  std::vector<int> stamp(nv, -1), nb;
+  for (int i = 0; i < nv; ++i) {
+    neighbourhood(g, s, i, fit_radius, stamp, i, nb);
+    const V3 n = -V3(normals[i][0], normals[i][1], normals[i][2]).normalized();  // into the lumen
+    const V3 t1 = (std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY()).cross(n).normalized();
+    const V3 t2 = n.cross(t1);
+    const V3 pc = P(s, i);
+    Eigen::Matrix<double, 5, 5> A = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
+    int used = 0;
+    for (int j : nb) {
+      if (j == i) continue;
+      const V3 d = P(s, j) - pc;
+      const double x = d.dot(t1), y = d.dot(t2), h = d.dot(n);
+      const double w = std::exp(-d.squaredNorm() / (fit_radius * fit_radius));
+      Eigen::Matrix<double, 5, 1> r;
+      r << 0.5 * x * x, x * y, 0.5 * y * y, x, y;
+      A += w * r * r.transpose();
+      b += w * h * r;
+      ++used;
+    }
+    if (used < 5) continue;
+    A.diagonal().array() += 1e-12 * (A.trace() + 1e-30);
+    const Eigen::Matrix<double, 5, 1> q = A.ldlt().solve(b);
+    Eigen::Matrix2d H;
+    H << q[0], q[1], q[1], q[2];
+    const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(-H).eigenvalues();  // ascending
+    const double k1 = ev[1], k2 = ev[0];
+    c.k1[i] = k1;
+    c.k2[i] = k2;
+    c.si[i] = k1 - k2 > 1e-12 ? 2 / M_PI * std::atan((k1 + k2) / (k1 - k2)) : (k1 > 0 ? 1.0 : k1 < 0 ? -1.0 : 0.0);
+    c.cv[i] = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+  }
+  return c;
+}
+
+std::vector<PolypCandidate> detect_polyps(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
+                                          const PolypOptions& o, Curvature* curvature_out) {
+  const int nv = int(s.points.size());
+  Curvature c = surface_curvature(s, normals, o.fit_radius);
+  const Graph g = vertex_graph(s);
+  const std::vector<double> area = vertex_areas(s);
+  auto in_cap = [&](int v) { return c.si[v] >= o.grow_si && c.cv[v] >= 0.5 * o.min_curvedness && c.cv[v] <= 2 * o.max_curvedness; };
+  auto seed = [&](int v) { return c.si[v] >= o.seed_si && c.cv[v] >= o.min_curvedness && c.cv[v] <= o.max_curvedness; };
+  std::vector<int> region(nv, -1);
+  std::vector<PolypCandidate> out;
+  std::vector<int> stack, fp_stamp(nv, -1);
+  int nreg = 0;
+  for (int v0 = 0; v0 < nv; ++v0) {
+    if (region[v0] >= 0 || !seed(v0)) continue;
+    std::vector<int> cap{v0};
+    region[v0] = nreg;
+    for (std::size_t k = 0; k < cap.size(); ++k)
+      for (int q = g.start[cap[k]]; q < g.start[cap[k] + 1]; ++q) {
+        const int w = g.nbr[q];
+        if (region[w] < 0 && in_cap(w)) region[w] = nreg, cap.push_back(w);
+      }
+    ++nreg;
+    PolypCandidate pc;
+    V3 cen = V3::Zero();
+    double a = 0, si = 0, cv = 0;
+    for (int v : cap) cen += area[v] * P(s, v), a += area[v], si += area[v] * c.si[v], cv += area[v] * c.cv[v];
+    if (a <= 0) continue;
+    cen /= a;
+    pc.cap_area_mm2 = a;
+    pc.mean_si = si / a;
+    pc.mean_cv = cv / a;
+    int apex = cap[0];
+    for (int v : cap)
+      if ((P(s, v) - cen).squaredNorm() < (P(s, apex) - cen).squaredNorm()) apex = v;
+    pc.vertex = apex;
+    pc.center_lps_mm = s.points[apex];
+    // Footprint: the convex part around the cap, within max_radius of the apex.
+    const V3 pa = P(s, apex);
+    std::vector<int> fp(cap);
+    for (int v : fp) fp_stamp[v] = nreg;
+    double fa = 0;
+    for (std::size_t k = 0; k < fp.size(); ++k) {
+      fa += area[fp[k]];
+      for (int q = g.start[fp[k]]; q < g.start[fp[k] + 1]; ++q) {
+        const int w = g.nbr[q];
+        if (fp_stamp[w] == nreg || c.si[w] < o.footprint_si || (P(s, w) - pa).norm() > o.max_radius) continue;
+        fp_stamp[w] = nreg;
+        fp.push_back(w);
+      }
+    }
+    pc.footprint_area_mm2 = fa;
+    pc.size_mm = 2 * std::sqrt(fa / M_PI);
+    pc.footprint = std::move(fp);
+    // Score: how cap-like (mean SI), how much of the footprint is cap, and curvature consistent with
+    // the size (a dome of diameter D has curvature ~ 2..6 / D).
+    const double s_si = std::clamp((pc.mean_si - o.grow_si) / (1 - o.grow_si), 0.0, 1.0);
+    const double s_cap = std::clamp(3 * pc.cap_area_mm2 / std::max(1e-9, fa), 0.0, 1.0);
+    const double kd = pc.mean_cv * pc.size_mm;
+    const double s_k = std::clamp(kd / 1.5, 0.0, 1.0);
+    pc.score = 0.4 * s_si + 0.3 * s_cap + 0.3 * s_k;
+    if (pc.size_mm < o.min_size || pc.size_mm > o.max_size || pc.score < o.min_score) continue;
+    out.push_back(std::move(pc));
+  }
+  // Merge candidates whose apexes are closer than the larger radius (one polyp, several caps).
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });
+  std::vector<PolypCandidate> kept;
+  for (auto& p : out) {
+    bool dup = false;
+    for (const auto& k : kept) {
+      const double d = (V3(p.center_lps_mm[0], p.center_lps_mm[1], p.center_lps_mm[2]) -
+                        V3(k.center_lps_mm[0], k.center_lps_mm[1], k.center_lps_mm[2])).norm();
+      if (d < 0.5 * std::max(p.size_mm, k.size_mm)) dup = true;
+    }
+    if (!dup) kept.push_back(std::move(p));
+  }
+  for (std::size_t i = 0; i < kept.size(); ++i) kept[i].id = int(i) + 1;
+  if (curvature_out) *curvature_out = std::move(c);
+  return kept;
+}
+
+std::vector<KnownPolyp> known_polyps_from_json(const nlohmann::json& j0, const std::string& name) {
+  const nlohmann::json& j = j0.is_object() && j0.contains("polyps") ? j0["polyps"] : j0;
+  if (!j.is_array()) throw InputError(name, "known polyps must be a JSON list");
+  std::vector<KnownPolyp> out;
+  int next = 1;
+  for (const auto& e : j) {
+    KnownPolyp k;
+    k.id = next++;
+    const nlohmann::json* c = &e;
+    if (e.is_object()) {
+      for (const char* key : {"center_lps_mm", "center", "position", "position_lps_mm"})
+        if (e.contains(key)) c = &e[key];
+      if (e.contains("id") && e["id"].is_number_integer()) k.id = e["id"];
+      k.diameter_mm = e.value("diameter_mm", 0.0);
+      k.type = e.value("type", "");
+    }
+    if (!c->is_array() || c->size() != 3 || !(*c)[0].is_number() || !(*c)[1].is_number() || !(*c)[2].is_number())
+      throw InputError(name, "known polyp " + std::to_string(out.size() + 1) + " has no [x, y, z] position (LPS mm)");
+    k.center_lps_mm = {(*c)[0].get<double>(), (*c)[1].get<double>(), (*c)[2].get<double>()};
+    out.push_back(k);
+  }
+  return out;
+}
+
+std::vector<KnownPolyp> read_known_polyps(const std::filesystem::path& path) {
+  return known_polyps_from_json(read_json_file(path), path.string());
+}
+
+DetectionScore score_detections(const std::vector<PolypCandidate>& cands, const std::vector<KnownPolyp>& truth,
+                                double min_diameter, double tol) {
+  DetectionScore sc;
+  auto dist = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  };
+  auto hit = [&](const PolypCandidate& c, const KnownPolyp& k) {
+    return dist(c.center_lps_mm, k.center_lps_mm) <= 0.5 * k.diameter_mm + tol;
+  };
+  for (const auto& k : truth) {
+    if (k.diameter_mm < min_diameter) continue;
+    ++sc.polyps;
+    bool found = false;
+    for (const auto& c : cands) found = found || hit(c, k);
+    if (found) ++sc.polyps_detected;
+    else sc.missed_ids.push_back(k.id);
+  }
+  for (const auto& c : cands) {
+    bool any = false;
+    for (const auto& k : truth) any = any || hit(c, k);
+    if (!any) ++sc.false_positives;
+  }
+  sc.sensitivity = sc.polyps ? double(sc.polyps_detected) / sc.polyps : 1.0;
+  return sc;
+}
+
+}  // namespace cf

@@ -1,0 +1,204 @@
+#include "colonflat/render/snapshot.h"
+
+#include <vtkAutoInit.h>
+VTK_MODULE_INIT(vtkRenderingOpenGL2);
+VTK_MODULE_INIT(vtkRenderingFreeType);
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkTubeFilter.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <mutex>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/vtk_messages.h"
+
+namespace cf {
+namespace {
+
+pid_t g_xvfb = -1;
+
+void stop_xvfb() {
+  if (g_xvfb > 0) {
+    kill(g_xvfb, SIGTERM);
+    waitpid(g_xvfb, nullptr, 0);
+    g_xvfb = -1;
+  }
+}
+
+std::string start_xvfb() {
+  int fds[2];
+  if (pipe(fds) != 0) throw Error("cannot start Xvfb: pipe failed");
+  const pid_t pid = fork();
+  if (pid < 0) throw Error("cannot start Xvfb: fork failed");
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    close(fds[0]);
+    const int devnull = open("/dev/null", O_RDWR);
+    if (devnull >= 0) dup2(devnull, 1), dup2(devnull, 2);
+    const std::string fd = std::to_string(fds[1]);
+    execlp("Xvfb", "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "1600x1200x24", "-nolisten", "tcp",
+           "-noreset", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(fds[1]);
+  std::string num;
+  pollfd p{fds[0], POLLIN, 0};
+  for (int waited = 0; waited < 15000;) {
+    if (poll(&p, 1, 250) > 0) {
+      char buf[32];
+      const ssize_t n = read(fds[0], buf, sizeof buf);
+      if (n <= 0) break;
+      num.append(buf, buf + n);
+      if (num.find('\n') != std::string::npos) break;
+    } else {
+      waited += 250;
+      int st;
+      if (waitpid(pid, &st, WNOHANG) == pid) break;
+    }
+  }
+  close(fds[0]);
+  while (!num.empty() && (num.back() == '\n' || num.back() == ' ')) num.pop_back();
+  if (num.empty()) {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+    throw Error("3D snapshots need an X display: DISPLAY is not set and Xvfb could not be started "
+                "(install xvfb or run under xvfb-run)");
+  }
+  g_xvfb = pid;
+  std::atexit(stop_xvfb);
+  return ":" + num;
+}
+
+}  // namespace
+
+std::string ensure_display() {
+  static std::mutex m;
+  std::lock_guard<std::mutex> lock(m);
+  const char* d = std::getenv("DISPLAY");
+  if (d && *d) return d;
+  const std::string disp = start_xvfb();
+  setenv("DISPLAY", disp.c_str(), 1);
+  return disp;
+}
+
+ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
+  ensure_display();
+  VtkMessageCapture msgs;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (const auto& p : surface.points) pts->InsertNextPoint(p.data());
+  vtkNew<vtkCellArray> polys;
+  for (const auto& t : surface.triangles) {
+    vtkIdType c[3] = {t[0], t[1], t[2]};
+    polys->InsertNextCell(3, c);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(pd);
+  normals->SplittingOff();
+  normals->ConsistencyOff();
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(normals->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.88, 0.62, 0.56);
+  actor->GetProperty()->SetSpecular(0.2);
+  actor->GetProperty()->SetSpecularPower(20);
+  vtkNew<vtkRenderer> ren;
+  ren->AddActor(actor);
+  ren->SetBackground(0.12, 0.13, 0.16);
+  ren->SetBackground2(0.3, 0.32, 0.38);
+  ren->GradientBackgroundOn();
+  double b[6];
+  pd->GetBounds(b);
+  const double diag = std::sqrt((b[1] - b[0]) * (b[1] - b[0]) + (b[3] - b[2]) * (b[3] - b[2]) + (b[5] - b[4]) * (b[5] - b[4]));
+  if (loops && loops->GetNumberOfPoints() > 0) {
+    actor->GetProperty()->SetOpacity(0.55);
+    vtkNew<vtkTubeFilter> tubes;
+    tubes->SetInputData(loops);
+    tubes->SetRadius(std::max(0.8, diag / 250));
+    tubes->SetNumberOfSides(10);
+    vtkNew<vtkPolyDataMapper> lm;
+    lm->SetInputConnection(tubes->GetOutputPort());
+    vtkNew<vtkLookupTable> lut;
+    lut->SetNumberOfTableValues(2);
+    lut->SetTableValue(0, 0.95, 0.15, 0.1, 1);  // handle
+    lut->SetTableValue(1, 0.15, 0.45, 1.0, 1);  // tunnel
+    lut->SetTableRange(0, 1);
+    lut->Build();
+    if (loops->GetCellData()->GetArray("type")) {
+      lm->SetScalarModeToUseCellFieldData();
+      lm->SelectColorArray("type");
+      lm->SetLookupTable(lut);
+      lm->SetScalarRange(0, 1);
+      lm->ScalarVisibilityOn();
+    } else {
+      lm->ScalarVisibilityOff();
+    }
+    vtkNew<vtkActor> la;
+    la->SetMapper(lm);
+    la->GetProperty()->SetColor(1.0, 0.55, 0.0);
+    ren->AddActor(la);
+  }
+  if (!o.caption.empty()) {
+    vtkNew<vtkTextActor> ta;
+    ta->SetInput(o.caption.c_str());
+    ta->GetTextProperty()->SetFontSize(20);
+    ta->GetTextProperty()->SetColor(1, 1, 1);
+    ta->SetDisplayPosition(12, o.height - 34);
+    ren->AddViewProp(ta);
+  }
+  vtkNew<vtkRenderWindow> win;
+  win->SetOffScreenRendering(1);
+  win->SetMultiSamples(0);
+  win->AddRenderer(ren);
+  win->SetSize(o.width, o.height);
+  vtkCamera* cam = ren->GetActiveCamera();
+  const double c[3] = {0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])};
+  cam->SetFocalPoint(c);
+  if (o.view == "left") cam->SetPosition(c[0] + diag, c[1], c[2]);
+  else cam->SetPosition(c[0], c[1] - diag, c[2]);  // anterior: LPS -y
+  cam->SetViewUp(0, 0, 1);                          // superior: LPS +z
+  ren->ResetCamera();
+  cam->Zoom(1.15);
+  win->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(win);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  if (!msgs.errors().empty()) throw Error("off-screen rendering failed: " + msgs.errors().front());
+  ImagePtr img = ImagePtr::New();
+  img->DeepCopy(grab->GetOutput());
+  return img;
+}
+
+}  // namespace cf

@@ -1,0 +1,180 @@
+// The colon image (size, wall pixels, overlays), candidate JSON, known polyps, off-screen 3D
+// snapshots (own Xvfb when there is no display) and the `colonflat render` command.
+#include <gtest/gtest.h>
+
+#include <vtkCellArray.h>
+#include <vtkImageData.h>
+#include <vtkIntArray.h>
+#include <vtkCellData.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "colonflat/core/mesh_io.h"
+#include "colonflat/core/synthetic.h"
+#include "colonflat/flatten/flat_artifact.h"
+#include "colonflat/flatten/flatten.h"
+#include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/render/artifacts.h"
+#include "colonflat/render/render_stage.h"
+#include "colonflat/render/snapshot.h"
+#include "colonflat/testing/temp_dir.h"
+
+namespace cf {
+namespace {
+
+synthetic::Colon test_colon() {
+  synthetic::ColonOptions o;
+  o.length = 300;
+  o.radius = 18;
+  o.spacing = 0.8;
+  o.polyps = {{45, 0.3, 8}, {150, 3.0, 10}, {220, 5.0, 7}};
+  return synthetic::colon(o);
+}
+
+const unsigned char* at(vtkImageData* img, int col, int row_from_top) {
+  int e[6];
+  img->GetExtent(e);
+  const int h = e[3] - e[2] + 1;
+  return static_cast<unsigned char*>(img->GetScalarPointer(col, h - 1 - row_from_top, 0));
+}
+
+// The image is length/pixel wide plus margins, the wall is drawn (tissue colour) where the map is,
+// every polyp is a candidate and is marked at a wall pixel; the PNG reads back the same size.
+TEST(RenderImage, ColonImageShowsWallAndCandidates) {
+  testing::TempDir tmp;
+  auto c = test_colon();
+  FlatMap f = flatten_colon(c.mesh);
+  RenderOptions o;
+  o.pixel_size = 0.5;
+  RenderResult r = render_flat(f, o);
+  const auto& s = f.segments[0];
+  EXPECT_EQ(r.colon.width, int(std::ceil(s.length / 0.5)) + 60);
+  EXPECT_EQ(r.colon.height, int(std::ceil(s.period / 0.5)) + 50 + 70);
+  ASSERT_EQ(r.candidates.size(), 3u);
+  // wall pixels: reddish tissue, not the dark background
+  const unsigned char* p = at(r.colon.image, r.colon.width / 2, 50 + int(s.period / 0.5 / 2));
+  EXPECT_GT(p[0], 40);
+  EXPECT_GT(p[0], p[2]);
+  for (const auto& m : r.markers) {
+    EXPECT_GT(m.px, 30);
+    EXPECT_LT(m.px, r.colon.width - 30);
+    EXPECT_GT(m.py, 50);
+    EXPECT_LT(m.py, r.colon.height - 70);
+    // the outline ring is drawn in yellow at the marker's radius somewhere around the centre
+    bool yellow = false;
+    for (int dy = -30; dy <= 30 && !yellow; ++dy)
+      for (int dx = -30; dx <= 30 && !yellow; ++dx) {
+        const unsigned char* q = at(r.colon.image, int(m.px) + dx, int(m.py) + dy);
+        yellow = q[0] == 255 && q[1] == 230 && q[2] == 0;
+      }
+    EXPECT_TRUE(yellow) << m.label;
+  }
+  const auto& cj = r.candidates_json["candidates"];
+  ASSERT_EQ(cj.size(), 3u);
+  EXPECT_EQ(cj[0]["id"], 1);
+  EXPECT_TRUE(cj[0].contains("center_lps_mm"));
+  EXPECT_TRUE(cj[0].contains("flat_mm"));
+  EXPECT_GT(cj[0]["size_mm"].get<double>(), 4.0);
+  write_png(r.colon.image, tmp / "colon.png");
+  ImagePtr back = read_png(tmp / "colon.png");
+  int dims[3];
+  back->GetDimensions(dims);
+  EXPECT_EQ(dims[0], r.colon.width);
+  EXPECT_EQ(dims[1], r.colon.height);
+}
+
+// Known polyps are placed on the nearest wall point and scored against the candidates.
+TEST(RenderImage, KnownPolypsAreOverlaidAndScored) {
+  testing::TempDir tmp;
+  auto c = test_colon();
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& p : c.polyps) j.push_back({{"id", p.id}, {"center_lps_mm", p.center}, {"diameter_mm", p.diameter}});
+  std::ofstream(tmp / "known.json") << j.dump();
+  RenderOptions o;
+  o.known_polyps = tmp.str("known.json");
+  o.color = "curvature";
+  RenderResult r = render_flat(flatten_colon(c.mesh), o);
+  const auto& kj = r.candidates_json["known_polyps"];
+  ASSERT_EQ(kj.size(), 3u);
+  for (const auto& k : kj) EXPECT_LT(k["distance_to_surface_mm"].get<double>(), 1.0);
+  EXPECT_EQ(r.candidates_json["score_vs_known"]["sensitivity"], 1.0);
+  EXPECT_EQ(r.candidates_json["score_vs_known"]["false_positives"], 0);
+}
+
+// Off-screen VTK rendering works without a display (a private Xvfb is started): the sphere is
+// drawn over the background and a loop polyline is visible in red.
+TEST(RenderSnapshot, OffScreenWithoutDisplay) {
+  auto sphere = synthetic::sphere(20, 48, 24);
+  vtkNew<vtkPoints> pts;
+  for (int k = 0; k < 64; ++k) pts->InsertNextPoint(20.5 * std::cos(2 * M_PI * k / 64), -0.0, 20.5 * std::sin(2 * M_PI * k / 64));
+  vtkNew<vtkCellArray> lines;
+  std::vector<vtkIdType> ids(65);
+  for (int k = 0; k < 65; ++k) ids[k] = k % 64;
+  lines->InsertNextCell(65, ids.data());
+  vtkNew<vtkPolyData> loops;
+  loops->SetPoints(pts);
+  loops->SetLines(lines);
+  vtkNew<vtkIntArray> type;
+  type->SetName("type");
+  type->InsertNextValue(0);
+  loops->GetCellData()->AddArray(type);
+  SnapshotOptions so;
+  so.width = so.height = 300;
+  ImagePtr img;
+  ASSERT_NO_THROW(img = render_snapshot(sphere, loops, so));
+  int dims[3];
+  img->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 300);
+  EXPECT_EQ(dims[1], 300);
+  const unsigned char* corner = at(img, 2, 2);
+  const unsigned char* centre = at(img, 150, 150);
+  EXPECT_GT(std::abs(int(centre[0]) - int(corner[0])), 40);
+  int red = 0;
+  for (int y = 0; y < 300; ++y)
+    for (int x = 0; x < 300; ++x) {
+      const unsigned char* q = at(img, x, y);
+      if (q[0] > 150 && q[1] < 90 && q[2] < 90) ++red;
+    }
+  EXPECT_GT(red, 50);
+}
+
+struct Cli {
+  int code;
+  std::string out, err;
+};
+Cli render_cli(const std::vector<std::string>& args) {
+  auto tool = make_stage_tool(make_render_stage);
+  std::ostringstream out, err;
+  const int code = tool->run(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+// `colonflat render` writes the colon PNG, the candidate JSON and both snapshots.
+TEST(RenderCli, WritesImageJsonAndSnapshots) {
+  testing::TempDir tmp;
+  auto c = test_colon();
+  write_mesh(synthetic::to_mesh(c.mesh), tmp / "surface.vtp");
+  write_flat(flatten_colon(c.mesh), tmp / "flat.vtp");
+  auto r = render_cli({tmp.str("flat.vtp"), "-o", tmp.str("colon.png"), "--candidates", tmp.str("polyps.json"),
+                       "--surface", tmp.str("surface.vtp"), "--snapshot_before", tmp.str("before.png"),
+                       "--snapshot_after", tmp.str("after.png"), "--snapshot-size", "256", "-q"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_json_file(tmp / "polyps.json")["candidates"].size(), 3u);
+  int d[3];
+  read_png(tmp / "before.png")->GetDimensions(d);
+  EXPECT_EQ(d[0], 256);
+  read_png(tmp / "colon.png")->GetDimensions(d);
+  EXPECT_GT(d[0], 600);
+  auto bad = render_cli({tmp.str("surface.vtp"), "-o", tmp.str("x.png")});
+  EXPECT_EQ(bad.code, 3);
+  EXPECT_NE(bad.err.find("not a flat colon map"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace cf
