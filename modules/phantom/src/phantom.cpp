@@ -755,7 +755,7 @@ Phantom generate_phantom(const PhantomOptions& o) {
         Rng r(o.seed * 1000003ull + std::uint64_t(k) * 7919ull + 17);
         for (std::size_t q = std::size_t(k) * slice; q < std::size_t(k + 1) * slice; ++q) {
           const double v = hu[q] + (o.noise_hu > 0 ? o.noise_hu * r.normal() : 0.0);
-          hu[q] = float(std::clamp(std::nearbyint(v), -1024.0, 3071.0));
+          hu[q] = float(std::clamp(std::nearbyint(v), -1024.0, 3071.0)) + 0.0f;  // no -0
         }
       }
     });

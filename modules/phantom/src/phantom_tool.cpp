@@ -47,7 +47,6 @@ class PhantomTool : public Tool {
     return run_cli(app, name(), args, out, err, [&]() -> int {
       if (format != "nrrd" && format != "dicom") throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
       Stopwatch t;
-      if (!quiet) err << "phantom: generating " << o.size << " phantom, seed " << o.seed << "\n";
       Phantom p = generate_phantom(o);
       const double gen = t.seconds();
       write_phantom(p, dir, format);

@@ -420,8 +420,26 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
     lap("crop");
 
     // 2. Tagged fluid: bright voxels in contact (along gravity, across the partial-volume layer) with gas.
-    for (std::size_t q = 0; q < d.total; ++q)
-      if (!lab[q] && hu[q] >= opts.fluid_threshold && hu[q] <= opts.fluid_max) lab[q] = 2;
+    // Fluid is classified on a 3x3x3 box average so that noise spikes in soft tissue are not fluid.
+    {
+      std::vector<float> sm(hub), tmp(d.total);
+      for (int ax = 0; ax < 3; ++ax) {
+        const std::size_t stp = d.stride[ax], len = d.n[ax];
+        parallel_for(d.total / len, [&](std::size_t l0, std::size_t l1) {
+          for (std::size_t l = l0; l < l1; ++l) {
+            const std::size_t base = line_base(d, ax, l);
+            for (std::size_t p = 0; p < len; ++p) {
+              const std::size_t q = base + p * stp;
+              const float a = sm[p > 0 ? q - stp : q], c = sm[p + 1 < len ? q + stp : q];
+              tmp[q] = (a + sm[q] + c) * (1.0f / 3.0f);
+            }
+          }
+        });
+        sm.swap(tmp);
+      }
+      for (std::size_t q = 0; q < d.total; ++q)
+        if (!lab[q] && sm[q] >= opts.fluid_threshold && sm[q] <= opts.fluid_max) lab[q] = 2;
+    }
     const int wvox = int(std::ceil(opts.interface_width / d.sp[grav_axis]));
     std::vector<unsigned char> touch(d.total, 0);
     {

@@ -38,8 +38,6 @@ const ParamTable<SegmentOptions>& SegmentStage::table() const {
 
 void SegmentStage::run(ArtifactBag& bag, RunContext& ctx) {
   const auto& ct = bag.get<CtImage::Pointer>("ct");
-  ctx.progress("segment: colon lumen from " + std::to_string(ct->GetLargestPossibleRegion().GetNumberOfPixels()) +
-               " voxels");
   SegmentStats stats;
   MaskImage::Pointer mask = segment_colon(ct.GetPointer(), opts_, &stats);
   std::ostringstream s;
