@@ -43,6 +43,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
     throw PreconditionError("--method paper needs closed components (the paper's Algorithm 4 input); got " +
                             std::to_string(b.boundary_loops) + " boundary loops - use --method exact");
   st.n_input = st.mesh.n_vertices();
+  st.mean_edge = b.mean_edge_length;
   st.origin.resize(st.n_input);
   for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
   st.component.assign(st.n_input, -1);
@@ -99,12 +100,13 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
 
   res.loops = st.loops;
   res.mesh = std::move(st.mesh);
-  std::size_t loop_vertices = 0;
+  std::size_t loop_vertices = 0, cap_intersections = 0;
   double loop_len = 0;
   nlohmann::json loops = nlohmann::json::array();
   for (const auto& L : res.loops) {
     loop_vertices += L.vertex_ids.size();
     loop_len += L.length;
+    cap_intersections += L.cap_intersections;
     loops.push_back({{"id", L.id},
                      {"iteration", L.iteration},
                      {"component", L.component},
@@ -112,7 +114,8 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                      {"vertex_count", L.vertex_ids.size()},
                      {"length_mm", L.length},
                      {"type", L.type},
-                     {"separating", L.separating}});
+                     {"separating", L.separating},
+                     {"cap_intersections", L.cap_intersections}});
   }
   auto g = [](const TopologyReport& t) { return t.genus ? nlohmann::json(*t.genus) : nlohmann::json(nullptr); };
   res.report = {{"method", o.method},
@@ -126,7 +129,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                 {"per_component", comps},
                 {"stop_reason", reason},
                 {"loops", loops},
-                {"totals", {{"loops", res.loops.size()}, {"loop_vertices", loop_vertices}, {"loop_length_mm", loop_len}}},
+                {"totals", {{"loops", res.loops.size()}, {"loop_vertices", loop_vertices}, {"loop_length_mm", loop_len}, {"cap_intersections", cap_intersections}}},
                 {"search", stats},
                 {"time_s",
                  {{"analysis", t_analysis},

@@ -1,5 +1,6 @@
 #pragma once
 // Internal to the denoise module: state shared by the exact and paper methods.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,8 @@ struct DenoiseState {
   std::vector<int> genus_left;  // per input component
   std::vector<LoopRecord> loops;
   Timers t;
+  std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked
+  double mean_edge = 0;
 
   // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others
   // (caps) have no input id.

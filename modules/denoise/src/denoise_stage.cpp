@@ -28,6 +28,8 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
     t.integer("target-genus", &DenoiseOptions::target_genus, "", "stop when the total genus reaches this", 0);
     t.real("ring-pull", &DenoiseOptions::ring_pull, "",
            "fraction of the way each cut ring moves into its own side (separates the two caps; 0 = paper)", 0.0, 0.5);
+    t.flag("check-caps", &DenoiseOptions::check_caps,
+           "check every cap for intersections with the surface and try other placements");
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
            "first loop-search radius of the exact method (0 = 6 x mean edge length)", 0.0);
     return t;

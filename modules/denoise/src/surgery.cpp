@@ -1,6 +1,9 @@
 #include "colonflat/denoise/surgery.h"
 
+#include <vtkTriangle.h>
+
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <unordered_map>
 #include <unordered_set>
@@ -97,9 +100,9 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
     mesh.set_halfedge_handle(r.left_ring[i], x[(i + k - 1) % k]);
   }
 
-  // 6. Pull each ring into its own side (after the split, a ring vertex's non-ring neighbours are
-  //    exactly its own side's).
-  auto pull = [&](const std::vector<Mesh::VertexHandle>& ring) {
+  // 6. Side targets: after the split, a ring vertex's non-ring neighbours are exactly its own
+  //    side's; a ring is pulled towards the centroid of those (face barycentres as a fallback).
+  auto side_targets = [&](const std::vector<Mesh::VertexHandle>& ring) {
     std::unordered_set<int> in_ring;
     for (auto v : ring) in_ring.insert(v.idx());
     std::vector<Vec3> target(ring.size());
@@ -111,7 +114,7 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
           c += mesh.point(w);
           ++n;
         }
-      if (n == 0) {  // all neighbours on the ring: use the barycentres of its faces
+      if (n == 0) {
         for (auto f : mesh.vf_range(ring[i])) {
           Vec3 b(0, 0, 0);
           for (auto w : mesh.fv_range(f)) b += mesh.point(w);
@@ -121,49 +124,299 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
       }
       target[i] = n ? c / double(n) : mesh.point(ring[i]);
     }
-    for (std::size_t i = 0; i < ring.size(); ++i)
-      mesh.point(ring[i]) += opts.ring_pull * (target[i] - mesh.point(ring[i]));
+    return target;
   };
-  pull(r.left_ring);
-  pull(r.right_ring);
+  const std::vector<Vec3> target_left = side_targets(r.left_ring), target_right = side_targets(r.right_ring);
+  std::vector<Vec3> p0(k);
+  for (std::size_t i = 0; i < k; ++i) p0[i] = mesh.point(loop[i]);
 
-  // 7. Caps: a fan from the centroid of each ring.
-  auto cap = [&](const std::vector<Mesh::HalfedgeHandle>& ring_halfedges, const std::vector<Mesh::VertexHandle>& ring) {
-    Vec3 c(0, 0, 0);
-    for (auto v : ring) c += mesh.point(v);
-    const auto w = mesh.add_vertex(c / double(ring.size()));
-    for (auto b : ring_halfedges) {
-      const auto f = mesh.add_face(mesh.from_vertex_handle(b), mesh.to_vertex_handle(b), w);
-      if (!f.is_valid()) throw Error("surgery: could not add a cap triangle");
-    }
-    return w;
-  };
-  r.right_cap = cap(h, r.right_ring);
-  r.left_cap = cap(x, r.left_ring);
-
-  // 8. Classes of the new edges: y_i copies h_i; spokes are prefix sums along the ring, so that
-  //    every cap triangle sums to zero (the ring itself is the loop's class, which the caller
-  //    quotients out).
+  // 6b. Classes of the left copies of the loop edges (needed by the caps): y_i copies h_i.
+  const int W = homology ? homology->words() : 0;
   if (homology) {
-    const int W = homology->words();
     for (std::size_t i = 0; i < k; ++i) {
       std::vector<std::uint64_t> c(homology->edge_class(mesh.edge_handle(h[i])),
                                    homology->edge_class(mesh.edge_handle(h[i])) + W);
       homology->set_edge_class(mesh.edge_handle(y[i]), c.data());
     }
-    auto spokes = [&](Mesh::VertexHandle w, const std::vector<Mesh::VertexHandle>& ring) {
-      std::vector<std::uint64_t> acc(W, 0);
-      for (std::size_t i = 0; i < k; ++i) {
-        const auto he = mesh.find_halfedge(w, ring[i]);
-        homology->set_edge_class(mesh.edge_handle(he), acc.data());
-        const auto ring_edge = mesh.edge_handle(mesh.find_halfedge(ring[i], ring[(i + 1) % k]));
-        xor_into(acc.data(), homology->edge_class(ring_edge), W);
-      }
+  }
+
+  // 7. Caps (topology): a disk spanning each ring, made of m concentric rings around a centre
+  //    vertex (m = 1: the paper's fan). Classes: each cap vertex gets a potential P (ring vertex
+  //    i: prefix sum of the ring's edge classes; interior: 0) and each new edge (x, y) the class
+  //    P(x) ^ P(y), so every cap triangle sums to zero (the closing one to the loop's class,
+  //    which the caller quotients out).
+  struct Cap {
+    std::vector<std::vector<Mesh::VertexHandle>> rings;  // rings[0] = the cut ring, boundary order
+    Mesh::VertexHandle centre;
+    std::vector<Mesh::FaceHandle> faces;
+  };
+  auto make_cap = [&](const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {
+    Cap cap;
+    const std::size_t n = ring_halfedges.size();
+    std::vector<Mesh::VertexHandle> a(n);
+    for (std::size_t i = 0; i < n; ++i) a[i] = mesh.from_vertex_handle(ring_halfedges[i]);
+    const int m = std::max(1, std::min(opts.cap_rings, static_cast<int>(n) / 4));
+    cap.rings.push_back(a);
+    for (int j = 1; j < m; ++j) {
+      std::vector<Mesh::VertexHandle> rj(n);
+      for (std::size_t i = 0; i < n; ++i) rj[i] = mesh.add_vertex(Vec3(0, 0, 0));
+      cap.rings.push_back(std::move(rj));
+    }
+    cap.centre = mesh.add_vertex(Vec3(0, 0, 0));
+    auto add = [&](Mesh::VertexHandle x, Mesh::VertexHandle y2, Mesh::VertexHandle z) {
+      const auto f = mesh.add_face(x, y2, z);
+      if (!f.is_valid()) throw Error("surgery: could not add a cap triangle");
+      cap.faces.push_back(f);
     };
-    spokes(r.right_cap, r.right_ring);
-    spokes(r.left_cap, r.left_ring);
+    for (int j = 0; j + 1 < m; ++j)
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t i1 = (i + 1) % n;
+        add(cap.rings[j][i], cap.rings[j][i1], cap.rings[j + 1][i1]);
+        add(cap.rings[j][i], cap.rings[j + 1][i1], cap.rings[j + 1][i]);
+      }
+    for (std::size_t i = 0; i < n; ++i) add(cap.rings[m - 1][i], cap.rings[m - 1][(i + 1) % n], cap.centre);
+    if (homology) {
+      std::unordered_map<int, std::vector<std::uint64_t>> P;
+      std::vector<std::uint64_t> acc(W, 0);
+      for (std::size_t i = 0; i < n; ++i) {
+        P[a[i].idx()] = acc;
+        xor_into(acc.data(), homology->edge_class(mesh.edge_handle(ring_halfedges[i])), W);
+      }
+      const std::vector<std::uint64_t> zero(W, 0);
+      auto pot = [&](Mesh::VertexHandle v) -> const std::vector<std::uint64_t>& {
+        auto it = P.find(v.idx());
+        return it == P.end() ? zero : it->second;
+      };
+      std::vector<std::uint64_t> cls(W);
+      std::vector<Mesh::VertexHandle> inner;
+      for (int j = 1; j < m; ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
+      inner.push_back(cap.centre);
+      for (auto v : inner)  // every new edge has an interior endpoint
+        for (auto he : mesh.voh_range(v)) {
+          const auto& q0 = pot(v);
+          const auto& q1 = pot(mesh.to_vertex_handle(he));
+          for (int i = 0; i < W; ++i) cls[i] = q0[i] ^ q1[i];
+          homology->set_edge_class(mesh.edge_handle(he), cls.data());
+        }
+    }
+    return cap;
+  };
+  Cap cap_right = make_cap(h);                                                             // h_0 -> h_1 -> ...
+  Cap cap_left = make_cap(std::vector<Mesh::HalfedgeHandle>(x.rbegin(), x.rend()));  // x_(k-1) -> ... -> x_0
+  r.right_cap = cap_right.centre;
+  r.left_cap = cap_left.centre;
+
+  // 8. Geometry. A placement = ring pull p (towards the side targets) + cap shape: interior rings
+  //    interpolated towards the ring centroid and relaxed to a discrete minimal surface (uniform
+  //    Laplacian, ring fixed), then bulged by `dome` (x mean ring edge) against the cap's normal,
+  //    i.e. into its own side, so the two caps of one loop part even where the pull runs nearly
+  //    in the cap's plane.
+  auto place_cap = [&](Cap& cap, double dome) {
+    const auto& a = cap.rings[0];
+    const std::size_t n = a.size();
+    const int m = static_cast<int>(cap.rings.size());
+    Vec3 c(0, 0, 0);
+    double edge = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      c += mesh.point(a[i]);
+      edge += (mesh.point(a[(i + 1) % n]) - mesh.point(a[i])).norm();
+    }
+    c /= double(n);
+    edge /= double(n);
+    for (int j = 1; j < m; ++j)
+      for (std::size_t i = 0; i < n; ++i) {
+        const double t = double(j) / m;
+        mesh.point(cap.rings[j][i]) = (1 - t) * mesh.point(a[i]) + t * c;
+      }
+    mesh.point(cap.centre) = c;
+    std::vector<Mesh::VertexHandle> inner;
+    for (int j = 1; j < m; ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
+    inner.push_back(cap.centre);
+    std::vector<Vec3> next(inner.size());
+    for (int it = 0; it < 20 * m && m > 1; ++it) {
+      for (std::size_t q = 0; q < inner.size(); ++q) {
+        Vec3 sum(0, 0, 0);
+        int deg = 0;
+        for (auto nb : mesh.vv_range(inner[q])) {
+          sum += mesh.point(nb);
+          ++deg;
+        }
+        next[q] = sum / double(deg);
+      }
+      for (std::size_t q = 0; q < inner.size(); ++q) mesh.point(inner[q]) = next[q];
+    }
+    if (dome != 0) {
+      Vec3 nrm(0, 0, 0);
+      for (auto f : cap.faces) {
+        auto it = mesh.cfv_iter(f);
+        const Vec3 p1 = mesh.point(*it), p2 = mesh.point(*++it), p3 = mesh.point(*++it);
+        nrm += OpenMesh::cross(p2 - p1, p3 - p1);
+      }
+      if (nrm.norm() > 0) nrm /= nrm.norm();
+      for (int j = 1; j < m; ++j) {
+        const double t = double(j) / m;
+        for (auto v : cap.rings[j]) mesh.point(v) -= dome * edge * (1 - (1 - t) * (1 - t)) * nrm;
+      }
+      mesh.point(cap.centre) -= dome * edge * nrm;
+    }
+  };
+  auto place = [&](double pull, double dome) {
+    for (std::size_t i = 0; i < k; ++i) {
+      mesh.point(r.left_ring[i]) = p0[i] + pull * (target_left[i] - p0[i]);
+      mesh.point(r.right_ring[i]) = p0[i] + pull * (target_right[i] - p0[i]);
+    }
+    place_cap(cap_left, dome);
+    place_cap(cap_right, dome);
+  };
+  place(opts.ring_pull, 0.0);
+  if (opts.guard) {
+    // Faces whose geometry the placement moves: both caps and the faces around both rings.
+    std::vector<Mesh::FaceHandle> moving = cap_left.faces;
+    moving.insert(moving.end(), cap_right.faces.begin(), cap_right.faces.end());
+    for (const auto* ring : {&r.left_ring, &r.right_ring})
+      for (auto v : *ring)
+        for (auto f : mesh.vf_range(v)) moving.push_back(f);
+    std::sort(moving.begin(), moving.end());
+    moving.erase(std::unique(moving.begin(), moving.end()), moving.end());
+    auto refresh = [&]() {
+      for (auto f : moving) opts.guard->insert(mesh, f);
+    };
+    refresh();
+    std::size_t best = opts.guard->count_intersections(mesh, moving);
+    double best_pull = opts.ring_pull, best_dome = 0;
+    if (best > 0) {
+      for (double pull : {opts.ring_pull, 0.4, 0.15})
+        for (double dome : {0.25, 0.5, 1.0, 0.0, -0.25}) {
+          if (pull <= 0 && dome == 0) continue;
+          place(pull, dome);
+          refresh();
+          const std::size_t n = opts.guard->count_intersections(mesh, moving);
+          if (n < best) {
+            best = n;
+            best_pull = pull;
+            best_dome = dome;
+          }
+          if (best == 0) break;
+        }
+      place(best_pull, best_dome);
+      refresh();
+    }
+    r.intersections = best;
   }
   return r;
+}
+
+FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) {
+  for (auto f : mesh.faces()) insert(mesh, f);
+}
+
+FaceGrid::Key FaceGrid::key(const Vec3& p) const {
+  return {static_cast<long long>(std::floor(p[0] / cell_)), static_cast<long long>(std::floor(p[1] / cell_)),
+          static_cast<long long>(std::floor(p[2] / cell_))};
+}
+
+namespace {
+void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::array<int, 3>& ids,
+              std::array<Vec3, 3>& pts) {
+  int k = 0;
+  for (auto v : mesh.fv_range(f)) {
+    ids[k] = v.idx();
+    pts[k] = mesh.point(v);
+    ++k;
+  }
+  lo = hi = pts[0];
+  for (int i = 1; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], pts[i][a]);
+      hi[a] = std::max(hi[a], pts[i][a]);
+    }
+}
+}  // namespace
+
+void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
+  Vec3 lo, hi;
+  std::array<int, 3> ids;
+  std::array<Vec3, 3> pts;
+  face_box(mesh, f, lo, hi, ids, pts);
+  const Key a = key(lo), b = key(hi);
+  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
+    big_.push_back(f.idx());  // large triangles are checked by every query instead
+    return;
+  }
+  for (long long x = a.x; x <= b.x; ++x)
+    for (long long y = a.y; y <= b.y; ++y)
+      for (long long z = a.z; z <= b.z; ++z) {
+        auto& v = cells_[{x, y, z}];
+        if (std::find(v.begin(), v.end(), f.idx()) == v.end()) v.push_back(f.idx());
+      }
+}
+
+std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const {
+  return intersecting_pairs(mesh, faces).size();
+}
+
+std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
+                                                              const std::vector<Mesh::FaceHandle>& faces) const {
+  std::vector<std::pair<int, int>> pairs;
+  std::unordered_set<int> in_set;
+  for (auto f : faces) in_set.insert(f.idx());
+  std::unordered_set<long long> seen;
+  for (auto f : faces) {
+    Vec3 lo, hi;
+    std::array<int, 3> ids;
+    std::array<Vec3, 3> p;
+    face_box(mesh, f, lo, hi, ids, p);
+    const Key a = key(lo), b = key(hi);
+    // Candidates: faces in the cells (the caller inserts moved faces at their current place;
+    // stale cells only cost time, the test below uses current geometry).
+    std::vector<int> cand(big_.begin(), big_.end());
+    if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
+      for (const auto& [k, v] : cells_) {  // a large query triangle: scan the grid once
+        (void)k;
+        cand.insert(cand.end(), v.begin(), v.end());
+      }
+    } else {
+      for (long long x = a.x; x <= b.x; ++x)
+        for (long long y = a.y; y <= b.y; ++y)
+          for (long long z = a.z; z <= b.z; ++z) {
+            auto it = cells_.find({x, y, z});
+            if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
+          }
+    }
+    std::sort(cand.begin(), cand.end());
+    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    for (int gi : cand) {
+      if (gi == f.idx()) continue;
+      const auto g = Mesh::FaceHandle(gi);
+      if (in_set.count(gi)) {
+        const long long lo_id = std::min(f.idx(), gi), hi_id = std::max(f.idx(), gi);
+        if (!seen.insert(lo_id * 4000000000LL + hi_id).second) continue;
+      }
+      Vec3 glo, ghi;
+      std::array<int, 3> gids;
+      std::array<Vec3, 3> q;
+      face_box(mesh, g, glo, ghi, gids, q);
+      if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+        continue;
+      // Triangles sharing vertices touch there; they intersect improperly (a fold) when they
+      // still meet after their shared corners are pulled slightly towards their centroids.
+      int shared = 0;
+      std::array<Vec3, 3> pa = p, qa = q;
+      const Vec3 cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
+      for (int i1 = 0; i1 < 3; ++i1)
+        for (int i2 = 0; i2 < 3; ++i2)
+          if (ids[i1] == gids[i2]) {
+            ++shared;
+            pa[i1] += 1e-3 * (cp - pa[i1]);
+            qa[i2] += 1e-3 * (cq - qa[i2]);
+          }
+      if (shared == 3) continue;
+      if (vtkTriangle::TrianglesIntersect(pa[0].data(), pa[1].data(), pa[2].data(), qa[0].data(), qa[1].data(),
+                                          qa[2].data()))
+        pairs.emplace_back(f.idx(), gi);
+    }
+  }
+  return pairs;
 }
 
 bool vertices_connected(const Mesh& mesh, Mesh::VertexHandle a, Mesh::VertexHandle b) {

@@ -2,6 +2,8 @@
 // closed, manifold, consistently oriented and connected; the two caps are apart.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "colonflat/core/error.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/core/topology.h"
@@ -31,19 +33,23 @@ TEST(DenoiseSurgery, TorusMeridianGivesSphere) {
   EXPECT_TRUE(t.manifold);
   EXPECT_TRUE(t.consistently_oriented);
   EXPECT_EQ(t.components.size(), 1u);
-  EXPECT_EQ(m.n_vertices(), V + nv + 2);  // left copies and two caps
-  EXPECT_EQ(m.n_faces(), F + 2 * nv);     // two fans
+  // Left copies, and per cap (m concentric rings, m = min(cap_rings, k / 4)): (m - 1) k ring
+  // vertices + a centre, 2 (m - 1) k strip triangles + a fan of k.
+  const std::size_t k = nv, mr = std::max<std::size_t>(1, std::min<std::size_t>(SurgeryOptions{}.cap_rings, k / 4));
+  EXPECT_EQ(m.n_vertices(), V + k + 2 * ((mr - 1) * k + 1));
+  EXPECT_EQ(m.n_faces(), F + 2 * (2 * (mr - 1) * k + k));
   EXPECT_TRUE(vertices_connected(m, r.left_cap, r.right_cap));
   // The right copies keep their ids; the caps are apart (at least a tenth of an edge).
   EXPECT_EQ(r.right_ring.front(), VH(5 * nv));
   EXPECT_GT((m.point(r.left_cap) - m.point(r.right_cap)).norm(), 0.1 * 2 * 3.14159 * 3 / nu * 0.25);
 }
 
-// With ring_pull = 0 the caps coincide, as in the paper.
+// With ring_pull = 0 and one cap ring the caps are the paper's: two coinciding centroid fans.
 TEST(DenoiseSurgery, ZeroPullGivesPaperCaps) {
   Mesh m = to_mesh(torus(3, 1, 16, 8));
   SurgeryOptions o;
   o.ring_pull = 0;
+  o.cap_rings = 1;
   SurgeryResult r = cut_and_cap(m, meridian(2, 8), o);
   EXPECT_LT((m.point(r.left_cap) - m.point(r.right_cap)).norm(), 1e-12);
   EXPECT_EQ(analyze_topology(m).genus, 0);

@@ -37,6 +37,8 @@ struct DenoiseOptions {
   int target_genus = 0;              // stop when the total genus reaches this
   double ring_pull = 0.25;           // 0..0.5; how far each ring moves into its own side (0 = paper's caps)
   double initial_radius = 0;         // mm; first search radius for "exact" (0 = 6 x mean edge length)
+  bool check_caps = true;            // test each cap for intersections with the surface and try
+                                     // other placements until none remains
 };
 
 struct LoopRecord {
@@ -48,6 +50,7 @@ struct LoopRecord {
   double length = 0;            // Euclidean length (mm)
   std::string type;             // "handle" | "tunnel"
   bool separating = false;      // only "paper" can cut separating loops
+  std::size_t cap_intersections = 0;  // triangle pairs its caps still intersect (0 unless no placement worked)
 };
 
 struct DenoiseResult {

@@ -4,10 +4,12 @@
 // cut_and_cap() slices the mesh along a simple edge cycle, which splits each loop vertex into a
 // left and a right copy and opens two boundary rings, then fills each ring with a fan to a new
 // vertex. Unlike the paper, whose two centroid fans coincide in space, each ring is first pulled
-// a fraction of the way into its own side (towards its own neighbours), and each cap vertex is the
-// centroid of its pulled ring, so the two caps are disjoint. Nothing is deleted: the input's
+// a fraction of the way into its own side (towards its own neighbours), and each cap is a small
+// disk relaxed to a discrete minimal surface spanning its pulled ring (centre vertex at the
+// centroid for a plain fan), so the two caps are disjoint and follow non-planar loops. Nothing is deleted: the input's
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
@@ -16,14 +18,47 @@ namespace cf {
 
 class HomologyBasis;
 
+// A spatial hash of the mesh's triangles, to check new geometry for intersections with the
+// rest of the surface (triangles sharing corners count when they meet beyond those corners).
+class FaceGrid {
+ public:
+  FaceGrid(const Mesh& mesh, double cell_size);
+  void insert(const Mesh& mesh, Mesh::FaceHandle f);
+  // Pairs (f in `faces`, g any face) that intersect improperly; pairs inside `faces` count once.
+  // Precondition: every face in `faces` was insert()ed at its current position.
+  std::size_t count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
+  // The intersecting pairs themselves (same rules as count_intersections).
+  std::vector<std::pair<int, int>> intersecting_pairs(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
+
+ private:
+  struct Key {
+    long long x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return static_cast<std::size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
+    }
+  };
+  Key key(const Vec3& p) const;
+  static constexpr long long kMaxCellsPerFace = 512;
+  double cell_;
+  std::unordered_map<Key, std::vector<int>, KeyHash> cells_;
+  std::vector<int> big_;  // faces spanning more than kMaxCellsPerFace cells
+};
+
 struct SurgeryOptions {
   double ring_pull = 0.25;  // fraction (0..0.5) of the way from a ring vertex to the centroid of
                             // its same-side neighbours; 0 gives the paper's coincident caps
+  int cap_rings = 4;        // concentric rings of a cap (1 = the paper's fan to the centroid)
+  FaceGrid* guard = nullptr;  // when set: try placements until the new geometry intersects
+                              // nothing (see SurgeryResult::intersections), and update the grid
 };
 
 struct SurgeryResult {
   std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
-  Mesh::VertexHandle left_cap, right_cap;                 // fan centres
+  Mesh::VertexHandle left_cap, right_cap;                 // cap centres
+  std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
 };
 
 // Preconditions (checked, PreconditionError otherwise): `loop` is a simple cycle of >= 3
