@@ -1,6 +1,7 @@
 #include "colonflat/volume/volume_io.h"
 
 #include <gdcmDirectory.h>
+#include <gdcmReader.h>
 #include <gdcmScanner.h>
 #include <gdcmTrace.h>
 #include <itkGDCMImageIO.h>
@@ -124,7 +125,7 @@ struct ScannedFolder {
 };
 
 const gdcm::Tag kSeriesUid(0x0020, 0x000e), kIpp(0x0020, 0x0032), kIop(0x0020, 0x0037), kSopClass(0x0008, 0x0016),
-    kModality(0x0008, 0x0060), kFrames(0x0028, 0x0008), kDescription(0x0008, 0x103e);
+    kModality(0x0008, 0x0060), kFrames(0x0028, 0x0008), kDescription(0x0008, 0x103e), kTransferSyntax(0x0002, 0x0010);
 
 std::unique_ptr<ScannedFolder> scan_folder(const fs::path& dir) {
   quiet_libraries();
@@ -132,7 +133,8 @@ std::unique_ptr<ScannedFolder> scan_folder(const fs::path& dir) {
   gdcm::Directory d;
   d.Load(dir.string(), false);
   const auto& files = d.GetFilenames();
-  for (const auto& t : {kSeriesUid, kIpp, kIop, kSopClass, kModality, kFrames, kDescription}) f->scanner.AddTag(t);
+  for (const auto& t : {kSeriesUid, kIpp, kIop, kSopClass, kModality, kFrames, kDescription, kTransferSyntax})
+    f->scanner.AddTag(t);
   if (files.empty()) return f;
   f->scanner.Scan(files);
   for (const auto& file : files) {
@@ -156,6 +158,26 @@ std::vector<std::string> sorted_checked_series(const fs::path& dir, const Scanne
     throw InputError(where, fname(first) + " is an enhanced multi-frame CT (" +
                                 (frames.empty() ? std::string("several") : frames) +
                                 " frames), which is not supported; export a classic single-frame CT series");
+  // A truncated file (uncompressed transfer syntaxes).
+  for (const auto& file : files) {
+    const std::string ts = trim(f.scanner.GetValue(file.c_str(), kTransferSyntax));
+    if (ts != "1.2.840.10008.1.2" && ts != "1.2.840.10008.1.2.1" && ts != "1.2.840.10008.1.2.2") continue;
+    if (!has_dicom_magic(file)) continue;  // without a preamble the meta length below is not comparable
+    // GDCM pads truncated pixel data silently: compare the file size with the length its data set
+    // declares (meta header with preamble, plus the data set with its pixel data).
+    gdcm::Reader r;
+    r.SetFileName(file.c_str());
+    const bool ok = r.Read();
+    const gdcm::DataSet& ds = r.GetFile().GetDataSet();
+    const double declared = double(r.GetFile().GetHeader().GetFullLength()) +
+                            double(ts == "1.2.840.10008.1.2" ? ds.GetLength<gdcm::ImplicitDataElement>()
+                                                             : ds.GetLength<gdcm::ExplicitDataElement>());
+    std::error_code ec;
+    const double have = double(fs::file_size(file, ec));
+    if (!ok || (!ec && have < declared))
+      throw InputError(where, fname(file) + " is truncated (" + format_number(have) + " bytes; its header declares " +
+                                  format_number(declared) + ")");
+  }
   if (files.size() == 1) return files;
   const std::vector<double> iop = ds_values(trim(f.scanner.GetValue(first.c_str(), kIop)));
   if (iop.size() != 6) throw InputError(where, fname(first) + ": no valid ImageOrientationPatient (0020,0037)");
@@ -688,8 +710,14 @@ bool looks_like_volume(const fs::path& p) {
 }
 
 bool try_volume_info(const std::string& path, bool json, std::ostream& out) {
+  return try_volume_info(path, json, out, "");
+}
+
+bool try_volume_info(const std::string& path, bool json, std::ostream& out, const std::string& series_uid) {
   if (!looks_like_volume(path)) return false;
-  const nlohmann::json j = volume_info_json(path);
+  VolumeReadOptions o;
+  o.series_uid = series_uid;
+  const nlohmann::json j = volume_info_json(path, o);
   if (json) out << j.dump(2) << "\n";
   else out << volume_info_text(j);
   return true;

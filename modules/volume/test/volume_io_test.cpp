@@ -226,6 +226,25 @@ TEST(VolumeIoDicom, SeveralSeriesListedAndChosen) {
   ASSERT_TRUE(try_volume_info((tmp / "both").string(), true, out));
   auto j = nlohmann::json::parse(out.str());
   EXPECT_EQ(j["series"].size(), 2u);
+  EXPECT_FALSE(j.contains("size"));
+  // With a chosen series, the info reads that volume.
+  std::ostringstream chosen;
+  ASSERT_TRUE(try_volume_info((tmp / "both").string(), true, chosen, uid_a));
+  auto ja = nlohmann::json::parse(chosen.str());
+  EXPECT_EQ(ja["series_uid"], uid_a);
+  EXPECT_EQ(ja["size"][2], 4);
+}
+
+// A truncated slice file in a series: one-line InputError naming the folder; nothing returned.
+TEST(VolumeIoDicom, TruncatedSliceIsReported) {
+  testing::TempDir tmp;
+  write_dicom_series(make_ct(32, 32, 6, false), tmp / "s");
+  const fs::path f = tmp / "s" / "IM00003.dcm";
+  const auto size = fs::file_size(f);
+  fs::resize_file(f, size - 1000);
+  const std::string e = error_of([&] { read_ct_volume(tmp / "s"); });
+  EXPECT_EQ(e.rfind((tmp / "s").string() + ": ", 0), 0u) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
 // The derived UIDs are valid DICOM UIDs (digits and dots, at most 64 characters) and deterministic.
@@ -289,6 +308,12 @@ TEST(VolumeIoShared, SingleDicomSlices) {
     float lo = 1e9f;
     for (std::size_t i = 0; i < im->GetLargestPossibleRegion().GetNumberOfPixels(); ++i) lo = std::min(lo, im->GetBufferPointer()[i]);
     EXPECT_LT(lo, -500.f) << "air should be negative HU after the rescale";
+    // The same file as a one-file series folder (the series checks accept it) gives the same volume.
+    testing::TempDir tmp;
+    fs::create_directories(tmp / "one");
+    fs::copy_file(dir / c.file, tmp / "one" / c.file);
+    auto as_series = read_ct_volume(tmp / "one");
+    expect_same_values(im, as_series);
   }
 }
 

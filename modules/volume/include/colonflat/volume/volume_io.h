@@ -86,6 +86,8 @@ bool looks_like_volume(const std::filesystem::path& path);
 // true; returns false (printing nothing) when it is not a volume. Throws InputError when it is a
 // volume that cannot be read.
 bool try_volume_info(const std::string& path, bool json, std::ostream& out);
+// The same with a DICOM series chosen by UID (for `colonflat info DIR --series UID`).
+bool try_volume_info(const std::string& path, bool json, std::ostream& out, const std::string& series_uid);
 
 // Pipeline artifacts: "volume" (std::any holding CtImage::Pointer) and "mask" (MaskImage::Pointer).
 const ArtifactType& volume_artifact();
