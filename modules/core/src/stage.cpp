@@ -91,7 +91,7 @@ class StageTool : public Tool {
       ctx.log = quiet ? nullptr : &err;
       Stopwatch t;
       stage->run(bag, ctx);
-      ctx.report["time_s"] = t.seconds();
+      const double run_time = t.seconds();
       OutputTransaction tx;
       for (const Port& p : spec.outputs) {
         const std::string& f = out_files[p.name];
@@ -103,6 +103,7 @@ class StageTool : public Tool {
                                {"version", colonflat_version()},
                                {"parameters", stage->params_json()},
                                {"result", ctx.report},
+                               {"run_time_s", run_time},
                                {"total_time_s", total.seconds()},
                                {"peak_memory_mib", peak_memory_mib()}};
       if (!report_file.empty()) {

@@ -64,7 +64,10 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
   // 2. Left copies and the new edges y_i: left^i -> left^(i+1) (x_i = opposite, boundary).
   SurgeryResult r;
   r.right_ring = loop;
-  for (std::size_t i = 0; i < k; ++i) r.left_ring.push_back(mesh.add_vertex(mesh.point(loop[i])));
+  for (std::size_t i = 0; i < k; ++i) {
+    const Vec3 p = mesh.point(loop[i]);  // a copy: add_vertex may reallocate the point array
+    r.left_ring.push_back(mesh.add_vertex(p));
+  }
   std::vector<Mesh::HalfedgeHandle> y(k), x(k);
   std::unordered_map<int, Mesh::HalfedgeHandle> repl;
   for (std::size_t i = 0; i < k; ++i) {

@@ -1,1 +1,106 @@
-// placeholder
+// `colonflat denoise` as a command: outputs, report, progress, exit codes and messages.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/mesh_io.h"
+#include "colonflat/core/synthetic.h"
+#include "colonflat/denoise/loops_io.h"
+#include "colonflat/pipeline/dispatch.h"
+#include "colonflat/testing/temp_dir.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+namespace {
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+Result call(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  const int code = colonflat_main(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+// A genus-3 chain: genus-0 mesh, loops .vtp and a report with per-component genus, loops and times.
+TEST(DenoiseCli, WritesMeshLoopsAndReport) {
+  testing::TempDir dir;
+  write_mesh(synthetic::to_mesh(synthetic::torus_chain(3, 3, 1, 16, 8, 10)), dir / "in.off");
+  auto r = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--loops", dir.str("loops.vtp"), "--report",
+                 dir.str("report.json")});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("denoise: 3/3 handles removed"), std::string::npos) << r.err;
+  auto out = load_mesh(dir / "out.vtp");
+  EXPECT_EQ(out.topology.genus, 0);
+  EXPECT_TRUE(out.topology.closed);
+  LoopSet loops = read_loops(dir / "loops.vtp");
+  ASSERT_EQ(loops.size(), 3u);
+  EXPECT_EQ(loops[0].type, "handle");
+  std::ifstream in(dir / "report.json");
+  auto j = nlohmann::json::parse(in);
+  const auto& res = j["result"];
+  EXPECT_EQ(res["genus_before"], 3);
+  EXPECT_EQ(res["genus_after"], 0);
+  EXPECT_EQ(res["per_component"][0]["genus_before"], 3);
+  EXPECT_EQ(res["loops"].size(), 3u);
+  EXPECT_EQ(res["loops"][0]["vertex_count"], res["loops"][0]["vertex_ids"].size());
+  EXPECT_GT(res["totals"]["loop_vertices"].get<int>(), 0);
+  EXPECT_TRUE(res["time_s"].contains("loop_search"));
+  EXPECT_EQ(j["parameters"]["method"], "exact");
+}
+
+// A non-manifold mesh: exit 3 with one line naming the file; nothing written.
+TEST(DenoiseCli, NonManifoldInputIsRefused) {
+  testing::TempDir dir;
+  const std::string bad = std::string(COLONFLAT_SHARED_DIR) + "/meshes/BAD_beast.off";
+  auto r = call({"denoise", bad, "-o", dir.str("out.vtp"), "-q"});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("colonflat denoise: error: " + bad + ": not a 2-manifold", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out.vtp"));
+}
+
+// Invalid parameters: exit 2, the reason, nothing written.
+TEST(DenoiseCli, InvalidParametersAreUsageErrors) {
+  testing::TempDir dir;
+  write_mesh(synthetic::to_mesh(synthetic::torus(3, 1, 12, 8)), dir / "in.off");
+  auto a = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--target-genus", "-1"});
+  EXPECT_EQ(a.code, 2);
+  EXPECT_NE(a.err.find("--target-genus must be >= 0 (got -1)"), std::string::npos) << a.err;
+  auto b = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--method", "paper", "--policy", "fill"});
+  EXPECT_EQ(b.code, 2);
+  EXPECT_NE(b.err.find("needs --method exact"), std::string::npos) << b.err;
+  auto c = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--max-loop-length", "0"});
+  EXPECT_EQ(c.code, 2);
+  EXPECT_FALSE(fs::exists(dir / "out.vtp"));
+}
+
+// --help lists the parameters with defaults and units.
+TEST(DenoiseCli, HelpListsParameters) {
+  auto r = call({"denoise", "--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("--max-loop-length"), std::string::npos);
+  EXPECT_NE(r.out.find("[mm] (default inf"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("exact|paper"), std::string::npos);
+  EXPECT_NE(r.out.find("--loops"), std::string::npos);
+}
+
+// The paper method through the command marks the separating neck loop in the loops file.
+TEST(DenoiseCli, PaperMarksSeparatingLoops) {
+  testing::TempDir dir;
+  write_mesh(synthetic::to_mesh(synthetic::torus_chain(2, 3, 1, 16, 8, 10)), dir / "in.vtp");
+  auto r = call({"denoise", dir.str("in.vtp"), "-o", dir.str("out.vtp"), "--method", "paper", "--loops",
+                 dir.str("loops.vtp"), "-q"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  LoopSet loops = read_loops(dir / "loops.vtp");
+  ASSERT_FALSE(loops.empty());
+  EXPECT_TRUE(loops[0].separating);
+}
+
+}  // namespace
+}  // namespace cf
