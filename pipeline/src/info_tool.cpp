@@ -5,6 +5,10 @@
 #include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/pipeline/registry.h"
+#if __has_include("colonflat/volume/volume_io.h")
+#include "colonflat/volume/volume_io.h"
+#define COLONFLAT_HAS_VOLUME 1
+#endif
 
 namespace cf {
 namespace {
@@ -12,19 +16,29 @@ namespace {
 class InfoTool : public Tool {
  public:
   std::string name() const override { return "info"; }
-  std::string summary() const override { return "topology and defects of a mesh (V, E, F, genus, ...)"; }
+  std::string summary() const override {
+    return "mesh topology and defects (V, E, F, genus, ...), or volume geometry and HU range";
+  }
   int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) override {
     CLI::App app("Reports a mesh's topology (conventions: docs/conventions.md) and every defect with counts "
                  "and example ids. Exit 0 when the mesh is a valid closed 2-manifold (or, with "
                  "--allow-boundary, a 2-manifold with boundary), 3 when it has defects or cannot be read.",
                  "colonflat info");
     app.set_version_flag("--version", colonflat_version());
-    std::string file;
+    std::string file, series;
     bool json = false, allow_boundary = false;
-    app.add_option("file", file, "mesh file (" + mesh_format_list() + ")")->required()->type_name("FILE");
+    app.add_option("file", file,
+                   "mesh file (" + mesh_format_list() + "), or a CT volume (NRRD, NIfTI, MHA/MHD, DICOM file or folder)")
+        ->required()
+        ->type_name("FILE");
+    app.add_option("--series", series, "DICOM folder with several series: the SeriesInstanceUID to read")
+        ->type_name("UID");
     app.add_flag("--json", json, "print the report as JSON on stdout");
     app.add_flag("--allow-boundary", allow_boundary, "an open surface (boundary loops) is not a defect");
     return run_cli(app, name(), args, out, err, [&]() -> int {
+#ifdef COLONFLAT_HAS_VOLUME
+      if (!mesh_format_from_path(file) && try_volume_info(file, json, out, series)) return kExitOk;
+#endif
       PolygonSoup soup = read_polygon_soup(file);
       MeshDiagnosis diag = diagnose_soup(soup);
       std::optional<TopologyReport> topo;

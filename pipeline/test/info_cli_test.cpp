@@ -105,3 +105,22 @@ TEST(InfoCli, InputUntouched) {
 
 }  // namespace
 }  // namespace cf
+
+#if __has_include("colonflat/volume/volume_io.h")
+namespace cf {
+namespace {
+// `colonflat info VOLUME` reports the real head CT's size and spacing (single-file and detached NRRD).
+TEST(InfoCli, VolumeInfo) {
+  const std::string dir = std::string(COLONFLAT_SHARED_DIR) + "/ct/vtk_headsq_quarter_ct_head/";
+  auto r = call({"info", "--json", dir + "headsq_quarter.nrrd"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.dump().find("93") != std::string::npos, true) << r.out;
+  EXPECT_NE(r.out.find("3.2"), std::string::npos) << r.out;
+  auto missing = call({"info", dir + "nope.nrrd"});
+  EXPECT_EQ(missing.code, 3);
+  EXPECT_NE(missing.err.find("nope.nrrd"), std::string::npos);
+}
+}  // namespace
+}  // namespace cf
+#endif
