@@ -182,7 +182,10 @@ struct Fold {
   double s, depth, width, theta0;  // arclength, depth fraction of radius, half-width mm, crescent phase
 };
 struct Pool {
-  double s0, s1, level_y, hu;
+  double s0, s1;  // arclength range of the segment it lies in (kept free of polyps and strands)
+  double level_y, hu;
+  V3 seed;        // a point below the level in the lumen: the pool is the lumen below the level connected to it
+  std::size_t voxels = 0;
 };
 struct Bulge {
   double s, amp, sigma_s;
@@ -434,18 +437,22 @@ Phantom generate_phantom(const PhantomOptions& o) {
     }
   }
 
-  // Tagged-fluid pools in dependent parts: rectum, descending, ascending + cecum.
+  // Tagged-fluid pools in dependent parts: rectum, descending, ascending + cecum. Each has one
+  // horizontal level (constant LPS y) at its lowest point and fills the lumen below that level
+  // connected to it (communicating vessels), so its surface is flat everywhere.
   if (o.tagged_fluid) {
     const int pool_segs[] = {0, 2, 4};
     for (int ps : pool_segs) {
       double a, b;
       seg_range(ps, a, b);
       if (ps == 4) b = P.length;  // ascending + cecum
-      const double s0 = a + 0.15 * (b - a), s1 = b - (ps == 4 ? 5.0 : 0.15 * (b - a));
-      const std::size_t im = index_at(0.5 * (s0 + s1));
+      std::size_t low = index_at(a + 10);
+      for (std::size_t i = index_at(a + 10); i <= index_at(b - 5); ++i)
+        if (P.p[i].y() > P.p[low].y()) low = i;
       // Fluid surface: between 20 % and 55 % of the diameter from the dependent side.
-      const double level = P.p[im].y() + P.r[im] * rng.uniform(-0.1, 0.6);
-      md.pools.push_back({s0, s1, level, std::round(rng.uniform(320, 580))});
+      const double level = P.p[low].y() + P.r[low] * rng.uniform(-0.1, 0.6);
+      const V3 seed = P.p[low] + V3(0, 1, 0) * (0.5 * (level - P.p[low].y()) + 0.5 * P.r[low]);
+      md.pools.push_back({a, b, level, std::round(rng.uniform(320, 580)), seed});
     }
   }
 
@@ -649,13 +656,6 @@ Phantom generate_phantom(const PhantomOptions& o) {
           if (m == kOutsideAir || m == kSubcutFat) continue;
           if (L.d < L.Reff) {
             m = kColonGas;
-            const double y = g.org[1] + j * g.sp[1];
-            for (std::size_t pi = 0; pi < md.pools.size(); ++pi) {
-              const Pool& p = md.pools[pi];
-              // The pool fades out (its level sinks) over 40 mm beyond its ends.
-              const double out = std::max({0.0, p.s0 - L.s, L.s - p.s1});
-              if (out < 40 && y > p.level_y + out * out / 40.0 * 1.2) m = kFluid0 + pi;
-            }
           } else if (L.d < std::max(L.Reff, L.R) + md.wall) {
             m = kColonWall;
           }
@@ -698,6 +698,40 @@ Phantom generate_phantom(const PhantomOptions& o) {
           if (m != kColonWall || !local_at(i, j, k, L) || L.d >= L.R) continue;  // only the fold ridge
           if (seg_point_dist2(g.point(i, j, k), ho.a, ho.b) <= ho.r * ho.r) m = kColonGas;
         }
+  }
+
+  // Fluid pools: flood fill of the gas below each level from its seed.
+  for (std::size_t pi = 0; pi < md.pools.size(); ++pi) {
+    Pool& pool = md.pools[pi];
+    int c[3];
+    for (int d = 0; d < 3; ++d) c[d] = int(std::lround((pool.seed[d] - g.org[d]) / g.sp[d]));
+    auto below = [&](int j) { return g.org[1] + j * g.sp[1] > pool.level_y; };
+    std::vector<std::size_t> stack;
+    // The seed voxel, or the nearest gas voxel below the level around it.
+    for (int r = 0; r <= 3 && stack.empty(); ++r)
+      for (int dk = -r; dk <= r && stack.empty(); ++dk)
+        for (int dj = -r; dj <= r && stack.empty(); ++dj)
+          for (int di = -r; di <= r && stack.empty(); ++di) {
+            const int i = c[0] + di, j = c[1] + dj, k = c[2] + dk;
+            if (i < 0 || j < 0 || k < 0 || i >= g.n[0] || j >= g.n[1] || k >= g.n[2]) continue;
+            if (mat[g.index(i, j, k)] == kColonGas && below(j)) stack.push_back(g.index(i, j, k));
+          }
+    const unsigned char fl = static_cast<unsigned char>(kFluid0 + pi);
+    for (std::size_t q : stack) mat[q] = fl;
+    while (!stack.empty()) {
+      const std::size_t q = stack.back();
+      stack.pop_back();
+      ++pool.voxels;
+      const int i = int(q % g.n[0]), j = int((q / g.n[0]) % g.n[1]), k = int(q / (std::size_t(g.n[0]) * g.n[1]));
+      const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+      for (const auto& n : nb) {
+        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= g.n[0] || n[1] >= g.n[1] || n[2] >= g.n[2]) continue;
+        const std::size_t r = g.index(n[0], n[1], n[2]);
+        if (mat[r] != kColonGas || !below(n[1])) continue;
+        mat[r] = fl;
+        stack.push_back(r);
+      }
+    }
   }
 
   // ---- Images.
@@ -775,7 +809,12 @@ Phantom generate_phantom(const PhantomOptions& o) {
   }
   nlohmann::json pools = nlohmann::json::array();
   for (const Pool& p : md.pools)
-    pools.push_back({{"start_mm", p.s0}, {"end_mm", p.s1}, {"level_y_lps_mm", p.level_y}, {"hu", p.hu}});
+    pools.push_back({{"segment_start_mm", p.s0},
+                     {"segment_end_mm", p.s1},
+                     {"level_y_lps_mm", p.level_y},
+                     {"seed_lps_mm", {p.seed.x(), p.seed.y(), p.seed.z()}},
+                     {"hu", p.hu},
+                     {"volume_ml", double(p.voxels) * g.sp[0] * g.sp[1] * g.sp[2] / 1000.0}});
   nlohmann::json gas = nlohmann::json::array();
   for (const auto& [c, r] : md.gas)
     gas.push_back({{"center_lps_mm", {c.x(), c.y(), c.z()}}, {"radii_mm", {r.x(), r.y(), r.z()}}});

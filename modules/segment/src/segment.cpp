@@ -12,6 +12,8 @@
 #include <cstring>
 #include <exception>
 #include <functional>
+#include <iomanip>
+#include <sstream>
 #include <mutex>
 #include <numeric>
 #include <thread>
@@ -32,6 +34,7 @@ nlohmann::json SegmentStats::to_json() const {
           {"graph_edges", graph_edges},
           {"max_flow", flow},
           {"removed_components", removed_components},
+          {"rejected_fluid_components", rejected_fluid_components},
           {"time_s", time_s},
           {"graph_cut_time_s", graph_cut_time_s},
           {"peak_memory_mib", peak_memory_mib},
@@ -46,10 +49,12 @@ void validate(const SegmentOptions& o) {
   check(o.fluid_threshold >= 50 && o.fluid_threshold <= 1000, "--fluid-threshold must be in [50, 1000] HU (got " + format_number(o.fluid_threshold) + ")");
   check(o.fluid_max > o.fluid_threshold && o.fluid_max <= 4000, "--fluid-max must be above --fluid-threshold and <= 4000 HU (got " + format_number(o.fluid_max) + ")");
   check(o.interface_width >= 0 && o.interface_width <= 20, "--interface-width must be in [0, 20] mm (got " + format_number(o.interface_width) + ")");
+  check(o.level_tolerance >= 0.5 && o.level_tolerance <= 50, "--level-tolerance must be in [0.5, 50] mm (got " + format_number(o.level_tolerance) + ")");
   check(o.band_width >= 0.5 && o.band_width <= 10, "--band-width must be in [0.5, 10] mm (got " + format_number(o.band_width) + ")");
   check(o.smoothness >= 0 && o.smoothness <= 10, "--smoothness must be in [0, 10] (got " + format_number(o.smoothness) + ")");
   check(o.edge_sigma >= 1 && o.edge_sigma <= 2000, "--edge-sigma must be in [1, 2000] HU (got " + format_number(o.edge_sigma) + ")");
   check(o.min_segment_volume >= 0 && o.min_segment_volume <= 5000, "--min-segment-volume must be in [0, 5000] mL (got " + format_number(o.min_segment_volume) + ")");
+  check(o.min_colon_volume >= 0 && o.min_colon_volume <= 10000, "--min-colon-volume must be in [0, 10000] mL (got " + format_number(o.min_colon_volume) + ")");
   check(o.min_segment_fraction >= 0 && o.min_segment_fraction <= 1, "--min-segment-fraction must be in [0, 1] (got " + format_number(o.min_segment_fraction) + ")");
   check(o.max_segments >= 1 && o.max_segments <= 100, "--max-segments must be in [1, 100] (got " + std::to_string(o.max_segments) + ")");
 }
@@ -464,36 +469,68 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
         if (!lab[q] && sm[q] >= opts.fluid_threshold && sm[q] <= opts.fluid_max) lab[q] = 2;
     }
     const int wvox = int(std::ceil(opts.interface_width / d.sp[grav_axis]));
-    std::vector<unsigned char> touch(d.total, 0);
-    {
-      const std::size_t st_g = d.stride[grav_axis], len = d.n[grav_axis];
-      parallel_for(d.total / len, [&](std::size_t l0, std::size_t l1) {
+    const std::size_t st_g = d.stride[grav_axis], glen = d.n[grav_axis];
+    // Scans every line along gravity for gas and fluid at most wvox voxels apart. contact: 1 where
+    // a fluid voxel has gas on its lower-index side, 2 on its higher-index side. With `mark_layer`,
+    // the voxels between become layer (3) in `lab`.
+    auto scan_lines = [&](std::vector<unsigned char>* contact, bool mark_layer) {
+      parallel_for(d.total / glen, [&](std::size_t l0, std::size_t l1) {
         for (std::size_t l = l0; l < l1; ++l) {
           const std::size_t base = line_base(d, grav_axis, l);
           int last_kind = 0, last_pos = -1000000;
-          for (int p = 0; p < int(len); ++p) {
+          for (int p = 0; p < int(glen); ++p) {
             const std::size_t q = base + std::size_t(p) * st_g;
             const unsigned char k = lab[q];
             if (k != 1 && k != 2) continue;
             if (last_kind && last_kind != k && p - last_pos - 1 <= wvox) {
-              for (int r = last_pos + 1; r < p; ++r) touch[base + std::size_t(r) * st_g] = 2;  // layer
-              touch[q] = 1;
-              touch[base + std::size_t(last_pos) * st_g] = 1;
+              if (mark_layer)
+                for (int r = last_pos + 1; r < p; ++r) lab[base + std::size_t(r) * st_g] = 3;
+              if (contact) {
+                if (k == 2) (*contact)[q] = 1;  // gas below in index, fluid here
+                else (*contact)[base + std::size_t(last_pos) * st_g] = 2;
+              }
             }
             last_kind = k;
             last_pos = p;
           }
         }
       });
-    }
+    };
     {
+      std::vector<unsigned char> contact(d.total, 0);
+      scan_lines(&contact, false);
       for (std::size_t q = 0; q < d.total; ++q) cw[q] = lab[q] == 2;
       std::uint32_t nf = 0;
       LabelImage::Pointer fl = components(cwork, nf);
       const std::uint32_t* flb = fl->GetBufferPointer();
-      std::vector<unsigned char> keep(nf + 1, 0);
+      // A tagged-fluid pool meets the gas above it along a horizontal level: the contacts of one
+      // side must be many and at (nearly) one height. Bone touching gas here and there is not.
+      std::vector<std::vector<float>> levels[2];
+      levels[0].resize(nf + 1);
+      levels[1].resize(nf + 1);
       for (std::size_t q = 0; q < d.total; ++q)
-        if (flb[q] && touch[q] == 1) keep[flb[q]] = 1;
+        if (contact[q]) {
+          std::size_t c[3];
+          d.coords(q, c[0], c[1], c[2]);
+          levels[contact[q] - 1][flb[q]].push_back(float(double(c[grav_axis]) * d.sp[grav_axis]));
+        }
+      std::vector<unsigned char> keep(nf + 1, 0);
+      const std::size_t min_columns =
+          std::max<std::size_t>(8, std::size_t(std::ceil(100.0 / (d.total / double(d.n[grav_axis]) > 0
+                                                                        ? d.sp[0] * d.sp[1] * d.sp[2] / d.sp[grav_axis]
+                                                                        : 1.0))));
+      std::size_t rejected = 0;
+      for (std::uint32_t l = 1; l <= nf; ++l) {
+        for (int side = 0; side < 2; ++side) {
+          auto& v = levels[side][l];
+          if (v.size() < min_columns) continue;
+          std::sort(v.begin(), v.end());
+          const double spread = v[v.size() * 9 / 10] - v[v.size() / 10];
+          if (spread <= std::max(opts.level_tolerance, 1.5 * d.sp[grav_axis])) keep[l] = 1;
+        }
+        if (!keep[l] && (!levels[0][l].empty() || !levels[1][l].empty())) ++rejected;
+      }
+      st.rejected_fluid_components = rejected;
       double fsum = 0;
       std::size_t fcount = 0;
       for (std::size_t q = 0; q < d.total; ++q) {
@@ -505,9 +542,8 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
       }
       st.fluid_hu = fcount ? fsum / double(fcount) : 0.0;
     }
-    for (std::size_t q = 0; q < d.total; ++q)
-      if (touch[q] == 2 && !lab[q]) lab[q] = 3;
-    std::vector<unsigned char>().swap(touch);
+    // The layer between gas and the kept fluid joins the lumen.
+    scan_lines(nullptr, true);
     lap("tagged_fluid");
 
     // 3. Colon segments: components of gas + fluid + layer, kept by volume.
@@ -539,6 +575,16 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
     if (vols.empty())
       throw PreconditionError("no colon found: no gas/fluid body inside the body of at least " +
                               format_number(opts.min_segment_volume) + " mL");
+    {
+      const double total = std::accumulate(vols.begin(), vols.end(), 0.0);
+      if (total < opts.min_colon_volume) {
+        std::ostringstream m;
+        m << "no colon found: the gas/fluid bodies inside the body total " << std::fixed << std::setprecision(1)
+          << total << " mL, less than --min-colon-volume " << format_number(opts.min_colon_volume)
+          << " mL (an insufflated colon holds several hundred mL)";
+        throw PreconditionError(m.str());
+      }
+    }
     lap("segments");
 
     // Class means.

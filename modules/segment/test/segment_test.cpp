@@ -93,6 +93,7 @@ std::size_t components(const MaskImage* m) {
 SegmentOptions small_volume_options() {
   SegmentOptions o;
   o.min_segment_volume = 1;  // mL: the test volumes are small
+  o.min_colon_volume = 1;
   return o;
 }
 
@@ -163,8 +164,7 @@ TEST(SegmentSynthetic, LungsSmallGasAndBoneRemoved) {
     if (std::abs(x - 32) < 5 && y > 44 && y < 54 && z < 50) return 500.0;  // bone column
     return kKeep;
   });
-  SegmentOptions o;
-  o.min_segment_volume = 1;
+  SegmentOptions o = small_volume_options();
   SegmentStats st;
   auto m = segment_colon(ct, o, &st);
   EXPECT_TRUE(at(m, 32, 24, 24));
@@ -402,6 +402,32 @@ TEST(SegmentStageTool, Spec) {
   EXPECT_EQ(s.spec().outputs[0].type, &mask_artifact());
   EXPECT_EQ(s.spec().outputs[0].file_name, "lumen_mask.nrrd");
   EXPECT_EQ(s.params_json()["interface-width"], 3.0);
+}
+
+}  // namespace
+}  // namespace cf
+
+namespace cf {
+namespace {
+
+// Real CT (the shared head CT, converted from scanner units to HU): it holds no colon, so the
+// segmentation refuses it with "no colon found" (its airway gas, 56 mL, is far below an insufflated
+// colon), and as stored (scanner units) it is "not a CT volume in HU".
+TEST(SegmentRealCt, HeadCtHasNoColon) {
+  const fs::path f = fs::path(COLONFLAT_SHARED_DIR) / "ct" / "vtk_headsq_quarter_ct_head" / "headsq_quarter.nrrd";
+  if (!fs::exists(f)) GTEST_SKIP() << "shared data not available";
+  auto ct = read_ct_volume(f);
+  EXPECT_NE(error_of([&] { segment_colon(ct); }).find("not a CT volume in HU"), std::string::npos);
+  for (std::size_t q = 0; q < ct->GetLargestPossibleRegion().GetNumberOfPixels(); ++q) ct->GetBufferPointer()[q] -= 1024;
+  SegmentStats st;
+  const std::string e = error_of([&] { segment_colon(ct, {}, &st); });
+  EXPECT_NE(e.find("no colon found"), std::string::npos) << e << st.to_json().dump();
+  // Its bone touches the sinus gas but has no level surface: not taken for tagged fluid.
+  SegmentOptions o;
+  o.min_colon_volume = 0;
+  auto m = segment_colon(ct, o, &st);
+  EXPECT_EQ(st.fluid_volume_ml, 0.0);
+  EXPECT_GE(st.rejected_fluid_components, 1u);
 }
 
 }  // namespace

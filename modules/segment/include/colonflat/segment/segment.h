@@ -21,11 +21,13 @@ struct SegmentOptions {
   double fluid_threshold = 200;       // HU; above (and below fluid-max): tagged-fluid candidate
   double fluid_max = 1400;            // HU; above: not fluid (metal, dense bone)
   double interface_width = 3.0;       // mm; air/fluid layer thickness taken as lumen
+  double level_tolerance = 4.0;       // mm; spread (10th-90th percentile) of a fluid pool's surface height
   double band_width = 2.0;            // mm; half-width of the graph-cut band around the initial boundary
   double smoothness = 0.5;            // weight of the boundary (smoothness) term against the data term
   double edge_sigma = 60;             // HU; contrast sensitivity of the smoothness term
   double min_segment_volume = 20;     // mL; smaller gas/fluid bodies are not colon
   double min_segment_fraction = 0.05; // fraction of the largest kept segment a further segment must reach
+  double min_colon_volume = 100;      // mL; less gas + fluid in all kept segments: no (insufflated) colon
   int max_segments = 6;               // at most this many colon segments kept
   bool graph_cut = true;              // refine the boundary by graph cut (off: thresholds only)
 };
@@ -39,6 +41,7 @@ struct SegmentStats {
   std::size_t band_voxels = 0, graph_edges = 0;
   double flow = 0;
   std::size_t removed_components = 0;
+  std::size_t rejected_fluid_components = 0;  // bright bodies touching gas without a level surface
   double time_s = 0, graph_cut_time_s = 0;
   double peak_memory_mib = 0;
   nlohmann::json timings;  // seconds per step
