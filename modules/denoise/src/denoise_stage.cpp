@@ -31,7 +31,7 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
     t.flag("check-caps", &DenoiseOptions::check_caps,
            "check every cap for intersections with the surface and try other placements");
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
-           "first loop-search radius of the exact method (0 = 6 x mean edge length)", 0.0);
+           "first loop-search radius of the exact method (0 = 10 x mean edge length)", 0.0);
     return t;
   }();
   return t;

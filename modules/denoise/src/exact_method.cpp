@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <memory>
 #include <queue>
+#include <thread>
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
@@ -105,7 +106,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
   };
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> pq;
   std::vector<std::uint32_t> ver;
-  double R = o.initial_radius > 0 ? o.initial_radius : 6.0 * mean_edge;
+  double R = o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge;
   if (std::isfinite(o.max_loop_length)) R = std::min(R, o.max_loop_length);
   bool truncated_any = false;
   long long searches = 0, settled = 0;
@@ -141,10 +142,39 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     else if (c.truncated) pq.push({R, v, ver[v], false});
     st.t.search += sw.seconds();
   };
+  // Full sweeps over all sources run on every core: searches only read the mesh, the classes
+  // and the span, and each thread has its own search state; results are queued in source order,
+  // so the outcome does not depend on the thread count.
+  const unsigned n_threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   auto compute_all = [&]() {
+    Stopwatch sw;
     while (!pq.empty()) pq.pop();
     truncated_any = false;
-    for (int v : sources) compute(v);
+    std::vector<CycleCandidate> results(sources.size());
+    std::vector<long long> settled_by(n_threads, 0);
+    auto work = [&](unsigned t) {
+      FundamentalCycleSearch local(st.mesh, hb, span);
+      for (std::size_t i = t; i < sources.size(); i += n_threads) {
+        results[i] = local.run(Mesh::VertexHandle(sources[i]), R, accept_ptr);
+        settled_by[t] += static_cast<long long>(local.last_settled());
+      }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(work, t);
+    work(0);
+    for (auto& th : pool) th.join();
+    if (ver.size() < st.mesh.n_vertices()) ver.resize(st.mesh.n_vertices() + 1024, 0);
+    for (std::size_t i = 0; i < sources.size(); ++i) {
+      const int v = sources[i];
+      const CycleCandidate& c = results[i];
+      ++ver[v];
+      truncated_any = truncated_any || c.truncated;
+      if (c.found) pq.push({c.value, v, ver[v], true});
+      else if (c.truncated) pq.push({R, v, ver[v], false});
+    }
+    searches += static_cast<long long>(sources.size());
+    for (long long x : settled_by) settled += x;
+    st.t.search += sw.seconds();
   };
 
   rebuild();

@@ -36,7 +36,7 @@ struct DenoiseOptions {
   double max_loop_length = kInf;     // mm; only loops shorter than this are cut
   int target_genus = 0;              // stop when the total genus reaches this
   double ring_pull = 0.25;           // 0..0.5; how far each ring moves into its own side (0 = paper's caps)
-  double initial_radius = 0;         // mm; first search radius for "exact" (0 = 6 x mean edge length)
+  double initial_radius = 0;         // mm; first search radius for "exact" (0 = 10 x mean edge length)
   bool check_caps = true;            // test each cap for intersections with the surface and try
                                      // other placements until none remains
 };
