@@ -19,9 +19,13 @@ BUILD_PKGS=(
   libcgal-dev            # tests only: independent self-intersection check
   xvfb xauth             # off-screen rendering where there is no display
   python3                # small test helpers
+  snakemake              # cohort processing (workflow/Snakefile) and its ctest test
 )
+# What the installed `colonflat` needs (checked with ldd on the built binary; every other library
+# it loads comes with these packages' dependencies). libgl1-mesa-dri: the software OpenGL driver
+# that Xvfb-based 3D snapshots use (ldd cannot see it: it is loaded at run time).
 RUNTIME_PKGS=(
-  libvtk9.1 libinsighttoolkit5.2 libopenmesh9.0 xvfb xauth
+  libvtk9.1 libinsighttoolkit5.2 libopenmesh1 libgl1-mesa-dri xvfb xauth
 )
 
 SUDO=""
