@@ -5,6 +5,7 @@
 //                                     (seed 1); then the Google Benchmark cases (small phantom).
 //   segment_bench --table-only        the table without Google Benchmark.
 //   segment_bench --size small --seeds 1,2 --no-dicom   other sizes / seeds.
+//   segment_bench --collapsed --seeds 1 --no-dicom      phantoms with a collapsed stretch (2 segments).
 // Peak memory: the process's peak resident set is reset (/proc/self/clear_refs) before each step,
 // so "peak" is the high-water mark of that step alone (segmentation: reading ct.nrrd included).
 #include <benchmark/benchmark.h>
@@ -129,9 +130,10 @@ bool same_mask(const cf::MaskImage* x, const cf::MaskImage* y) {
   return std::memcmp(x->GetBufferPointer(), y->GetBufferPointer(), n) == 0;
 }
 
-void table(const std::string& size, const std::vector<int>& seeds, bool dicom) {
+void table(const std::string& size, const std::vector<int>& seeds, bool dicom, bool collapsed) {
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_" + std::to_string(::getpid()));
-  std::printf("segment_bench: %s phantoms; times in s, peaks in MiB (per step%s)\n", size.c_str(),
+  std::printf("segment_bench: %s%s phantoms; times in s, peaks in MiB (per step%s)\n", size.c_str(),
+              collapsed ? " collapsed-colon" : "",
               reset_peak_memory() ? "" : "; NOT reset: process-wide");
   std::printf("%4s %8s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %6s %6s %6s\n", "seed", "gen_s", "gen_MiB",
               "write_s", "read_s", "seg_s", "gcut_s", "seg_MiB", "lumen_mL", "dice", "fn", "fp", "leak", "polyps",
@@ -144,6 +146,7 @@ void table(const std::string& size, const std::vector<int>& seeds, bool dicom) {
     cf::PhantomOptions o;
     o.size = size;
     o.seed = std::uint64_t(seed);
+    o.collapsed_segment = collapsed;
     cf::Phantom p = cf::generate_phantom(o);
     const double gen_s = t.seconds(), gen_mib = cf::peak_memory_mib();
     t.restart();
@@ -214,7 +217,7 @@ BENCHMARK(BM_GenerateSmallPhantom)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool table_only = false, dicom = true;
+  bool table_only = false, dicom = true, collapsed = false;
   std::string size = "full";
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
@@ -222,6 +225,7 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--table-only") table_only = true;
     else if (a == "--no-dicom") dicom = false;
+    else if (a == "--collapsed") collapsed = true;
     else if (a == "--size" && i + 1 < argc) size = argv[++i];
     else if (a == "--seeds" && i + 1 < argc) {
       seeds.clear();
@@ -229,7 +233,7 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  table(size, seeds, dicom);
+  table(size, seeds, dicom, collapsed);
   if (table_only) return 0;
   int n = int(rest.size());
   benchmark::Initialize(&n, rest.data());
