@@ -2,15 +2,30 @@
 //   flatten_bench            timing of cf::flatten_colon on a >= 1M-face synthetic colon (3 runs),
 //                            distortion and flipped triangles, then the Google Benchmark cases.
 //   flatten_bench --table-only   the table without Google Benchmark.
+//   flatten_bench --phantom 1-5 [--size full|small] [--out DIR]
+//                            acceptance on phantoms: ground-truth lumen -> reconstruct -> denoise ->
+//                            flatten -> polyp candidates, scored against the phantom's polyps
+//                            (sensitivity for polyps >= 6 mm, false positives per scan); DIR gets
+//                            the colon images (with the known polyps) and the candidate JSON.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <cstring>
 #include <string>
 
+#include <filesystem>
+#include <fstream>
+
 #include "colonflat/core/run_stats.h"
+#include "colonflat/denoise/denoise.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/phantom/phantom.h"
+#include "colonflat/reconstruct/reconstruct.h"
+#include <vtkImageData.h>
+
+#include "colonflat/render/artifacts.h"
+#include "colonflat/render/render_stage.h"
 
 namespace {
 
@@ -43,6 +58,58 @@ void table() {
   std::printf("peak memory %.0f MiB\n", cf::peak_memory_mib());
 }
 
+void phantom_table(int first, int last, const std::string& size, const std::string& out) {
+  std::printf("%-5s %8s %5s %7s %7s %8s %8s %8s %7s %7s %6s %6s %6s %4s %s\n", "seed", "faces", "genus", "flat_s",
+              "flipped", "qc_mean", "qc_p95", "qc_max", "area05", "area95", "polyps", "found", "sens", "FP",
+              "missed (id:diameter)");
+  int tot_p = 0, tot_f = 0, tot_fp = 0;
+  for (int seed = first; seed <= last; ++seed) {
+    cf::PhantomOptions po;
+    po.seed = std::uint64_t(seed);
+    po.size = size;
+    cf::Phantom ph = cf::generate_phantom(po);
+    ph.ct = nullptr;
+    const cf::Mesh surface = cf::reconstruct_surface(ph.lumen.GetPointer(), cf::ReconstructOptions{});
+    ph.lumen = nullptr;
+    const cf::DenoiseResult dn = cf::denoise(surface, cf::DenoiseOptions{});
+    cf::Stopwatch sw;
+    const cf::FlatMap flat = cf::flatten_colon(dn.mesh);
+    const double t = sw.seconds();
+    nlohmann::json known = nlohmann::json::array();
+    std::vector<cf::KnownPolyp> truth;
+    for (const auto& p : ph.polyps) {
+      known.push_back({{"id", p.id}, {"center_lps_mm", p.center_lps_mm}, {"diameter_mm", p.diameter_mm}, {"type", p.type}});
+      truth.push_back({p.id, p.center_lps_mm, p.diameter_mm, p.type});
+    }
+    const std::string dir = out.empty() ? std::string() : out + "/seed" + std::to_string(seed);
+    cf::RenderOptions ro;
+    if (!dir.empty()) {
+      std::filesystem::create_directories(dir);
+      std::ofstream(dir + "/known_polyps.json") << known.dump(2);
+      ro.known_polyps = dir + "/known_polyps.json";
+    }
+    const cf::RenderResult rr = cf::render_flat(flat, ro);
+    const cf::DetectionScore sc = cf::score_detections(rr.candidates, truth, 6.0, 5.0);
+    std::string missed;
+    for (int id : sc.missed_ids)
+      for (const auto& p : ph.polyps)
+        if (p.id == id) missed += std::to_string(id) + ":" + std::to_string(int(std::lround(p.diameter_mm))) + " ";
+    const auto& st = flat.stats;
+    std::printf("%-5d %8zu %5d %7.2f %7zu %8.4f %8.4f %8.2f %7.3f %7.3f %6d %6d %6.2f %4d %s\n", seed,
+                dn.mesh.n_faces(), dn.before.genus ? *dn.before.genus : -1, t, st.flipped, st.qc_mean, st.qc_p95,
+                st.qc_max, st.area_p05, st.area_p95, sc.polyps, sc.polyps_detected, sc.sensitivity,
+                sc.false_positives, missed.c_str());
+    std::fflush(stdout);
+    tot_p += sc.polyps, tot_f += sc.polyps_detected, tot_fp += sc.false_positives;
+    if (!dir.empty()) {
+      cf::write_png(rr.colon.image, dir + "/colon.png");
+      std::ofstream(dir + "/polyps.json") << rr.candidates_json.dump(2);
+    }
+  }
+  std::printf("total: %d/%d polyps >= 6 mm found (sensitivity %.3f), %.2f false positives per scan\n", tot_f, tot_p,
+              tot_p ? double(tot_f) / tot_p : 1.0, double(tot_fp) / (last - first + 1));
+}
+
 void BM_FlattenColon(benchmark::State& state) {
   cf::synthetic::ColonOptions o;
   o.length = 600;
@@ -58,8 +125,23 @@ BENCHMARK(BM_FlattenColon)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   bool table_only = false;
-  for (int i = 1; i < argc; ++i)
+  int first = 0, last = -1;
+  std::string size = "full", out;
+  for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--table-only")) table_only = true;
+    if (!std::strcmp(argv[i], "--phantom") && i + 1 < argc) {
+      const std::string r = argv[++i];
+      const auto dash = r.find('-');
+      first = std::stoi(r.substr(0, dash));
+      last = dash == std::string::npos ? first : std::stoi(r.substr(dash + 1));
+    }
+    if (!std::strcmp(argv[i], "--size") && i + 1 < argc) size = argv[++i];
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+  }
+  if (last >= first) {
+    phantom_table(first, last, size, out);
+    return 0;
+  }
   table();
   if (table_only) return 0;
   benchmark::Initialize(&argc, argv);

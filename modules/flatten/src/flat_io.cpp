@@ -41,11 +41,14 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   if (j.contains("end_a_lps_mm")) s.end_a = j["end_a_lps_mm"].get<std::array<double, 3>>();
   if (j.contains("end_b_lps_mm")) s.end_b = j["end_b_lps_mm"].get<std::array<double, 3>>();
   s.weights = j.value("weights", "");
+  s.untangled_vertices = j.value("untangled_vertices", std::size_t(0));
+  s.crowded_faces = j.value("crowded_faces_left_out", std::size_t(0));
   s.dirichlet_period_ratio = j.value("period_consistency", 1.0);
   if (j.contains("distortion")) {
     const auto& d = j["distortion"];
     s.stats.faces = d.value("faces", std::size_t(0));
     s.stats.flipped = d.value("flipped_triangles", std::size_t(0));
+    s.stats.degenerate = d.value("degenerate_triangles", std::size_t(0));
     s.stats.qc_mean = d.value("quasi_conformal_mean", 0.0);
     s.stats.qc_p95 = d.value("quasi_conformal_p95", 0.0);
     s.stats.qc_max = d.value("quasi_conformal_max", 0.0);

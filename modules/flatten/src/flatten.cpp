@@ -424,8 +424,92 @@ std::vector<std::array<Eigen::Vector2d, 3>> lift(const Surface& s, const Edges& 
   return c;
 }
 
+// Removes fold-overs (negative cotangent weights, or crowding: long thin protrusions such as strand
+// stumps shrink exponentially under a conformal map): the vertices of flipped triangles and 1, 2,
+// 4, ... rings around them are re-embedded by Tutte's method (uniform weights, the ring around the
+// region fixed, a sparse solve) until every triangle with a positive 3D area has a positive 2D area.
+// Returns the number of vertices moved.
+std::size_t untangle(const Surface& s, const Edges& E, Harmonic& h, double sign, const std::vector<char>& on_loop,
+                     const std::vector<char>& degenerate) {
+  const int nv = int(s.p.size());
+  // vertex -> (neighbour, edge) lists
+  std::vector<int> start(nv + 1, 0);
+  for (const auto& e : E.ev) ++start[e[0] + 1], ++start[e[1] + 1];
+  for (int i = 0; i < nv; ++i) start[i + 1] += start[i];
+  std::vector<std::pair<int, int>> nb(start[nv]);
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t e = 0; e < E.ev.size(); ++e) {
+      nb[fill[E.ev[e][0]]++] = {E.ev[e][1], int(e)};
+      nb[fill[E.ev[e][1]]++] = {E.ev[e][0], int(e)};
+    }
+  }
+  std::vector<std::vector<int>> vf(nv);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    for (int v : s.t[f]) vf[v].push_back(int(f));
+  const double P = h.period;
+  auto face_area = [&](int f) {
+    const Tri& t = s.t[f];
+    const double y0 = sign * P * h.v[t[0]];
+    const double y1 = sign * P * (h.v[t[1]] + eta_dir(h, E, E.fe[f][2], t[0]));
+    const double y2 = sign * P * (h.v[t[2]] + eta_dir(h, E, E.fe[f][1], t[0]));
+    return (h.u[t[1]] - h.u[t[0]]) * (y2 - y0) - (y1 - y0) * (h.u[t[2]] - h.u[t[0]]);
+  };
+  std::vector<char> in(nv, 0);
+  std::vector<int> region;
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (!degenerate[f] && face_area(int(f)) <= 0)
+      for (int v : s.t[f])
+        if (!in[v]) in[v] = 1, region.push_back(v);
+  if (region.empty()) return 0;
+  std::vector<int> idx(nv, -1);
+  for (int round = 0; round < 3; ++round) {
+    for (int ring = 0; ring < (1 << round) && round > 0; ++ring) {  // grow 1, 2, 4, ... rings
+      const std::size_t n0 = region.size();
+      for (std::size_t k = 0; k < n0; ++k)
+        for (int q = start[region[k]]; q < start[region[k] + 1]; ++q)
+          if (!in[nb[q].first]) in[nb[q].first] = 1, region.push_back(nb[q].first);
+    }
+    // Tutte embedding of the region (uniform weights), its outer ring and the ends fixed.
+    int n = 0;
+    for (int i : region) idx[i] = on_loop[i] ? -1 : n++;
+    std::vector<Eigen::Triplet<double>> trip;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
+    for (int i : region) {
+      if (idx[i] < 0) continue;
+      const int r = idx[i];
+      trip.emplace_back(r, r, double(start[i + 1] - start[i]));
+      for (int q = start[i]; q < start[i + 1]; ++q) {
+        const auto [j, e] = nb[q];
+        const double eta = E.ev[e][0] == i ? h.eta[e] : -h.eta[e];
+        if (in[j] && idx[j] >= 0) {
+          trip.emplace_back(r, idx[j], -1.0);
+          rhs(r, 1) += eta;
+        } else {
+          rhs(r, 0) += h.u[j];
+          rhs(r, 1) += h.v[j] + eta;
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> A(n, n);
+    A.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+    if (solver.info() != Eigen::Success) break;
+    const Eigen::MatrixXd x = solver.solve(rhs);
+    for (int i : region)
+      if (idx[i] >= 0) h.u[i] = x(idx[i], 0), h.v[i] = x(idx[i], 1);
+    bool any = false;
+    for (int i : region)
+      for (int f : vf[i])
+        if (!degenerate[f] && face_area(f) <= 0) any = true;
+    if (!any) break;
+  }
+  return region.size();
+}
+
 struct FaceDistortion {
   double qc, area3, area2;
+  bool degenerate = false;
 };
 
 FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const Eigen::Vector2d& q0,
@@ -434,7 +518,7 @@ FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const E
   const V3 n = e1.cross(e2);
   const double a3 = 0.5 * n.norm();
   const double l1 = e1.norm();
-  FaceDistortion d{kInf, a3, 0};
+  FaceDistortion d{kInf, a3, 0, false};
   const Eigen::Vector2d d1 = q1 - q0, d2 = q2 - q0;
   d.area2 = 0.5 * (d1.x() * d2.y() - d1.y() * d2.x());
   if (a3 <= 0 || l1 <= 0) return d;
@@ -469,6 +553,10 @@ DistortionStats stats_of(const std::vector<FaceDistortion>& fd) {
   const double scale = a2 > 0 ? a3 / a2 : 1;
   double qsum = 0, lsum = 0, wsum = 0;
   for (const auto& d : fd) {
+    if (d.degenerate) {
+      ++s.degenerate;
+      continue;
+    }
     if (d.area2 <= 0) ++s.flipped;
     const double q = std::isfinite(d.qc) ? d.qc : 1e9;
     qc.push_back(q);
@@ -480,7 +568,7 @@ DistortionStats stats_of(const std::vector<FaceDistortion>& fd) {
       if (r > 0) lsum += d.area3 * std::abs(std::log2(r)), wsum += d.area3;
     }
   }
-  s.qc_mean = qsum / double(fd.size());
+  s.qc_mean = qc.empty() ? 0 : qsum / double(qc.size());
   s.qc_p95 = percentile(qc, 0.95);
   s.area_p05 = percentile(ar, 0.05);
   s.area_median = percentile(ar, 0.5);
@@ -505,6 +593,10 @@ DistortionStats distortion_stats(const FlatMap& flat, int segment) {
     auto Q = [&](int i) { return Eigen::Vector2d(flat.uv[i][0], flat.uv[i][1]); };
     fd.push_back(face_distortion(P(t[0]), P(t[1]), P(t[2]), Q(t[0]), Q(t[1]), Q(t[2])));
   }
+  double mean = 0;
+  for (const auto& d : fd) mean += d.area3;
+  mean /= std::max<std::size_t>(1, fd.size());
+  for (auto& d : fd) d.degenerate = d.area3 <= 1e-6 * mean;
   return stats_of(fd);
 }
 
@@ -564,6 +656,12 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
     double vol = 0;
     for (const Tri& t : s.t)
       vol += (s.p[t[0]] - centroid).dot((s.p[t[1]] - centroid).cross(s.p[t[2]] - centroid));
+    // Normals out of the lumen (the reconstruct convention): a closed component enclosing a negative
+    // volume is the wall of a cavity (a blob floating in the lumen), not colon wall: skipped.
+    if (ct.boundary_loops == 0 && vol < 0) {
+      ++out.skipped_components;
+      continue;
+    }
     const double lumen_sign = vol >= 0 ? 1.0 : -1.0;  // face normals * sign point out of the lumen
 
     FlatSegment seg;
@@ -611,7 +709,20 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
       std::vector<std::array<Eigen::Vector2d, 3>> corners;
       std::vector<FaceDistortion> fd;
       DistortionStats st;
+      std::size_t untangled = 0;
+      std::vector<char> crowded;
+      std::size_t ncrowded = 0;
     };
+    // Degenerate input triangles (zero 3D area) have no meaningful 2D orientation or ratio.
+    double mean_area = area3 / double(ann.t.size());
+    std::vector<char> degenerate(ann.t.size(), 0);
+    for (std::size_t f = 0; f < ann.t.size(); ++f) {
+      const Tri& t = ann.t[f];
+      degenerate[f] = 0.5 * (ann.p[t[1]] - ann.p[t[0]]).cross(ann.p[t[2]] - ann.p[t[0]]).norm() <= 1e-6 * mean_area;
+    }
+    std::vector<char> on_loop(ann.p.size(), 0);
+    for (const auto& l : loops)
+      for (int v : l) on_loop[v] = 1;
     auto attempt = [&](bool clamp) {
       Trial tr;
       tr.h = solve_harmonic(ann, E, loops[0], loops[1], clamp);
@@ -622,7 +733,8 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
         signed_area += d1.x() * d2.y() - d1.y() * d2.x();
       }
       tr.sign = signed_area >= 0 ? 1.0 : -1.0;
-      tr.corners = tr.sign > 0 ? std::move(c1) : lift(ann, E, tr.h, -1.0);
+      tr.untangled = untangle(ann, E, tr.h, tr.sign, on_loop, degenerate);
+      tr.corners = lift(ann, E, tr.h, tr.sign);
       tr.scale = std::sqrt(area3 / tr.h.period);
       for (auto& c3 : tr.corners)
         for (auto& q : c3) q *= tr.scale;
@@ -631,15 +743,31 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
         const Tri& t = ann.t[f];
         tr.fd.push_back(face_distortion(ann.p[t[0]], ann.p[t[1]], ann.p[t[2]], tr.corners[f][0], tr.corners[f][1],
                                         tr.corners[f][2]));
+        tr.fd.back().degenerate = degenerate[f];
       }
-      tr.st = stats_of(tr.fd);
+      // Crowding: long thin protrusions (e.g. the stumps of cut strands) shrink exponentially under
+      // a conformal map, below what double precision resolves; their triangles (2D/3D area ratio
+      // < 1e-7 at the area-preserving scale, or still folded) are left out of the map.
+      tr.crowded.assign(ann.t.size(), 0);
+      tr.ncrowded = 0;
+      for (std::size_t f = 0; f < ann.t.size(); ++f)
+        if (!degenerate[f] && (tr.fd[f].area2 <= 1e-7 * tr.fd[f].area3)) tr.crowded[f] = 1, ++tr.ncrowded;
+      {
+        std::vector<FaceDistortion> kept;
+        kept.reserve(tr.fd.size());
+        for (std::size_t f = 0; f < ann.t.size(); ++f)
+          if (!tr.crowded[f]) kept.push_back(tr.fd[f]);
+        tr.st = stats_of(kept);
+      }
       return tr;
     };
     Trial tr = attempt(opts.weights == "clamped");
-    if (opts.weights == "auto" && tr.st.flipped > 0) {
+    if (opts.weights == "auto" && tr.ncrowded > ann.t.size() / 100) {
       Trial t2 = attempt(true);
-      if (t2.st.flipped < tr.st.flipped) tr = std::move(t2);
+      if (t2.ncrowded < tr.ncrowded) tr = std::move(t2);
     }
+    seg.crowded_faces = tr.ncrowded;
+    seg.untangled_vertices = tr.untangled;
     seg.weights = tr.h.weights;
     seg.length = tr.scale;
     seg.period = tr.scale * tr.h.period;
@@ -663,6 +791,7 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
     vid.reserve(ann.p.size() * 11 / 10);
     const double Pmm = seg.period;
     for (std::size_t f = 0; f < ann.t.size(); ++f) {
+      if (tr.crowded[f]) continue;
       Tri ot;
       for (int k = 0; k < 3; ++k) {
         const int v = ann.t[f][k];
@@ -683,7 +812,12 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
       }
       out.triangles.push_back(ot);
     }
-    all_fd.push_back(std::move(tr.fd));
+    {
+      std::vector<FaceDistortion> kept;
+      for (std::size_t f = 0; f < ann.t.size(); ++f)
+        if (!tr.crowded[f]) kept.push_back(tr.fd[f]);
+      all_fd.push_back(std::move(kept));
+    }
     out.segments.push_back(seg);
   }
   if (out.segments.empty()) throw PreconditionError("no colon segment large enough to flatten");
@@ -712,6 +846,7 @@ TriangleList flat_to_surface(const FlatMap& flat, std::vector<int>* flat_to_3d) 
 nlohmann::json distortion_to_json(const DistortionStats& s) {
   return {{"faces", s.faces},
           {"flipped_triangles", s.flipped},
+          {"degenerate_triangles", s.degenerate},
           {"quasi_conformal_mean", s.qc_mean},
           {"quasi_conformal_p95", s.qc_p95},
           {"quasi_conformal_max", s.qc_max},
@@ -733,6 +868,8 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
           {"end_a_lps_mm", s.end_a},
           {"end_b_lps_mm", s.end_b},
           {"weights", s.weights},
+          {"untangled_vertices", s.untangled_vertices},
+          {"crowded_faces_left_out", s.crowded_faces},
           {"period_consistency", s.dirichlet_period_ratio},
           {"distortion", distortion_to_json(s.stats)}};
 }

@@ -74,10 +74,11 @@ Colon colon(const ColonOptions& o) {
   auto bump = [&](double s, double th) {
     double h = 0;
     for (const auto& p : o.polyps) {
-      const double rb = 0.6 * p.diameter;
+      // a hemisphere of the polyp's diameter, with a small fillet at its base
+      const double r = 0.5 * p.diameter;
       const double ds = s - p.s, dt = R * ang_diff(th, p.angle);
-      const double q = (ds * ds + dt * dt) / (rb * rb);
-      if (q < 1) h += 0.3 * p.diameter * (1 - q) * (1 - q);
+      const double q = (ds * ds + dt * dt) / (r * r);
+      if (q < 1) h += r * std::sqrt(1 - q) * (1 - std::exp(-8 * (1 - q)));
     }
     return h;
   };
@@ -138,7 +139,7 @@ Colon colon(const ColonOptions& o) {
   cen /= double(P.size());
   double vol = 0;
   for (const auto& t : F) {
-    auto q = [&](int v) { return V3(P[v][0], P[v][1], P[v][2]) - cen; };
+    auto q = [&](int v) -> V3 { return V3(P[v][0], P[v][1], P[v][2]) - cen; };
     vol += q(t[0]).dot(q(t[1]).cross(q(t[2])));
   }
   if (vol < 0)

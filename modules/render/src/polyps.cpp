@@ -170,16 +170,26 @@ std::vector<PolypCandidate> detect_polyps(const TriangleList& s, const std::vect
       }
     }
     pc.footprint_area_mm2 = fa;
-    pc.size_mm = 2 * std::sqrt(fa / M_PI);
     pc.footprint = std::move(fp);
-    // Score: how cap-like (mean SI), how much of the footprint is cap, and curvature consistent with
-    // the size (a dome of diameter D has curvature ~ 2..6 / D).
+    // Elongation of the cap (fold tips are long, polyp heads round): spread of its vertices.
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int v : cap) {
+      const V3 d = P(s, v) - cen;
+      cov += area[v] * d * d.transpose();
+    }
+    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov / a).eigenvalues();  // ascending
+    pc.elongation = ev[1] > 1e-12 ? std::sqrt(ev[2] / ev[1]) : 99.0;
+    // Size: diameter of the sphere with the cap's curvature (2 / CV); the cap of a polyp head is
+    // close to a sphere, a fold is not a cap at all.
+    pc.size_mm = 2.0 / std::max(1e-6, pc.mean_cv);
+    // Score: how cap-like (mean SI), how much of the sphere the cap covers, how round it is.
     const double s_si = std::clamp((pc.mean_si - o.grow_si) / (1 - o.grow_si), 0.0, 1.0);
-    const double s_cap = std::clamp(3 * pc.cap_area_mm2 / std::max(1e-9, fa), 0.0, 1.0);
-    const double kd = pc.mean_cv * pc.size_mm;
-    const double s_k = std::clamp(kd / 1.5, 0.0, 1.0);
-    pc.score = 0.4 * s_si + 0.3 * s_cap + 0.3 * s_k;
-    if (pc.size_mm < o.min_size || pc.size_mm > o.max_size || pc.score < o.min_score) continue;
+    const double s_area = std::clamp(pc.cap_area_mm2 * pc.mean_cv * pc.mean_cv / M_PI / 0.6, 0.0, 1.0);
+    const double s_round = std::clamp((2.5 - pc.elongation) / 1.5, 0.0, 1.0);
+    pc.score = 0.4 * s_si + 0.3 * s_area + 0.3 * s_round;
+    if (pc.cap_area_mm2 < o.min_cap_area || pc.size_mm < o.min_size || pc.size_mm > o.max_size ||
+        pc.score < o.min_score)
+      continue;
     out.push_back(std::move(pc));
   }
   // Merge candidates whose apexes are closer than the larger radius (one polyp, several caps).

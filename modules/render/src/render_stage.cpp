@@ -14,6 +14,11 @@
 #include "colonflat/render/artifacts.h"
 #include "colonflat/render/snapshot.h"
 
+#ifdef COLONFLAT_RENDER_HAVE_DENOISE
+#include "colonflat/core/atomic_file.h"
+#include "colonflat/denoise/loops_io.h"
+#endif
+
 namespace cf {
 
 namespace {
@@ -125,6 +130,7 @@ RenderResult render_flat(const FlatMap& flat, const RenderOptions& o) {
                   {"shape_index", c.mean_si},
                   {"curvedness_per_mm", c.mean_cv},
                   {"cap_area_mm2", c.cap_area_mm2},
+                  {"elongation", c.elongation},
                   {"footprint_area_mm2", c.footprint_area_mm2}});
   }
   nlohmann::json kj = nlohmann::json::array();
@@ -211,6 +217,20 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
     PolylinesPtr loops;
     if (bag.has("loops")) {
       if (const auto* lp = std::any_cast<PolylinesPtr>(&bag.raw("loops"))) loops = *lp;
+#ifdef COLONFLAT_RENDER_HAVE_DENOISE
+      else if (const auto* ls = std::any_cast<LoopSet>(&bag.raw("loops"))) {
+        // through denoise's writer and our reader: exactly what `colonflat render --loops` sees
+        const auto tmp = temp_sibling(std::filesystem::temp_directory_path() / "colonflat_render_loops.vtp");
+        write_loops(*ls, tmp);
+        try {
+          loops = std::any_cast<PolylinesPtr>(polylines_artifact().read(tmp));
+        } catch (...) {
+          std::filesystem::remove(tmp);
+          throw;
+        }
+        std::filesystem::remove(tmp);
+      }
+#endif
       else ctx.report["snapshot_note"] = "loops artifact of another type: not drawn";
     }
     SnapshotOptions so;

@@ -58,11 +58,13 @@ TEST(PolypDetect, FindsBumpsNotFolds) {
   TriangleList s = flat_to_surface(f, &map);
   std::vector<std::array<double, 3>> n(s.points.size());
   for (std::size_t i = 0; i < map.size(); ++i) n[map[i]] = f.normal[i];
-  auto cands = detect_polyps(s, n, PolypOptions{});
-  for (const auto& k : cands)
-    std::printf("cand %d at %.1f %.1f %.1f size %.1f score %.2f si %.2f cv %.3f cap %.1f fp %.1f\n", k.id,
+  PolypOptions all;
+  all.min_score = 0;
+  for (const auto& k : detect_polyps(s, n, all))
+    std::printf("cand %d at %.1f %.1f %.1f size %.1f score %.2f si %.2f cv %.3f cap %.1f elong %.2f\n", k.id,
                 k.center_lps_mm[0], k.center_lps_mm[1], k.center_lps_mm[2], k.size_mm, k.score, k.mean_si, k.mean_cv,
-                k.cap_area_mm2, k.footprint_area_mm2);
+                k.cap_area_mm2, k.elongation);
+  auto cands = detect_polyps(s, n, PolypOptions{});
   const auto sc = score_detections(cands, truth(c), 6.0, 3.0);
   EXPECT_EQ(sc.polyps, 5);
   EXPECT_EQ(sc.polyps_detected, 5);

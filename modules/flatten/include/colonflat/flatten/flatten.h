@@ -25,13 +25,14 @@ struct FlattenOptions {
   double end_cut_radius = 15.0;        // mm; geodesic radius of the cap opened at each closed end
   double min_segment_fraction = 0.02;  // components with fewer faces than this fraction of the largest are skipped
   double segment_gap = 20.0;           // mm between the rectangles of several segments in the 2D layout
-  std::string weights = "auto";        // "cotan", "clamped" (negative cotangents clamped), "auto"
+  std::string weights = "auto";        // "cotan", "clamped" (negative cotangents clamped), "auto" (cotan; clamped if > 1% crowded)
 };
 
 // Distortion of the 3D -> 2D map, per triangle.
 struct DistortionStats {
   std::size_t faces = 0;
   std::size_t flipped = 0;                        // triangles with non-positive 2D signed area
+  std::size_t degenerate = 0;                     // input triangles with ~zero 3D area (not counted above)
   double qc_mean = 0, qc_p95 = 0, qc_max = 0;     // quasi-conformal ratio sigma1/sigma2 (1 = conformal)
   double area_p05 = 0, area_median = 0, area_p95 = 0;  // 2D area / 3D area (area-preserving scale: mean ~1)
   double area_log2_mean_abs = 0;                  // mean |log2(area ratio)|, area-weighted
@@ -50,6 +51,8 @@ struct FlatSegment {
   std::array<double, 3> end_a{0, 0, 0}, end_b{0, 0, 0};  // LPS mm, centres of the end loops
   double dirichlet_period_ratio = 1;     // period from u's energy / period from v's energy (1 = consistent)
   std::string weights;      // weights used ("cotan" or "clamped")
+  std::size_t untangled_vertices = 0;    // vertices re-embedded (Tutte) to undo fold-overs
+  std::size_t crowded_faces = 0;         // faces left out: conformal area factor < 1e-7 (thin protrusions)
   DistortionStats stats;
 };
 
@@ -64,7 +67,7 @@ struct FlatMap {
   std::vector<std::array<int, 3>> triangles;    // counter-clockwise in 2D
   std::vector<FlatSegment> segments;
   DistortionStats stats;                        // over all segments
-  std::size_t skipped_components = 0;           // small components not flattened
+  std::size_t skipped_components = 0;           // small components and cavity walls not flattened
   std::size_t input_vertices = 0, input_faces = 0;
 };
 

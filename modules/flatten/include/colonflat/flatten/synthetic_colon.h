@@ -1,7 +1,7 @@
 #pragma once
 // A synthetic colon for tests and benchmarks: a tube of radius `radius` along a bent 3D
 // centreline, with haustral folds (ridges across the tube, height varying around it) and polyps
-// (smooth domes of known diameter, protruding into the lumen), closed by hemispherical caps or
+// (hemispheres of known diameter, protruding into the lumen), closed by hemispherical caps or
 // left open. Triangle size ~`spacing` mm. Genus 0; outward normals (out of the lumen).
 #include <array>
 #include <vector>

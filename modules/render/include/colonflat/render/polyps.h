@@ -3,9 +3,10 @@
 // curvatures from a local quadric fit (radius `fit_radius` mm), shape index SI (+1 cap, +0.5
 // ridge, 0 saddle, -0.5 rut, -1 cup; signs taken with the normal pointing into the lumen, so a
 // polyp is a cap and a haustral fold a ridge) and curvedness CV (1/mm). Seeds SI >= seed_si with
-// CV in range, grown through SI >= grow_si; each region's footprint (SI >= footprint_si: cap, dome sides and the start of the base, within
-// max_radius) gives the size estimate 2 sqrt(area / pi). Folds are ridges (SI ~0.5) and are not
-// flagged.
+// CV in range, grown through SI >= grow_si into a cap region; the size estimate is the diameter of
+// the sphere with the cap's mean curvedness (2 / CV); the score combines mean SI, cap coverage of
+// that sphere and roundness (fold tips are elongated caps). Folds are ridges (SI ~0.5) and are not
+// flagged. The footprint (SI >= footprint_si within max_radius) is kept for outlines.
 #include <array>
 #include <filesystem>
 #include <string>
@@ -27,7 +28,8 @@ struct PolypOptions {
   double min_size = 4.0;        // mm, smallest reported candidate diameter
   double max_size = 40.0;       // mm, larger regions are not polyps
   double max_radius = 15.0;     // mm, footprint growth limit from the candidate centre
-  double min_score = 0.5;       // candidates below this score are dropped
+  double min_cap_area = 3.0;    // mm^2, smallest cap region (smaller caps are surface noise)
+  double min_score = 0.65;      // candidates below this score are dropped
 };
 
 struct Curvature {
@@ -46,6 +48,7 @@ struct PolypCandidate {
   double size_mm = 0;                           // estimated diameter
   double score = 0;                             // 0..1
   double mean_si = 0, mean_cv = 0, cap_area_mm2 = 0, footprint_area_mm2 = 0;
+  double elongation = 1;                        // sqrt of the cap's two in-plane spread eigenvalues
   std::vector<int> footprint;                   // surface vertices of the footprint
 };
 

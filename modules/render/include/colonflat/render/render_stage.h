@@ -22,7 +22,7 @@ struct RenderOptions {
   int snapshot_size = 900;          // pixels
   double fit_radius = 2.5;          // mm
   double min_size = 4.0;            // mm
-  double min_score = 0.5;
+  double min_score = 0.65;
   double seed_si = 0.9;
 };
 
