@@ -59,8 +59,8 @@ void table() {
 }
 
 void phantom_table(int first, int last, const std::string& size, const std::string& out) {
-  std::printf("%-5s %8s %5s %7s %7s %8s %8s %8s %7s %7s %6s %6s %6s %4s %s\n", "seed", "faces", "genus", "flat_s",
-              "flipped", "qc_mean", "qc_p95", "qc_max", "area05", "area95", "polyps", "found", "sens", "FP",
+  std::printf("%-5s %8s %5s %7s %7s %8s %8s %8s %8s %7s %7s %6s %6s %6s %4s %s\n", "seed", "faces", "genus", "flat_s",
+              "flipped", "left_out", "qc_mean", "qc_p95", "qc_max", "area05", "area95", "polyps", "found", "sens", "FP",
               "missed (id:diameter)");
   int tot_p = 0, tot_f = 0, tot_fp = 0;
   for (int seed = first; seed <= last; ++seed) {
@@ -95,8 +95,10 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
       for (const auto& p : ph.polyps)
         if (p.id == id) missed += std::to_string(id) + ":" + std::to_string(int(std::lround(p.diameter_mm))) + " ";
     const auto& st = flat.stats;
-    std::printf("%-5d %8zu %5d %7.2f %7zu %8.4f %8.4f %8.2f %7.3f %7.3f %6d %6d %6.2f %4d %s\n", seed,
-                dn.mesh.n_faces(), dn.before.genus ? *dn.before.genus : -1, t, st.flipped, st.qc_mean, st.qc_p95,
+    std::size_t left_out = 0;
+    for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
+    std::printf("%-5d %8zu %5d %7.2f %7zu %8zu %8.4f %8.4f %8.2f %7.3f %7.3f %6d %6d %6.2f %4d %s\n", seed,
+                dn.mesh.n_faces(), dn.before.genus ? *dn.before.genus : -1, t, st.flipped, left_out, st.qc_mean, st.qc_p95,
                 st.qc_max, st.area_p05, st.area_p95, sc.polyps, sc.polyps_detected, sc.sensitivity,
                 sc.false_positives, missed.c_str());
     std::fflush(stdout);

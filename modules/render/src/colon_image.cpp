@@ -174,7 +174,7 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
   double px = o.pixel_size;
   if (maxlen / px > o.max_width) px = maxlen / o.max_width;
   out.pixel_size = px;
-  const int margin = 30, top = 50, gap = 46, bottom = 70;
+  const int margin = 30, top = 70, gap = 46, bottom = 70;
   std::vector<Band> bands;
   int width = 0, rows = bottom;
   // bands from the bottom of the VTK image upwards, last segment lowest

@@ -19,6 +19,8 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+#include <vtkIdList.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkTubeFilter.h>
@@ -167,6 +169,33 @@ ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const 
     la->SetMapper(lm);
     la->GetProperty()->SetColor(1.0, 0.55, 0.0);
     ren->AddActor(la);
+    // Loops are often a few mm long: a translucent ball around each makes it findable.
+    vtkDataArray* type = loops->GetCellData()->GetArray("type");
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType c = 0; c < loops->GetNumberOfCells(); ++c) {
+      loops->GetCellPoints(c, ids);
+      if (ids->GetNumberOfIds() == 0) continue;
+      double m[3] = {0, 0, 0};
+      for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
+        double q[3];
+        loops->GetPoint(ids->GetId(k), q);
+        for (int d = 0; d < 3; ++d) m[d] += q[d] / double(ids->GetNumberOfIds());
+      }
+      vtkNew<vtkSphereSource> ball;
+      ball->SetCenter(m);
+      ball->SetRadius(std::max(4.0, diag / 70));
+      ball->SetThetaResolution(24);
+      ball->SetPhiResolution(16);
+      vtkNew<vtkPolyDataMapper> bm;
+      bm->SetInputConnection(ball->GetOutputPort());
+      vtkNew<vtkActor> ba;
+      ba->SetMapper(bm);
+      const bool tunnel = type && type->GetTuple1(c) > 0.5;
+      if (tunnel) ba->GetProperty()->SetColor(0.2, 0.5, 1.0);
+      else ba->GetProperty()->SetColor(1.0, 0.2, 0.1);
+      ba->GetProperty()->SetOpacity(0.45);
+      ren->AddActor(ba);
+    }
   }
   if (!o.caption.empty()) {
     vtkNew<vtkTextActor> ta;

@@ -55,16 +55,16 @@ TEST(RenderImage, ColonImageShowsWallAndCandidates) {
   RenderResult r = render_flat(f, o);
   const auto& s = f.segments[0];
   EXPECT_EQ(r.colon.width, int(std::ceil(s.length / 0.5)) + 60);
-  EXPECT_EQ(r.colon.height, int(std::ceil(s.period / 0.5)) + 50 + 70);
+  EXPECT_EQ(r.colon.height, int(std::ceil(s.period / 0.5)) + 70 + 70);
   ASSERT_EQ(r.candidates.size(), 3u);
   // wall pixels: reddish tissue, not the dark background
-  const unsigned char* p = at(r.colon.image, r.colon.width / 2, 50 + int(s.period / 0.5 / 2));
+  const unsigned char* p = at(r.colon.image, r.colon.width / 2, 70 + int(s.period / 0.5 / 2));
   EXPECT_GT(p[0], 40);
   EXPECT_GT(p[0], p[2]);
   for (const auto& m : r.markers) {
     EXPECT_GT(m.px, 30);
     EXPECT_LT(m.px, r.colon.width - 30);
-    EXPECT_GT(m.py, 50);
+    EXPECT_GT(m.py, 70);
     EXPECT_LT(m.py, r.colon.height - 70);
     // the outline ring is drawn in yellow at the marker's radius somewhere around the centre
     bool yellow = false;
