@@ -109,6 +109,8 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
   double R = o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge;
   if (std::isfinite(o.max_loop_length)) R = std::min(R, o.max_loop_length);
   bool truncated_any = false;
+  double sweep_time = 0;
+  int sweeps = 0;
   long long searches = 0, settled = 0;
   int rebuilds = 0, cuts_since_build = 0;
 
@@ -174,6 +176,8 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     }
     searches += static_cast<long long>(sources.size());
     for (long long x : settled_by) settled += x;
+    sweep_time += sw.seconds();
+    ++sweeps;
     st.t.search += sw.seconds();
   };
 
@@ -252,6 +256,9 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
       if (v < static_cast<int>(is_source.size()) && is_source[v]) compute(v);
   }
   stats["searches"] = searches;
+  stats["sweeps"] = sweeps;
+  stats["sweep_time_s"] = sweep_time;
+  stats["threads"] = n_threads;
   stats["settled_vertices"] = settled;
   stats["homology_rebuilds"] = rebuilds;
   stats["final_search_radius_mm"] = R;
