@@ -69,17 +69,23 @@ int main(int argc, char** argv) {
     row(name, m, "paper");
     row(name, m, "exact");
   }
-  // Large generated surfaces: genus 300 at three resolutions (time vs faces), and genus 100.
+  // Large generated surfaces. Scaling: fixed voxel (0.6 mm) and handle density, area and handle
+  // count growing together (time vs faces at the same local structure); then the >= 1.5M-face,
+  // genus >= 300 target case, and a finer one.
   struct Big {
-    double voxel;
+    double radius;
     int handles;
+    double voxel;
   };
-  std::vector<Big> bigs = quick ? std::vector<Big>{{0.9, 100}} : std::vector<Big>{{0.9, 300}, {0.6, 300}, {0.42, 300}, {0.42, 100}};
+  std::vector<Big> bigs = quick ? std::vector<Big>{{50, 75, 0.6}}
+                                : std::vector<Big>{{50, 75, 0.6},   {71, 150, 0.6},  {100, 300, 0.6},
+                                                   {141, 600, 0.6}, {100, 300, 0.52}, {100, 400, 0.52}};
   for (const auto& b : bigs) {
     Stopwatch sw;
-    Mesh m = bench::sphere_with_handles(100.0, b.handles, b.voxel);
+    Mesh m = bench::sphere_with_handles(b.radius, b.handles, b.voxel);
     std::fprintf(stderr, "generated %zu faces in %.1f s\n", m.n_faces(), sw.seconds());
-    const std::string name = "sphere+" + std::to_string(b.handles) + "h@" + std::to_string(b.voxel).substr(0, 4);
+    char name[64];
+    std::snprintf(name, sizeof name, "sphere%.0f+%dh@%.2f", b.radius, b.handles, b.voxel);
     row(name, m, "exact");
     row(name, m, "paper", 3);
   }
