@@ -19,6 +19,7 @@
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/pipeline/registry.h"
+#include "colonflat/testing/command.h"
 #include "colonflat/testing/temp_dir.h"
 
 #if __has_include("colonflat/volume/volume_io.h")
@@ -31,16 +32,8 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-struct Call {
-  int code;
-  std::string out, err;
-};
-
-Call colonflat(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  const int code = colonflat_main(args, out, err);
-  return {code, out.str(), err.str()};
-}
+using Call = testing::CommandResult;
+Call colonflat(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
 
 std::string join(const std::vector<std::string>& v) {
   std::string s;

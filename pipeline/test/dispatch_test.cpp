@@ -4,19 +4,12 @@
 #include <sstream>
 
 #include "colonflat/pipeline/dispatch.h"
+#include "colonflat/testing/command.h"
 
 namespace cf {
 namespace {
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-Result call(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  int code = colonflat_main(args, out, err);
-  return {code, out.str(), err.str()};
-}
+testing::CommandResult call(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
 
 // --help lists the commands and exits 0; no arguments is a usage error (2).
 TEST(Dispatch, HelpListsCommands) {

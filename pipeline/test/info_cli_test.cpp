@@ -11,21 +11,14 @@
 #include "colonflat/core/synthetic.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/pipeline/dispatch.h"
+#include "colonflat/testing/command.h"
 
 namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-Result call(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  int code = colonflat_main(args, out, err);
-  return {code, out.str(), err.str()};
-}
+testing::CommandResult call(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
 std::string shared(const std::string& name) { return std::string(COLONFLAT_SHARED_DIR) + "/meshes/" + name; }
 
 // A valid closed mesh: exit 0, genus and flags in the text report, nothing on stderr.

@@ -9,36 +9,15 @@
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/validation.h"
+#include "colonflat/testing/manifest.h"
 
 namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
 
-using Row = std::map<std::string, std::string>;
-
-std::vector<Row> read_manifest() {
-  std::vector<Row> rows;
-  std::ifstream in(fs::path(COLONFLAT_SHARED_DIR) / "meshes" / "MANIFEST.tsv");
-  std::string line;
-  std::vector<std::string> head;
-  auto split = [](const std::string& s) {
-    std::vector<std::string> v;
-    std::stringstream ss(s);
-    std::string x;
-    while (std::getline(ss, x, '\t')) v.push_back(x);
-    return v;
-  };
-  if (!std::getline(in, line)) return rows;
-  head = split(line);
-  while (std::getline(in, line)) {
-    auto v = split(line);
-    Row r;
-    for (std::size_t i = 0; i < head.size() && i < v.size(); ++i) r[head[i]] = v[i];
-    rows.push_back(r);
-  }
-  return rows;
-}
+using Row = testing::ManifestRow;
+std::vector<Row> read_manifest() { return testing::read_mesh_manifest(); }
 
 struct Inspected {
   MeshDiagnosis diag;

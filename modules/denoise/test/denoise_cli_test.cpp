@@ -10,6 +10,7 @@
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/loops_io.h"
 #include "colonflat/pipeline/dispatch.h"
+#include "colonflat/testing/command.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -17,15 +18,7 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-Result call(const std::vector<std::string>& args) {
-  std::ostringstream out, err;
-  const int code = colonflat_main(args, out, err);
-  return {code, out.str(), err.str()};
-}
+testing::CommandResult call(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
 
 // A genus-3 chain: genus-0 mesh, loops .vtp and a report with per-component genus, loops and times.
 TEST(DenoiseCli, WritesMeshLoopsAndReport) {

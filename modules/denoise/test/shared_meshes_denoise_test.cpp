@@ -10,6 +10,7 @@
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/denoise/denoise.h"
+#include "colonflat/testing/manifest.h"
 #include "self_intersections.h"
 
 namespace fs = std::filesystem;
@@ -25,22 +26,7 @@ struct Case {
 
 std::vector<Case> closed_cases() {
   std::vector<Case> out;
-  std::ifstream in(fs::path(COLONFLAT_SHARED_DIR) / "meshes" / "MANIFEST.tsv");
-  std::string line;
-  std::vector<std::string> head;
-  auto split = [](const std::string& s) {
-    std::vector<std::string> v;
-    std::stringstream ss(s);
-    std::string x;
-    while (std::getline(ss, x, '\t')) v.push_back(x);
-    return v;
-  };
-  if (!std::getline(in, line)) return out;
-  head = split(line);
-  while (std::getline(in, line)) {
-    auto v = split(line);
-    std::map<std::string, std::string> r;
-    for (std::size_t i = 0; i < head.size() && i < v.size(); ++i) r[head[i]] = v[i];
+  for (auto& r : testing::read_mesh_manifest()) {
     if (r["genus"] == "NA" || r["closed"] != "True" || std::stoi(r["genus"]) < 1) continue;
     out.push_back({r["name"], std::stoi(r["genus"]), std::stoul(r["components"]), std::stoul(r["faces"])});
   }
