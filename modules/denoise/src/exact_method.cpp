@@ -109,6 +109,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
   double R = o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge;
   if (std::isfinite(o.max_loop_length)) R = std::min(R, o.max_loop_length);
   bool truncated_any = false;
+  double next_radius_hint = kInf;  // min frontier bound seen since the last sweep
   double sweep_time = 0;
   int sweeps = 0;
   long long searches = 0, settled = 0;
@@ -140,6 +141,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     settled += static_cast<long long>(search->last_settled());
     ++ver[v];
     truncated_any = truncated_any || c.truncated;
+    next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
     if (c.found) pq.push({c.value, v, ver[v], true});
     else if (c.truncated) pq.push({R, v, ver[v], false});
     st.t.search += sw.seconds();
@@ -152,6 +154,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     Stopwatch sw;
     while (!pq.empty()) pq.pop();
     truncated_any = false;
+    next_radius_hint = kInf;
     std::vector<CycleCandidate> results(sources.size());
     std::vector<long long> settled_by(n_threads, 0);
     auto work = [&](unsigned t) {
@@ -171,6 +174,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
       const CycleCandidate& c = results[i];
       ++ver[v];
       truncated_any = truncated_any || c.truncated;
+      next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
       if (c.found) pq.push({c.value, v, ver[v], true});
       else if (c.truncated) pq.push({R, v, ver[v], false});
     }
@@ -204,7 +208,10 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
         reason = "no further loops found";
         break;
       }
-      R = std::min(2 * R, o.max_loop_length);
+      // Next radius: the shortest non-separating closed walk seen across search frontiers
+      // bounds the next loop from above, so searching to it finds that loop; never less than
+      // 1.05 R nor more than 2 R.
+      R = std::min({2 * R, std::max(1.05 * R, next_radius_hint * (1 + 1e-9)), o.max_loop_length});
       if (cuts_since_build > 0) rebuild();
       compute_all();
       continue;
@@ -262,6 +269,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
   stats["settled_vertices"] = settled;
   stats["homology_rebuilds"] = rebuilds;
   stats["final_search_radius_mm"] = R;
+  stats["radius_schedule"] = "frontier bound, 1.05x..2x";
   stats["sources_last"] = sources.size();
   return reason;
 }

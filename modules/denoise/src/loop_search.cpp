@@ -47,6 +47,7 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
     const auto [d, vi] = heap_.top();
     if (d > 0.5 * std::min(limit, best.value)) {
       best.truncated = true;
+      if (!best.found) best.frontier_bound = frontier_bound();
       break;
     }
     heap_.pop();
@@ -109,6 +110,39 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
     }
   }
   return best;
+}
+
+double FundamentalCycleSearch::frontier_bound() {
+  // Unsettled vertices with a tentative distance are in the heap (possibly several times).
+  double bound = std::numeric_limits<double>::infinity();
+  std::vector<std::uint64_t> cls(W_);
+  auto heap = heap_;  // a copy: the caller's heap is not consumed
+  while (!heap.empty()) {
+    const int wi = heap.top().second;
+    heap.pop();
+    if (settled_flag_[wi] || stamp_[wi] != run_id_ || parent_[wi] < 0) continue;
+    const auto w = Mesh::VertexHandle(wi);
+    const auto ph = Mesh::HalfedgeHandle(parent_[wi]);
+    const int p = mesh_.from_vertex_handle(ph).idx();
+    // Class of path(s, w) through its tentative parent.
+    const std::uint64_t* ap = &acc_[std::size_t(slot_[p]) * W_];
+    const std::uint64_t* ae = hom_.edge_class(mesh_.edge_handle(ph));
+    for (auto h : mesh_.voh_range(w)) {
+      const int u = mesh_.to_vertex_handle(h).idx();
+      if (u == p || stamp_[u] != run_id_ || !settled_flag_[u]) continue;
+      const double value = dist_[wi] + (mesh_.point(Mesh::VertexHandle(u)) - mesh_.point(w)).norm() + dist_[u];
+      if (value >= bound) continue;
+      const std::uint64_t* au = &acc_[std::size_t(slot_[u]) * W_];
+      const std::uint64_t* eu = hom_.edge_class(mesh_.edge_handle(h));
+      bool zero = true;
+      for (int i = 0; i < W_; ++i) {
+        cls[i] = ap[i] ^ ae[i] ^ au[i] ^ eu[i];
+        zero = zero && cls[i] == 0;
+      }
+      if (!zero && !span_.reduce(cls.data())) bound = value;
+    }
+  }
+  return bound;
 }
 
 std::vector<Mesh::VertexHandle> FundamentalCycleSearch::extract(const CycleCandidate& c) {

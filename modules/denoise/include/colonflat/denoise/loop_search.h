@@ -25,6 +25,11 @@ struct CycleCandidate {
   double value = std::numeric_limits<double>::infinity();  // d(u) + |uv| + d(v)
   Mesh::VertexHandle source, u, v;
   bool truncated = false;  // the search stopped at the limit with vertices left unexplored
+  // When truncated: the length of the shortest closed walk with a class outside the span seen
+  // across the search frontier (settled u, edge uw, tentative path to w). It contains a
+  // non-separating cycle, so it bounds the global shortest one from above; used to choose the
+  // next search radius instead of blind doubling.
+  double frontier_bound = std::numeric_limits<double>::infinity();
 };
 
 class FundamentalCycleSearch {
@@ -43,6 +48,7 @@ class FundamentalCycleSearch {
 
  private:
   void grow();
+  double frontier_bound();
   bool settled(int v) const { return stamp_[v] == run_id_ && settled_flag_[v]; }
   const Mesh& mesh_;
   const HomologyBasis& hom_;
