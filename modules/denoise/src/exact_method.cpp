@@ -160,7 +160,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     auto work = [&](unsigned t) {
       FundamentalCycleSearch local(st.mesh, hb, span);
       for (std::size_t i = t; i < sources.size(); i += n_threads) {
-        results[i] = local.run(Mesh::VertexHandle(sources[i]), R, accept_ptr);
+        results[i] = local.run(Mesh::VertexHandle(sources[i]), R, accept_ptr, /*frontier=*/true);
         settled_by[t] += static_cast<long long>(local.last_settled());
       }
     };

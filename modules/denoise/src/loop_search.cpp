@@ -12,6 +12,8 @@ FundamentalCycleSearch::FundamentalCycleSearch(const Mesh& mesh, const HomologyB
 
 void FundamentalCycleSearch::grow() {
   const std::size_t n = mesh_.n_vertices();
+  // Boundary flags: vertices created by surgery are interior, so only new entries are computed.
+  for (std::size_t v = blocked_.size(); v < n; ++v) blocked_.push_back(mesh_.is_boundary(Mesh::VertexHandle(static_cast<int>(v))));
   if (stamp_.size() >= n) return;
   const std::size_t cap = std::max(n, stamp_.size() * 5 / 4);
   stamp_.resize(cap, 0);
@@ -22,7 +24,7 @@ void FundamentalCycleSearch::grow() {
   mark_.resize(cap, 0);
 }
 
-CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, const Accept* accept) {
+CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, const Accept* accept, bool frontier) {
   grow();
   ++run_id_;
   if (run_id_ == 0) {  // wrapped: reset stamps
@@ -33,7 +35,12 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
   best.source = s;
   settled_count_ = 0;
   acc_.clear();
-  while (!heap_.empty()) heap_.pop();
+  heap_.clear();
+  const std::greater<Item> cmp;
+  auto push = [&](double d, int v) {
+    heap_.emplace_back(d, v);
+    std::push_heap(heap_.begin(), heap_.end(), cmp);
+  };
   auto touch = [&](int v, double d, int parent) {
     stamp_[v] = run_id_;
     settled_flag_[v] = 0;
@@ -41,16 +48,17 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
     parent_[v] = parent;
   };
   touch(s.idx(), 0.0, -1);
-  heap_.push({0.0, s.idx()});
+  push(0.0, s.idx());
   std::vector<Mesh::VertexHandle> loop;
   while (!heap_.empty()) {
-    const auto [d, vi] = heap_.top();
+    const auto [d, vi] = heap_.front();
     if (d > 0.5 * std::min(limit, best.value)) {
       best.truncated = true;
-      if (!best.found) best.frontier_bound = frontier_bound();
+      if (!best.found && frontier) best.frontier_bound = frontier_bound();
       break;
     }
-    heap_.pop();
+    std::pop_heap(heap_.begin(), heap_.end(), cmp);
+    heap_.pop_back();
     if (settled_flag_[vi] || d > dist_[vi]) continue;
     settled_flag_[vi] = 1;
     ++settled_count_;
@@ -67,19 +75,23 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
       for (int i = 0; i < W_; ++i) mine[i] = theirs[i] ^ e[i];
     }
     const Vec3& pv = mesh_.point(v);
-    for (auto h : mesh_.voh_range(v)) {
+    const auto h0 = mesh_.halfedge_handle(v);
+    auto h = h0;
+    do {
       const auto w = mesh_.to_vertex_handle(h);
       const int wi = w.idx();
-      if (mesh_.is_boundary(w)) continue;
+      const auto this_h = h;
+      h = mesh_.cw_rotated_halfedge_handle(h);
+      if (blocked_[wi]) continue;
       const double len = (mesh_.point(w) - pv).norm();
       if (stamp_[wi] == run_id_ && settled_flag_[wi]) {
         // Non-tree edge between two settled vertices: a fundamental cycle.
-        if (parent_[vi] >= 0 && mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])) == mesh_.edge_handle(h)) continue;
+        if (parent_[vi] >= 0 && mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])) == mesh_.edge_handle(this_h)) continue;
         const double value = d + len + dist_[wi];
         if (value >= best.value || value > limit) continue;
         const std::uint64_t* a = &acc_[std::size_t(slot_[vi]) * W_];
         const std::uint64_t* b = &acc_[std::size_t(slot_[wi]) * W_];
-        const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(h));
+        const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(this_h));
         bool zero = true;
         for (int i = 0; i < W_; ++i) {
           tmp_[i] = a[i] ^ b[i] ^ e[i];
@@ -100,14 +112,14 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
       }
       const double nd = d + len;
       if (stamp_[wi] != run_id_) {
-        touch(wi, nd, h.idx());
-        heap_.push({nd, wi});
+        touch(wi, nd, this_h.idx());
+        push(nd, wi);
       } else if (nd < dist_[wi]) {
         dist_[wi] = nd;
-        parent_[wi] = h.idx();
-        heap_.push({nd, wi});
+        parent_[wi] = this_h.idx();
+        push(nd, wi);
       }
-    }
+    } while (h != h0);
   }
   return best;
 }
@@ -116,11 +128,9 @@ double FundamentalCycleSearch::frontier_bound() {
   // Unsettled vertices with a tentative distance are in the heap (possibly several times).
   double bound = std::numeric_limits<double>::infinity();
   std::vector<std::uint64_t> cls(W_);
-  auto heap = heap_;  // a copy: the caller's heap is not consumed
-  while (!heap.empty()) {
-    const int wi = heap.top().second;
-    heap.pop();
-    if (settled_flag_[wi] || stamp_[wi] != run_id_ || parent_[wi] < 0) continue;
+  for (const auto& [dw, wi] : heap_) {
+    // Each unsettled vertex once: its current entry (stale duplicates carry a larger distance).
+    if (settled_flag_[wi] || stamp_[wi] != run_id_ || parent_[wi] < 0 || dw != dist_[wi]) continue;
     const auto w = Mesh::VertexHandle(wi);
     const auto ph = Mesh::HalfedgeHandle(parent_[wi]);
     const int p = mesh_.from_vertex_handle(ph).idx();

@@ -39,7 +39,8 @@ class FundamentalCycleSearch {
 
   // Best fundamental cycle of value <= limit whose class is not in `cut_classes` (and that
   // `accept` approves, when given). The search state is kept for extract().
-  CycleCandidate run(Mesh::VertexHandle s, double limit, const Accept* accept = nullptr);
+  // With `frontier`, a truncated search without a loop also computes frontier_bound.
+  CycleCandidate run(Mesh::VertexHandle s, double limit, const Accept* accept = nullptr, bool frontier = false);
   // The simple cycle of a candidate from the last run() (the common stem from s is dropped).
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
@@ -55,6 +56,7 @@ class FundamentalCycleSearch {
   const Z2Span& span_;
   int W_;
   std::uint32_t run_id_ = 0;
+  std::vector<std::uint8_t> blocked_;  // boundary vertices (never on a loop)
   std::vector<std::uint32_t> stamp_;
   std::vector<std::uint8_t> settled_flag_;
   std::vector<double> dist_;
@@ -66,7 +68,7 @@ class FundamentalCycleSearch {
   std::uint32_t mark_id_ = 0;
   std::size_t settled_count_ = 0;
   using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap_;
+  std::vector<Item> heap_;  // binary min-heap (std::push_heap / pop_heap with std::greater)
 };
 
 // Euclidean length of a closed loop.
