@@ -81,6 +81,16 @@ TEST_F(RunTool, SetAndParamsIn) {
   EXPECT_FALSE(fs::exists(dir_ / "c"));
 }
 
+// The example parameter files shipped in data/params are accepted by `run`.
+TEST_F(RunTool, ShippedParameterFilesAreValid) {
+  for (const char* f : {"partial_denoise.json", "paper_method.json"}) {
+    auto r = testing::run_colonflat({"run", dir_.str("chain.vtp"), "--from", "denoise", "--to", "denoise", "-o",
+                                     dir_.str(std::string("out_") + f), "--params-in",
+                                     std::string(COLONFLAT_SOURCE_DIR) + "/data/params/" + f, "-q"});
+    EXPECT_EQ(r.code, 0) << f << ": " << r.err;
+  }
+}
+
 // Errors: unknown stage, --from after --to, a parameter out of range; nothing is written.
 TEST_F(RunTool, UsageErrors) {
   auto a = testing::run_colonflat({"run", dir_.str("chain.vtp"), "--from", "polish", "-o", dir_.str("x")});
