@@ -629,7 +629,7 @@ nlohmann::json volume_info_json(const fs::path& p, const VolumeReadOptions& opts
     j["series"] = list;
     if (uid.empty()) uid = opts.series_uid;
     if (f->series.size() > 1 && uid.empty()) {
-      j["note"] = "several series; choose one with DIR/UID";
+      j["note"] = "several series; choose one with --series UID (or the path DIR/UID)";
       return j;
     }
     if (f->series.empty()) throw InputError(p.string(), "folder holds no readable DICOM file");
