@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "colonflat/core/stage.h"
+#include "colonflat/testing/small_phantom.h"
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/phantom/phantom_tool.h"
 #include "colonflat/testing/temp_dir.h"
@@ -20,18 +21,7 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-const Phantom& small(std::uint64_t seed = 1, bool collapsed = false) {
-  static std::map<std::pair<std::uint64_t, bool>, Phantom> cache;
-  auto key = std::make_pair(seed, collapsed);
-  auto it = cache.find(key);
-  if (it == cache.end()) {
-    PhantomOptions o;
-    o.seed = seed;
-    o.collapsed_segment = collapsed;
-    it = cache.emplace(key, generate_phantom(o)).first;
-  }
-  return it->second;
-}
+const Phantom& small(std::uint64_t seed = 1, bool collapsed = false) { return testing::small_phantom(seed, collapsed); }
 
 std::size_t lumen_components(const MaskImage* m) {
   using CC = itk::ConnectedComponentImageFilter<MaskImage, itk::Image<std::uint32_t, 3>>;

@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "colonflat/core/stage.h"
+#include "colonflat/testing/errors.h"
+#include "colonflat/testing/small_phantom.h"
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/segment/segment.h"
 #include "colonflat/segment/segment_stage.h"
@@ -214,14 +216,7 @@ TEST(SegmentSynthetic, GraphCutAtLeastAsGoodAsThresholds) {
   EXPECT_LE(e_gc, e_th);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::error_of;
 
 // Not CT-like (scanner units without negative values), absurd spacing, no colon: clear errors.
 TEST(SegmentBadInput, ClearPreconditionErrors) {
@@ -267,18 +262,7 @@ TEST(SegmentOptionsCheck, InvalidOptionsRejected) {
   EXPECT_THROW(segment_colon(nullptr, o), UsageError);
 }
 
-const Phantom& small_phantom(std::uint64_t seed = 1, bool collapsed = false) {
-  static std::map<std::pair<std::uint64_t, bool>, Phantom> cache;
-  auto key = std::make_pair(seed, collapsed);
-  auto it = cache.find(key);
-  if (it == cache.end()) {
-    PhantomOptions o;
-    o.seed = seed;
-    o.collapsed_segment = collapsed;
-    it = cache.emplace(key, generate_phantom(o)).first;
-  }
-  return it->second;
-}
+using testing::small_phantom;
 
 // Small phantom (2.8 mm voxels): Dice >= 0.99, no leak into outside air or lungs, one segment.
 TEST(SegmentPhantom, SmallPhantomDice) {

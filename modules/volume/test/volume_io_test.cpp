@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/testing/errors.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
 
@@ -61,14 +62,7 @@ void expect_same_values(const CtImage* a, const CtImage* b) {
   for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(a->GetBufferPointer()[i], b->GetBufferPointer()[i]) << "voxel " << i;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::error_of;
 
 // Each written format reads back with the same HU values and the same LPS geometry (oblique direction).
 TEST(VolumeIoFormats, RoundTripKeepsValuesAndGeometry) {
