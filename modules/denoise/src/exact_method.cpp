@@ -133,17 +133,21 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     ++rebuilds;
     cuts_since_build = 0;
   };
-  auto compute = [&](int v) {
-    Stopwatch sw;
+  // Queues a source's search result: an exact value, or the lower bound R when the search hit the
+  // radius (a source whose whole reachable part has no loop is dropped until a surgery nears it).
+  auto queue_result = [&](int v, const CycleCandidate& c) {
     if (v >= static_cast<int>(ver.size())) ver.resize(st.mesh.n_vertices() + 1024, 0);
-    const CycleCandidate c = search->run(Mesh::VertexHandle(v), R, accept_ptr);
-    ++searches;
-    settled += static_cast<long long>(search->last_settled());
     ++ver[v];
     truncated_any = truncated_any || c.truncated;
     next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
     if (c.found) pq.push({c.value, v, ver[v], true});
     else if (c.truncated) pq.push({R, v, ver[v], false});
+  };
+  auto compute = [&](int v) {
+    Stopwatch sw;
+    queue_result(v, search->run(Mesh::VertexHandle(v), R, accept_ptr));
+    ++searches;
+    settled += static_cast<long long>(search->last_settled());
     st.t.search += sw.seconds();
   };
   // Full sweeps over all sources run on every core: searches only read the mesh, the classes
@@ -168,16 +172,7 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(work, t);
     work(0);
     for (auto& th : pool) th.join();
-    if (ver.size() < st.mesh.n_vertices()) ver.resize(st.mesh.n_vertices() + 1024, 0);
-    for (std::size_t i = 0; i < sources.size(); ++i) {
-      const int v = sources[i];
-      const CycleCandidate& c = results[i];
-      ++ver[v];
-      truncated_any = truncated_any || c.truncated;
-      next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
-      if (c.found) pq.push({c.value, v, ver[v], true});
-      else if (c.truncated) pq.push({R, v, ver[v], false});
-    }
+    for (std::size_t i = 0; i < sources.size(); ++i) queue_result(sources[i], results[i]);
     searches += static_cast<long long>(sources.size());
     for (long long x : settled_by) settled += x;
     sweep_time += sw.seconds();
@@ -226,15 +221,11 @@ std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, con
     const CycleCandidate c = search->run(Mesh::VertexHandle(top.v), R, accept_ptr);
     ++searches;
     st.t.search += sw.seconds();
-    ++ver[top.v];
-    if (!c.found) {
-      if (c.truncated) pq.push({R, top.v, ver[top.v], false});
+    if (!c.found || c.value > top.key + 1e-12 * (1.0 + top.key)) {
+      queue_result(top.v, c);  // changed since it was queued: back in line with its new value
       continue;
     }
-    if (c.value > top.key + 1e-12 * (1.0 + top.key)) {
-      pq.push({c.value, top.v, ver[top.v], true});
-      continue;
-    }
+    ++ver[top.v];  // consumed by this cut
     const std::vector<Mesh::VertexHandle> loop = search->extract(c);
     const std::vector<std::uint64_t> cls = search->cycle_class(loop);
     if (!span.insert(cls.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
