@@ -17,6 +17,7 @@ BUILD_PKGS=(
   libcli11-dev           # command-line parsing
   nlohmann-json3-dev     # JSON reports
   libcgal-dev            # tests only: independent self-intersection check
+  libdcmtk-dev           # tests only: a second DICOM reader checks the series we write
   xvfb xauth             # off-screen rendering where there is no display
   python3                # small test helpers
   snakemake              # cohort processing (workflow/Snakefile) and its ctest test
