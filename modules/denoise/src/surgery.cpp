@@ -204,6 +204,107 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
     }
     return cap;
   };
+  // 7a. With a guard, loops up to 200 vertices first try minimum-area triangulations of the pulled
+  //     rings: no interior vertex; on an elongated loop around a thin curved band they join
+  //     opposite sides and follow the band, where a spanning minimal surface would cut through
+  //     its wall. Kept when neither they nor the faces around the pulled rings intersect anything.
+  if (opts.guard && k <= 200) {
+    std::vector<Mesh::VertexHandle> order_r = r.right_ring, order_l{r.left_ring[0]};
+    for (std::size_t i = k - 1; i >= 1; --i) order_l.push_back(r.left_ring[i]);  // x_(k-1) -> ... -> x_0
+    for (std::size_t i = 0; i < k; ++i) {
+      mesh.point(r.left_ring[i]) = p0[i] + opts.ring_pull * (target_left[i] - p0[i]);
+      mesh.point(r.right_ring[i]) = p0[i] + opts.ring_pull * (target_right[i] - p0[i]);
+    }
+    std::vector<Mesh::FaceHandle> ring_faces;
+    for (const auto* ring : {&r.left_ring, &r.right_ring})
+      for (auto v : *ring)
+        for (auto f : mesh.vf_range(v)) ring_faces.push_back(f);
+    std::sort(ring_faces.begin(), ring_faces.end());
+    ring_faces.erase(std::unique(ring_faces.begin(), ring_faces.end()), ring_faces.end());
+    for (auto f : ring_faces) opts.guard->insert(mesh, f);
+    auto triangulate = [&](const std::vector<Mesh::VertexHandle>& ring) {
+      std::vector<Vec3> pts;
+      for (auto v : ring) pts.push_back(mesh.point(v));
+      std::vector<std::array<int, 3>> t = min_area_triangulation(pts);
+      for (auto& tri : t)
+        for (int& i : tri) i = ring[i].idx();
+      return t;
+    };
+    const auto tri_r = triangulate(order_r), tri_l = triangulate(order_l);
+    std::vector<std::array<int, 3>> all = tri_r;
+    all.insert(all.end(), tri_l.begin(), tri_l.end());
+    // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
+    bool chord = false;
+    auto is_ring_edge = [&](int a, int b, const std::vector<Mesh::VertexHandle>& ring) {
+      for (std::size_t i = 0; i < k; ++i)
+        if ((ring[i].idx() == a && ring[(i + 1) % k].idx() == b) || (ring[i].idx() == b && ring[(i + 1) % k].idx() == a))
+          return true;
+      return false;
+    };
+    for (const auto* tl : {&tri_r, &tri_l})
+      for (const auto& t : *tl)
+        for (int e = 0; e < 3; ++e) {
+          const int a = t[e], b = t[(e + 1) % 3];
+          const auto& ring = tl == &tri_r ? order_r : order_l;
+          if (!is_ring_edge(a, b, ring) && mesh.find_halfedge(Mesh::VertexHandle(a), Mesh::VertexHandle(b)).is_valid())
+            chord = true;
+        }
+    if (!chord && opts.guard->count_intersections(mesh, ring_faces) == 0 && opts.guard->count_triangles(mesh, all) == 0) {
+      // Add as ears of the shrinking hole, so that every face is added next to the boundary.
+      auto add_ears = [&](const std::vector<Mesh::VertexHandle>& ring, std::vector<std::array<int, 3>> tris) {
+        std::vector<int> poly;
+        for (auto v : ring) poly.push_back(v.idx());
+        while (!tris.empty()) {
+          bool added = false;
+          for (std::size_t t = 0; t < tris.size() && !added; ++t)
+            for (std::size_t j = 0; j < poly.size() && !added; ++j) {
+              const int a = poly[j], b = poly[(j + 1) % poly.size()], c = poly[(j + 2) % poly.size()];
+              const auto& tr = tris[t];
+              const bool match = (tr[0] == a && tr[1] == b && tr[2] == c) || (tr[1] == a && tr[2] == b && tr[0] == c) ||
+                                 (tr[2] == a && tr[0] == b && tr[1] == c);
+              if (!match) continue;
+              const auto f = mesh.add_face(Mesh::VertexHandle(a), Mesh::VertexHandle(b), Mesh::VertexHandle(c));
+              if (!f.is_valid()) throw Error("surgery: could not add a cap triangle");
+              opts.guard->insert(mesh, f);
+              poly.erase(poly.begin() + static_cast<long>((j + 1) % poly.size()));
+              tris.erase(tris.begin() + static_cast<long>(t));
+              added = true;
+            }
+          if (!added) throw Error("surgery: cap triangulation is not a disk");
+        }
+      };
+      add_ears(order_r, tri_r);
+      add_ears(order_l, tri_l);
+      if (homology) {
+        auto classes = [&](const std::vector<Mesh::VertexHandle>& ring) {
+          std::unordered_map<int, std::vector<std::uint64_t>> P;
+          std::vector<std::uint64_t> acc(W, 0), cls(W);
+          for (std::size_t i = 0; i < k; ++i) {
+            P[ring[i].idx()] = acc;
+            const auto he = mesh.find_halfedge(ring[i], ring[(i + 1) % k]);
+            xor_into(acc.data(), homology->edge_class(mesh.edge_handle(he)), W);
+          }
+          for (std::size_t i = 0; i < k; ++i)
+            for (auto he : mesh.voh_range(ring[i])) {
+              const auto w = mesh.to_vertex_handle(he);
+              auto it = P.find(w.idx());
+              if (it == P.end()) continue;                                   // not a chord of this ring
+              const std::size_t j = static_cast<std::size_t>(std::find(ring.begin(), ring.end(), w) - ring.begin());
+              if (j == (i + 1) % k || i == (j + 1) % k) continue;           // a ring edge (old)
+              for (int b = 0; b < W; ++b) cls[b] = P[ring[i].idx()][b] ^ it->second[b];
+              homology->set_edge_class(mesh.edge_handle(he), cls.data());
+            }
+        };
+        classes(order_r);
+        classes(order_l);
+      }
+      r.right_cap = r.right_ring[0];
+      r.left_cap = r.left_ring[0];
+      r.intersections = 0;
+      return r;
+    }
+  }
+
   Cap cap_right = make_cap(h);                                                             // h_0 -> h_1 -> ...
   Cap cap_left = make_cap(std::vector<Mesh::HalfedgeHandle>(x.rbegin(), x.rend()));  // x_(k-1) -> ... -> x_0
   r.right_cap = cap_right.centre;
@@ -354,6 +455,27 @@ void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
       }
 }
 
+namespace {
+// Triangles sharing vertices touch there; they intersect improperly (a fold) when they still
+// meet after their shared corners are pulled slightly towards their centroids.
+bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p, const std::array<int, 3>& gids,
+                           const std::array<Vec3, 3>& q) {
+  int shared = 0;
+  std::array<Vec3, 3> pa = p, qa = q;
+  const Vec3 cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
+  for (int i1 = 0; i1 < 3; ++i1)
+    for (int i2 = 0; i2 < 3; ++i2)
+      if (ids[i1] == gids[i2]) {
+        ++shared;
+        pa[i1] += 1e-3 * (cp - pa[i1]);
+        qa[i2] += 1e-3 * (cq - qa[i2]);
+      }
+  if (shared == 3) return false;
+  return vtkTriangle::TrianglesIntersect(pa[0].data(), pa[1].data(), pa[2].data(), qa[0].data(), qa[1].data(),
+                                         qa[2].data()) != 0;
+}
+}  // namespace
+
 std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const {
   return intersecting_pairs(mesh, faces).size();
 }
@@ -401,25 +523,88 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
       face_box(mesh, g, glo, ghi, gids, q);
       if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
         continue;
-      // Triangles sharing vertices touch there; they intersect improperly (a fold) when they
-      // still meet after their shared corners are pulled slightly towards their centroids.
-      int shared = 0;
-      std::array<Vec3, 3> pa = p, qa = q;
-      const Vec3 cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
-      for (int i1 = 0; i1 < 3; ++i1)
-        for (int i2 = 0; i2 < 3; ++i2)
-          if (ids[i1] == gids[i2]) {
-            ++shared;
-            pa[i1] += 1e-3 * (cp - pa[i1]);
-            qa[i2] += 1e-3 * (cq - qa[i2]);
-          }
-      if (shared == 3) continue;
-      if (vtkTriangle::TrianglesIntersect(pa[0].data(), pa[1].data(), pa[2].data(), qa[0].data(), qa[1].data(),
-                                          qa[2].data()))
+      if (improper_intersection(ids, p, gids, q))
         pairs.emplace_back(f.idx(), gi);
     }
   }
   return pairs;
+}
+
+std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const {
+  std::size_t count = 0;
+  std::vector<std::array<Vec3, 3>> pts(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int i = 0; i < 3; ++i) pts[t][i] = mesh.point(Mesh::VertexHandle(tris[t][i]));
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    Vec3 lo = pts[t][0], hi = pts[t][0];
+    for (int i = 1; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], pts[t][i][a]);
+        hi[a] = std::max(hi[a], pts[t][i][a]);
+      }
+    const Key a = key(lo), b = key(hi);
+    std::vector<int> cand(big_.begin(), big_.end());
+    if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
+      for (const auto& [k, v] : cells_) {
+        (void)k;
+        cand.insert(cand.end(), v.begin(), v.end());
+      }
+    } else {
+      for (long long x = a.x; x <= b.x; ++x)
+        for (long long y = a.y; y <= b.y; ++y)
+          for (long long z = a.z; z <= b.z; ++z) {
+            auto it = cells_.find({x, y, z});
+            if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
+          }
+    }
+    std::sort(cand.begin(), cand.end());
+    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    for (int gi : cand) {
+      Vec3 glo, ghi;
+      std::array<int, 3> gids;
+      std::array<Vec3, 3> q;
+      face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
+      if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+        continue;
+      if (improper_intersection(tris[t], pts[t], gids, q)) ++count;
+    }
+    for (std::size_t u = t + 1; u < tris.size(); ++u)
+      if (improper_intersection(tris[t], pts[t], tris[u], pts[u])) ++count;
+  }
+  return count;
+}
+
+std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring) {
+  const int n = static_cast<int>(ring.size());
+  std::vector<std::array<int, 3>> tris;
+  if (n < 3) return tris;
+  auto area = [&](int i, int m, int j) { return 0.5 * OpenMesh::cross(ring[m] - ring[i], ring[j] - ring[i]).norm(); };
+  std::vector<double> W(static_cast<std::size_t>(n) * n, 0.0);
+  std::vector<int> arg(static_cast<std::size_t>(n) * n, -1);
+  for (int len = 2; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      double best = std::numeric_limits<double>::infinity();
+      for (int m = i + 1; m < j; ++m) {
+        const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] + area(i, m, j);
+        if (w < best) {
+          best = w;
+          arg[std::size_t(i) * n + j] = m;
+        }
+      }
+      W[std::size_t(i) * n + j] = best;
+    }
+  std::vector<std::pair<int, int>> stack{{0, n - 1}};
+  while (!stack.empty()) {
+    auto [i, j] = stack.back();
+    stack.pop_back();
+    if (j - i < 2) continue;
+    const int m = arg[std::size_t(i) * n + j];
+    tris.push_back({i, m, j});
+    stack.push_back({i, m});
+    stack.push_back({m, j});
+  }
+  return tris;
 }
 
 bool vertices_connected(const Mesh& mesh, Mesh::VertexHandle a, Mesh::VertexHandle b) {

@@ -8,6 +8,7 @@
 // disk relaxed to a discrete minimal surface spanning its pulled ring (centre vertex at the
 // centroid for a plain fan), so the two caps are disjoint and follow non-planar loops. Nothing is deleted: the input's
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
+#include <array>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -27,6 +28,9 @@ class FaceGrid {
   // Pairs (f in `faces`, g any face) that intersect improperly; pairs inside `faces` count once.
   // Precondition: every face in `faces` was insert()ed at its current position.
   std::size_t count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
+  // Intersections of triangles not (yet) in the mesh, given by mesh vertex ids, with the grid's
+  // faces and with each other.
+  std::size_t count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const;
   // The intersecting pairs themselves (same rules as count_intersections).
   std::vector<std::pair<int, int>> intersecting_pairs(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
 
@@ -66,6 +70,10 @@ struct SurgeryResult {
 // When `homology` is given, new edges get classes consistent with it modulo the loop's class.
 SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts,
                           HomologyBasis* homology = nullptr);
+
+// Minimum-area triangulation of a closed polygon (dynamic programming, O(n^3)); triangles
+// (i, m, j) with i < m < j index `ring` and are oriented like the polygon.
+std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring);
 
 // True when a and b are connected in the mesh graph (bidirectional breadth-first search, which
 // stops early when both sides meet: cheap for the small handles of denoising).
