@@ -8,7 +8,6 @@ namespace cf {
 
 void HomologyBasis::build(const Mesh& mesh) {
   const std::size_t F = mesh.n_faces(), E = mesh.n_edges(), V = mesh.n_vertices();
-  n_vertices_ = V;
   // Virtual faces: one per boundary loop, numbered F, F+1, ...
   std::vector<int> boundary_face(mesh.n_halfedges(), -1);  // virtual face id of a boundary halfedge
   int n_virtual = 0;

@@ -437,6 +437,27 @@ void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::arr
 }
 }  // namespace
 
+std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
+  const Key a = key(lo), b = key(hi);
+  std::vector<int> cand(big_.begin(), big_.end());
+  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
+    for (const auto& [k, v] : cells_) {  // a large query box: scan the grid once
+      (void)k;
+      cand.insert(cand.end(), v.begin(), v.end());
+    }
+  } else {
+    for (long long x = a.x; x <= b.x; ++x)
+      for (long long y = a.y; y <= b.y; ++y)
+        for (long long z = a.z; z <= b.z; ++z) {
+          auto it = cells_.find({x, y, z});
+          if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
+        }
+  }
+  std::sort(cand.begin(), cand.end());
+  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  return cand;
+}
+
 void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
   Vec3 lo, hi;
   std::array<int, 3> ids;
@@ -491,25 +512,9 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
     std::array<int, 3> ids;
     std::array<Vec3, 3> p;
     face_box(mesh, f, lo, hi, ids, p);
-    const Key a = key(lo), b = key(hi);
     // Candidates: faces in the cells (the caller inserts moved faces at their current place;
     // stale cells only cost time, the test below uses current geometry).
-    std::vector<int> cand(big_.begin(), big_.end());
-    if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
-      for (const auto& [k, v] : cells_) {  // a large query triangle: scan the grid once
-        (void)k;
-        cand.insert(cand.end(), v.begin(), v.end());
-      }
-    } else {
-      for (long long x = a.x; x <= b.x; ++x)
-        for (long long y = a.y; y <= b.y; ++y)
-          for (long long z = a.z; z <= b.z; ++z) {
-            auto it = cells_.find({x, y, z});
-            if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
-          }
-    }
-    std::sort(cand.begin(), cand.end());
-    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    const std::vector<int> cand = candidates(lo, hi);
     for (int gi : cand) {
       if (gi == f.idx()) continue;
       const auto g = Mesh::FaceHandle(gi);
@@ -542,23 +547,7 @@ std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::a
         lo[a] = std::min(lo[a], pts[t][i][a]);
         hi[a] = std::max(hi[a], pts[t][i][a]);
       }
-    const Key a = key(lo), b = key(hi);
-    std::vector<int> cand(big_.begin(), big_.end());
-    if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
-      for (const auto& [k, v] : cells_) {
-        (void)k;
-        cand.insert(cand.end(), v.begin(), v.end());
-      }
-    } else {
-      for (long long x = a.x; x <= b.x; ++x)
-        for (long long y = a.y; y <= b.y; ++y)
-          for (long long z = a.z; z <= b.z; ++z) {
-            auto it = cells_.find({x, y, z});
-            if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
-          }
-    }
-    std::sort(cand.begin(), cand.end());
-    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    const std::vector<int> cand = candidates(lo, hi);
     for (int gi : cand) {
       Vec3 glo, ghi;
       std::array<int, 3> gids;

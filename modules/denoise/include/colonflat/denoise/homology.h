@@ -39,7 +39,6 @@ class HomologyBasis {
   int rank_ = 0, words_ = 1;
   std::vector<std::uint64_t> ann_;
   std::vector<std::uint8_t> cut_edge_, pruned_edge_;
-  std::size_t n_vertices_ = 0;
   std::vector<int> pruned_vertices_;
 };
 

@@ -45,6 +45,7 @@ class FaceGrid {
     }
   };
   Key key(const Vec3& p) const;
+  std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
   static constexpr long long kMaxCellsPerFace = 512;
   double cell_;
   std::unordered_map<Key, std::vector<int>, KeyHash> cells_;
