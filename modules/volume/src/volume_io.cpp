@@ -61,12 +61,19 @@ std::string full_ext(const fs::path& p) {
   return lower(p.extension().string());
 }
 
-// First line of an ITK exception description, without ITK's file/line decoration.
+// First line of an ITK exception description, without ITK's decoration ("ITK ERROR:",
+// "NrrdImageIO(0x55...):") and with a reason where ITK gives none.
 std::string itk_message(const itk::ExceptionObject& e) {
   std::string d = e.GetDescription() ? e.GetDescription() : "";
   const auto nl = d.find('\n');
   if (nl != std::string::npos) d = d.substr(0, nl);
-  while (!d.empty() && (d.back() == ' ' || d.back() == '.' || d.back() == '\r')) d.pop_back();
+  if (d.rfind("ITK ERROR: ", 0) == 0) d = d.substr(11);
+  const auto addr = d.find("(0x"), close = d.find("): ");
+  if (addr != std::string::npos && close != std::string::npos && addr < close) d = d.substr(close + 3);
+  while (!d.empty() && (d.back() == ' ' || d.back() == '.' || d.back() == '\r' || d.back() == ':')) d.pop_back();
+  // "Read: Error reading <file>" says nothing more than that the pixel data could not be read.
+  if (d.rfind("Read: Error reading", 0) == 0 || d.rfind("Error reading", 0) == 0)
+    d = "cannot read the pixel data (truncated or corrupt file)";
   if (d.empty()) d = "unreadable";
   return d;
 }

@@ -120,7 +120,8 @@ TEST(VolumeIoFormats, RefusesUnsupportedOutput) {
   EXPECT_TRUE(fs::is_empty(tmp.path()));
 }
 
-// Missing, unknown, truncated and empty-folder inputs: InputError naming the file and the problem.
+// Missing, unknown, truncated and empty-folder inputs: InputError naming the file and the problem
+// (for a truncated NRRD: the reason, without ITK's decoration).
 TEST(VolumeIoBadInput, ClearErrors) {
   testing::TempDir tmp;
   EXPECT_EQ(error_of([&] { read_ct_volume(tmp / "none.nrrd"); }), (tmp / "none.nrrd").string() + ": no such file");
@@ -136,6 +137,8 @@ TEST(VolumeIoBadInput, ClearErrors) {
   const std::string e = error_of([&] { read_ct_volume(tmp / "cut.nrrd"); });
   EXPECT_EQ(e.rfind((tmp / "cut.nrrd").string() + ": ", 0), 0u) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_NE(e.find("truncated or corrupt"), std::string::npos) << e;  // a reason, not ITK's bare "Error reading"
+  EXPECT_EQ(e.find("0x"), std::string::npos) << e;                    // no object addresses
   fs::create_directories(tmp / "empty");
   EXPECT_NE(error_of([&] { read_ct_volume(tmp / "empty"); }).find("no readable DICOM"), std::string::npos);
   try {
