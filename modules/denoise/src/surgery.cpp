@@ -126,6 +126,17 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
         }
       }
       target[i] = n ? c / double(n) : mesh.point(ring[i]);
+      Vec3 nrm(0, 0, 0);
+      for (auto f : mesh.vf_range(ring[i])) {
+        auto it = mesh.cfv_iter(f);
+        const Vec3 a = mesh.point(*it), b = mesh.point(*++it), d = mesh.point(*++it);
+        nrm += OpenMesh::cross(b - a, d - a);
+      }
+      if (nrm.norm() > 0) {
+        nrm /= nrm.norm();
+        const Vec3 move = target[i] - mesh.point(ring[i]);
+        target[i] = mesh.point(ring[i]) + move - OpenMesh::dot(move, nrm) * nrm;
+      }
     }
     return target;
   };
@@ -477,23 +488,50 @@ void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
 }
 
 namespace {
-// Triangles sharing vertices touch there; they intersect improperly (a fold) when they still
-// meet after their shared corners are pulled slightly towards their centroids.
+// Segment [p, q] against triangle (a, b, c), excluding the segment's first 1e-9 (Moller-Trumbore).
+bool segment_hits_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 d = q - p, e1 = b - a, e2 = c - a;
+  const Vec3 h = OpenMesh::cross(d, e2);
+  const double det = OpenMesh::dot(e1, h);
+  const double scale = e1.norm() * e2.norm() * d.norm();
+  if (std::fabs(det) <= 1e-12 * scale) return false;
+  const Vec3 s = p - a;
+  const double u = OpenMesh::dot(s, h) / det;
+  if (u < 0 || u > 1) return false;
+  const Vec3 qv = OpenMesh::cross(s, e1);
+  const double v = OpenMesh::dot(d, qv) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = OpenMesh::dot(e2, qv) / det;
+  return t > 1e-9 && t <= 1.0;
+}
+
+// Improper intersection of two triangles (ids = mesh vertex ids): disjoint ones by VTK's
+// triangle test; sharing one vertex v: an edge of one pierces the other away from v; sharing an
+// edge: the two fold flat onto each other.
 bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p, const std::array<int, 3>& gids,
                            const std::array<Vec3, 3>& q) {
-  int shared = 0;
-  std::array<Vec3, 3> pa = p, qa = q;
-  const Vec3 cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
+  int shared = 0, ia = -1, ib = -1;
   for (int i1 = 0; i1 < 3; ++i1)
     for (int i2 = 0; i2 < 3; ++i2)
       if (ids[i1] == gids[i2]) {
         ++shared;
-        pa[i1] += 1e-3 * (cp - pa[i1]);
-        qa[i2] += 1e-3 * (cq - qa[i2]);
+        ia = i1;
+        ib = i2;
       }
+  if (shared == 0)
+    return vtkTriangle::TrianglesIntersect(p[0].data(), p[1].data(), p[2].data(), q[0].data(), q[1].data(),
+                                           q[2].data()) != 0;
   if (shared == 3) return false;
-  return vtkTriangle::TrianglesIntersect(pa[0].data(), pa[1].data(), pa[2].data(), qa[0].data(), qa[1].data(),
-                                         qa[2].data()) != 0;
+  if (shared == 1) {
+    const Vec3& v = p[ia];
+    const Vec3 &a1 = p[(ia + 1) % 3], &a2 = p[(ia + 2) % 3], &b1 = q[(ib + 1) % 3], &b2 = q[(ib + 2) % 3];
+    return segment_hits_triangle(a1, a2, v, b1, b2) || segment_hits_triangle(b1, b2, v, a1, a2) ||
+           segment_hits_triangle(v, a1, v, b1, b2) || segment_hits_triangle(v, a2, v, b1, b2) ||
+           segment_hits_triangle(v, b1, v, a1, a2) || segment_hits_triangle(v, b2, v, a1, a2);
+  }
+  const Vec3 na = OpenMesh::cross(p[1] - p[0], p[2] - p[0]), nb = OpenMesh::cross(q[1] - q[0], q[2] - q[0]);
+  if (na.norm() == 0 || nb.norm() == 0) return false;
+  return OpenMesh::dot(na, nb) / (na.norm() * nb.norm()) < -0.9999999;
 }
 }  // namespace
 
