@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -143,6 +144,35 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
   const std::vector<Vec3> target_left = side_targets(r.left_ring), target_right = side_targets(r.right_ring);
   std::vector<Vec3> p0(k);
   for (std::size_t i = 0; i < k; ++i) p0[i] = mesh.point(loop[i]);
+  // 6a. Edge targets: the far end of the side edge most across the ring (direction least aligned
+  //     with the ring's tangent). A ring vertex moved along an edge of its own side stays on the
+  //     old surface, which keeps the faces around it from folding where the surface is creased
+  //     (marching-cubes junctions) and the averaged normal of the tangential target misleads.
+  auto edge_targets = [&](const std::vector<Mesh::VertexHandle>& ring) {
+    std::unordered_set<int> in_ring;
+    for (auto v : ring) in_ring.insert(v.idx());
+    std::vector<Vec3> target(ring.size());
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec3 p = mesh.point(ring[i]);
+      Vec3 tangent = mesh.point(ring[(i + 1) % k]) - mesh.point(ring[(i + k - 1) % k]);
+      if (tangent.norm() > 0) tangent /= tangent.norm();
+      target[i] = p;
+      double best = 2;
+      for (auto w : mesh.vv_range(ring[i])) {
+        if (in_ring.count(w.idx())) continue;
+        Vec3 d = mesh.point(w) - p;
+        const double len = d.norm();
+        if (len == 0) continue;
+        const double align = std::fabs(OpenMesh::dot(d / len, tangent));
+        if (align < best) {
+          best = align;
+          target[i] = mesh.point(w);
+        }
+      }
+    }
+    return target;
+  };
+  const std::vector<Vec3> edge_left = edge_targets(r.left_ring), edge_right = edge_targets(r.right_ring);
 
   // 6b. Classes of the left copies of the loop edges (needed by the caps): y_i copies h_i.
   const int W = homology ? homology->words() : 0;
@@ -218,49 +248,88 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
   // 7a. With a guard, loops up to 200 vertices first try minimum-area triangulations of the pulled
   //     rings: no interior vertex; on an elongated loop around a thin curved band they join
   //     opposite sides and follow the band, where a spanning minimal surface would cut through
-  //     its wall. Kept when neither they nor the faces around the pulled rings intersect anything.
+  //     its wall. If the plain one intersects something, the dynamic programme runs again over
+  //     triangles that intersect nothing (surface, other cap, existing edges). Kept when neither
+  //     the caps nor the faces around the pulled rings intersect anything; tried at three pulls.
   if (opts.guard && k <= 200) {
     std::vector<Mesh::VertexHandle> order_r = r.right_ring, order_l{r.left_ring[0]};
     for (std::size_t i = k - 1; i >= 1; --i) order_l.push_back(r.left_ring[i]);  // x_(k-1) -> ... -> x_0
-    for (std::size_t i = 0; i < k; ++i) {
-      mesh.point(r.left_ring[i]) = p0[i] + opts.ring_pull * (target_left[i] - p0[i]);
-      mesh.point(r.right_ring[i]) = p0[i] + opts.ring_pull * (target_right[i] - p0[i]);
-    }
     std::vector<Mesh::FaceHandle> ring_faces;
     for (const auto* ring : {&r.left_ring, &r.right_ring})
       for (auto v : *ring)
         for (auto f : mesh.vf_range(v)) ring_faces.push_back(f);
     std::sort(ring_faces.begin(), ring_faces.end());
     ring_faces.erase(std::unique(ring_faces.begin(), ring_faces.end()), ring_faces.end());
-    for (auto f : ring_faces) opts.guard->insert(mesh, f);
-    auto triangulate = [&](const std::vector<Mesh::VertexHandle>& ring) {
+    // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
+    auto chord = [&](const std::vector<Mesh::VertexHandle>& ring, int a, int b) {
+      const int n = static_cast<int>(ring.size());
+      if (std::abs(a - b) == 1 || std::abs(a - b) == n - 1) return false;  // a ring edge
+      return mesh.find_halfedge(ring[a], ring[b]).is_valid();
+    };
+    // Triangulates `ring`; `avoid`: only triangles that cross neither the surface, nor `other`, nor
+    // an existing edge (slower: used when the plain minimum-area one intersects something).
+    auto triangulate = [&](const std::vector<Mesh::VertexHandle>& ring, bool avoid,
+                           const std::vector<std::array<int, 3>>& other) {
       std::vector<Vec3> pts;
       for (auto v : ring) pts.push_back(mesh.point(v));
-      std::vector<std::array<int, 3>> t = min_area_triangulation(pts);
-      for (auto& tri : t)
+      // A near-collinear triangle (height below 1e-4 of its longest edge) is no cap face: it
+      // would leave a ring vertex on the next triangle's edge, touching the faces around it.
+      auto proper = [&](int i, int m, int j) {
+        const Vec3 &a = pts[i], &b = pts[m], &c = pts[j];
+        const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
+        return OpenMesh::cross(b - a, c - a).norm() >= 1e-4 * longest;
+      };
+      std::function<bool(int, int, int)> allowed = proper;
+      if (avoid)
+        allowed = [&](int i, int m, int j) {
+          if (!proper(i, m, j)) return false;
+          if (chord(ring, i, m) || chord(ring, m, j) || chord(ring, i, j)) return false;
+          const std::array<int, 3> t{ring[i].idx(), ring[m].idx(), ring[j].idx()};
+          return !opts.guard->hits(mesh, t, other);
+        };
+      std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed);
+      for (auto& tri : t) {
+        if (!avoid)
+          for (int e = 0; e < 3; ++e)
+            if (chord(ring, tri[e], tri[(e + 1) % 3])) return std::vector<std::array<int, 3>>{};
         for (int& i : tri) i = ring[i].idx();
+      }
       return t;
     };
-    const auto tri_r = triangulate(order_r), tri_l = triangulate(order_l);
-    std::vector<std::array<int, 3>> all = tri_r;
-    all.insert(all.end(), tri_l.begin(), tri_l.end());
-    // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
-    bool chord = false;
-    auto is_ring_edge = [&](int a, int b, const std::vector<Mesh::VertexHandle>& ring) {
-      for (std::size_t i = 0; i < k; ++i)
-        if ((ring[i].idx() == a && ring[(i + 1) % k].idx() == b) || (ring[i].idx() == b && ring[(i + 1) % k].idx() == a))
-          return true;
-      return false;
+    std::vector<std::array<int, 3>> tri_r, tri_l;
+    bool found = false;
+    struct Try {
+      double pull;
+      bool along_edge;
     };
-    for (const auto* tl : {&tri_r, &tri_l})
-      for (const auto& t : *tl)
-        for (int e = 0; e < 3; ++e) {
-          const int a = t[e], b = t[(e + 1) % 3];
-          const auto& ring = tl == &tri_r ? order_r : order_l;
-          if (!is_ring_edge(a, b, ring) && mesh.find_halfedge(Mesh::VertexHandle(a), Mesh::VertexHandle(b)).is_valid())
-            chord = true;
+    const double p1 = opts.ring_pull;
+    for (const Try tr : {Try{p1, false}, Try{p1, true}, Try{0.4, false}, Try{0.4, true}, Try{0.15, false},
+                         Try{0.15, true}, Try{0.08, true}}) {
+      const double pull = tr.pull;
+      if (pull <= 0) continue;
+      const auto& tl = tr.along_edge ? edge_left : target_left;
+      const auto& tg = tr.along_edge ? edge_right : target_right;
+      for (std::size_t i = 0; i < k; ++i) {
+        mesh.point(r.left_ring[i]) = p0[i] + pull * (tl[i] - p0[i]);
+        mesh.point(r.right_ring[i]) = p0[i] + pull * (tg[i] - p0[i]);
+      }
+      for (auto f : ring_faces) opts.guard->insert(mesh, f);
+      if (opts.guard->count_intersections(mesh, ring_faces) != 0) continue;
+      for (bool avoid : {false, true}) {
+        tri_r = triangulate(order_r, avoid, {});
+        if (tri_r.empty()) continue;
+        tri_l = triangulate(order_l, avoid, tri_r);
+        if (tri_l.empty()) continue;
+        std::vector<std::array<int, 3>> all = tri_r;
+        all.insert(all.end(), tri_l.begin(), tri_l.end());
+        if (opts.guard->count_triangles(mesh, all) == 0) {
+          found = true;
+          break;
         }
-    if (!chord && opts.guard->count_intersections(mesh, ring_faces) == 0 && opts.guard->count_triangles(mesh, all) == 0) {
+      }
+      if (found) break;
+    }
+    if (found) {
       // Add as ears of the shrinking hole, so that every face is added next to the boundary.
       auto add_ears = [&](const std::vector<Mesh::VertexHandle>& ring, std::vector<std::array<int, 3>> tris) {
         std::vector<int> poly;
@@ -601,7 +670,42 @@ std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::a
   return count;
 }
 
-std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring) {
+bool FaceGrid::hits(const Mesh& mesh, const std::array<int, 3>& tri,
+                    const std::vector<std::array<int, 3>>& others) const {
+  std::array<Vec3, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = mesh.point(Mesh::VertexHandle(tri[i]));
+  Vec3 lo = p[0], hi = p[0];
+  for (int i = 1; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[i][a]);
+      hi[a] = std::max(hi[a], p[i][a]);
+    }
+  auto disjoint_boxes = [&](const std::array<Vec3, 3>& q) {
+    for (int a = 0; a < 3; ++a) {
+      const double qlo = std::min({q[0][a], q[1][a], q[2][a]}), qhi = std::max({q[0][a], q[1][a], q[2][a]});
+      if (qlo > hi[a] || qhi < lo[a]) return true;
+    }
+    return false;
+  };
+  for (const auto& o : others) {
+    std::array<Vec3, 3> q;
+    for (int i = 0; i < 3; ++i) q[i] = mesh.point(Mesh::VertexHandle(o[i]));
+    if (!disjoint_boxes(q) && improper_intersection(tri, p, o, q)) return true;
+  }
+  for (int gi : candidates(lo, hi)) {
+    Vec3 glo, ghi;
+    std::array<int, 3> gids;
+    std::array<Vec3, 3> q;
+    face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
+    if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+      continue;
+    if (improper_intersection(tri, p, gids, q)) return true;
+  }
+  return false;
+}
+
+std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
+                                                        const std::function<bool(int, int, int)>& allowed) {
   const int n = static_cast<int>(ring.size());
   std::vector<std::array<int, 3>> tris;
   if (n < 3) return tris;
@@ -614,7 +718,7 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
       double best = std::numeric_limits<double>::infinity();
       for (int m = i + 1; m < j; ++m) {
         const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] + area(i, m, j);
-        if (w < best) {
+        if (w < best && (!allowed || allowed(i, m, j))) {
           best = w;
           arg[std::size_t(i) * n + j] = m;
         }
@@ -627,6 +731,7 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
     stack.pop_back();
     if (j - i < 2) continue;
     const int m = arg[std::size_t(i) * n + j];
+    if (m < 0) return {};  // every triangulation uses a forbidden triangle
     tris.push_back({i, m, j});
     stack.push_back({i, m});
     stack.push_back({m, j});

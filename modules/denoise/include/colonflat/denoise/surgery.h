@@ -6,10 +6,13 @@
 // vertex. Unlike the paper, whose two centroid fans coincide in space, each ring is first pulled
 // a fraction of the way into its own side (towards its own neighbours), and each cap is a small
 // disk relaxed to a discrete minimal surface spanning its pulled ring (centre vertex at the
-// centroid for a plain fan), so the two caps are disjoint and follow non-planar loops. Nothing is deleted: the input's
+// centroid for a plain fan), so the two caps are disjoint and follow non-planar loops. With a
+// guard, caps are first minimum-area triangulations of the pulled rings, restricted when needed
+// to triangles that intersect nothing (see surgery.cpp, step 7a). Nothing is deleted: the input's
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -31,6 +34,9 @@ class FaceGrid {
   // Intersections of triangles not (yet) in the mesh, given by mesh vertex ids, with the grid's
   // faces and with each other.
   std::size_t count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const;
+  // True when triangle `tri` (mesh vertex ids, not in the mesh) intersects a grid face or one of
+  // `others` (stops at the first hit).
+  bool hits(const Mesh& mesh, const std::array<int, 3>& tri, const std::vector<std::array<int, 3>>& others = {}) const;
   // The intersecting pairs themselves (same rules as count_intersections).
   std::vector<std::pair<int, int>> intersecting_pairs(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
 
@@ -73,8 +79,11 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
                           HomologyBasis* homology = nullptr);
 
 // Minimum-area triangulation of a closed polygon (dynamic programming, O(n^3)); triangles
-// (i, m, j) with i < m < j index `ring` and are oriented like the polygon.
-std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring);
+// (i, m, j) with i < m < j index `ring` and are oriented like the polygon. With `allowed`, only
+// triangles it accepts are used (called once per candidate that would improve a subproblem);
+// empty result when no triangulation consists of allowed triangles.
+std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
+                                                        const std::function<bool(int, int, int)>& allowed = {});
 
 // True when a and b are connected in the mesh graph (bidirectional breadth-first search, which
 // stops early when both sides meet: cheap for the small handles of denoising).
