@@ -520,8 +520,9 @@ void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::arr
 std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   const Key a = key(lo), b = key(hi);
   std::vector<int> cand(big_.begin(), big_.end());
-  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
-    for (const auto& [k, v] : cells_) {  // a large query box: scan the grid once
+  const double box_cells = double(b.x - a.x + 1) * double(b.y - a.y + 1) * double(b.z - a.z + 1);
+  if (box_cells > double(cells_.size())) {
+    for (const auto& [k, v] : cells_) {  // a query box with more cells than the grid: scan the grid
       (void)k;
       cand.insert(cand.end(), v.begin(), v.end());
     }

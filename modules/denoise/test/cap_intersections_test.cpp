@@ -60,6 +60,7 @@ struct Band {
   double thickness;
   int twist;
 };
+void PrintTo(const Band& b, std::ostream* os) { *os << "thickness " << b.thickness << ", " << b.twist << " half turns"; }
 
 class DenoiseCapIntersections : public ::testing::TestWithParam<Band> {};
 
@@ -87,7 +88,11 @@ TEST_P(DenoiseCapIntersections, ChevronBandCutCleanly) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bands, DenoiseCapIntersections,
-                         ::testing::Values(Band{0.05, 0}, Band{0.05, 2}, Band{0.02, 2}, Band{0.1, 4}));
+                         ::testing::Values(Band{0.05, 0}, Band{0.05, 2}, Band{0.02, 2}, Band{0.1, 4}),
+                         [](const ::testing::TestParamInfo<Band>& i) {
+                           return "t" + std::to_string(static_cast<int>(i.param.thickness * 1000)) + "um_twist" +
+                                  std::to_string(i.param.twist);
+                         });
 
 // Flying-edges surfaces of a sphere with half-sunk tori (12 handles, ~20K faces): the tunnel loops
 // at the torus-sphere junctions run along creases where pulling a ring along the averaged tangent

@@ -23,6 +23,7 @@ struct Case {
   int genus;
   std::size_t components, faces;
 };
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 std::vector<Case> closed_cases() {
   std::vector<Case> out;
