@@ -643,28 +643,34 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
   return pairs;
 }
 
+std::size_t FaceGrid::grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
+                                bool first_only) const {
+  Vec3 lo = p[0], hi = p[0];
+  for (int i = 1; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[i][a]);
+      hi[a] = std::max(hi[a], p[i][a]);
+    }
+  std::size_t count = 0;
+  for (int gi : candidates(lo, hi)) {
+    Vec3 glo, ghi;
+    std::array<int, 3> gids;
+    std::array<Vec3, 3> q;
+    face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
+    if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+      continue;
+    if (improper_intersection(ids, p, gids, q) && (++count, first_only)) break;
+  }
+  return count;
+}
+
 std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const {
   std::size_t count = 0;
   std::vector<std::array<Vec3, 3>> pts(tris.size());
   for (std::size_t t = 0; t < tris.size(); ++t)
     for (int i = 0; i < 3; ++i) pts[t][i] = mesh.point(Mesh::VertexHandle(tris[t][i]));
   for (std::size_t t = 0; t < tris.size(); ++t) {
-    Vec3 lo = pts[t][0], hi = pts[t][0];
-    for (int i = 1; i < 3; ++i)
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], pts[t][i][a]);
-        hi[a] = std::max(hi[a], pts[t][i][a]);
-      }
-    const std::vector<int> cand = candidates(lo, hi);
-    for (int gi : cand) {
-      Vec3 glo, ghi;
-      std::array<int, 3> gids;
-      std::array<Vec3, 3> q;
-      face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
-      if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
-        continue;
-      if (improper_intersection(tris[t], pts[t], gids, q)) ++count;
-    }
+    count += grid_hits(mesh, tris[t], pts[t], false);
     for (std::size_t u = t + 1; u < tris.size(); ++u)
       if (improper_intersection(tris[t], pts[t], tris[u], pts[u])) ++count;
   }
@@ -675,34 +681,16 @@ bool FaceGrid::hits(const Mesh& mesh, const std::array<int, 3>& tri,
                     const std::vector<std::array<int, 3>>& others) const {
   std::array<Vec3, 3> p;
   for (int i = 0; i < 3; ++i) p[i] = mesh.point(Mesh::VertexHandle(tri[i]));
-  Vec3 lo = p[0], hi = p[0];
-  for (int i = 1; i < 3; ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[i][a]);
-      hi[a] = std::max(hi[a], p[i][a]);
-    }
-  auto disjoint_boxes = [&](const std::array<Vec3, 3>& q) {
-    for (int a = 0; a < 3; ++a) {
-      const double qlo = std::min({q[0][a], q[1][a], q[2][a]}), qhi = std::max({q[0][a], q[1][a], q[2][a]});
-      if (qlo > hi[a] || qhi < lo[a]) return true;
-    }
-    return false;
-  };
   for (const auto& o : others) {
     std::array<Vec3, 3> q;
     for (int i = 0; i < 3; ++i) q[i] = mesh.point(Mesh::VertexHandle(o[i]));
-    if (!disjoint_boxes(q) && improper_intersection(tri, p, o, q)) return true;
+    bool apart = false;  // bounding boxes disjoint
+    for (int a = 0; a < 3 && !apart; ++a)
+      apart = std::min({q[0][a], q[1][a], q[2][a]}) > std::max({p[0][a], p[1][a], p[2][a]}) ||
+              std::max({q[0][a], q[1][a], q[2][a]}) < std::min({p[0][a], p[1][a], p[2][a]});
+    if (!apart && improper_intersection(tri, p, o, q)) return true;
   }
-  for (int gi : candidates(lo, hi)) {
-    Vec3 glo, ghi;
-    std::array<int, 3> gids;
-    std::array<Vec3, 3> q;
-    face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
-    if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
-      continue;
-    if (improper_intersection(tri, p, gids, q)) return true;
-  }
-  return false;
+  return grid_hits(mesh, tri, p, true) > 0;
 }
 
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,

@@ -52,6 +52,9 @@ class FaceGrid {
   };
   Key key(const Vec3& p) const;
   std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
+  // Grid faces that triangle (ids, p) intersects improperly (at most 1 with first_only).
+  std::size_t grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
+                        bool first_only) const;
   static constexpr long long kMaxCellsPerFace = 512;
   double cell_;
   std::unordered_map<Key, std::vector<int>, KeyHash> cells_;
