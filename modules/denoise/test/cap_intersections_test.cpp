@@ -59,19 +59,22 @@ double mean_edge(const Mesh& m) {
 struct Band {
   double thickness;
   int twist;
+  int side = 20;  // vertices per wall side: loops of 2 x side vertices
 };
-void PrintTo(const Band& b, std::ostream* os) { *os << "thickness " << b.thickness << ", " << b.twist << " half turns"; }
+void PrintTo(const Band& b, std::ostream* os) {
+  *os << "thickness " << b.thickness << ", " << b.twist << " half turns, loop of " << 2 * b.side;
+}
 
 class DenoiseCapIntersections : public ::testing::TestWithParam<Band> {};
 
-// Cutting a thin chevron band across (loops of 40 vertices, like heptoroid's) leaves a closed,
-// manifold, genus-0 surface with no self-intersection, and the guard reports none.
+// Cutting a thin chevron band across (loops of 40 vertices like heptoroid's, and of 300) leaves a
+// closed, manifold, genus-0 surface with no self-intersection, and the guard reports none.
 TEST_P(DenoiseCapIntersections, ChevronBandCutCleanly) {
   const Band b = GetParam();
-  Mesh m = chevron_band(b.thickness, 20, 48, b.twist);
+  Mesh m = chevron_band(b.thickness, b.side, 48, b.twist);
   ASSERT_EQ(analyze_topology(m).genus, 1);
   ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the band itself must be embedded";
-  const int n = 40;
+  const int n = 2 * b.side;
   std::vector<Mesh::VertexHandle> loop;
   for (int j = 0; j < n; ++j) loop.push_back(Mesh::VertexHandle(7 * n + j));
   FaceGrid grid(m, 2 * mean_edge(m));
@@ -88,10 +91,10 @@ TEST_P(DenoiseCapIntersections, ChevronBandCutCleanly) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bands, DenoiseCapIntersections,
-                         ::testing::Values(Band{0.05, 0}, Band{0.05, 2}, Band{0.02, 2}, Band{0.1, 4}),
+                         ::testing::Values(Band{0.05, 0}, Band{0.05, 2}, Band{0.02, 2}, Band{0.1, 4}, Band{0.02, 2, 150}),
                          [](const ::testing::TestParamInfo<Band>& i) {
                            return "t" + std::to_string(static_cast<int>(i.param.thickness * 1000)) + "um_twist" +
-                                  std::to_string(i.param.twist);
+                                  std::to_string(i.param.twist) + "_loop" + std::to_string(2 * i.param.side);
                          });
 
 // Flying-edges surfaces of a sphere with half-sunk tori (12 handles, ~20K faces): the tunnel loops

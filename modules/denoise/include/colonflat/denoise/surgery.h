@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
@@ -58,7 +59,8 @@ class FaceGrid {
   static constexpr long long kMaxCellsPerFace = 512;
   double cell_;
   std::unordered_map<Key, std::vector<int>, KeyHash> cells_;
-  std::vector<int> big_;  // faces spanning more than kMaxCellsPerFace cells
+  std::vector<int> big_;  // faces spanning more than kMaxCellsPerFace cells (each once)
+  std::unordered_set<int> big_set_;
 };
 
 struct SurgeryOptions {
@@ -82,7 +84,8 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
                           HomologyBasis* homology = nullptr);
 
 // Minimum-area triangulation of a closed polygon (dynamic programming, O(n^3)); triangles
-// (i, m, j) with i < m < j index `ring` and are oriented like the polygon. With `allowed`, only
+// (i, m, j) with i < m < j index `ring` and are oriented like the polygon, listed as ears: each
+// triangle has two edges on the polygon left by removing the ones before it. With `allowed`, only
 // triangles it accepts are used (called once per candidate that would improve a subproblem);
 // empty result when no triangulation consists of allowed triangles.
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
