@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/synthetic.h"
@@ -79,82 +78,6 @@ TEST(DenoiseSurgery, RepeatedSurgery) {
   EXPECT_EQ(t.genus, 1);
   EXPECT_EQ(t.components.size(), 1u);
   EXPECT_TRUE(t.consistently_oriented);
-}
-
-double triangulation_area(const std::vector<Vec3>& ring, const std::vector<std::array<int, 3>>& tris) {
-  double a = 0;
-  for (const auto& t : tris) a += 0.5 * OpenMesh::cross(ring[t[1]] - ring[t[0]], ring[t[2]] - ring[t[0]]).norm();
-  return a;
-}
-
-// True when each triangle, in order, is three consecutive corners of the polygon left by
-// clipping the ones before it (the order in which surgery adds cap faces).
-bool ear_order(int n, const std::vector<std::array<int, 3>>& tris) {
-  std::vector<int> poly(n);
-  for (int i = 0; i < n; ++i) poly[i] = i;
-  for (const auto& t : tris) {
-    bool clipped = false;
-    for (std::size_t j = 0; j < poly.size() && !clipped; ++j) {
-      const std::size_t j1 = (j + 1) % poly.size(), j2 = (j + 2) % poly.size();
-      if (poly[j] == t[0] && poly[j1] == t[1] && poly[j2] == t[2]) {
-        poly.erase(poly.begin() + static_cast<long>(j1));
-        clipped = true;
-      }
-    }
-    if (!clipped) return false;
-  }
-  return poly.size() == 2;
-}
-
-// A planar non-convex polygon (an L) gets a proper triangulation: n - 2 triangles in ear order,
-// all turning the polygon's way, covering exactly its area (4 unit squares).
-TEST(DenoiseSurgery, MinAreaTriangulationOfPlanarPolygon) {
-  const std::vector<Vec3> L = {Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(3, 1, 0), Vec3(1, 1, 0), Vec3(1, 2, 0), Vec3(0, 2, 0)};
-  const auto tris = min_area_triangulation(L);
-  ASSERT_EQ(tris.size(), L.size() - 2);
-  EXPECT_TRUE(ear_order(static_cast<int>(L.size()), tris));
-  EXPECT_NEAR(triangulation_area(L, tris), 4.0, 1e-12);
-  for (const auto& t : tris) EXPECT_GT(OpenMesh::cross(L[t[1]] - L[t[0]], L[t[2]] - L[t[0]])[2], 0);
-}
-
-// On a long, bumpy 3D ring (300 corners) the triangulation still comes in ear order.
-TEST(DenoiseSurgery, MinAreaTriangulationIsInEarOrder) {
-  std::vector<Vec3> ring;
-  for (int i = 0; i < 300; ++i) {
-    const double a = 2 * M_PI * i / 300;
-    ring.push_back(Vec3(3 * std::cos(a), std::sin(a), 0.3 * std::sin(7 * a)));
-  }
-  const auto tris = min_area_triangulation(ring);
-  ASSERT_EQ(tris.size(), ring.size() - 2);
-  EXPECT_TRUE(ear_order(static_cast<int>(ring.size()), tris));
-}
-
-// `allowed` is obeyed: forbidding every diagonal at vertex 0 forces the ear (0, 1, 5); forbidding
-// everything yields no triangulation.
-TEST(DenoiseSurgery, MinAreaTriangulationRespectsAllowed) {
-  std::vector<Vec3> hexagon;
-  for (int i = 0; i < 6; ++i) hexagon.push_back(Vec3(std::cos(i * M_PI / 3), std::sin(i * M_PI / 3), 0));
-  auto no_diagonal_at_0 = [](int i, int m, int j) { return i != 0 || (m == 1 && j == 5); };
-  const auto tris = min_area_triangulation(hexagon, no_diagonal_at_0);
-  ASSERT_EQ(tris.size(), 4u);
-  for (const auto& t : tris) EXPECT_TRUE(no_diagonal_at_0(t[0], t[1], t[2]));
-  EXPECT_NE(std::find(tris.begin(), tris.end(), std::array<int, 3>{0, 1, 5}), tris.end());
-  EXPECT_NEAR(triangulation_area(hexagon, tris), 1.5 * std::sqrt(3.0), 1e-12);
-  EXPECT_TRUE(min_area_triangulation(hexagon, [](int, int, int) { return false; }).empty());
-}
-
-// FaceGrid::hits: a triangle piercing the surface is caught, one beside it is not, and so is a
-// crossing with one of the extra triangles.
-TEST(DenoiseSurgery, FaceGridHitsPiercingTriangles) {
-  Mesh m = to_mesh(sphere(1, 16, 8));
-  const FaceGrid grid(m, 0.3);
-  const auto in = m.add_vertex(Vec3(0, 0, 0.5)), out = m.add_vertex(Vec3(0, 0, 1.5)), side = m.add_vertex(Vec3(0.1, 0, 1.5));
-  const auto far1 = m.add_vertex(Vec3(0, 0, 2)), far2 = m.add_vertex(Vec3(0.1, 0, 2)), far3 = m.add_vertex(Vec3(0, 0.1, 2));
-  EXPECT_TRUE(grid.hits(m, {in.idx(), out.idx(), side.idx()}));
-  EXPECT_FALSE(grid.hits(m, {far1.idx(), far2.idx(), far3.idx()}));
-  const auto c1 = m.add_vertex(Vec3(-0.05, 0.05, 1.75)), c2 = m.add_vertex(Vec3(0.15, 0.05, 1.75)),
-             c3 = m.add_vertex(Vec3(0.05, -0.2, 1.75));
-  EXPECT_TRUE(grid.hits(m, {far1.idx(), far2.idx(), out.idx()}, {{c1.idx(), c2.idx(), c3.idx()}}));
 }
 
 // Invalid loops are refused with a reason: too short, not simple, not edge-connected, on the boundary.

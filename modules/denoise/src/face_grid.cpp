@@ -1,0 +1,214 @@
+#include "colonflat/denoise/face_grid.h"
+
+#include <vtkTriangle.h>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+namespace cf {
+
+FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) {
+  for (auto f : mesh.faces()) insert(mesh, f);
+}
+
+FaceGrid::Key FaceGrid::key(const Vec3& p) const {
+  return {static_cast<long long>(std::floor(p[0] / cell_)), static_cast<long long>(std::floor(p[1] / cell_)),
+          static_cast<long long>(std::floor(p[2] / cell_))};
+}
+
+namespace {
+void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::array<int, 3>& ids,
+              std::array<Vec3, 3>& pts) {
+  int k = 0;
+  for (auto v : mesh.fv_range(f)) {
+    ids[k] = v.idx();
+    pts[k] = mesh.point(v);
+    ++k;
+  }
+  lo = hi = pts[0];
+  for (int i = 1; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], pts[i][a]);
+      hi[a] = std::max(hi[a], pts[i][a]);
+    }
+}
+}  // namespace
+
+std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
+  const Key a = key(lo), b = key(hi);
+  std::vector<int> cand(big_.begin(), big_.end());
+  const double box_cells = double(b.x - a.x + 1) * double(b.y - a.y + 1) * double(b.z - a.z + 1);
+  if (box_cells > double(cells_.size())) {
+    for (const auto& [k, v] : cells_) {  // a query box with more cells than the grid: scan the grid
+      (void)k;
+      cand.insert(cand.end(), v.begin(), v.end());
+    }
+  } else {
+    for (long long x = a.x; x <= b.x; ++x)
+      for (long long y = a.y; y <= b.y; ++y)
+        for (long long z = a.z; z <= b.z; ++z) {
+          auto it = cells_.find({x, y, z});
+          if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
+        }
+  }
+  std::sort(cand.begin(), cand.end());
+  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  return cand;
+}
+
+void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
+  Vec3 lo, hi;
+  std::array<int, 3> ids;
+  std::array<Vec3, 3> pts;
+  face_box(mesh, f, lo, hi, ids, pts);
+  const Key a = key(lo), b = key(hi);
+  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
+    if (big_set_.insert(f.idx()).second) big_.push_back(f.idx());  // checked by every query instead
+    return;
+  }
+  for (long long x = a.x; x <= b.x; ++x)
+    for (long long y = a.y; y <= b.y; ++y)
+      for (long long z = a.z; z <= b.z; ++z) {
+        auto& v = cells_[{x, y, z}];
+        if (std::find(v.begin(), v.end(), f.idx()) == v.end()) v.push_back(f.idx());
+      }
+}
+
+namespace {
+// Segment [p, q] against triangle (a, b, c), excluding the segment's first 1e-9 (Moller-Trumbore).
+bool segment_hits_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 d = q - p, e1 = b - a, e2 = c - a;
+  const Vec3 h = OpenMesh::cross(d, e2);
+  const double det = OpenMesh::dot(e1, h);
+  const double scale = e1.norm() * e2.norm() * d.norm();
+  if (std::fabs(det) <= 1e-12 * scale) return false;
+  const Vec3 s = p - a;
+  const double u = OpenMesh::dot(s, h) / det;
+  if (u < 0 || u > 1) return false;
+  const Vec3 qv = OpenMesh::cross(s, e1);
+  const double v = OpenMesh::dot(d, qv) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = OpenMesh::dot(e2, qv) / det;
+  return t > 1e-9 && t <= 1.0;
+}
+
+// Improper intersection of two triangles (ids = mesh vertex ids): disjoint ones by VTK's
+// triangle test; sharing one vertex v: an edge of one pierces the other away from v; sharing an
+// edge: the two fold flat onto each other.
+bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p, const std::array<int, 3>& gids,
+                           const std::array<Vec3, 3>& q) {
+  int shared = 0, ia = -1, ib = -1;
+  for (int i1 = 0; i1 < 3; ++i1)
+    for (int i2 = 0; i2 < 3; ++i2)
+      if (ids[i1] == gids[i2]) {
+        ++shared;
+        ia = i1;
+        ib = i2;
+      }
+  if (shared == 0)
+    return vtkTriangle::TrianglesIntersect(p[0].data(), p[1].data(), p[2].data(), q[0].data(), q[1].data(),
+                                           q[2].data()) != 0;
+  if (shared == 3) return false;
+  if (shared == 1) {
+    const Vec3& v = p[ia];
+    const Vec3 &a1 = p[(ia + 1) % 3], &a2 = p[(ia + 2) % 3], &b1 = q[(ib + 1) % 3], &b2 = q[(ib + 2) % 3];
+    return segment_hits_triangle(a1, a2, v, b1, b2) || segment_hits_triangle(b1, b2, v, a1, a2) ||
+           segment_hits_triangle(v, a1, v, b1, b2) || segment_hits_triangle(v, a2, v, b1, b2) ||
+           segment_hits_triangle(v, b1, v, a1, a2) || segment_hits_triangle(v, b2, v, a1, a2);
+  }
+  const Vec3 na = OpenMesh::cross(p[1] - p[0], p[2] - p[0]), nb = OpenMesh::cross(q[1] - q[0], q[2] - q[0]);
+  if (na.norm() == 0 || nb.norm() == 0) return false;
+  return OpenMesh::dot(na, nb) / (na.norm() * nb.norm()) < -0.9999999;
+}
+}  // namespace
+
+std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const {
+  return intersecting_pairs(mesh, faces).size();
+}
+
+std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
+                                                              const std::vector<Mesh::FaceHandle>& faces) const {
+  std::vector<std::pair<int, int>> pairs;
+  std::unordered_set<int> in_set;
+  for (auto f : faces) in_set.insert(f.idx());
+  std::unordered_set<long long> seen;
+  for (auto f : faces) {
+    Vec3 lo, hi;
+    std::array<int, 3> ids;
+    std::array<Vec3, 3> p;
+    face_box(mesh, f, lo, hi, ids, p);
+    // Candidates: faces in the cells (the caller inserts moved faces at their current place;
+    // stale cells only cost time, the test below uses current geometry).
+    const std::vector<int> cand = candidates(lo, hi);
+    for (int gi : cand) {
+      if (gi == f.idx()) continue;
+      const auto g = Mesh::FaceHandle(gi);
+      if (in_set.count(gi)) {
+        const long long lo_id = std::min(f.idx(), gi), hi_id = std::max(f.idx(), gi);
+        if (!seen.insert(lo_id * 4000000000LL + hi_id).second) continue;
+      }
+      Vec3 glo, ghi;
+      std::array<int, 3> gids;
+      std::array<Vec3, 3> q;
+      face_box(mesh, g, glo, ghi, gids, q);
+      if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+        continue;
+      if (improper_intersection(ids, p, gids, q))
+        pairs.emplace_back(f.idx(), gi);
+    }
+  }
+  return pairs;
+}
+
+std::size_t FaceGrid::grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
+                                bool first_only) const {
+  Vec3 lo = p[0], hi = p[0];
+  for (int i = 1; i < 3; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[i][a]);
+      hi[a] = std::max(hi[a], p[i][a]);
+    }
+  std::size_t count = 0;
+  for (int gi : candidates(lo, hi)) {
+    Vec3 glo, ghi;
+    std::array<int, 3> gids;
+    std::array<Vec3, 3> q;
+    face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
+    if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
+      continue;
+    if (improper_intersection(ids, p, gids, q) && (++count, first_only)) break;
+  }
+  return count;
+}
+
+std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const {
+  std::size_t count = 0;
+  std::vector<std::array<Vec3, 3>> pts(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int i = 0; i < 3; ++i) pts[t][i] = mesh.point(Mesh::VertexHandle(tris[t][i]));
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    count += grid_hits(mesh, tris[t], pts[t], false);
+    for (std::size_t u = t + 1; u < tris.size(); ++u)
+      if (improper_intersection(tris[t], pts[t], tris[u], pts[u])) ++count;
+  }
+  return count;
+}
+
+bool FaceGrid::hits(const Mesh& mesh, const std::array<int, 3>& tri,
+                    const std::vector<std::array<int, 3>>& others) const {
+  std::array<Vec3, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = mesh.point(Mesh::VertexHandle(tri[i]));
+  for (const auto& o : others) {
+    std::array<Vec3, 3> q;
+    for (int i = 0; i < 3; ++i) q[i] = mesh.point(Mesh::VertexHandle(o[i]));
+    bool apart = false;  // bounding boxes disjoint
+    for (int a = 0; a < 3 && !apart; ++a)
+      apart = std::min({q[0][a], q[1][a], q[2][a]}) > std::max({p[0][a], p[1][a], p[2][a]}) ||
+              std::max({q[0][a], q[1][a], q[2][a]}) < std::min({p[0][a], p[1][a], p[2][a]});
+    if (!apart && improper_intersection(tri, p, o, q)) return true;
+  }
+  return grid_hits(mesh, tri, p, true) > 0;
+}
+
+}  // namespace cf

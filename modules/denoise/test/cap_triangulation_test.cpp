@@ -1,0 +1,76 @@
+// Minimum-area triangulation of closed polygons: proper on planar polygons, in ear order (the
+// order surgery adds cap faces), and restricted to the triangles `allowed` accepts.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "colonflat/denoise/cap_triangulation.h"
+
+namespace cf {
+namespace {
+
+double triangulation_area(const std::vector<Vec3>& ring, const std::vector<std::array<int, 3>>& tris) {
+  double a = 0;
+  for (const auto& t : tris) a += 0.5 * OpenMesh::cross(ring[t[1]] - ring[t[0]], ring[t[2]] - ring[t[0]]).norm();
+  return a;
+}
+
+// True when each triangle, in order, is three consecutive corners of the polygon left by
+// clipping the ones before it (the order in which surgery adds cap faces).
+bool ear_order(int n, const std::vector<std::array<int, 3>>& tris) {
+  std::vector<int> poly(n);
+  for (int i = 0; i < n; ++i) poly[i] = i;
+  for (const auto& t : tris) {
+    bool clipped = false;
+    for (std::size_t j = 0; j < poly.size() && !clipped; ++j) {
+      const std::size_t j1 = (j + 1) % poly.size(), j2 = (j + 2) % poly.size();
+      if (poly[j] == t[0] && poly[j1] == t[1] && poly[j2] == t[2]) {
+        poly.erase(poly.begin() + static_cast<long>(j1));
+        clipped = true;
+      }
+    }
+    if (!clipped) return false;
+  }
+  return poly.size() == 2;
+}
+
+// A planar non-convex polygon (an L) gets a proper triangulation: n - 2 triangles in ear order,
+// all turning the polygon's way, covering exactly its area (4 unit squares).
+TEST(DenoiseCapTriangulation, MinAreaTriangulationOfPlanarPolygon) {
+  const std::vector<Vec3> L = {Vec3(0, 0, 0), Vec3(3, 0, 0), Vec3(3, 1, 0), Vec3(1, 1, 0), Vec3(1, 2, 0), Vec3(0, 2, 0)};
+  const auto tris = min_area_triangulation(L);
+  ASSERT_EQ(tris.size(), L.size() - 2);
+  EXPECT_TRUE(ear_order(static_cast<int>(L.size()), tris));
+  EXPECT_NEAR(triangulation_area(L, tris), 4.0, 1e-12);
+  for (const auto& t : tris) EXPECT_GT(OpenMesh::cross(L[t[1]] - L[t[0]], L[t[2]] - L[t[0]])[2], 0);
+}
+
+// On a long, bumpy 3D ring (300 corners) the triangulation still comes in ear order.
+TEST(DenoiseCapTriangulation, MinAreaTriangulationIsInEarOrder) {
+  std::vector<Vec3> ring;
+  for (int i = 0; i < 300; ++i) {
+    const double a = 2 * M_PI * i / 300;
+    ring.push_back(Vec3(3 * std::cos(a), std::sin(a), 0.3 * std::sin(7 * a)));
+  }
+  const auto tris = min_area_triangulation(ring);
+  ASSERT_EQ(tris.size(), ring.size() - 2);
+  EXPECT_TRUE(ear_order(static_cast<int>(ring.size()), tris));
+}
+
+// `allowed` is obeyed: forbidding every diagonal at vertex 0 forces the ear (0, 1, 5); forbidding
+// everything yields no triangulation.
+TEST(DenoiseCapTriangulation, MinAreaTriangulationRespectsAllowed) {
+  std::vector<Vec3> hexagon;
+  for (int i = 0; i < 6; ++i) hexagon.push_back(Vec3(std::cos(i * M_PI / 3), std::sin(i * M_PI / 3), 0));
+  auto no_diagonal_at_0 = [](int i, int m, int j) { return i != 0 || (m == 1 && j == 5); };
+  const auto tris = min_area_triangulation(hexagon, no_diagonal_at_0);
+  ASSERT_EQ(tris.size(), 4u);
+  for (const auto& t : tris) EXPECT_TRUE(no_diagonal_at_0(t[0], t[1], t[2]));
+  EXPECT_NE(std::find(tris.begin(), tris.end(), std::array<int, 3>{0, 1, 5}), tris.end());
+  EXPECT_NEAR(triangulation_area(hexagon, tris), 1.5 * std::sqrt(3.0), 1e-12);
+  EXPECT_TRUE(min_area_triangulation(hexagon, [](int, int, int) { return false; }).empty());
+}
+
+}  // namespace
+}  // namespace cf
