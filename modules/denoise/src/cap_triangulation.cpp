@@ -1,6 +1,7 @@
 #include "colonflat/denoise/cap_triangulation.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 
 namespace cf {
@@ -39,6 +40,34 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
   }
   std::reverse(tris.begin(), tris.end());  // every triangle after the ones inside its sub-polygons
   return tris;
+}
+
+std::vector<std::array<int, 3>> triangulate_ring(
+    const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
+    const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid,
+    const std::vector<std::array<int, 3>>& others) {
+  const int n = static_cast<int>(ring.size());
+  std::vector<Vec3> pts;
+  for (auto v : ring) pts.push_back(mesh.point(v));
+  auto diagonal_ok = [&](int a, int b) {
+    if (std::abs(a - b) == 1 || std::abs(a - b) == n - 1) return true;  // a ring edge
+    return !blocked(ring[a], ring[b]);
+  };
+  auto allowed = [&](int i, int m, int j) {
+    const Vec3 &a = pts[i], &b = pts[m], &c = pts[j];
+    const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
+    if (OpenMesh::cross(b - a, c - a).norm() < 1e-4 * longest) return false;
+    if (!grid) return true;  // diagonals are checked on the result: cheaper than here
+    if (!diagonal_ok(i, m) || !diagonal_ok(m, j) || !diagonal_ok(i, j)) return false;
+    return !grid->hits(mesh, {ring[i].idx(), ring[m].idx(), ring[j].idx()}, others);
+  };
+  std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed);
+  for (auto& tri : t) {
+    for (int e = 0; e < 3; ++e)
+      if (!diagonal_ok(tri[e], tri[(e + 1) % 3])) return {};
+    for (int& i : tri) i = ring[i].idx();
+  }
+  return t;
 }
 
 }  // namespace cf

@@ -268,40 +268,10 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
     std::sort(ring_faces.begin(), ring_faces.end());
     ring_faces.erase(std::unique(ring_faces.begin(), ring_faces.end()), ring_faces.end());
     // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
-    auto chord = [&](const std::vector<Mesh::VertexHandle>& ring, int a, int b) {
-      const int n = static_cast<int>(ring.size());
-      if (std::abs(a - b) == 1 || std::abs(a - b) == n - 1) return false;  // a ring edge
-      return mesh.find_halfedge(ring[a], ring[b]).is_valid();
-    };
-    // Triangulates `ring`; `avoid`: only triangles that cross neither the surface, nor `other`, nor
-    // an existing edge (slower: used when the plain minimum-area one intersects something).
+    auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh.find_halfedge(a, b).is_valid(); };
     auto triangulate = [&](const std::vector<Mesh::VertexHandle>& ring, bool avoid,
                            const std::vector<std::array<int, 3>>& other) {
-      std::vector<Vec3> pts;
-      for (auto v : ring) pts.push_back(mesh.point(v));
-      // A near-collinear triangle (height below 1e-4 of its longest edge) is no cap face: it
-      // would leave a ring vertex on the next triangle's edge, touching the faces around it.
-      auto proper = [&](int i, int m, int j) {
-        const Vec3 &a = pts[i], &b = pts[m], &c = pts[j];
-        const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
-        return OpenMesh::cross(b - a, c - a).norm() >= 1e-4 * longest;
-      };
-      std::function<bool(int, int, int)> allowed = proper;
-      if (avoid)
-        allowed = [&](int i, int m, int j) {
-          if (!proper(i, m, j)) return false;
-          if (chord(ring, i, m) || chord(ring, m, j) || chord(ring, i, j)) return false;
-          const std::array<int, 3> t{ring[i].idx(), ring[m].idx(), ring[j].idx()};
-          return !opts.guard->hits(mesh, t, other);
-        };
-      std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed);
-      for (auto& tri : t) {
-        if (!avoid)
-          for (int e = 0; e < 3; ++e)
-            if (chord(ring, tri[e], tri[(e + 1) % 3])) return std::vector<std::array<int, 3>>{};
-        for (int& i : tri) i = ring[i].idx();
-      }
-      return t;
+      return triangulate_ring(mesh, ring, chord, avoid ? opts.guard : nullptr, other);
     };
     std::vector<std::array<int, 3>> tri_r, tri_l;
     bool found = false;

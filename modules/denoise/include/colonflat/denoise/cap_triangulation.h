@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "colonflat/core/mesh.h"
+#include "colonflat/denoise/face_grid.h"
 
 namespace cf {
 
@@ -15,5 +16,17 @@ namespace cf {
 // empty result when no triangulation consists of allowed triangles.
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
                                                         const std::function<bool(int, int, int)>& allowed = {});
+
+// A cap for the closed ring `ring` (mesh vertices in boundary order; the triangles are oriented
+// like it): its minimum-area triangulation without near-collinear triangles (height below 1e-4
+// of the longest edge: they would leave a ring vertex on a neighbour's edge) and without a
+// diagonal (a, b) for which blocked(a, b) holds. With `grid`, only triangles that intersect none
+// of its faces and none of `others` (slower; for when the plain one intersects something).
+// Returns mesh vertex ids in ear order (ready for add_face one by one), or nothing if no such
+// triangulation exists.
+std::vector<std::array<int, 3>> triangulate_ring(
+    const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
+    const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid = nullptr,
+    const std::vector<std::array<int, 3>>& others = {});
 
 }  // namespace cf
