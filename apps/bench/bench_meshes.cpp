@@ -18,17 +18,41 @@
 
 namespace cf::bench {
 
+namespace {
+// An n^3 grid of voxel size `voxel` from (lo, lo, lo) carrying a float scalar "sdf"; returns the values.
+float* sdf_grid(vtkImageData* img, double lo, int n, double voxel) {
+  img->SetDimensions(n, n, n);
+  img->SetSpacing(voxel, voxel, voxel);
+  img->SetOrigin(lo, lo, lo);
+  vtkNew<vtkFloatArray> f;
+  f->SetName("sdf");
+  f->SetNumberOfValues(static_cast<vtkIdType>(n) * n * n);
+  img->GetPointData()->SetScalars(f);
+  return f->GetPointer(0);
+}
+
+// The zero level set of `sdf` (negative inside) by VTK flying edges, as a consistently oriented mesh.
+Mesh iso_surface(vtkImageData* img) {
+  vtkNew<vtkFlyingEdges3D> fe;
+  fe->SetInputData(img);
+  fe->SetValue(0, 1e-4);  // off the grid values: no vertex exactly on the iso-surface
+  fe->ComputeNormalsOff();
+  fe->ComputeGradientsOff();
+  fe->ComputeScalarsOff();
+  fe->Update();
+  PolygonSoup soup = polydata_to_soup(fe->GetOutput());
+  MeshDiagnosis diag = diagnose_soup(soup);
+  TriangleList t = soup_to_triangles(soup, LoadPolicy{}, diag);
+  return triangles_to_mesh(t, analyze_topology(t), true);
+}
+}  // namespace
+
 Mesh sphere_with_handles(double radius, int handles, double voxel, unsigned seed) {
   const double R = 3.0, r = 1.0, margin = R + r + 2 * voxel;
   const double lo = -radius - margin;
   const int n = static_cast<int>(std::ceil(2 * (radius + margin) / voxel)) + 1;
   vtkNew<vtkImageData> img;
-  img->SetDimensions(n, n, n);
-  img->SetSpacing(voxel, voxel, voxel);
-  img->SetOrigin(lo, lo, lo);
-  vtkNew<vtkFloatArray> f;
-  f->SetNumberOfValues(static_cast<vtkIdType>(n) * n * n);
-  float* d = f->GetPointer(0);
+  float* d = sdf_grid(img, lo, n, voxel);
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
@@ -73,19 +97,26 @@ Mesh sphere_with_handles(double radius, int handles, double voxel, unsigned seed
           v = std::min(v, static_cast<float>(sdf));
         }
   }
-  f->SetName("sdf");
-  img->GetPointData()->SetScalars(f);
-  vtkNew<vtkFlyingEdges3D> fe;
-  fe->SetInputData(img);
-  fe->SetValue(0, 1e-4);  // off the grid values: no vertex exactly on the iso-surface
-  fe->ComputeNormalsOff();
-  fe->ComputeGradientsOff();
-  fe->ComputeScalarsOff();
-  fe->Update();
-  PolygonSoup soup = polydata_to_soup(fe->GetOutput());
-  MeshDiagnosis diag = diagnose_soup(soup);
-  TriangleList t = soup_to_triangles(soup, LoadPolicy{}, diag);
-  return triangles_to_mesh(t, analyze_topology(t), true);
+  return iso_surface(img);
+}
+
+Mesh sphere_with_strand(double radius, double strand_radius, double voxel) {
+  const double lo = -radius - 2 * voxel;
+  const int n = static_cast<int>(std::ceil(2 * (radius + 2 * voxel) / voxel)) + 1;
+  vtkNew<vtkImageData> img;
+  float* d = sdf_grid(img, lo, n, voxel);
+  // The strand's axis: a chord through (0, 0.3 R, 0.2 R) along x, slightly tilted.
+  const double cy = 0.3 * radius, cz = 0.2 * radius, ty = 0.1;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double x = lo + i * voxel, y = lo + j * voxel, z = lo + k * voxel;
+        const double ball = std::sqrt(x * x + y * y + z * z) - radius;
+        const double dy = y - cy - ty * x, dz = z - cz;
+        const double strand = strand_radius - std::sqrt(dy * dy + dz * dz) / std::sqrt(1 + ty * ty);
+        d[(static_cast<std::size_t>(k) * n + j) * n + i] = static_cast<float>(std::max(ball, strand));
+      }
+  return iso_surface(img);
 }
 
 }  // namespace cf::bench

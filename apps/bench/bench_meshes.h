@@ -12,4 +12,9 @@ namespace cf::bench {
 // the caller). Deterministic for a seed.
 Mesh sphere_with_handles(double radius, int handles, double voxel, unsigned seed = 1);
 
+// A ball of radius `radius` mm pierced by a straight strand of radius `strand_radius` mm along a
+// chord (the lumen with a tissue bridge across it): genus 1, the strand a tunnel through the
+// ball. Flying edges at `voxel` mm.
+Mesh sphere_with_strand(double radius, double strand_radius, double voxel);
+
 }  // namespace cf::bench

@@ -83,7 +83,7 @@ TEST_F(RunTool, SetAndParamsIn) {
 
 // The example parameter files shipped in data/params are accepted by `run`.
 TEST_F(RunTool, ShippedParameterFilesAreValid) {
-  for (const char* f : {"partial_denoise.json", "paper_method.json"}) {
+  for (const char* f : {"partial_denoise.json", "paper_method.json", "remove_stumps.json"}) {
     auto r = testing::run_colonflat({"run", dir_.str("chain.vtp"), "--from", "denoise", "--to", "denoise", "-o",
                                      dir_.str(std::string("out_") + f), "--params-in",
                                      std::string(COLONFLAT_SOURCE_DIR) + "/data/params/" + f, "-q"});

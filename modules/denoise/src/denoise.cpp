@@ -4,6 +4,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/denoise/stumps.h"
 #include "denoise_internal.h"
 
 namespace cf {
@@ -18,6 +19,9 @@ void validate_denoise_options(const DenoiseOptions& o) {
   if (!(o.ring_pull >= 0 && o.ring_pull <= 0.5))
     throw UsageError("--ring-pull must be in [0, 0.5] (got " + format_number(o.ring_pull) + ")");
   if (!(o.initial_radius >= 0)) throw UsageError("--initial-radius must be >= 0");
+  if (!(o.remove_stumps >= 0)) throw UsageError("--remove-stumps must be >= 0 (got " + format_number(o.remove_stumps) + ")");
+  if (o.method == "paper" && o.remove_stumps > 0)
+    throw UsageError("--remove-stumps needs --method exact (the paper's method is kept as published)");
   if (o.method == "paper" && o.policy != "shortest")
     throw UsageError("--policy " + o.policy + " needs --method exact (the paper's method has no loop types)");
 }
@@ -98,6 +102,40 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                        {"faces_after", a.components[c].faces}});
   }
 
+  // Stumps: after the checks above (they match components through input face ids, which the
+  // removal's garbage collection renumbers); topology is checked again.
+  nlohmann::json stumps = nullptr;
+  if (o.remove_stumps > 0) {
+    sw.restart();
+    const std::vector<StumpRecord> recs = remove_stumps(st.mesh, st.cap_rings, StumpOptions{o.remove_stumps, 1.5});
+    TopologyReport after = analyze_topology(st.mesh);
+    auto genera = [](const TopologyReport& t) {
+      std::vector<int> g;
+      for (const auto& c : t.components) g.push_back(c.genus ? *c.genus : -1);
+      std::sort(g.begin(), g.end());
+      return g;
+    };
+    if (after.components.size() != a.components.size() || genera(after) != genera(a) ||
+        after.boundary_loops != a.boundary_loops || !after.manifold || !after.consistently_oriented)
+      throw Error("denoise: postcondition failed after stump removal: components " +
+                  std::to_string(a.components.size()) + " -> " + std::to_string(after.components.size()) +
+                  ", genus " + std::to_string(*a.genus) + " -> " + (after.genus ? std::to_string(*after.genus) : "?"));
+    nlohmann::json list = nlohmann::json::array();
+    std::size_t removed_faces = 0;
+    for (const auto& r : recs) {
+      removed_faces += r.faces_removed;
+      list.push_back({{"length_mm", r.length_mm},
+                      {"ring_length_mm", r.ring_length_mm},
+                      {"base_length_mm", r.base_length_mm},
+                      {"faces_removed", r.faces_removed},
+                      {"cap_faces", r.cap_faces}});
+    }
+    stumps = {{"removed", recs.size()}, {"rings_examined", st.cap_rings.size()}, {"faces_removed", removed_faces},
+              {"max_length_mm", o.remove_stumps}, {"stumps", list}};
+    res.after = std::move(after);
+    st.t.stumps = sw.seconds();
+  }
+
   res.loops = st.loops;
   res.mesh = std::move(st.mesh);
   std::size_t loop_vertices = 0, cap_intersections = 0;
@@ -131,12 +169,14 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                 {"loops", loops},
                 {"totals", {{"loops", res.loops.size()}, {"loop_vertices", loop_vertices}, {"loop_length_mm", loop_len}, {"cap_intersections", cap_intersections}}},
                 {"search", stats},
+                {"stumps", stumps},
                 {"time_s",
                  {{"analysis", t_analysis},
                   {"homology_and_cut_graph", st.t.homology},
                   {"loop_search", st.t.search},
                   {"surgery", st.t.surgery},
                   {"verification", st.t.verify},
+                  {"stumps", st.t.stumps},
                   {"total", total.seconds()}}},
                 {"units", "mm"}};
   return res;

@@ -13,7 +13,7 @@
 namespace cf::detail {
 
 struct Timers {
-  double homology = 0, search = 0, surgery = 0, verify = 0;
+  double homology = 0, search = 0, surgery = 0, verify = 0, stumps = 0;
 };
 
 // The mesh being denoised and what is known of its vertices.
@@ -24,6 +24,7 @@ struct DenoiseState {
   std::vector<int> component;   // vertex -> input component id
   std::vector<int> genus_left;  // per input component
   std::vector<LoopRecord> loops;
+  std::vector<std::vector<Mesh::VertexHandle>> cap_rings;  // both rings of every surgery
   Timers t;
   std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked
   double mean_edge = 0;
@@ -35,8 +36,10 @@ struct DenoiseState {
   LoopRecord& record(const std::vector<Mesh::VertexHandle>& loop, int iteration, bool separating);
 };
 
-// Vertices within graph distance `radius` of any seed (multi-source Dijkstra).
-std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius);
+// Vertices within graph distance `radius` of any seed (multi-source Dijkstra), nearest first;
+// their distances in `distances` when given.
+std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
+                                 std::vector<double>* distances = nullptr);
 
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,

@@ -30,6 +30,8 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
            "fraction of the way each cut ring moves into its own side (separates the two caps; 0 = paper)", 0.0, 0.5);
     t.flag("check-caps", &DenoiseOptions::check_caps,
            "check every cap for intersections with the surface and try other placements");
+    t.real("remove-stumps", &DenoiseOptions::remove_stumps, "mm",
+           "remove the finger-like stumps up to this long that cutting thin strands leaves (0 = keep; exact only)", 0.0);
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
            "first loop-search radius of the exact method (0 = 10 x mean edge length)", 0.0);
     return t;

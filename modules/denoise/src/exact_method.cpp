@@ -34,7 +34,8 @@ LoopRecord& DenoiseState::record(const std::vector<Mesh::VertexHandle>& loop, in
   return loops.back();
 }
 
-std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius) {
+std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
+                                 std::vector<double>* distances) {
   std::unordered_map<int, double> dist;
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
@@ -48,6 +49,7 @@ std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::Verte
     q.pop();
     if (d > dist[v]) continue;
     out.push_back(v);
+    if (distances) distances->push_back(d);
     const Vec3& p = mesh.point(Mesh::VertexHandle(v));
     for (auto w : mesh.vv_range(Mesh::VertexHandle(v))) {
       const double nd = d + (mesh.point(w) - p).norm();
@@ -76,6 +78,8 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   *out = cut_and_cap(st.mesh, loop, so, hb);
   st.loops.back().cap_intersections = out->intersections;
   st.extend_vertices(out->right_ring, out->left_ring, comp);
+  st.cap_rings.push_back(out->left_ring);
+  st.cap_rings.push_back(out->right_ring);
   st.t.surgery += sw.seconds();
   sw.restart();
   const bool connected = vertices_connected(st.mesh, out->left_cap, out->right_cap);

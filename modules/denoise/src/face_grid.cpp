@@ -12,6 +12,10 @@ FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) {
   for (auto f : mesh.faces()) insert(mesh, f);
 }
 
+FaceGrid::FaceGrid(const Mesh& mesh, double cell_size, const std::vector<Mesh::FaceHandle>& faces) : cell_(cell_size) {
+  for (auto f : faces) insert(mesh, f);
+}
+
 FaceGrid::Key FaceGrid::key(const Vec3& p) const {
   return {static_cast<long long>(std::floor(p[0] / cell_)), static_cast<long long>(std::floor(p[1] / cell_)),
           static_cast<long long>(std::floor(p[2] / cell_))};
@@ -57,22 +61,34 @@ std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   return cand;
 }
 
-void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
+template <class Visit>
+bool FaceGrid::visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) {
   Vec3 lo, hi;
   std::array<int, 3> ids;
   std::array<Vec3, 3> pts;
   face_box(mesh, f, lo, hi, ids, pts);
   const Key a = key(lo), b = key(hi);
-  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) {
-    if (big_set_.insert(f.idx()).second) big_.push_back(f.idx());  // checked by every query instead
-    return;
-  }
+  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) return false;
   for (long long x = a.x; x <= b.x; ++x)
     for (long long y = a.y; y <= b.y; ++y)
-      for (long long z = a.z; z <= b.z; ++z) {
-        auto& v = cells_[{x, y, z}];
-        if (std::find(v.begin(), v.end(), f.idx()) == v.end()) v.push_back(f.idx());
-      }
+      for (long long z = a.z; z <= b.z; ++z) visit(Key{x, y, z});
+  return true;
+}
+
+void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
+  const bool small = visit_cells(mesh, f, [&](const Key& k) {
+    auto& v = cells_[k];
+    if (std::find(v.begin(), v.end(), f.idx()) == v.end()) v.push_back(f.idx());
+  });
+  if (!small && big_set_.insert(f.idx()).second) big_.push_back(f.idx());  // checked by every query instead
+}
+
+void FaceGrid::erase(const Mesh& mesh, Mesh::FaceHandle f) {
+  const bool small = visit_cells(mesh, f, [&](const Key& k) {
+    auto it = cells_.find(k);
+    if (it != cells_.end()) it->second.erase(std::remove(it->second.begin(), it->second.end(), f.idx()), it->second.end());
+  });
+  if (!small && big_set_.erase(f.idx())) big_.erase(std::find(big_.begin(), big_.end(), f.idx()));
 }
 
 namespace {

@@ -70,6 +70,11 @@ TEST(DenoiseCli, InvalidParametersAreUsageErrors) {
   EXPECT_NE(b.err.find("needs --method exact"), std::string::npos) << b.err;
   auto c = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--max-loop-length", "0"});
   EXPECT_EQ(c.code, 2);
+  auto d = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--method", "paper", "--remove-stumps", "20"});
+  EXPECT_EQ(d.code, 2);
+  EXPECT_NE(d.err.find("--remove-stumps needs --method exact"), std::string::npos) << d.err;
+  auto e = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--remove-stumps", "-1"});
+  EXPECT_EQ(e.code, 2);
   EXPECT_FALSE(fs::exists(dir / "out.vtp"));
 }
 
@@ -81,6 +86,7 @@ TEST(DenoiseCli, HelpListsParameters) {
   EXPECT_NE(r.out.find("[mm] (default inf"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("exact|paper"), std::string::npos);
   EXPECT_NE(r.out.find("--loops"), std::string::npos);
+  EXPECT_NE(r.out.find("--remove-stumps"), std::string::npos);
 }
 
 // The paper method through the command marks the separating neck loop in the loops file.

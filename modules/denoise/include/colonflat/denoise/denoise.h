@@ -39,6 +39,9 @@ struct DenoiseOptions {
   double initial_radius = 0;         // mm; first search radius for "exact" (0 = 10 x mean edge length)
   bool check_caps = true;            // test each cap for intersections with the surface and try
                                      // other placements until none remains
+  double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
+                                     // stumps up to this long that cutting thin strands leaves
+                                     // (stumps.h); changes vertex ids
 };
 
 struct LoopRecord {

@@ -23,7 +23,11 @@ namespace cf {
 class FaceGrid {
  public:
   FaceGrid(const Mesh& mesh, double cell_size);
+  // A grid of some faces only.
+  FaceGrid(const Mesh& mesh, double cell_size, const std::vector<Mesh::FaceHandle>& faces);
   void insert(const Mesh& mesh, Mesh::FaceHandle f);
+  // Takes f out (f at the place where it was inserted).
+  void erase(const Mesh& mesh, Mesh::FaceHandle f);
   // Pairs (f in `faces`, g any face) that intersect improperly; pairs inside `faces` count once.
   // Precondition: every face in `faces` was insert()ed at its current position.
   std::size_t count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
@@ -47,6 +51,10 @@ class FaceGrid {
     }
   };
   Key key(const Vec3& p) const;
+  // Calls visit(key) for each cell of f's bounding box; false (nothing visited) when they are more
+  // than kMaxCellsPerFace.
+  template <class Visit>
+  bool visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit);
   std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
   // Grid faces that triangle (ids, p) intersects improperly (at most 1 with first_only).
   std::size_t grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
