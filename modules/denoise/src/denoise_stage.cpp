@@ -54,6 +54,9 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
   std::ostringstream msg;
   msg << "denoise: genus " << r.report["genus_before"].dump() << " -> " << r.report["genus_after"].dump() << ", "
       << r.loops.size() << " loops (" << r.report["stop_reason"].get<std::string>() << ")";
+  if (!r.report["stumps"].is_null())
+    msg << ", " << r.report["stumps"]["removed"].get<std::size_t>() << " stumps removed ("
+        << r.report["stumps"]["faces_removed"].get<std::size_t>() << " faces)";
   ctx.progress(msg.str());
   ctx.report = r.report;
   bag.put("denoised", std::move(r.mesh));
