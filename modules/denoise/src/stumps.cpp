@@ -174,6 +174,10 @@ std::vector<StumpRecord> remove_stumps(Mesh& mesh, const std::vector<std::vector
     }
   }
   mesh.garbage_collection();
+  mesh.release_face_status();  // as requested above (OpenMesh counts requests)
+  mesh.release_halfedge_status();
+  mesh.release_edge_status();
+  mesh.release_vertex_status();
   return out;
 }
 
