@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <queue>
 #include <sstream>
 
 #include "colonflat/core/error.h"
@@ -15,39 +14,10 @@
 #include "colonflat/reconstruct/reconstruct_stage.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
+#include "mask_components.h"
 
 namespace cf {
 namespace {
-
-// Voxel counts of the 6-connected lumen components.
-std::vector<std::size_t> component_sizes_6(const MaskImage* m) {
-  const auto sz = m->GetBufferedRegion().GetSize();
-  const long nx = long(sz[0]), ny = long(sz[1]), nz = long(sz[2]);
-  const unsigned char* d = m->GetBufferPointer();
-  std::vector<char> seen(std::size_t(nx * ny * nz), 0);
-  std::vector<std::size_t> sizes;
-  for (long s = 0; s < nx * ny * nz; ++s) {
-    if (!d[s] || seen[s]) continue;
-    std::size_t count = 0;
-    std::queue<long> q;
-    q.push(s);
-    seen[s] = 1;
-    while (!q.empty()) {
-      const long c = q.front();
-      q.pop();
-      ++count;
-      const long i = c % nx, j = (c / nx) % ny, k = c / (nx * ny);
-      const long nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
-      for (const auto& p : nb) {
-        if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= nx || p[1] >= ny || p[2] >= nz) continue;
-        const long id = (p[2] * ny + p[1]) * nx + p[0];
-        if (d[id] && !seen[id]) seen[id] = 1, q.push(id);
-      }
-    }
-    sizes.push_back(count);
-  }
-  return sizes;
-}
 
 void check_phantom(bool collapsed) {
   PhantomOptions po;
@@ -73,7 +43,7 @@ void check_phantom(bool collapsed) {
   // One surface component per lumen segment (6-connected lumen component above the minimum).
   const auto sp = gt->GetSpacing();
   std::size_t segments = 0;
-  for (std::size_t n : component_sizes_6(gt)) segments += double(n) * sp[0] * sp[1] * sp[2] >= o.min_component_volume;
+  for (std::size_t n : testing::component_sizes_6(gt)) segments += double(n) * sp[0] * sp[1] * sp[2] >= o.min_component_volume;
   EXPECT_EQ(t.components.size(), segments);
   EXPECT_EQ(st.kept.size(), segments);
   if (collapsed) EXPECT_GE(segments, 2u);
@@ -85,7 +55,7 @@ void check_phantom(bool collapsed) {
   EXPECT_LE(bd.mean_mm, 0.25 * std::min({sp[0], sp[1], sp[2]})) << bd.to_json().dump();
   // Enclosed volume ~ the lumen volume.
   double lumen = 0, surf = 0;
-  for (std::size_t n : component_sizes_6(gt)) lumen += double(n) * sp[0] * sp[1] * sp[2];
+  for (std::size_t n : testing::component_sizes_6(gt)) lumen += double(n) * sp[0] * sp[1] * sp[2];
   for (const auto& c : st.kept) surf += c.volume_mm3;
   EXPECT_NEAR(surf, lumen, 0.03 * lumen);
 }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <functional>
 #include <algorithm>
-#include <queue>
 #include <random>
 
 #include <itkImageRegionIteratorWithIndex.h>
@@ -14,6 +13,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/reconstruct/reconstruct.h"
+#include "mask_components.h"
 
 namespace cf {
 namespace {
@@ -102,37 +102,6 @@ ReconstructOptions raw() {
   return o;
 }
 
-// Number of 6-connected components of the non-zero voxels (independent of the library).
-int count_6_components(const MaskImage* m) {
-  const auto sz = m->GetBufferedRegion().GetSize();
-  const long nx = long(sz[0]), ny = long(sz[1]), nz = long(sz[2]);
-  const unsigned char* d = m->GetBufferPointer();
-  std::vector<char> seen(std::size_t(nx * ny * nz), 0);
-  int count = 0;
-  for (long s = 0; s < nx * ny * nz; ++s) {
-    if (!d[s] || seen[s]) continue;
-    ++count;
-    std::queue<long> q;
-    q.push(s);
-    seen[s] = 1;
-    while (!q.empty()) {
-      const long c = q.front();
-      q.pop();
-      const long i = c % nx, j = (c / nx) % ny, k = c / (nx * ny);
-      const long nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
-      for (const auto& p : nb) {
-        if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= nx || p[1] >= ny || p[2] >= nz) continue;
-        const long id = (p[2] * ny + p[1]) * nx + p[0];
-        if (d[id] && !seen[id]) {
-          seen[id] = 1;
-          q.push(id);
-        }
-      }
-    }
-  }
-  return count;
-}
-
 // Euler characteristic of the lumen in (6,18) topology by direct counting (voxels, face pairs,
 // full squares, full blocks, and blocks whose two background voxels are opposite corners).
 long long brute_euler_6_18(const MaskImage* m) {
@@ -185,7 +154,7 @@ void expect_faithful(const MaskImage* m, const Mesh& s, const std::string& what)
   }
   int outer = 0;
   for (double v : vol) outer += v > 0;
-  EXPECT_EQ(outer, count_6_components(m)) << what;
+  EXPECT_EQ(outer, static_cast<int>(testing::component_sizes_6(m).size())) << what;
 }
 
 // A sphere in an anisotropic, rotated, offset image lies within a voxel of the true sphere in LPS
