@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cstdlib>
 #include <limits>
+#include <string>
+
+#include "colonflat/core/error.h"
 
 namespace cf {
 
@@ -68,6 +71,14 @@ std::vector<std::array<int, 3>> triangulate_ring(
     for (int& i : tri) i = ring[i].idx();
   }
   return t;
+}
+
+void add_cap(Mesh& mesh, const std::vector<std::array<int, 3>>& tris, FaceGrid* grid, const char* what) {
+  for (const auto& t : tris) {
+    const auto f = mesh.add_face(Mesh::VertexHandle(t[0]), Mesh::VertexHandle(t[1]), Mesh::VertexHandle(t[2]));
+    if (!f.is_valid()) throw Error(std::string(what) + ": could not add a cap triangle");
+    if (grid) grid->insert(mesh, f);
+  }
 }
 
 }  // namespace cf

@@ -164,11 +164,7 @@ std::vector<StumpRecord> remove_stumps(Mesh& mesh, const std::vector<std::vector
         continue;
       }
       for (auto f : region) mesh.delete_face(f, true);
-      for (const auto& t : cap) {
-        const auto f = mesh.add_face(Mesh::VertexHandle(t[0]), Mesh::VertexHandle(t[1]), Mesh::VertexHandle(t[2]));
-        if (!f.is_valid()) throw Error("stump removal: could not add a base cap triangle");
-        grid.insert(mesh, f);
-      }
+      add_cap(mesh, cap, &grid, "stump removal");
       out.push_back({ri, g.dist[p], ring_len, cycle_length(mesh, base), region.size(), cap.size()});
       break;
     }

@@ -150,35 +150,6 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
   const std::vector<Vec3> target_left = side_targets(r.left_ring), target_right = side_targets(r.right_ring);
   std::vector<Vec3> p0(k);
   for (std::size_t i = 0; i < k; ++i) p0[i] = mesh.point(loop[i]);
-  // 6a. Edge targets: the far end of the side edge most across the ring (direction least aligned
-  //     with the ring's tangent). A ring vertex moved along an edge of its own side stays on the
-  //     old surface, which keeps the faces around it from folding where the surface is creased
-  //     (marching-cubes junctions) and the averaged normal of the tangential target misleads.
-  auto edge_targets = [&](const std::vector<Mesh::VertexHandle>& ring) {
-    std::unordered_set<int> in_ring;
-    for (auto v : ring) in_ring.insert(v.idx());
-    std::vector<Vec3> target(ring.size());
-    for (std::size_t i = 0; i < ring.size(); ++i) {
-      const Vec3 p = mesh.point(ring[i]);
-      Vec3 tangent = mesh.point(ring[(i + 1) % k]) - mesh.point(ring[(i + k - 1) % k]);
-      if (tangent.norm() > 0) tangent /= tangent.norm();
-      target[i] = p;
-      double best = 2;
-      for (auto w : mesh.vv_range(ring[i])) {
-        if (in_ring.count(w.idx())) continue;
-        Vec3 d = mesh.point(w) - p;
-        const double len = d.norm();
-        if (len == 0) continue;
-        const double align = std::fabs(OpenMesh::dot(d / len, tangent));
-        if (align < best) {
-          best = align;
-          target[i] = mesh.point(w);
-        }
-      }
-    }
-    return target;
-  };
-  const std::vector<Vec3> edge_left = edge_targets(r.left_ring), edge_right = edge_targets(r.right_ring);
 
   // 6b. Classes of the left copies of the loop edges (needed by the caps): y_i copies h_i.
   const int W = homology ? homology->words() : 0;
@@ -261,6 +232,35 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
   if (opts.guard && k <= kMaxTriangulatedLoop) {
     std::vector<Mesh::VertexHandle> order_r = r.right_ring, order_l{r.left_ring[0]};
     for (std::size_t i = k - 1; i >= 1; --i) order_l.push_back(r.left_ring[i]);  // x_(k-1) -> ... -> x_0
+    // Edge targets: the far end of the side edge most across the ring (direction least aligned
+    // with the ring's tangent). A ring vertex moved along an edge of its own side stays on the
+    // old surface, which keeps the faces around it from folding where the surface is creased
+    // (marching-cubes junctions) and the averaged normal of the tangential target misleads.
+    auto edge_targets = [&](const std::vector<Mesh::VertexHandle>& ring) {
+      std::unordered_set<int> in_ring;
+      for (auto v : ring) in_ring.insert(v.idx());
+      std::vector<Vec3> target(ring.size());
+      for (std::size_t i = 0; i < ring.size(); ++i) {
+        const Vec3 p = mesh.point(ring[i]);
+        Vec3 tangent = mesh.point(ring[(i + 1) % k]) - mesh.point(ring[(i + k - 1) % k]);
+        if (tangent.norm() > 0) tangent /= tangent.norm();
+        target[i] = p;
+        double best = 2;
+        for (auto w : mesh.vv_range(ring[i])) {
+          if (in_ring.count(w.idx())) continue;
+          Vec3 d = mesh.point(w) - p;
+          const double len = d.norm();
+          if (len == 0) continue;
+          const double align = std::fabs(OpenMesh::dot(d / len, tangent));
+          if (align < best) {
+            best = align;
+            target[i] = mesh.point(w);
+          }
+        }
+      }
+      return target;
+    };
+    const std::vector<Vec3> edge_left = edge_targets(r.left_ring), edge_right = edge_targets(r.right_ring);
     std::vector<Mesh::FaceHandle> ring_faces;
     for (const auto* ring : {&r.left_ring, &r.right_ring})
       for (auto v : *ring)
@@ -307,17 +307,8 @@ SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loo
       if (found) break;
     }
     if (found) {
-      // Add as ears of the shrinking hole, so that every face is added next to the boundary.
-      // min_area_triangulation lists ears first: each triangle joins the hole's boundary as it is.
-      auto add_ears = [&](const std::vector<std::array<int, 3>>& tris) {
-        for (const auto& t : tris) {
-          const auto f = mesh.add_face(Mesh::VertexHandle(t[0]), Mesh::VertexHandle(t[1]), Mesh::VertexHandle(t[2]));
-          if (!f.is_valid()) throw Error("surgery: could not add a cap triangle");
-          opts.guard->insert(mesh, f);
-        }
-      };
-      add_ears(tri_r);
-      add_ears(tri_l);
+      add_cap(mesh, tri_r, opts.guard, "surgery");  // ear order: each face joins the hole's boundary
+      add_cap(mesh, tri_l, opts.guard, "surgery");
       if (homology) {
         auto classes = [&](const std::vector<Mesh::VertexHandle>& ring) {
           std::unordered_map<int, std::vector<std::uint64_t>> P;

@@ -29,4 +29,8 @@ std::vector<std::array<int, 3>> triangulate_ring(
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid = nullptr,
     const std::vector<std::array<int, 3>>& others = {});
 
+// Adds the triangles of triangulate_ring (in its ear order) to the mesh, and to `grid` when given.
+// Throws cf::Error naming `what` if OpenMesh refuses one (the ring was not a hole's boundary).
+void add_cap(Mesh& mesh, const std::vector<std::array<int, 3>>& tris, FaceGrid* grid, const char* what);
+
 }  // namespace cf
