@@ -5,5 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 GEN=()
 command -v ninja >/dev/null && GEN=(-G Ninja)
-cmake -S . -B build "${GEN[@]}" -DCMAKE_BUILD_TYPE=Release "$@"
+# A compiler cache, when the machine has one, makes rebuilds of other checkouts cheap; never required.
+LAUNCHER=()
+command -v ccache >/dev/null && LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B build "${GEN[@]}" "${LAUNCHER[@]}" -DCMAKE_BUILD_TYPE=Release "$@"
 cmake --build build --parallel "$(nproc)"
