@@ -1,10 +1,13 @@
+// The exact method: at every step the shortest non-separating edge cycle of the current mesh,
+// found by bounded Dijkstra searches from a source set, with per-source lower bounds shared
+// between nearby sources (docs/denoise.md, "How it is fast").
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <queue>
-#include <thread>
-#include <unordered_map>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/geodesic_ball.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/loop_search.h"
 #include "denoise_internal.h"
@@ -28,40 +31,11 @@ LoopRecord& DenoiseState::record(const std::vector<Mesh::VertexHandle>& loop, in
     r.points.push_back(mesh.point(v));
   }
   r.length = loop_length(mesh, loop);
+  describe_cross_section(&r);
   r.type = loop_type_name(classify_loop(mesh, loop));
   r.separating = separating;
   loops.push_back(std::move(r));
   return loops.back();
-}
-
-std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
-                                 std::vector<double>* distances) {
-  std::unordered_map<int, double> dist;
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-  for (auto s : seeds) {
-    dist[s.idx()] = 0;
-    q.push({0, s.idx()});
-  }
-  std::vector<int> out;
-  while (!q.empty()) {
-    auto [d, v] = q.top();
-    q.pop();
-    if (d > dist[v]) continue;
-    out.push_back(v);
-    if (distances) distances->push_back(d);
-    const Vec3& p = mesh.point(Mesh::VertexHandle(v));
-    for (auto w : mesh.vv_range(Mesh::VertexHandle(v))) {
-      const double nd = d + (mesh.point(w) - p).norm();
-      if (nd > radius) continue;
-      auto it = dist.find(w.idx());
-      if (it == dist.end() || nd < it->second) {
-        dist[w.idx()] = nd;
-        q.push({nd, w.idx()});
-      }
-    }
-  }
-  return out;
 }
 
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
@@ -87,185 +61,265 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   return connected;
 }
 
-std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
-                       double mean_edge, nlohmann::json& stats) {
-  HomologyBasis hb;
-  Z2Span span;
-  std::unique_ptr<FundamentalCycleSearch> search;
-  std::vector<std::uint8_t> is_source;
-  std::vector<int> sources;
-  const bool want_type = o.policy != "shortest";
-  const LoopType wanted = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
-  FundamentalCycleSearch::Accept accept = [&](const std::vector<Mesh::VertexHandle>& loop) {
-    return classify_loop(st.mesh, loop) == wanted;
-  };
-  const FundamentalCycleSearch::Accept* accept_ptr = want_type ? &accept : nullptr;
+namespace {
 
-  struct Entry {
-    double key;
-    int v;
-    std::uint32_t ver;
-    bool exact;
-    bool operator>(const Entry& e) const { return key > e.key; }
-  };
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> pq;
-  std::vector<std::uint32_t> ver;
-  double R = o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge;
-  if (std::isfinite(o.max_loop_length)) R = std::min(R, o.max_loop_length);
-  bool truncated_any = false;
-  double next_radius_hint = kInf;  // min frontier bound seen since the last sweep
-  double sweep_time = 0;
-  int sweeps = 0;
-  long long searches = 0, settled = 0;
-  int rebuilds = 0, cuts_since_build = 0;
+// What is known of one source's shortest fundamental cycle value F(s) (the minimum over the
+// fundamental cycles of its shortest-path tree whose class is outside the cut span):
+// F(s) == value when exact, F(s) >= value otherwise. `centre` is the source whose search gave
+// it (-1: none yet); the bound stays valid while that search's ball is untouched by surgery.
+struct SourceBound {
+  double value = 0;
+  bool exact = false;
+  int centre = -1;
+  std::uint32_t version = 0;
+};
 
-  auto add_source = [&](int v) {
-    if (v >= static_cast<int>(is_source.size())) is_source.resize(st.mesh.n_vertices(), 0);
-    if (is_source[v] || st.mesh.is_boundary(Mesh::VertexHandle(v))) return;
-    is_source[v] = 1;
-    sources.push_back(v);
-  };
-  auto rebuild = [&]() {
-    Stopwatch sw;
-    hb.build(st.mesh);
-    span.reset(hb.words());
-    search = std::make_unique<FundamentalCycleSearch>(st.mesh, hb, span);
-    is_source.assign(st.mesh.n_vertices(), 0);
-    sources.clear();
-    for (int v : hb.pruned_cut_graph_vertices()) add_source(v);
-    st.t.homology += sw.seconds();
-    ++rebuilds;
-    cuts_since_build = 0;
-  };
-  // Queues a source's search result: an exact value, or the lower bound R when the search hit the
-  // radius (a source whose whole reachable part has no loop is dropped until a surgery nears it).
-  auto queue_result = [&](int v, const CycleCandidate& c) {
-    if (v >= static_cast<int>(ver.size())) ver.resize(st.mesh.n_vertices() + 1024, 0);
-    ++ver[v];
-    truncated_any = truncated_any || c.truncated;
-    next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
-    if (c.found) pq.push({c.value, v, ver[v], true});
-    else if (c.truncated) pq.push({R, v, ver[v], false});
-  };
-  auto compute = [&](int v) {
-    Stopwatch sw;
-    queue_result(v, search->run(Mesh::VertexHandle(v), R, accept_ptr));
-    ++searches;
-    settled += static_cast<long long>(search->last_settled());
-    st.t.search += sw.seconds();
-  };
-  // Full sweeps over all sources run on every core: searches only read the mesh, the classes
-  // and the span, and each thread has its own search state; results are queued in source order,
-  // so the outcome does not depend on the thread count.
-  const unsigned n_threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-  auto compute_all = [&]() {
-    Stopwatch sw;
-    while (!pq.empty()) pq.pop();
-    truncated_any = false;
-    next_radius_hint = kInf;
-    std::vector<CycleCandidate> results(sources.size());
-    std::vector<long long> settled_by(n_threads, 0);
-    auto work = [&](unsigned t) {
-      FundamentalCycleSearch local(st.mesh, hb, span);
-      for (std::size_t i = t; i < sources.size(); i += n_threads) {
-        results[i] = local.run(Mesh::VertexHandle(sources[i]), R, accept_ptr, /*frontier=*/true);
-        settled_by[t] += static_cast<long long>(local.last_settled());
-      }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(work, t);
-    work(0);
-    for (auto& th : pool) th.join();
-    for (std::size_t i = 0; i < sources.size(); ++i) queue_result(sources[i], results[i]);
-    searches += static_cast<long long>(sources.size());
-    for (long long x : settled_by) settled += x;
-    sweep_time += sw.seconds();
-    ++sweeps;
-    st.t.search += sw.seconds();
-  };
+struct QueueEntry {
+  double key;
+  int vertex;
+  std::uint32_t version;
+  bool exact;
+  // Min-heap order: smaller key first; at equal keys exact values before lower bounds.
+  bool operator>(const QueueEntry& e) const { return key != e.key ? key > e.key : (!exact && e.exact); }
+};
 
-  rebuild();
-  compute_all();
-  int cuts = 0;
-  std::string reason = "target genus reached";
-  while (cuts < needed) {
-    if (pq.empty()) {
-      reason = want_type ? "no further " + std::string(o.policy == "cut" ? "handle" : "tunnel") + " loops found"
-                         : "no further non-separating loops found";
-      break;
-    }
-    const Entry top = pq.top();
-    pq.pop();
-    if (top.ver != ver[top.v]) continue;
-    if (!top.exact) {
-      // Every remaining loop is longer than R.
-      if (R >= o.max_loop_length) {
-        reason = "no loop shorter than --max-loop-length remains";
-        break;
-      }
-      if (!truncated_any) {
-        reason = "no further loops found";
-        break;
-      }
-      // Next radius: the shortest non-separating closed walk seen across search frontiers
-      // bounds the next loop from above, so searching to it finds that loop; never less than
-      // 1.05 R nor more than 2 R.
-      R = std::min({2 * R, std::max(1.05 * R, next_radius_hint * (1 + 1e-9)), o.max_loop_length});
-      if (cuts_since_build > 0) rebuild();
-      compute_all();
-      continue;
-    }
-    if (top.key > o.max_loop_length) {
-      reason = "no loop shorter than --max-loop-length remains";
-      break;
-    }
-    // Re-run from the source on the current mesh: the entry is the global minimum if it is
-    // still exact (all other keys are lower bounds of their sources' current values).
-    Stopwatch sw;
-    const CycleCandidate c = search->run(Mesh::VertexHandle(top.v), R, accept_ptr);
-    ++searches;
-    st.t.search += sw.seconds();
-    if (!c.found || c.value > top.key + 1e-12 * (1.0 + top.key)) {
-      queue_result(top.v, c);  // changed since it was queued: back in line with its new value
-      continue;
-    }
-    ++ver[top.v];  // consumed by this cut
-    const std::vector<Mesh::VertexHandle> loop = search->extract(c);
-    const std::vector<std::uint64_t> cls = search->cycle_class(loop);
-    if (!span.insert(cls.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
-    const int comp = st.component[loop.front().idx()];
-    st.record(loop, cuts + 1, false);
-    SurgeryResult sr;
-    if (!cut_loop(st, loop, o, &hb, &sr))
-      throw Error("denoise: surgery along loop " + std::to_string(cuts) + " (length " +
-                  format_number(st.loops.back().length) + " mm) split component " + std::to_string(comp) +
-                  " - the loop was separating; refusing to continue");
-    --st.genus_left[comp];
-    ++cuts;
-    ++cuts_since_build;
-    if (progress) progress(cuts, needed);
-    // New sources: every non-separating cycle of the new mesh meets the old sources or the new
-    // rings/caps. Sources whose search ball reached the surgery are recomputed now.
-    std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
-    seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
-    seeds.push_back(sr.left_cap);
-    seeds.push_back(sr.right_cap);
-    for (auto v : seeds) add_source(v.idx());
-    double slack = 0;
-    for (auto v : seeds)
-      for (auto w : st.mesh.vv_range(v)) slack = std::max(slack, (st.mesh.point(w) - st.mesh.point(v)).norm());
-    for (int v : vertices_within(st.mesh, seeds, 0.5 * R + 2 * slack))
-      if (v < static_cast<int>(is_source.size()) && is_source[v]) compute(v);
+// The greedy loop of the exact method. Invariant: every source is in the queue with its current
+// bound (or dropped with F = inf), and min over the queue of F(s) is the shortest non-separating
+// cycle of the current mesh. Lower bounds spread from each search: a closed walk W through s
+// gives one through any vertex t at distance d, of length |W| + 2d, so F(s) >= F(c) - 2 d(c, s)
+// for every source s the search from c settled (F(c) > limit when it found nothing).
+class ExactGreedy {
+ public:
+  ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge)
+      : st_(st), opts_(o), first_radius_(o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge) {
+    want_type_ = o.policy != "shortest";
+    wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
+    accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
   }
-  stats["searches"] = searches;
-  stats["sweeps"] = sweeps;
-  stats["sweep_time_s"] = sweep_time;
-  stats["threads"] = n_threads;
-  stats["settled_vertices"] = settled;
-  stats["homology_rebuilds"] = rebuilds;
-  stats["final_search_radius_mm"] = R;
-  stats["radius_schedule"] = "frontier bound, 1.05x..2x";
-  stats["sources_last"] = sources.size();
+  std::string run(int needed, const DenoiseProgress& progress);
+  void write_stats(nlohmann::json& stats) const;
+
+ private:
+  void build_homology();
+  void add_source(int v);
+  void set_bound(int v, const SourceBound& b);
+  double search_limit(int v);
+  double best_exact_value();
+  CycleCandidate search_from(int v, double limit);
+  void spread_bounds(int centre, double bound);
+  bool stop_before(const QueueEntry& top, std::string* reason) const;
+  void cut(const CycleCandidate& c, int iteration);
+  void add_surgery_sources(const SurgeryResult& sr);
+  void invalidate_near(const SurgeryResult& sr);
+
+  DenoiseState& st_;
+  const DenoiseOptions& opts_;
+  const double first_radius_;  // mm: limit of a source's first search
+  bool want_type_ = false;
+  LoopType wanted_ = LoopType::kHandle;
+  FundamentalCycleSearch::Accept accept_;
+  HomologyBasis homology_;
+  Z2Span span_;
+  std::unique_ptr<FundamentalCycleSearch> search_;
+  std::vector<std::uint8_t> is_source_;
+  std::vector<int> sources_;
+  std::vector<SourceBound> bound_;  // per vertex (sources only)
+  std::vector<double> ball_radius_;  // per vertex: largest ball its searches settled still backing bounds
+  double largest_ball_ = 0;          // max of ball_radius_ ever (mm)
+  std::vector<std::uint32_t> touched_;  // per vertex: stamp of the last surgery that reached its ball
+  std::uint32_t surgery_stamp_ = 0;
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> queue_;
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
+  long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
+  double largest_limit_ = 0;
+};
+
+void ExactGreedy::build_homology() {
+  Stopwatch sw;
+  homology_.build(st_.mesh);
+  span_.reset(homology_.words());
+  search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  for (int v : homology_.pruned_cut_graph_vertices()) add_source(v);
+  st_.t.homology += sw.seconds();
+}
+
+void ExactGreedy::add_source(int v) {
+  const std::size_t n = std::max<std::size_t>(st_.mesh.n_vertices(), v + 1);
+  if (is_source_.size() < n) {
+    is_source_.resize(n, 0);
+    bound_.resize(n);
+    ball_radius_.resize(n, 0);
+  }
+  if (is_source_[v] || st_.mesh.is_boundary(Mesh::VertexHandle(v))) return;
+  is_source_[v] = 1;
+  sources_.push_back(v);
+  set_bound(v, SourceBound{});
+}
+
+void ExactGreedy::set_bound(int v, const SourceBound& b) {
+  const std::uint32_t version = bound_[v].version + 1;
+  bound_[v] = b;
+  bound_[v].version = version;
+  if (!std::isfinite(b.value)) return;  // no loop through this source's part of the mesh
+  queue_.push({b.value, v, version, b.exact});
+  if (b.exact) exact_queue_.push({b.value, v, version, true});
+}
+
+// The smallest exact value still queued (an upper bound of the shortest loop), or inf.
+double ExactGreedy::best_exact_value() {
+  while (!exact_queue_.empty()) {
+    const QueueEntry& e = exact_queue_.top();
+    if (e.version == bound_[e.vertex].version) return e.key;
+    exact_queue_.pop();
+  }
+  return kInf;
+}
+
+// Limit of the next search from v (lower bound m): twice m, at least the first radius, no
+// more than the best exact value known (a longer loop through v would not be cut next) nor
+// --max-loop-length.
+double ExactGreedy::search_limit(int v) {
+  const double m = bound_[v].value;
+  double limit = std::max(first_radius_, 2.0 * m);
+  const double best = best_exact_value();
+  if (best > m) limit = std::min(limit, best);
+  limit = std::max(limit, 1.05 * m);
+  return std::min(limit, opts_.max_loop_length);
+}
+
+CycleCandidate ExactGreedy::search_from(int v, double limit) {
+  Stopwatch sw;
+  const CycleCandidate c = search_->run(Mesh::VertexHandle(v), limit, want_type_ ? &accept_ : nullptr);
+  ++searches_;
+  settled_ += static_cast<long long>(search_->last_settled());
+  largest_limit_ = std::max(largest_limit_, limit);
+  const double own = c.found ? c.value : c.truncated ? limit : kInf;
+  set_bound(v, SourceBound{own, c.found, v, 0});
+  if (!want_type_) spread_bounds(v, own);  // with a type filter F is no closed-walk minimum
+  const auto& ball = search_->last_settled_vertices();
+  if (!ball.empty()) ball_radius_[v] = std::max(ball_radius_[v], search_->distance(ball.back()));
+  largest_ball_ = std::max(largest_ball_, ball_radius_[v]);
+  st_.t.search += sw.seconds();
+  return c;
+}
+
+void ExactGreedy::spread_bounds(int centre, double bound) {
+  for (int t : search_->last_settled_vertices()) {
+    if (t == centre || t >= static_cast<int>(is_source_.size()) || !is_source_[t]) continue;
+    const double lower = bound - 2.0 * search_->distance(t);
+    const SourceBound& b = bound_[t];
+    if (!(lower > b.value)) continue;  // also keeps dropped sources (inf) dropped
+    set_bound(t, SourceBound{lower, false, centre, 0});
+    ++bounds_spread_;
+  }
+}
+
+bool ExactGreedy::stop_before(const QueueEntry& top, std::string* reason) const {
+  const bool too_long = top.exact ? top.key > opts_.max_loop_length : top.key >= opts_.max_loop_length;
+  if (too_long) *reason = "no loop shorter than --max-loop-length remains";
+  return too_long;
+}
+
+std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
+  build_homology();
+  int cuts = 0;
+  while (cuts < needed) {
+    if (queue_.empty())
+      return want_type_ ? "no further " + std::string(opts_.policy == "cut" ? "handle" : "tunnel") + " loops found"
+                        : "no further non-separating loops found";
+    const QueueEntry top = queue_.top();
+    queue_.pop();
+    if (top.version != bound_[top.vertex].version) continue;
+    std::string reason;
+    if (stop_before(top, &reason)) return reason;
+    if (!top.exact) {
+      search_from(top.vertex, search_limit(top.vertex));
+      continue;
+    }
+    // Exact and the smallest key: the global minimum if the value still holds on the current
+    // mesh (surgery elsewhere can only have raised it).
+    const CycleCandidate c = search_from(top.vertex, top.key * (1 + 1e-12) + 1e-12);
+    if (!c.found || c.value > top.key * (1 + 1e-12) + 1e-12) continue;  // re-queued with its new bound
+    cut(c, ++cuts);
+    if (progress) progress(cuts, needed);
+  }
+  return "target genus reached";
+}
+
+void ExactGreedy::cut(const CycleCandidate& c, int iteration) {
+  set_bound(c.source.idx(), SourceBound{0, false, -1, 0});  // searched again after the surgery
+  const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
+  const std::vector<std::uint64_t> cls = search_->cycle_class(loop);
+  if (!span_.insert(cls.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
+  const int comp = st_.component[loop.front().idx()];
+  st_.record(loop, iteration, false);
+  SurgeryResult sr;
+  if (!cut_loop(st_, loop, opts_, &homology_, &sr))
+    throw Error("denoise: surgery along loop " + std::to_string(iteration - 1) + " (length " +
+                format_number(st_.loops.back().length) + " mm) split component " + std::to_string(comp) +
+                " - the loop was separating; refusing to continue");
+  --st_.genus_left[comp];
+  Stopwatch sw;
+  invalidate_near(sr);
+  add_surgery_sources(sr);
+  st_.t.search += sw.seconds();
+}
+
+// Every non-separating cycle of the new mesh meets the old sources or the new rings and caps.
+void ExactGreedy::add_surgery_sources(const SurgeryResult& sr) {
+  for (auto v : sr.left_ring) add_source(v.idx());
+  for (auto v : sr.right_ring) add_source(v.idx());
+  add_source(sr.left_cap.idx());
+  add_source(sr.right_cap.idx());
+}
+
+// Bounds from searches whose ball reached the surgery may be too high now (caps are shortcuts);
+// their sources start again from 0. Other bounds stay valid: inside an untouched ball distances
+// are unchanged and classes only gained the cut one in the span.
+void ExactGreedy::invalidate_near(const SurgeryResult& sr) {
+  std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
+  seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
+  double slack = 0;  // rings moved by the pull: edges at the rings changed length by at most this
+  for (auto v : seeds)
+    for (auto w : st_.mesh.vv_range(v)) slack = std::max(slack, (st_.mesh.point(w) - st_.mesh.point(v)).norm());
+  std::vector<double> dist;
+  const std::vector<int> near = vertices_within(st_.mesh, seeds, largest_ball_ + 2 * slack, &dist);
+  touched_.resize(st_.mesh.n_vertices(), 0);
+  ++surgery_stamp_;
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const int c = near[i];
+    if (c < static_cast<int>(ball_radius_.size()) && ball_radius_[c] > 0 && dist[i] <= ball_radius_[c] + 2 * slack) {
+      touched_[c] = surgery_stamp_;
+      ball_radius_[c] = 0;
+    }
+  }
+  for (int s : sources_) {
+    const int c = bound_[s].centre;
+    if (c < 0 || touched_[c] != surgery_stamp_) continue;
+    set_bound(s, SourceBound{});
+    ++bounds_reset_;
+  }
+}
+
+void ExactGreedy::write_stats(nlohmann::json& stats) const {
+  stats["searches"] = searches_;
+  stats["settled_vertices"] = settled_;
+  stats["bounds_spread"] = bounds_spread_;
+  stats["bounds_reset"] = bounds_reset_;
+  stats["homology_builds"] = 1;
+  stats["first_search_radius_mm"] = first_radius_;
+  stats["largest_search_limit_mm"] = largest_limit_;
+  stats["sources_last"] = sources_.size();
+  stats["schedule"] = "per-source limits, bounds shared within each search ball";
+}
+
+}  // namespace
+
+std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
+                      double mean_edge, nlohmann::json& stats) {
+  ExactGreedy greedy(st, o, mean_edge);
+  const std::string reason = greedy.run(needed, progress);
+  greedy.write_stats(stats);
   return reason;
 }
 
