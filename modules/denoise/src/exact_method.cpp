@@ -101,6 +101,7 @@ class ExactGreedy {
 
  private:
   void build_homology();
+  void maybe_rebuild(int cuts);
   void add_source(int v);
   void set_bound(int v, const SourceBound& b);
   double search_limit(int v);
@@ -124,6 +125,7 @@ class ExactGreedy {
   std::vector<std::uint8_t> is_source_;
   std::vector<int> sources_;
   std::vector<SourceBound> bound_;  // per vertex (sources only)
+  std::vector<double> own_limit_;    // per vertex: limit of its last own search (the next one doubles it)
   std::vector<double> ball_radius_;  // per vertex: largest ball its searches settled still backing bounds
   double largest_ball_ = 0;          // max of ball_radius_ ever (mm)
   std::vector<std::uint32_t> touched_;  // per vertex: stamp of the last surgery that reached its ball
@@ -131,16 +133,44 @@ class ExactGreedy {
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> queue_;
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
   long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
+  int builds_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
+  double build_time_ = 0, search_time_at_build_ = 0;
   double largest_limit_ = 0;
 };
 
+// Homology of the current mesh and its pruned cut graph as the source set (every
+// non-separating cycle meets it). Bounds are kept: F(s) is the same quantity whatever the
+// annotations (the shortest non-separating fundamental cycle of s's tree on the current mesh).
 void ExactGreedy::build_homology() {
   Stopwatch sw;
   homology_.build(st_.mesh);
   span_.reset(homology_.words());
   search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  for (int v : sources_) {
+    is_source_[v] = 0;
+    ++bound_[v].version;  // its queue entries are stale
+  }
+  sources_.clear();
   for (int v : homology_.pruned_cut_graph_vertices()) add_source(v);
-  st_.t.homology += sw.seconds();
+  for (int v : sources_) {  // kept bounds back in the queue
+    if (bound_[v].value > 0) set_bound(v, bound_[v]);
+  }
+  build_time_ = sw.seconds();
+  st_.t.homology += build_time_;
+  search_time_at_build_ = st_.t.search;
+  ++builds_;
+}
+
+// A fresh cut graph of the lower-genus mesh is much smaller than the old one plus every ring,
+// and searches start only from it; rebuilt once half the genus is gone, if searching has cost
+// more than two builds since the last one.
+void ExactGreedy::maybe_rebuild(int cuts) {
+  const int genus_left = genus_at_build_ - (cuts - cuts_at_build_);
+  if (genus_left < 1 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
+  if (st_.t.search - search_time_at_build_ < 2 * build_time_) return;
+  build_homology();
+  cuts_at_build_ = cuts;
+  genus_at_build_ = genus_left;
 }
 
 void ExactGreedy::add_source(int v) {
@@ -148,12 +178,13 @@ void ExactGreedy::add_source(int v) {
   if (is_source_.size() < n) {
     is_source_.resize(n, 0);
     bound_.resize(n);
+    own_limit_.resize(n, 0);
     ball_radius_.resize(n, 0);
   }
   if (is_source_[v] || st_.mesh.is_boundary(Mesh::VertexHandle(v))) return;
   is_source_[v] = 1;
   sources_.push_back(v);
-  set_bound(v, SourceBound{});
+  if (bound_[v].value == 0) set_bound(v, SourceBound{});
 }
 
 void ExactGreedy::set_bound(int v, const SourceBound& b) {
@@ -175,14 +206,16 @@ double ExactGreedy::best_exact_value() {
   return kInf;
 }
 
-// Limit of the next search from v (lower bound m): twice m, at least the first radius, no
-// more than the best exact value known (a longer loop through v would not be cut next) nor
-// --max-loop-length.
+// Limit of the next search from v (lower bound m): without a known loop, twice m (at least the
+// first radius, at least twice its previous own limit); once a loop of value U is known, 2U:
+// the search ends at the first loop found (value/2 from v), and when v has none up to 2U every
+// source within U/2 of v gets a bound >= U, so one search covers a stretch of sources instead
+// of each searching to U itself. Never above --max-loop-length.
 double ExactGreedy::search_limit(int v) {
   const double m = bound_[v].value;
-  double limit = std::max(first_radius_, 2.0 * m);
+  double limit = std::max({first_radius_, 2.0 * m, 2.0 * own_limit_[v]});
   const double best = best_exact_value();
-  if (best > m) limit = std::min(limit, best);
+  if (std::isfinite(best) && best > m) limit = 2.0 * best;
   limit = std::max(limit, 1.05 * m);
   return std::min(limit, opts_.max_loop_length);
 }
@@ -193,6 +226,7 @@ CycleCandidate ExactGreedy::search_from(int v, double limit) {
   ++searches_;
   settled_ += static_cast<long long>(search_->last_settled());
   largest_limit_ = std::max(largest_limit_, limit);
+  own_limit_[v] = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(v, SourceBound{own, c.found, v, 0});
   if (!want_type_) spread_bounds(v, own);  // with a type filter F is no closed-walk minimum
@@ -221,6 +255,7 @@ bool ExactGreedy::stop_before(const QueueEntry& top, std::string* reason) const 
 }
 
 std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
+  genus_at_build_ = needed;
   build_homology();
   int cuts = 0;
   while (cuts < needed) {
@@ -242,6 +277,7 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
     if (!c.found || c.value > top.key * (1 + 1e-12) + 1e-12) continue;  // re-queued with its new bound
     cut(c, ++cuts);
     if (progress) progress(cuts, needed);
+    if (cuts < needed) maybe_rebuild(cuts);
   }
   return "target genus reached";
 }
@@ -306,7 +342,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["settled_vertices"] = settled_;
   stats["bounds_spread"] = bounds_spread_;
   stats["bounds_reset"] = bounds_reset_;
-  stats["homology_builds"] = 1;
+  stats["homology_builds"] = builds_;
   stats["first_search_radius_mm"] = first_radius_;
   stats["largest_search_limit_mm"] = largest_limit_;
   stats["sources_last"] = sources_.size();
