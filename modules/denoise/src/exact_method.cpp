@@ -66,7 +66,7 @@ namespace {
 // What is known of one source's shortest fundamental cycle value F(s) (the minimum over the
 // fundamental cycles of its shortest-path tree whose class is outside the cut span):
 // F(s) == value when exact, F(s) >= value otherwise. `centre` is the source whose search gave
-// it (-1: none yet); the bound stays valid while that search's ball is untouched by surgery.
+// it (-1: none, or lowered after a surgery).
 struct SourceBound {
   double value = 0;
   bool exact = false;
@@ -111,7 +111,7 @@ class ExactGreedy {
   bool stop_before(const QueueEntry& top, std::string* reason) const;
   void cut(const CycleCandidate& c, int iteration);
   void add_surgery_sources(const SurgeryResult& sr);
-  void invalidate_near(const SurgeryResult& sr);
+  void lower_bounds_near(const SurgeryResult& sr);
 
   DenoiseState& st_;
   const DenoiseOptions& opts_;
@@ -126,10 +126,6 @@ class ExactGreedy {
   std::vector<int> sources_;
   std::vector<SourceBound> bound_;  // per vertex (sources only)
   std::vector<double> own_limit_;    // per vertex: limit of its last own search (the next one doubles it)
-  std::vector<double> ball_radius_;  // per vertex: largest ball its searches settled still backing bounds
-  double largest_ball_ = 0;          // max of ball_radius_ ever (mm)
-  std::vector<std::uint32_t> touched_;  // per vertex: stamp of the last surgery that reached its ball
-  std::uint32_t surgery_stamp_ = 0;
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> queue_;
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
   long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
@@ -179,7 +175,6 @@ void ExactGreedy::add_source(int v) {
     is_source_.resize(n, 0);
     bound_.resize(n);
     own_limit_.resize(n, 0);
-    ball_radius_.resize(n, 0);
   }
   if (is_source_[v] || st_.mesh.is_boundary(Mesh::VertexHandle(v))) return;
   is_source_[v] = 1;
@@ -230,9 +225,6 @@ CycleCandidate ExactGreedy::search_from(int v, double limit) {
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(v, SourceBound{own, c.found, v, 0});
   if (!want_type_) spread_bounds(v, own);  // with a type filter F is no closed-walk minimum
-  const auto& ball = search_->last_settled_vertices();
-  if (!ball.empty()) ball_radius_[v] = std::max(ball_radius_[v], search_->distance(ball.back()));
-  largest_ball_ = std::max(largest_ball_, ball_radius_[v]);
   st_.t.search += sw.seconds();
   return c;
 }
@@ -296,7 +288,7 @@ void ExactGreedy::cut(const CycleCandidate& c, int iteration) {
                 " - the loop was separating; refusing to continue");
   --st_.genus_left[comp];
   Stopwatch sw;
-  invalidate_near(sr);
+  lower_bounds_near(sr);
   add_surgery_sources(sr);
   st_.t.search += sw.seconds();
 }
@@ -309,30 +301,25 @@ void ExactGreedy::add_surgery_sources(const SurgeryResult& sr) {
   add_source(sr.right_cap.idx());
 }
 
-// Bounds from searches whose ball reached the surgery may be too high now (caps are shortcuts);
-// their sources start again from 0. Other bounds stay valid: inside an untouched ball distances
-// are unchanged and classes only gained the cut one in the span.
-void ExactGreedy::invalidate_near(const SurgeryResult& sr) {
+// After a surgery: a closed walk through t shorter than twice t's distance to the new rings
+// never reaches them, so it is a walk of the old mesh with the same class (only the span grew):
+// F_new(t) >= min(F_old bound, 2 d(t, rings)). Bounds are lowered to that, nothing more; sources
+// farther than half their bound from the rings keep it. (Bounds of inf are in genus-0
+// components, where no surgery happens.)
+void ExactGreedy::lower_bounds_near(const SurgeryResult& sr) {
   std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
   seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
-  double slack = 0;  // rings moved by the pull: edges at the rings changed length by at most this
-  for (auto v : seeds)
-    for (auto w : st_.mesh.vv_range(v)) slack = std::max(slack, (st_.mesh.point(w) - st_.mesh.point(v)).norm());
+  double reach = 0;
+  for (int s : sources_)
+    if (std::isfinite(bound_[s].value)) reach = std::max(reach, 0.5 * bound_[s].value);
   std::vector<double> dist;
-  const std::vector<int> near = vertices_within(st_.mesh, seeds, largest_ball_ + 2 * slack, &dist);
-  touched_.resize(st_.mesh.n_vertices(), 0);
-  ++surgery_stamp_;
+  const std::vector<int> near = vertices_within(st_.mesh, seeds, reach, &dist);
   for (std::size_t i = 0; i < near.size(); ++i) {
-    const int c = near[i];
-    if (c < static_cast<int>(ball_radius_.size()) && ball_radius_[c] > 0 && dist[i] <= ball_radius_[c] + 2 * slack) {
-      touched_[c] = surgery_stamp_;
-      ball_radius_[c] = 0;
-    }
-  }
-  for (int s : sources_) {
-    const int c = bound_[s].centre;
-    if (c < 0 || touched_[c] != surgery_stamp_) continue;
-    set_bound(s, SourceBound{});
+    const int t = near[i];
+    if (t >= static_cast<int>(is_source_.size()) || !is_source_[t]) continue;
+    const double cap = 2.0 * dist[i];
+    if (!(cap < bound_[t].value)) continue;
+    set_bound(t, SourceBound{cap, false, -1, 0});
     ++bounds_reset_;
   }
 }
@@ -341,7 +328,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["searches"] = searches_;
   stats["settled_vertices"] = settled_;
   stats["bounds_spread"] = bounds_spread_;
-  stats["bounds_reset"] = bounds_reset_;
+  stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["first_search_radius_mm"] = first_radius_;
   stats["largest_search_limit_mm"] = largest_limit_;
