@@ -106,6 +106,7 @@ class ExactGreedy {
   void set_bound(int v, const SourceBound& b);
   double search_limit(int v);
   double best_exact_value();
+  int farthest_pending(double best);
   CycleCandidate search_from(int v, double limit);
   void spread_bounds(int centre, double bound);
   bool stop_before(const QueueEntry& top, std::string* reason) const;
@@ -130,6 +131,11 @@ class ExactGreedy {
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
   long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
   int builds_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
+  // Sources to certify against the best known loop, farthest from its source first.
+  int far_anchor_ = -1;
+  double far_value_ = 0;
+  std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, source), a max-heap
+  long long far_searches_ = 0;
   double build_time_ = 0, search_time_at_build_ = 0;
   double largest_limit_ = 0;
 };
@@ -229,6 +235,37 @@ CycleCandidate ExactGreedy::search_from(int v, double limit) {
   return c;
 }
 
+// While sources with a bound below the best known loop (value U, source u) remain, any order of
+// searching them keeps the result exact. Farthest from u first: a source at distance D from the
+// loop finds a walk of about U + 2D and then covers every source within D of it, so far sources
+// certify the near ones, which could otherwise only search to U each. Returns -1 when the plain
+// smallest-bound order should be used.
+int ExactGreedy::farthest_pending(double best) {
+  if (!std::isfinite(best)) return -1;
+  const int anchor = exact_queue_.top().vertex;  // best_exact_value() left a valid top
+  if (anchor != far_anchor_ || best != far_value_) {
+    far_anchor_ = anchor;
+    far_value_ = best;
+    std::vector<double> dist;
+    const std::vector<int> near = vertices_within(st_.mesh, {Mesh::VertexHandle(anchor)}, best, &dist);
+    std::vector<double> from_anchor(st_.mesh.n_vertices(), kInf);
+    for (std::size_t i = 0; i < near.size(); ++i) from_anchor[near[i]] = dist[i];
+    far_order_.clear();
+    for (int s : sources_)
+      if (bound_[s].value < best && !bound_[s].exact) far_order_.push_back({from_anchor[s], s});
+    std::make_heap(far_order_.begin(), far_order_.end());
+  }
+  while (!far_order_.empty()) {
+    std::pop_heap(far_order_.begin(), far_order_.end());
+    const int s = far_order_.back().second;
+    far_order_.pop_back();
+    if (!is_source_[s] || bound_[s].exact || !(bound_[s].value < best)) continue;  // done meanwhile
+    ++far_searches_;
+    return s;
+  }
+  return -1;
+}
+
 void ExactGreedy::spread_bounds(int centre, double bound) {
   for (int t : search_->last_settled_vertices()) {
     if (t == centre || t >= static_cast<int>(is_source_.size()) || !is_source_[t]) continue;
@@ -260,7 +297,10 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
     std::string reason;
     if (stop_before(top, &reason)) return reason;
     if (!top.exact) {
-      search_from(top.vertex, search_limit(top.vertex));
+      queue_.push(top);  // still pending; the order below does not change what is cut
+      const int far = want_type_ ? -1 : farthest_pending(best_exact_value());
+      const int v = far >= 0 ? far : top.vertex;
+      search_from(v, search_limit(v));
       continue;
     }
     // Exact and the smallest key: the global minimum if the value still holds on the current
@@ -328,6 +368,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["searches"] = searches_;
   stats["settled_vertices"] = settled_;
   stats["bounds_spread"] = bounds_spread_;
+  stats["farthest_first_searches"] = far_searches_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["first_search_radius_mm"] = first_radius_;
