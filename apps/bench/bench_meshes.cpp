@@ -8,6 +8,7 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -115,6 +116,84 @@ Mesh sphere_with_strand(double radius, double strand_radius, double voxel) {
         const double dy = y - cy - ty * x, dz = z - cz;
         const double strand = strand_radius - std::sqrt(dy * dy + dz * dz) / std::sqrt(1 + ty * ty);
         d[(static_cast<std::size_t>(k) * n + j) * n + i] = static_cast<float>(std::max(ball, strand));
+      }
+  return iso_surface(img);
+}
+
+namespace {
+struct P3 {
+  double x, y, z;
+};
+// Distance from q to the segment ab minus r (a capsule's signed distance).
+double capsule(const P3& q, const P3& a, const P3& b, double r) {
+  const double abx = b.x - a.x, aby = b.y - a.y, abz = b.z - a.z;
+  const double t0 = ((q.x - a.x) * abx + (q.y - a.y) * aby + (q.z - a.z) * abz) / (abx * abx + aby * aby + abz * abz);
+  const double t = std::clamp(t0, 0.0, 1.0);
+  const double dx = q.x - a.x - t * abx, dy = q.y - a.y - t * aby, dz = q.z - a.z - t * abz;
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - r;
+}
+
+// Signed distance (< 0 in the lumen) of the colon-like shape at q.
+double colon_like_sdf(const ColonLikeOptions& o, const P3& q) {
+  constexpr double kRadius = 18, kLength = 200, kHalfGap = 1.5, kPi = 3.14159265358979323846;
+  const double s = kRadius + kHalfGap;  // limb axes at x = -s, +s
+  double d = std::min(capsule(q, {-s, 0, 0}, {-s, 0, kLength}, kRadius), capsule(q, {s, 0, 0}, {s, 0, kLength}, kRadius));
+  // The bend: a half torus of major radius s in the xz-plane above z = kLength.
+  if (q.z >= kLength) {
+    const double rho = std::sqrt(q.x * q.x + (q.z - kLength) * (q.z - kLength));
+    d = std::min(d, std::sqrt((rho - s) * (rho - s) + q.y * q.y) - kRadius);
+  }
+  if (o.contact_length > 0)
+    d = std::min(d, capsule(q, {0, 0, 70}, {0, 0, 70 + o.contact_length}, kHalfGap + 0.5));
+  if (o.bridge) {
+    const double by = kRadius + 30;  // small-bowel loop along z beside limb A
+    d = std::min(d, capsule(q, {-s, by, 30}, {-s, by, 170}, 10));
+    d = std::min(d, capsule(q, {-s, 0, 40}, {-s, by, 40}, 4));
+    d = std::min(d, capsule(q, {-s, 0, 160}, {-s, by, 160}, 4));
+  }
+  if (o.hooks)
+    for (double z : {25.0, 185.0}) {
+      const double out = -s - kRadius - 8;  // outside limb A, opposite the contact
+      const double h = std::min({capsule(q, {-s - kRadius + 3, -4, z - 6}, {out, -4, z - 6}, 2),
+                                 capsule(q, {out, -4, z - 6}, {out, -4, z + 6}, 2),
+                                 capsule(q, {out, -4, z + 6}, {-s - kRadius + 3, -4, z + 6}, 2)});
+      d = std::min(d, h);
+    }
+  if (o.strands) {  // tissue: removed from the lumen
+    const double straight = capsule(q, {s, -kRadius - 2, 120}, {s + 4, kRadius + 2, 126}, 6);
+    double curved = 1e9;
+    const P3 c{s, 0, 40};
+    for (int i = 0; i < 6; ++i) {  // an arc of radius 14 mm in the limb's cross-section plane, bowed
+      const double a0 = kPi * (0.15 + 0.7 * i / 6.0), a1 = kPi * (0.15 + 0.7 * (i + 1) / 6.0);
+      curved = std::min(curved, capsule(q, {c.x + 16 * std::cos(a0) - 8, c.y + 20 * std::sin(a0) - 10, c.z + 3 * i},
+                                        {c.x + 16 * std::cos(a1) - 8, c.y + 20 * std::sin(a1) - 10, c.z + 3 * (i + 1)}, 4));
+    }
+    d = std::max(d, -std::min(straight, curved));
+  }
+  return d;
+}
+}  // namespace
+
+Mesh colon_like_surface(const ColonLikeOptions& o) {
+  const double v = o.voxel, margin = 3 * v;
+  const double x0 = -70 - margin, y0 = -25 - margin, z0 = -20 - margin;
+  const int nx = static_cast<int>(std::ceil((140 + 2 * margin) / v)) + 1;
+  const int ny = static_cast<int>(std::ceil((85 + 2 * margin) / v)) + 1;
+  const int nz = static_cast<int>(std::ceil((260 + 2 * margin) / v)) + 1;
+  vtkNew<vtkImageData> img;
+  img->SetDimensions(nx, ny, nz);
+  img->SetSpacing(v, v, v);
+  img->SetOrigin(x0, y0, z0);
+  vtkNew<vtkFloatArray> f;
+  f->SetName("mask");
+  f->SetNumberOfValues(static_cast<vtkIdType>(nx) * ny * nz);
+  img->GetPointData()->SetScalars(f);
+  float* d = f->GetPointer(0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const bool lumen = colon_like_sdf(o, {x0 + i * v, y0 + j * v, z0 + k * v}) < 0;
+        d[(static_cast<std::size_t>(k) * ny + j) * nx + i] = lumen ? -1.0f : 1.0f;  // a binary mask
       }
   return iso_surface(img);
 }

@@ -17,4 +17,23 @@ Mesh sphere_with_handles(double radius, int handles, double voxel, unsigned seed
 // ball. Flying edges at `voxel` mm.
 Mesh sphere_with_strand(double radius, double strand_radius, double voxel);
 
+// A colon-like surface with the kinds of handles real CT colonography surfaces have, from the
+// binary mask (voxel `voxel` mm) of a U-shaped colon (two limbs of radius 18 mm, 200 mm long,
+// 3 mm apart, joined by a bend) extracted with VTK flying edges (stair-cased like a real mask):
+//   contact: the limbs touch over `contact_length` mm (a 4 mm-wide air channel overlapping both
+//            walls by 0.5 mm): one long handle (loop ~2 x contact_length) plus the small handles
+//            voxel noise makes along it;
+//   bridge:  an air bridge (radius 4 mm) to a small-bowel loop (radius 10 mm) that returns to
+//            the colon through a second bridge;
+//   strands: a straight tissue strand (radius 6 mm) and a curved one (radius 4 mm) across the
+//            lumen: tunnel loops of 25-40 mm around wide, curved walls;
+//   hooks:   two diverticulum-like tubes (radius 2 mm) leaving the wall and re-entering it.
+// Genus follows from the mask (measured by the caller). Deterministic.
+struct ColonLikeOptions {
+  double voxel = 0.5;            // mm
+  double contact_length = 60;    // mm; 0 = no contact
+  bool bridge = true, strands = true, hooks = true;
+};
+Mesh colon_like_surface(const ColonLikeOptions& options);
+
 }  // namespace cf::bench

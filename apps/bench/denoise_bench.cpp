@@ -1,14 +1,21 @@
-// Denoising benchmark: for every closed shared mesh of genus >= 1 and for large generated
-// surfaces (spheres with hundreds of handles, >= 1M faces), faces, genus, loops, total loop
-// vertices, total loop length and time for the paper's method and the default (exact), and
-// the triangle pairs its caps still intersect (cap_x; 0 = surgery introduced no intersection).
-// Run in Release: ./build/apps/denoise_bench [--quick]
+// Denoising benchmark: faces, genus, loops, total loop vertices (the seed paper's Table 3
+// column), total and longest loop length, triangle pairs the caps still intersect (cap_x), time
+// per phase (homology + cut graph, loop search, surgery) and total, peak memory, for
+//   - the real colon mask ../shared/real/ctc_lumen_mask_a.nii.gz (reconstructed here with the
+//     default reconstruct options) and the real GCA large-intestine surfaces;
+//   - colon-like generated surfaces (long contact handles, air bridges, wide strands, hooks);
+//   - every closed shared mesh of genus >= 1 (not with --quick);
+//   - large generated spheres with hundreds of handles (>= 1M faces).
+// Each with the default (exact) method and the paper's method (real and colon-like cases).
+// Times are wall-clock per phase (report's time_s) and in total; cpu_s is the process CPU time
+// of the row (both threads), the figure to compare when the machine is shared.
+// Run in Release: ./build/apps/denoise_bench [--quick] [--only real|colon|shared|spheres]
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <sstream>
 #include <string>
 
@@ -16,11 +23,19 @@
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/denoise.h"
+#include "colonflat/reconstruct/reconstruct.h"
+#include "colonflat/volume/volume_io.h"
 
 namespace fs = std::filesystem;
 using namespace cf;
 
 namespace {
+
+void header() {
+  std::printf("%-24s %8s %5s %-6s %5s %7s %9s %7s %5s %6s %7s %6s %7s %6s %8s %5s  %s\n", "mesh", "faces", "genus",
+              "method", "loops", "loopvtx", "looplen", "longest", "cap_x", "hom_s", "search_s", "surg_s", "total_s",
+              "cpu_s", "peak_MiB", "g_aft", "note");
+}
 
 void row(const std::string& name, const Mesh& m, const std::string& method, int max_loops = -1) {
   DenoiseOptions o;
@@ -28,15 +43,102 @@ void row(const std::string& name, const Mesh& m, const std::string& method, int 
   const int genus = *analyze_topology(m).genus;
   if (max_loops >= 0) o.target_genus = std::max(0, genus - max_loops);
   Stopwatch sw;
-  DenoiseResult r = denoise(m, o);
+  const std::clock_t cpu0 = std::clock();  // process CPU time (all threads): meaningful on a loaded machine
+  DenoiseResult r;
+  try {
+    r = denoise(m, o);
+  } catch (const std::exception& e) {
+    std::printf("%-24s %8zu %5d %-6s failed: %s\n", name.c_str(), m.n_faces(), genus, method.c_str(), e.what());
+    return;
+  }
   const double t = sw.seconds();
-  std::printf("%-22s %9zu %6d  %-6s %6zu %9zu %12.2f %9.2f %9.0f %6s %6zu  %s\n", name.c_str(), m.n_faces(), genus,
-              method.c_str(), r.loops.size(), r.report["totals"]["loop_vertices"].get<std::size_t>(),
-              r.report["totals"]["loop_length_mm"].get<double>(), t, peak_memory_mib(),
+  const double cpu = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  const auto& tot = r.report["totals"];
+  const auto& ts = r.report["time_s"];
+  std::printf("%-24s %8zu %5d %-6s %5zu %7zu %9.1f %7.1f %5zu %6.2f %8.2f %6.2f %7.2f %6.2f %8.0f %5s  %s\n", name.c_str(),
+              m.n_faces(), genus, method.c_str(), r.loops.size(), tot["loop_vertices"].get<std::size_t>(),
+              tot["loop_length_mm"].get<double>(), tot["longest_loop_mm"].get<double>(),
+              tot["cap_intersections"].get<std::size_t>(), ts["homology_and_cut_graph"].get<double>(),
+              ts["loop_search"].get<double>(), ts["surgery"].get<double>(), t, cpu, peak_memory_mib(),
               r.report["genus_after"].is_null() ? "-" : r.report["genus_after"].dump().c_str(),
-              r.report["totals"]["cap_intersections"].get<std::size_t>(),
               max_loops >= 0 ? ("first " + std::to_string(max_loops) + " loops only").c_str() : "");
+  if (std::getenv("DENOISE_BENCH_SEARCH")) std::printf("    search %s\n", r.report["search"].dump().c_str());
   std::fflush(stdout);
+}
+
+void real_cases() {
+  const fs::path real = fs::path(COLONFLAT_SHARED_DIR) / "real";
+  const fs::path mask_file = real / "ctc_lumen_mask_a.nii.gz";
+  if (fs::exists(mask_file)) {
+    Stopwatch sw;
+    const MaskImage::Pointer mask = read_mask(mask_file);
+    const Mesh m = reconstruct_surface(mask.GetPointer(), ReconstructOptions{});
+    std::fprintf(stderr, "reconstructed %s: %zu faces in %.1f s\n", mask_file.filename().c_str(), m.n_faces(), sw.seconds());
+    row("real ctc_lumen_mask_a", m, "exact");
+    row("real ctc_lumen_mask_a", m, "paper");
+  }
+  for (const char* f : {"gca_large_intestine_100k.vtk", "gca_large_intestine_20k.vtk"}) {
+    if (!fs::exists(real / f)) continue;
+    const Mesh m = load_mesh(real / f).mesh;
+    row(std::string("real ") + std::string(f).substr(4, std::strlen(f) - 8), m, "exact");
+    row(std::string("real ") + std::string(f).substr(4, std::strlen(f) - 8), m, "paper");
+  }
+}
+
+void colon_like_cases(bool quick) {
+  struct Case {
+    const char* name;
+    bench::ColonLikeOptions o;
+  };
+  std::vector<Case> cases{{"colonlike contact60", {0.42, 60, true, true, true}},
+                          {"colonlike contact120", {0.42, 120, true, true, true}},
+                          {"colonlike nocontact", {0.42, 0, true, true, true}}};
+  if (quick) cases = {{"colonlike contact60 @0.8", {0.8, 60, true, true, true}}};
+  for (const auto& c : cases) {
+    Stopwatch sw;
+    const Mesh m = bench::colon_like_surface(c.o);
+    std::fprintf(stderr, "generated %s: %zu faces in %.1f s\n", c.name, m.n_faces(), sw.seconds());
+    row(c.name, m, "exact");
+    row(c.name, m, "paper");
+  }
+}
+
+void shared_cases() {
+  const fs::path dir = fs::path(COLONFLAT_SHARED_DIR) / "meshes";
+  std::ifstream in(dir / "MANIFEST.tsv");
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string name, faces, verts, genus, comps, closed;
+    for (std::string* f : {&name, &faces, &verts, &genus, &comps, &closed}) std::getline(ss, *f, '\t');
+    if (genus == "NA" || closed != "True" || std::stoi(genus) < 1) continue;
+    const Mesh m = load_mesh(dir / (name + ".off")).mesh;
+    row(name, m, "paper");
+    row(name, m, "exact");
+  }
+}
+
+// Scaling: fixed voxel (0.6 mm) and handle density, area and handle count growing together;
+// then the >= 1.5M-face, genus >= 300 target case, and a finer one.
+void sphere_cases(bool quick) {
+  struct Big {
+    double radius;
+    int handles;
+    double voxel;
+  };
+  const std::vector<Big> bigs = quick ? std::vector<Big>{{100, 300, 0.52}}
+                                      : std::vector<Big>{{50, 75, 0.6},   {71, 150, 0.6},  {100, 300, 0.6},
+                                                         {141, 600, 0.6}, {100, 300, 0.52}, {100, 400, 0.52}};
+  for (const auto& b : bigs) {
+    Stopwatch sw;
+    const Mesh m = bench::sphere_with_handles(b.radius, b.handles, b.voxel);
+    std::fprintf(stderr, "generated %zu faces in %.1f s\n", m.n_faces(), sw.seconds());
+    char name[64];
+    std::snprintf(name, sizeof name, "sphere%.0f+%dh@%.2f", b.radius, b.handles, b.voxel);
+    row(name, m, "exact");
+    row(name, m, "paper", 3);
+  }
 }
 
 }  // namespace
@@ -50,46 +152,16 @@ int main(int argc, char** argv) {
                 r.report["search"].dump().c_str());
     return 0;
   }
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
-  std::printf("%-22s %9s %6s  %-6s %6s %9s %12s %9s %9s %6s %6s\n", "mesh", "faces", "genus", "method", "loops",
-              "loop_vtx", "loop_len_mm", "time_s", "peak_MiB", "g_after", "cap_x");
-  const fs::path dir = fs::path(COLONFLAT_SHARED_DIR) / "meshes";
-  std::ifstream in(dir / "MANIFEST.tsv");
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::string name, faces, verts, genus, comps, closed;
-    std::getline(ss, name, '\t');
-    std::getline(ss, faces, '\t');
-    std::getline(ss, verts, '\t');
-    std::getline(ss, genus, '\t');
-    std::getline(ss, comps, '\t');
-    std::getline(ss, closed, '\t');
-    if (genus == "NA" || closed != "True" || std::stoi(genus) < 1) continue;
-    const Mesh m = load_mesh(dir / (name + ".off")).mesh;
-    row(name, m, "paper");
-    row(name, m, "exact");
+  bool quick = false;
+  std::string only;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+    else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc) only = argv[++i];
   }
-  // Large generated surfaces. Scaling: fixed voxel (0.6 mm) and handle density, area and handle
-  // count growing together (time vs faces at the same local structure); then the >= 1.5M-face,
-  // genus >= 300 target case, and a finer one.
-  struct Big {
-    double radius;
-    int handles;
-    double voxel;
-  };
-  std::vector<Big> bigs = quick ? std::vector<Big>{{50, 75, 0.6}}
-                                : std::vector<Big>{{50, 75, 0.6},   {71, 150, 0.6},  {100, 300, 0.6},
-                                                   {141, 600, 0.6}, {100, 300, 0.52}, {100, 400, 0.52}};
-  for (const auto& b : bigs) {
-    Stopwatch sw;
-    Mesh m = bench::sphere_with_handles(b.radius, b.handles, b.voxel);
-    std::fprintf(stderr, "generated %zu faces in %.1f s\n", m.n_faces(), sw.seconds());
-    char name[64];
-    std::snprintf(name, sizeof name, "sphere%.0f+%dh@%.2f", b.radius, b.handles, b.voxel);
-    row(name, m, "exact");
-    row(name, m, "paper", 3);
-  }
+  header();
+  if (only.empty() || only == "real") real_cases();
+  if (only.empty() || only == "colon") colon_like_cases(quick);
+  if ((only.empty() && !quick) || only == "shared") shared_cases();
+  if (only.empty() || only == "spheres") sphere_cases(quick);
   return 0;
 }

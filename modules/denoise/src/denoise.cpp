@@ -1,6 +1,7 @@
 #include "colonflat/denoise/denoise.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
@@ -26,6 +27,160 @@ void validate_denoise_options(const DenoiseOptions& o) {
     throw UsageError("--policy " + o.policy + " needs --method exact (the paper's method has no loop types)");
 }
 
+void describe_cross_section(LoopRecord* loop) {
+  const auto& p = loop->points;
+  if (p.empty()) return;
+  Vec3 c(0, 0, 0);
+  for (const auto& q : p) c += q;
+  c /= double(p.size());
+  Vec3 area(0, 0, 0);  // vector area: half the sum of (p_i - c) x (p_i+1 - c)
+  for (std::size_t i = 0; i < p.size(); ++i) area += OpenMesh::cross(p[i] - c, p[(i + 1) % p.size()] - c);
+  area *= 0.5;
+  double diameter = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j) diameter = std::max(diameter, (p[i] - p[j]).sqrnorm());
+  loop->centroid = c;
+  loop->diameter_mm = std::sqrt(diameter);
+  loop->cross_section_area_mm2 = area.norm();
+  loop->cross_section_normal = area.norm() > 0 ? area / area.norm() : Vec3(0, 0, 0);
+}
+
+namespace {
+
+void check_input(const TopologyReport& b, const DenoiseOptions& o) {
+  if (b.faces == 0) throw PreconditionError("input mesh has no faces");
+  if (!b.manifold || !b.orientable)
+    throw PreconditionError("input must be an orientable 2-manifold; got " + std::to_string(b.nonmanifold_edges) +
+                            " non-manifold edges, " + std::to_string(b.nonmanifold_vertices) + " non-manifold vertices" +
+                            (b.orientable ? "" : ", non-orientable"));
+  if (b.unreferenced_vertices) throw PreconditionError("input has unreferenced vertices");
+  if (o.method == "paper" && !b.closed)
+    throw PreconditionError("--method paper needs closed components (the paper's Algorithm 4 input); got " +
+                            std::to_string(b.boundary_loops) + " boundary loops - use --method exact");
+}
+
+void init_state(detail::DenoiseState& st, const TopologyReport& b) {
+  st.n_input = st.mesh.n_vertices();
+  st.mean_edge = b.mean_edge_length;
+  st.origin.resize(st.n_input);
+  for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
+  st.component.assign(st.n_input, -1);
+  for (auto f : st.mesh.faces())
+    for (auto v : st.mesh.fv_range(f)) st.component[v.idx()] = b.face_component[f.idx()];
+  for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
+}
+
+// Postconditions of the exact method (components, boundaries, manifold, oriented, genus per
+// component as counted); returns the per-component report.
+nlohmann::json check_exact_result(const detail::DenoiseState& st, const TopologyReport& b, const TopologyReport& a) {
+  if (a.components.size() != b.components.size() || a.boundary_loops != b.boundary_loops || !a.manifold ||
+      !a.consistently_oriented)
+    throw Error("denoise: postcondition failed: components " + std::to_string(b.components.size()) + " -> " +
+                std::to_string(a.components.size()) + ", boundary loops " + std::to_string(b.boundary_loops) +
+                " -> " + std::to_string(a.boundary_loops) + (a.manifold ? "" : ", not manifold"));
+  std::vector<int> rep(b.components.size(), -1);  // components matched through an input face of each
+  for (auto f : st.mesh.faces()) {
+    if (f.idx() >= static_cast<int>(b.face_component.size())) break;
+    const int c = b.face_component[f.idx()];
+    if (rep[c] < 0) rep[c] = a.face_component[f.idx()];
+  }
+  nlohmann::json comps = nlohmann::json::array();
+  for (std::size_t c = 0; c < b.components.size(); ++c) {
+    const auto& ca = a.components.at(rep[c]);
+    if (!ca.genus || *ca.genus != st.genus_left[c])
+      throw Error("denoise: postcondition failed: component " + std::to_string(c) + " should have genus " +
+                  std::to_string(st.genus_left[c]) + " after surgery, has " +
+                  (ca.genus ? std::to_string(*ca.genus) : std::string("undefined")));
+    comps.push_back({{"id", c},
+                     {"genus_before", *b.components[c].genus},
+                     {"genus_after", *ca.genus},
+                     {"faces_before", b.components[c].faces},
+                     {"faces_after", ca.faces},
+                     {"boundary_loops", ca.boundary_loops}});
+  }
+  return comps;
+}
+
+nlohmann::json paper_components(const TopologyReport& a) {
+  nlohmann::json comps = nlohmann::json::array();
+  for (std::size_t c = 0; c < a.components.size(); ++c)
+    comps.push_back({{"id", c},
+                     {"genus_after", a.components[c].genus ? nlohmann::json(*a.components[c].genus) : nlohmann::json(nullptr)},
+                     {"faces_after", a.components[c].faces}});
+  return comps;
+}
+
+// Stump removal after the checks (they match components through input face ids, which its
+// garbage collection renumbers); topology is checked again. Replaces `after`.
+nlohmann::json run_stumps(detail::DenoiseState& st, const DenoiseOptions& o, TopologyReport& after) {
+  Stopwatch sw;
+  const std::vector<StumpRecord> recs = remove_stumps(st.mesh, st.cap_rings, StumpOptions{o.remove_stumps, 1.5});
+  TopologyReport now = analyze_topology(st.mesh);
+  auto genera = [](const TopologyReport& t) {
+    std::vector<int> g;
+    for (const auto& c : t.components) g.push_back(c.genus ? *c.genus : -1);
+    std::sort(g.begin(), g.end());
+    return g;
+  };
+  if (now.components.size() != after.components.size() || genera(now) != genera(after) ||
+      now.boundary_loops != after.boundary_loops || !now.manifold || !now.consistently_oriented)
+    throw Error("denoise: postcondition failed after stump removal: components " +
+                std::to_string(after.components.size()) + " -> " + std::to_string(now.components.size()) +
+                ", genus " + std::to_string(*after.genus) + " -> " + (now.genus ? std::to_string(*now.genus) : "?"));
+  nlohmann::json list = nlohmann::json::array();
+  std::size_t removed_faces = 0;
+  for (const auto& r : recs) {
+    removed_faces += r.faces_removed;
+    list.push_back({{"length_mm", r.length_mm},
+                    {"ring_length_mm", r.ring_length_mm},
+                    {"base_length_mm", r.base_length_mm},
+                    {"faces_removed", r.faces_removed},
+                    {"cap_faces", r.cap_faces}});
+  }
+  after = std::move(now);
+  st.t.stumps = sw.seconds();
+  return {{"removed", recs.size()}, {"rings_examined", st.cap_rings.size()}, {"faces_removed", removed_faces},
+          {"max_length_mm", o.remove_stumps}, {"stumps", list}};
+}
+
+nlohmann::json vec_json(const Vec3& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+
+nlohmann::json loop_json(const LoopRecord& L) {
+  return {{"id", L.id},
+          {"iteration", L.iteration},
+          {"component", L.component},
+          {"vertex_ids", L.vertex_ids},
+          {"vertex_count", L.vertex_ids.size()},
+          {"length_mm", L.length},
+          {"type", L.type},
+          {"separating", L.separating},
+          {"cap_intersections", L.cap_intersections},
+          {"centroid_lps_mm", vec_json(L.centroid)},
+          {"diameter_mm", L.diameter_mm},
+          {"cross_section_area_mm2", L.cross_section_area_mm2},
+          {"cross_section_normal", vec_json(L.cross_section_normal)}};
+}
+
+nlohmann::json loops_report(const std::vector<LoopRecord>& loops, nlohmann::json* totals) {
+  std::size_t loop_vertices = 0, cap_intersections = 0, unclean = 0;
+  double loop_len = 0, longest = 0;
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& L : loops) {
+    loop_vertices += L.vertex_ids.size();
+    loop_len += L.length;
+    longest = std::max(longest, L.length);
+    cap_intersections += L.cap_intersections;
+    unclean += L.cap_intersections > 0;
+    list.push_back(loop_json(L));
+  }
+  *totals = {{"loops", loops.size()},          {"loop_vertices", loop_vertices},
+             {"loop_length_mm", loop_len},      {"longest_loop_mm", longest},
+             {"cap_intersections", cap_intersections}, {"loops_with_cap_intersections", unclean}};
+  return list;
+}
+
+}  // namespace
+
 DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress) {
   validate_denoise_options(o);
   Stopwatch total;
@@ -37,137 +192,39 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   res.before = analyze_topology(st.mesh);
   const double t_analysis = sw.seconds();
   const TopologyReport& b = res.before;
-  if (b.faces == 0) throw PreconditionError("input mesh has no faces");
-  if (!b.manifold || !b.orientable)
-    throw PreconditionError("input must be an orientable 2-manifold; got " + std::to_string(b.nonmanifold_edges) +
-                            " non-manifold edges, " + std::to_string(b.nonmanifold_vertices) + " non-manifold vertices" +
-                            (b.orientable ? "" : ", non-orientable"));
-  if (b.unreferenced_vertices) throw PreconditionError("input has unreferenced vertices");
-  if (o.method == "paper" && !b.closed)
-    throw PreconditionError("--method paper needs closed components (the paper's Algorithm 4 input); got " +
-                            std::to_string(b.boundary_loops) + " boundary loops - use --method exact");
-  st.n_input = st.mesh.n_vertices();
-  st.mean_edge = b.mean_edge_length;
-  st.origin.resize(st.n_input);
-  for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
-  st.component.assign(st.n_input, -1);
-  for (auto f : st.mesh.faces())
-    for (auto v : st.mesh.fv_range(f)) st.component[v.idx()] = b.face_component[f.idx()];
-  for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
-  const int genus_before = *b.genus;
-  const int needed = std::max(0, genus_before - o.target_genus);
-
+  check_input(b, o);
+  init_state(st, b);
+  const int needed = std::max(0, *b.genus - o.target_genus);
   nlohmann::json stats = nlohmann::json::object();
   std::string reason = "target genus reached";
-  if (needed > 0) {
+  if (needed > 0)
     reason = o.method == "exact" ? detail::run_exact(st, o, needed, progress, b.mean_edge_length, stats)
                                  : detail::run_paper(st, o, needed, progress, stats);
-  }
   sw.restart();
   res.after = analyze_topology(st.mesh);
   st.t.verify += sw.seconds();
-
-  // Postconditions.
-  const TopologyReport& a = res.after;
-  nlohmann::json comps = nlohmann::json::array();
-  if (o.method == "exact") {
-    if (a.components.size() != b.components.size() || a.boundary_loops != b.boundary_loops || !a.manifold ||
-        !a.consistently_oriented)
-      throw Error("denoise: postcondition failed: components " + std::to_string(b.components.size()) + " -> " +
-                  std::to_string(a.components.size()) + ", boundary loops " + std::to_string(b.boundary_loops) +
-                  " -> " + std::to_string(a.boundary_loops) + (a.manifold ? "" : ", not manifold"));
-    // Match components through an input vertex of each.
-    std::vector<int> rep(b.components.size(), -1);
-    for (auto f : st.mesh.faces()) {
-      if (f.idx() >= static_cast<int>(b.face_component.size())) break;
-      const int c = b.face_component[f.idx()];
-      if (rep[c] < 0) rep[c] = a.face_component[f.idx()];
-    }
-    for (std::size_t c = 0; c < b.components.size(); ++c) {
-      const auto& ca = a.components.at(rep[c]);
-      if (!ca.genus || *ca.genus != st.genus_left[c])
-        throw Error("denoise: postcondition failed: component " + std::to_string(c) + " should have genus " +
-                    std::to_string(st.genus_left[c]) + " after surgery, has " +
-                    (ca.genus ? std::to_string(*ca.genus) : std::string("undefined")));
-      comps.push_back({{"id", c},
-                       {"genus_before", *b.components[c].genus},
-                       {"genus_after", *ca.genus},
-                       {"faces_before", b.components[c].faces},
-                       {"faces_after", ca.faces},
-                       {"boundary_loops", ca.boundary_loops}});
-    }
-  } else {
-    for (std::size_t c = 0; c < a.components.size(); ++c)
-      comps.push_back({{"id", c}, {"genus_after", a.components[c].genus ? nlohmann::json(*a.components[c].genus) : nlohmann::json(nullptr)},
-                       {"faces_after", a.components[c].faces}});
-  }
-
-  // Stumps: after the checks above (they match components through input face ids, which the
-  // removal's garbage collection renumbers); topology is checked again.
-  nlohmann::json stumps = nullptr;
-  if (o.remove_stumps > 0) {
-    sw.restart();
-    const std::vector<StumpRecord> recs = remove_stumps(st.mesh, st.cap_rings, StumpOptions{o.remove_stumps, 1.5});
-    TopologyReport after = analyze_topology(st.mesh);
-    auto genera = [](const TopologyReport& t) {
-      std::vector<int> g;
-      for (const auto& c : t.components) g.push_back(c.genus ? *c.genus : -1);
-      std::sort(g.begin(), g.end());
-      return g;
-    };
-    if (after.components.size() != a.components.size() || genera(after) != genera(a) ||
-        after.boundary_loops != a.boundary_loops || !after.manifold || !after.consistently_oriented)
-      throw Error("denoise: postcondition failed after stump removal: components " +
-                  std::to_string(a.components.size()) + " -> " + std::to_string(after.components.size()) +
-                  ", genus " + std::to_string(*a.genus) + " -> " + (after.genus ? std::to_string(*after.genus) : "?"));
-    nlohmann::json list = nlohmann::json::array();
-    std::size_t removed_faces = 0;
-    for (const auto& r : recs) {
-      removed_faces += r.faces_removed;
-      list.push_back({{"length_mm", r.length_mm},
-                      {"ring_length_mm", r.ring_length_mm},
-                      {"base_length_mm", r.base_length_mm},
-                      {"faces_removed", r.faces_removed},
-                      {"cap_faces", r.cap_faces}});
-    }
-    stumps = {{"removed", recs.size()}, {"rings_examined", st.cap_rings.size()}, {"faces_removed", removed_faces},
-              {"max_length_mm", o.remove_stumps}, {"stumps", list}};
-    res.after = std::move(after);
-    st.t.stumps = sw.seconds();
-  }
-
+  const nlohmann::json comps = o.method == "exact" ? check_exact_result(st, b, res.after) : paper_components(res.after);
+  const nlohmann::json stumps = o.remove_stumps > 0 ? run_stumps(st, o, res.after) : nlohmann::json(nullptr);
   res.loops = st.loops;
   res.mesh = std::move(st.mesh);
-  std::size_t loop_vertices = 0, cap_intersections = 0;
-  double loop_len = 0;
-  nlohmann::json loops = nlohmann::json::array();
-  for (const auto& L : res.loops) {
-    loop_vertices += L.vertex_ids.size();
-    loop_len += L.length;
-    cap_intersections += L.cap_intersections;
-    loops.push_back({{"id", L.id},
-                     {"iteration", L.iteration},
-                     {"component", L.component},
-                     {"vertex_ids", L.vertex_ids},
-                     {"vertex_count", L.vertex_ids.size()},
-                     {"length_mm", L.length},
-                     {"type", L.type},
-                     {"separating", L.separating},
-                     {"cap_intersections", L.cap_intersections}});
-  }
+  nlohmann::json totals;
+  const nlohmann::json loops = loops_report(res.loops, &totals);
+  if (o.strict && totals["cap_intersections"].get<std::size_t>() > 0)
+    throw Error("denoise: --strict: " + totals["loops_with_cap_intersections"].dump() + " loop(s) have caps that intersect the surface (" +
+                totals["cap_intersections"].dump() + " triangle pairs); see the report's loops[].cap_intersections");
   auto g = [](const TopologyReport& t) { return t.genus ? nlohmann::json(*t.genus) : nlohmann::json(nullptr); };
   res.report = {{"method", o.method},
                 {"policy", o.policy},
                 {"genus_before", g(b)},
-                {"genus_after", g(a)},
+                {"genus_after", g(res.after)},
                 {"components_before", b.components.size()},
-                {"components_after", a.components.size()},
+                {"components_after", res.after.components.size()},
                 {"faces_before", b.faces},
-                {"faces_after", a.faces},
+                {"faces_after", res.after.faces},
                 {"per_component", comps},
                 {"stop_reason", reason},
                 {"loops", loops},
-                {"totals", {{"loops", res.loops.size()}, {"loop_vertices", loop_vertices}, {"loop_length_mm", loop_len}, {"cap_intersections", cap_intersections}}},
+                {"totals", totals},
                 {"search", stats},
                 {"stumps", stumps},
                 {"time_s",
@@ -178,7 +235,8 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                   {"verification", st.t.verify},
                   {"stumps", st.t.stumps},
                   {"total", total.seconds()}}},
-                {"units", "mm"}};
+                {"units", "mm"},
+                {"coordinate_system", "LPS"}};
   return res;
 }
 

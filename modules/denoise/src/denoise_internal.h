@@ -36,11 +36,6 @@ struct DenoiseState {
   LoopRecord& record(const std::vector<Mesh::VertexHandle>& loop, int iteration, bool separating);
 };
 
-// Vertices within graph distance `radius` of any seed (multi-source Dijkstra), nearest first;
-// their distances in `distances` when given.
-std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
-                                 std::vector<double>* distances = nullptr);
-
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
               HomologyBasis* hb, SurgeryResult* out);

@@ -30,6 +30,8 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
            "fraction of the way each cut ring moves into its own side (separates the two caps; 0 = paper)", 0.0, 0.5);
     t.flag("check-caps", &DenoiseOptions::check_caps,
            "check every cap for intersections with the surface and try other placements");
+    t.flag("strict", &DenoiseOptions::strict,
+           "fail (non-zero exit, no output) when a cap still intersects the surface after every placement; default: report it");
     t.real("remove-stumps", &DenoiseOptions::remove_stumps, "mm",
            "remove the finger-like stumps up to this long that cutting thin strands leaves (0 = keep; exact only)", 0.0);
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
@@ -57,6 +59,10 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
   if (!r.report["stumps"].is_null())
     msg << ", " << r.report["stumps"]["removed"].get<std::size_t>() << " stumps removed ("
         << r.report["stumps"]["faces_removed"].get<std::size_t>() << " faces)";
+  const std::size_t unclean = r.report["totals"]["loops_with_cap_intersections"].get<std::size_t>();
+  if (unclean > 0)
+    msg << "; WARNING: " << unclean << " loop(s) with caps intersecting the surface ("
+        << r.report["totals"]["cap_intersections"].get<std::size_t>() << " triangle pairs; --strict makes this an error)";
   ctx.progress(msg.str());
   ctx.report = r.report;
   bag.put("denoised", std::move(r.mesh));

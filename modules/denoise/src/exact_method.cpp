@@ -1,10 +1,13 @@
+// The exact method: at every step the shortest non-separating edge cycle of the current mesh,
+// found by bounded Dijkstra searches from a source set, with per-source lower bounds shared
+// between nearby sources (docs/denoise.md, "How it is fast").
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <queue>
-#include <thread>
-#include <unordered_map>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/geodesic_ball.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/loop_search.h"
 #include "denoise_internal.h"
@@ -28,40 +31,11 @@ LoopRecord& DenoiseState::record(const std::vector<Mesh::VertexHandle>& loop, in
     r.points.push_back(mesh.point(v));
   }
   r.length = loop_length(mesh, loop);
+  describe_cross_section(&r);
   r.type = loop_type_name(classify_loop(mesh, loop));
   r.separating = separating;
   loops.push_back(std::move(r));
   return loops.back();
-}
-
-std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
-                                 std::vector<double>* distances) {
-  std::unordered_map<int, double> dist;
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-  for (auto s : seeds) {
-    dist[s.idx()] = 0;
-    q.push({0, s.idx()});
-  }
-  std::vector<int> out;
-  while (!q.empty()) {
-    auto [d, v] = q.top();
-    q.pop();
-    if (d > dist[v]) continue;
-    out.push_back(v);
-    if (distances) distances->push_back(d);
-    const Vec3& p = mesh.point(Mesh::VertexHandle(v));
-    for (auto w : mesh.vv_range(Mesh::VertexHandle(v))) {
-      const double nd = d + (mesh.point(w) - p).norm();
-      if (nd > radius) continue;
-      auto it = dist.find(w.idx());
-      if (it == dist.end() || nd < it->second) {
-        dist[w.idx()] = nd;
-        q.push({nd, w.idx()});
-      }
-    }
-  }
-  return out;
 }
 
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
@@ -87,185 +61,329 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   return connected;
 }
 
-std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
-                       double mean_edge, nlohmann::json& stats) {
-  HomologyBasis hb;
-  Z2Span span;
-  std::unique_ptr<FundamentalCycleSearch> search;
-  std::vector<std::uint8_t> is_source;
-  std::vector<int> sources;
-  const bool want_type = o.policy != "shortest";
-  const LoopType wanted = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
-  FundamentalCycleSearch::Accept accept = [&](const std::vector<Mesh::VertexHandle>& loop) {
-    return classify_loop(st.mesh, loop) == wanted;
-  };
-  const FundamentalCycleSearch::Accept* accept_ptr = want_type ? &accept : nullptr;
+namespace {
 
-  struct Entry {
-    double key;
-    int v;
-    std::uint32_t ver;
-    bool exact;
-    bool operator>(const Entry& e) const { return key > e.key; }
-  };
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> pq;
-  std::vector<std::uint32_t> ver;
-  double R = o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge;
-  if (std::isfinite(o.max_loop_length)) R = std::min(R, o.max_loop_length);
-  bool truncated_any = false;
-  double next_radius_hint = kInf;  // min frontier bound seen since the last sweep
-  double sweep_time = 0;
-  int sweeps = 0;
-  long long searches = 0, settled = 0;
-  int rebuilds = 0, cuts_since_build = 0;
+// What is known of one source's shortest fundamental cycle value F(s) (the minimum over the
+// fundamental cycles of its shortest-path tree whose class is outside the cut span):
+// F(s) == value when exact, F(s) >= value otherwise. `centre` is the source whose search gave
+// it (-1: none, or lowered after a surgery).
+struct SourceBound {
+  double value = 0;
+  bool exact = false;
+  int centre = -1;
+  std::uint32_t version = 0;
+};
 
-  auto add_source = [&](int v) {
-    if (v >= static_cast<int>(is_source.size())) is_source.resize(st.mesh.n_vertices(), 0);
-    if (is_source[v] || st.mesh.is_boundary(Mesh::VertexHandle(v))) return;
-    is_source[v] = 1;
-    sources.push_back(v);
-  };
-  auto rebuild = [&]() {
-    Stopwatch sw;
-    hb.build(st.mesh);
-    span.reset(hb.words());
-    search = std::make_unique<FundamentalCycleSearch>(st.mesh, hb, span);
-    is_source.assign(st.mesh.n_vertices(), 0);
-    sources.clear();
-    for (int v : hb.pruned_cut_graph_vertices()) add_source(v);
-    st.t.homology += sw.seconds();
-    ++rebuilds;
-    cuts_since_build = 0;
-  };
-  // Queues a source's search result: an exact value, or the lower bound R when the search hit the
-  // radius (a source whose whole reachable part has no loop is dropped until a surgery nears it).
-  auto queue_result = [&](int v, const CycleCandidate& c) {
-    if (v >= static_cast<int>(ver.size())) ver.resize(st.mesh.n_vertices() + 1024, 0);
-    ++ver[v];
-    truncated_any = truncated_any || c.truncated;
-    next_radius_hint = std::min(next_radius_hint, c.frontier_bound);
-    if (c.found) pq.push({c.value, v, ver[v], true});
-    else if (c.truncated) pq.push({R, v, ver[v], false});
-  };
-  auto compute = [&](int v) {
-    Stopwatch sw;
-    queue_result(v, search->run(Mesh::VertexHandle(v), R, accept_ptr));
-    ++searches;
-    settled += static_cast<long long>(search->last_settled());
-    st.t.search += sw.seconds();
-  };
-  // Full sweeps over all sources run on every core: searches only read the mesh, the classes
-  // and the span, and each thread has its own search state; results are queued in source order,
-  // so the outcome does not depend on the thread count.
-  const unsigned n_threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-  auto compute_all = [&]() {
-    Stopwatch sw;
-    while (!pq.empty()) pq.pop();
-    truncated_any = false;
-    next_radius_hint = kInf;
-    std::vector<CycleCandidate> results(sources.size());
-    std::vector<long long> settled_by(n_threads, 0);
-    auto work = [&](unsigned t) {
-      FundamentalCycleSearch local(st.mesh, hb, span);
-      for (std::size_t i = t; i < sources.size(); i += n_threads) {
-        results[i] = local.run(Mesh::VertexHandle(sources[i]), R, accept_ptr, /*frontier=*/true);
-        settled_by[t] += static_cast<long long>(local.last_settled());
-      }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(work, t);
-    work(0);
-    for (auto& th : pool) th.join();
-    for (std::size_t i = 0; i < sources.size(); ++i) queue_result(sources[i], results[i]);
-    searches += static_cast<long long>(sources.size());
-    for (long long x : settled_by) settled += x;
-    sweep_time += sw.seconds();
-    ++sweeps;
-    st.t.search += sw.seconds();
-  };
+struct QueueEntry {
+  double key;
+  int vertex;
+  std::uint32_t version;
+  bool exact;
+  // Min-heap order: smaller key first; at equal keys exact values before lower bounds.
+  bool operator>(const QueueEntry& e) const { return key != e.key ? key > e.key : (!exact && e.exact); }
+};
 
-  rebuild();
-  compute_all();
-  int cuts = 0;
-  std::string reason = "target genus reached";
-  while (cuts < needed) {
-    if (pq.empty()) {
-      reason = want_type ? "no further " + std::string(o.policy == "cut" ? "handle" : "tunnel") + " loops found"
-                         : "no further non-separating loops found";
-      break;
-    }
-    const Entry top = pq.top();
-    pq.pop();
-    if (top.ver != ver[top.v]) continue;
-    if (!top.exact) {
-      // Every remaining loop is longer than R.
-      if (R >= o.max_loop_length) {
-        reason = "no loop shorter than --max-loop-length remains";
-        break;
-      }
-      if (!truncated_any) {
-        reason = "no further loops found";
-        break;
-      }
-      // Next radius: the shortest non-separating closed walk seen across search frontiers
-      // bounds the next loop from above, so searching to it finds that loop; never less than
-      // 1.05 R nor more than 2 R.
-      R = std::min({2 * R, std::max(1.05 * R, next_radius_hint * (1 + 1e-9)), o.max_loop_length});
-      if (cuts_since_build > 0) rebuild();
-      compute_all();
-      continue;
-    }
-    if (top.key > o.max_loop_length) {
-      reason = "no loop shorter than --max-loop-length remains";
-      break;
-    }
-    // Re-run from the source on the current mesh: the entry is the global minimum if it is
-    // still exact (all other keys are lower bounds of their sources' current values).
-    Stopwatch sw;
-    const CycleCandidate c = search->run(Mesh::VertexHandle(top.v), R, accept_ptr);
-    ++searches;
-    st.t.search += sw.seconds();
-    if (!c.found || c.value > top.key + 1e-12 * (1.0 + top.key)) {
-      queue_result(top.v, c);  // changed since it was queued: back in line with its new value
-      continue;
-    }
-    ++ver[top.v];  // consumed by this cut
-    const std::vector<Mesh::VertexHandle> loop = search->extract(c);
-    const std::vector<std::uint64_t> cls = search->cycle_class(loop);
-    if (!span.insert(cls.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
-    const int comp = st.component[loop.front().idx()];
-    st.record(loop, cuts + 1, false);
-    SurgeryResult sr;
-    if (!cut_loop(st, loop, o, &hb, &sr))
-      throw Error("denoise: surgery along loop " + std::to_string(cuts) + " (length " +
-                  format_number(st.loops.back().length) + " mm) split component " + std::to_string(comp) +
-                  " - the loop was separating; refusing to continue");
-    --st.genus_left[comp];
-    ++cuts;
-    ++cuts_since_build;
-    if (progress) progress(cuts, needed);
-    // New sources: every non-separating cycle of the new mesh meets the old sources or the new
-    // rings/caps. Sources whose search ball reached the surgery are recomputed now.
-    std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
-    seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
-    seeds.push_back(sr.left_cap);
-    seeds.push_back(sr.right_cap);
-    for (auto v : seeds) add_source(v.idx());
-    double slack = 0;
-    for (auto v : seeds)
-      for (auto w : st.mesh.vv_range(v)) slack = std::max(slack, (st.mesh.point(w) - st.mesh.point(v)).norm());
-    for (int v : vertices_within(st.mesh, seeds, 0.5 * R + 2 * slack))
-      if (v < static_cast<int>(is_source.size()) && is_source[v]) compute(v);
+// The greedy loop of the exact method. Invariant: every source is in the queue with its current
+// bound (or dropped with F = inf), and min over the queue of F(s) is the shortest non-separating
+// cycle of the current mesh. Lower bounds spread from each search: a closed walk W through s
+// gives one through any vertex t at distance d, of length |W| + 2d, so F(s) >= F(c) - 2 d(c, s)
+// for every source s the search from c settled (F(c) > limit when it found nothing).
+class ExactGreedy {
+ public:
+  ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge)
+      : st_(st), opts_(o), first_radius_(o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge) {
+    want_type_ = o.policy != "shortest";
+    wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
+    accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
   }
-  stats["searches"] = searches;
-  stats["sweeps"] = sweeps;
-  stats["sweep_time_s"] = sweep_time;
-  stats["threads"] = n_threads;
-  stats["settled_vertices"] = settled;
-  stats["homology_rebuilds"] = rebuilds;
-  stats["final_search_radius_mm"] = R;
-  stats["radius_schedule"] = "frontier bound, 1.05x..2x";
-  stats["sources_last"] = sources.size();
+  std::string run(int needed, const DenoiseProgress& progress);
+  void write_stats(nlohmann::json& stats) const;
+
+ private:
+  void build_homology();
+  void maybe_rebuild(int cuts);
+  void add_source(int v);
+  void set_bound(int v, const SourceBound& b);
+  double search_limit(int v);
+  double best_exact_value();
+  int farthest_pending(double best);
+  CycleCandidate search_from(int v, double limit);
+  void spread_bounds(int centre, double bound);
+  bool stop_before(const QueueEntry& top, std::string* reason) const;
+  void cut(const CycleCandidate& c, int iteration);
+  void add_surgery_sources(const SurgeryResult& sr);
+  void lower_bounds_near(const SurgeryResult& sr);
+
+  DenoiseState& st_;
+  const DenoiseOptions& opts_;
+  const double first_radius_;  // mm: limit of a source's first search
+  bool want_type_ = false;
+  LoopType wanted_ = LoopType::kHandle;
+  FundamentalCycleSearch::Accept accept_;
+  HomologyBasis homology_;
+  Z2Span span_;
+  std::unique_ptr<FundamentalCycleSearch> search_;
+  std::vector<std::uint8_t> is_source_;
+  std::vector<int> sources_;
+  std::vector<SourceBound> bound_;  // per vertex (sources only)
+  std::vector<double> own_limit_;    // per vertex: limit of its last own search (the next one doubles it)
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> queue_;
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
+  long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
+  int builds_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
+  // Sources to certify against the best known loop, farthest from its source first.
+  int far_anchor_ = -1;
+  double far_value_ = 0;
+  std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, source), a max-heap
+  long long far_searches_ = 0;
+  double build_time_ = 0, search_time_at_build_ = 0;
+  double largest_limit_ = 0;
+};
+
+// Homology of the current mesh and its pruned cut graph as the source set (every
+// non-separating cycle meets it). Bounds are kept: F(s) is the same quantity whatever the
+// annotations (the shortest non-separating fundamental cycle of s's tree on the current mesh).
+void ExactGreedy::build_homology() {
+  Stopwatch sw;
+  homology_.build(st_.mesh);
+  span_.reset(homology_.words());
+  search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  for (int v : sources_) {
+    is_source_[v] = 0;
+    ++bound_[v].version;  // its queue entries are stale
+  }
+  sources_.clear();
+  for (int v : homology_.pruned_cut_graph_vertices()) add_source(v);
+  for (int v : sources_) {  // kept bounds back in the queue
+    if (bound_[v].value > 0) set_bound(v, bound_[v]);
+  }
+  build_time_ = sw.seconds();
+  st_.t.homology += build_time_;
+  search_time_at_build_ = st_.t.search;
+  ++builds_;
+}
+
+// A fresh cut graph of the lower-genus mesh is much smaller than the old one plus every ring,
+// and searches start only from it; rebuilt once half the genus is gone, if searching has cost
+// more than two builds since the last one.
+void ExactGreedy::maybe_rebuild(int cuts) {
+  const int genus_left = genus_at_build_ - (cuts - cuts_at_build_);
+  if (genus_left < 1 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
+  if (st_.t.search - search_time_at_build_ < 2 * build_time_) return;
+  build_homology();
+  cuts_at_build_ = cuts;
+  genus_at_build_ = genus_left;
+}
+
+void ExactGreedy::add_source(int v) {
+  const std::size_t n = std::max<std::size_t>(st_.mesh.n_vertices(), v + 1);
+  if (is_source_.size() < n) {
+    is_source_.resize(n, 0);
+    bound_.resize(n);
+    own_limit_.resize(n, 0);
+  }
+  if (is_source_[v] || st_.mesh.is_boundary(Mesh::VertexHandle(v))) return;
+  is_source_[v] = 1;
+  sources_.push_back(v);
+  if (bound_[v].value == 0) set_bound(v, SourceBound{});
+}
+
+void ExactGreedy::set_bound(int v, const SourceBound& b) {
+  const std::uint32_t version = bound_[v].version + 1;
+  bound_[v] = b;
+  bound_[v].version = version;
+  if (!std::isfinite(b.value)) return;  // no loop through this source's part of the mesh
+  queue_.push({b.value, v, version, b.exact});
+  if (b.exact) exact_queue_.push({b.value, v, version, true});
+}
+
+// The smallest exact value still queued (an upper bound of the shortest loop), or inf.
+double ExactGreedy::best_exact_value() {
+  while (!exact_queue_.empty()) {
+    const QueueEntry& e = exact_queue_.top();
+    if (e.version == bound_[e.vertex].version) return e.key;
+    exact_queue_.pop();
+  }
+  return kInf;
+}
+
+// Limit of the next search from v (lower bound m): without a known loop, twice m (at least the
+// first radius, at least twice its previous own limit); once a loop of value U is known, 2U:
+// the search ends at the first loop found (value/2 from v), and when v has none up to 2U every
+// source within U/2 of v gets a bound >= U, so one search covers a stretch of sources instead
+// of each searching to U itself. Never above --max-loop-length.
+double ExactGreedy::search_limit(int v) {
+  const double m = bound_[v].value;
+  double limit = std::max({first_radius_, 2.0 * m, 2.0 * own_limit_[v]});
+  const double best = best_exact_value();
+  if (std::isfinite(best) && best > m) limit = 2.0 * best;
+  limit = std::max(limit, 1.05 * m);
+  return std::min(limit, opts_.max_loop_length);
+}
+
+CycleCandidate ExactGreedy::search_from(int v, double limit) {
+  Stopwatch sw;
+  const CycleCandidate c = search_->run(Mesh::VertexHandle(v), limit, want_type_ ? &accept_ : nullptr);
+  ++searches_;
+  settled_ += static_cast<long long>(search_->last_settled());
+  largest_limit_ = std::max(largest_limit_, limit);
+  own_limit_[v] = limit;
+  const double own = c.found ? c.value : c.truncated ? limit : kInf;
+  set_bound(v, SourceBound{own, c.found, v, 0});
+  if (!want_type_) spread_bounds(v, own);  // with a type filter F is no closed-walk minimum
+  st_.t.search += sw.seconds();
+  return c;
+}
+
+// While sources with a bound below the best known loop (value U, source u) remain, any order of
+// searching them keeps the result exact. Farthest from u first: a source at distance D from the
+// loop finds a walk of about U + 2D and then covers every source within D of it, so far sources
+// certify the near ones, which could otherwise only search to U each. Returns -1 when the plain
+// smallest-bound order should be used.
+int ExactGreedy::farthest_pending(double best) {
+  if (!std::isfinite(best)) return -1;
+  const int anchor = exact_queue_.top().vertex;  // best_exact_value() left a valid top
+  if (anchor != far_anchor_ || best != far_value_) {
+    far_anchor_ = anchor;
+    far_value_ = best;
+    std::vector<double> dist;
+    const std::vector<int> near = vertices_within(st_.mesh, {Mesh::VertexHandle(anchor)}, best, &dist);
+    std::vector<double> from_anchor(st_.mesh.n_vertices(), kInf);
+    for (std::size_t i = 0; i < near.size(); ++i) from_anchor[near[i]] = dist[i];
+    far_order_.clear();
+    for (int s : sources_)
+      if (bound_[s].value < best && !bound_[s].exact) far_order_.push_back({from_anchor[s], s});
+    std::make_heap(far_order_.begin(), far_order_.end());
+  }
+  while (!far_order_.empty()) {
+    std::pop_heap(far_order_.begin(), far_order_.end());
+    const int s = far_order_.back().second;
+    far_order_.pop_back();
+    if (!is_source_[s] || bound_[s].exact || !(bound_[s].value < best)) continue;  // done meanwhile
+    ++far_searches_;
+    return s;
+  }
+  return -1;
+}
+
+void ExactGreedy::spread_bounds(int centre, double bound) {
+  for (int t : search_->last_settled_vertices()) {
+    if (t == centre || t >= static_cast<int>(is_source_.size()) || !is_source_[t]) continue;
+    const double lower = bound - 2.0 * search_->distance(t);
+    const SourceBound& b = bound_[t];
+    if (!(lower > b.value)) continue;  // also keeps dropped sources (inf) dropped
+    set_bound(t, SourceBound{lower, false, centre, 0});
+    ++bounds_spread_;
+  }
+}
+
+bool ExactGreedy::stop_before(const QueueEntry& top, std::string* reason) const {
+  const bool too_long = top.exact ? top.key > opts_.max_loop_length : top.key >= opts_.max_loop_length;
+  if (too_long) *reason = "no loop shorter than --max-loop-length remains";
+  return too_long;
+}
+
+std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
+  genus_at_build_ = needed;
+  build_homology();
+  int cuts = 0;
+  while (cuts < needed) {
+    if (queue_.empty())
+      return want_type_ ? "no further " + std::string(opts_.policy == "cut" ? "handle" : "tunnel") + " loops found"
+                        : "no further non-separating loops found";
+    const QueueEntry top = queue_.top();
+    queue_.pop();
+    if (top.version != bound_[top.vertex].version) continue;
+    std::string reason;
+    if (stop_before(top, &reason)) return reason;
+    if (!top.exact) {
+      queue_.push(top);  // still pending; the order below does not change what is cut
+      const int far = want_type_ ? -1 : farthest_pending(best_exact_value());
+      const int v = far >= 0 ? far : top.vertex;
+      search_from(v, search_limit(v));
+      continue;
+    }
+    // Exact and the smallest key: the global minimum if the value still holds on the current
+    // mesh (surgery elsewhere can only have raised it).
+    const CycleCandidate c = search_from(top.vertex, top.key * (1 + 1e-12) + 1e-12);
+    if (!c.found || c.value > top.key * (1 + 1e-12) + 1e-12) continue;  // re-queued with its new bound
+    cut(c, ++cuts);
+    if (progress) progress(cuts, needed);
+    if (cuts < needed) maybe_rebuild(cuts);
+  }
+  return "target genus reached";
+}
+
+void ExactGreedy::cut(const CycleCandidate& c, int iteration) {
+  set_bound(c.source.idx(), SourceBound{0, false, -1, 0});  // searched again after the surgery
+  const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
+  const std::vector<std::uint64_t> cls = search_->cycle_class(loop);
+  if (!span_.insert(cls.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
+  const int comp = st_.component[loop.front().idx()];
+  st_.record(loop, iteration, false);
+  SurgeryResult sr;
+  if (!cut_loop(st_, loop, opts_, &homology_, &sr))
+    throw Error("denoise: surgery along loop " + std::to_string(iteration - 1) + " (length " +
+                format_number(st_.loops.back().length) + " mm) split component " + std::to_string(comp) +
+                " - the loop was separating; refusing to continue");
+  --st_.genus_left[comp];
+  Stopwatch sw;
+  lower_bounds_near(sr);
+  add_surgery_sources(sr);
+  st_.t.search += sw.seconds();
+}
+
+// Every non-separating cycle of the new mesh meets the old sources or the new rings and caps.
+void ExactGreedy::add_surgery_sources(const SurgeryResult& sr) {
+  for (auto v : sr.left_ring) add_source(v.idx());
+  for (auto v : sr.right_ring) add_source(v.idx());
+  add_source(sr.left_cap.idx());
+  add_source(sr.right_cap.idx());
+}
+
+// After a surgery: a closed walk through t shorter than twice t's distance to the new rings
+// never reaches them, so it is a walk of the old mesh with the same class (only the span grew):
+// F_new(t) >= min(F_old bound, 2 d(t, rings)). Bounds are lowered to that, nothing more; sources
+// farther than half their bound from the rings keep it. (Bounds of inf are in genus-0
+// components, where no surgery happens.)
+void ExactGreedy::lower_bounds_near(const SurgeryResult& sr) {
+  std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
+  seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
+  double reach = 0;
+  for (int s : sources_)
+    if (std::isfinite(bound_[s].value)) reach = std::max(reach, 0.5 * bound_[s].value);
+  std::vector<double> dist;
+  const std::vector<int> near = vertices_within(st_.mesh, seeds, reach, &dist);
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const int t = near[i];
+    if (t >= static_cast<int>(is_source_.size()) || !is_source_[t]) continue;
+    const double cap = 2.0 * dist[i];
+    if (!(cap < bound_[t].value)) continue;
+    set_bound(t, SourceBound{cap, false, -1, 0});
+    ++bounds_reset_;
+  }
+}
+
+void ExactGreedy::write_stats(nlohmann::json& stats) const {
+  stats["searches"] = searches_;
+  stats["settled_vertices"] = settled_;
+  stats["bounds_spread"] = bounds_spread_;
+  stats["farthest_first_searches"] = far_searches_;
+  stats["bounds_lowered_after_surgery"] = bounds_reset_;
+  stats["homology_builds"] = builds_;
+  stats["first_search_radius_mm"] = first_radius_;
+  stats["largest_search_limit_mm"] = largest_limit_;
+  stats["sources_last"] = sources_.size();
+  stats["schedule"] = "per-source limits, bounds shared within each search ball";
+}
+
+}  // namespace
+
+std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,
+                      double mean_edge, nlohmann::json& stats) {
+  ExactGreedy greedy(st, o, mean_edge);
+  const std::string reason = greedy.run(needed, progress);
+  greedy.write_stats(stats);
   return reason;
 }
 

@@ -1,90 +1,113 @@
 #include "colonflat/denoise/homology.h"
 
-#include <deque>
+#include <algorithm>
 
 #include "colonflat/core/error.h"
 
 namespace cf {
 
-void HomologyBasis::build(const Mesh& mesh) {
-  const std::size_t F = mesh.n_faces(), E = mesh.n_edges(), V = mesh.n_vertices();
-  // Virtual faces: one per boundary loop, numbered F, F+1, ...
-  std::vector<int> boundary_face(mesh.n_halfedges(), -1);  // virtual face id of a boundary halfedge
-  int n_virtual = 0;
-  for (auto h : mesh.halfedges()) {
-    if (!mesh.is_boundary(h) || boundary_face[h.idx()] >= 0) continue;
-    const int id = static_cast<int>(F) + n_virtual++;
-    auto x = h;
-    do {
-      boundary_face[x.idx()] = id;
-      x = mesh.next_halfedge_handle(x);
-    } while (x != h);
-  }
-  const std::size_t NF = F + n_virtual;
-  auto face_of = [&](Mesh::HalfedgeHandle h) -> int {
-    return mesh.is_boundary(h) ? boundary_face[h.idx()] : mesh.face_handle(h).idx();
-  };
-  // Halfedges of a (real or virtual) face.
-  std::vector<Mesh::HalfedgeHandle> virtual_start(n_virtual);
-  for (auto h : mesh.halfedges())
-    if (mesh.is_boundary(h)) virtual_start[boundary_face[h.idx()] - F] = h;
-  auto face_halfedge = [&](int f) -> Mesh::HalfedgeHandle {
-    return f < static_cast<int>(F) ? mesh.halfedge_handle(Mesh::FaceHandle(f)) : virtual_start[f - F];
-  };
+namespace {
 
-  // Dual spanning forest by breadth-first search; parent_edge[f] = primal edge crossed to reach f.
-  std::vector<int> parent_edge(NF, -2), order;
-  order.reserve(NF);
-  std::vector<std::uint8_t> in_dual_tree(E, 0);
-  for (std::size_t root = 0; root < NF; ++root) {
+// The dual graph of the mesh closed by one virtual face per boundary loop (ids F, F+1, ...).
+struct ClosedDual {
+  const Mesh& mesh;
+  std::size_t real_faces;
+  std::vector<int> boundary_face;                   // per halfedge: its virtual face, or -1
+  std::vector<Mesh::HalfedgeHandle> virtual_start;  // a halfedge of each virtual face
+
+  explicit ClosedDual(const Mesh& m) : mesh(m), real_faces(m.n_faces()), boundary_face(m.n_halfedges(), -1) {
+    for (auto h : mesh.halfedges()) {
+      if (!mesh.is_boundary(h) || boundary_face[h.idx()] >= 0) continue;
+      const int id = static_cast<int>(real_faces + virtual_start.size());
+      virtual_start.push_back(h);
+      auto x = h;
+      do {
+        boundary_face[x.idx()] = id;
+        x = mesh.next_halfedge_handle(x);
+      } while (x != h);
+    }
+  }
+  std::size_t faces() const { return real_faces + virtual_start.size(); }
+  int face_of(Mesh::HalfedgeHandle h) const {
+    return mesh.is_boundary(h) ? boundary_face[h.idx()] : mesh.face_handle(h).idx();
+  }
+  Mesh::HalfedgeHandle face_halfedge(int f) const {
+    return f < static_cast<int>(real_faces) ? mesh.halfedge_handle(Mesh::FaceHandle(f)) : virtual_start[f - real_faces];
+  }
+};
+
+// Dual spanning forest by breadth-first search (Algorithm 1): parent_edge[f] = primal edge
+// crossed to reach f (-1 at roots); `order` = faces in visiting order; in_tree flags the edges.
+void dual_spanning_forest(const ClosedDual& dual, std::vector<int>& parent_edge, std::vector<int>& order,
+                          std::vector<std::uint8_t>& in_tree) {
+  const Mesh& mesh = dual.mesh;
+  parent_edge.assign(dual.faces(), -2);
+  order.clear();
+  order.reserve(dual.faces());
+  in_tree.assign(mesh.n_edges(), 0);
+  for (std::size_t root = 0; root < dual.faces(); ++root) {
     if (parent_edge[root] != -2) continue;
     parent_edge[root] = -1;
-    std::deque<int> q{static_cast<int>(root)};
-    while (!q.empty()) {
-      const int f = q.front();
-      q.pop_front();
-      order.push_back(f);
-      const auto h0 = face_halfedge(f);
+    std::size_t head = order.size();
+    order.push_back(static_cast<int>(root));
+    while (head < order.size()) {  // `order` doubles as the queue
+      const int f = order[head++];
+      const auto h0 = dual.face_halfedge(f);
       auto h = h0;
       do {
-        const int g = face_of(mesh.opposite_halfedge_handle(h));
+        const int g = dual.face_of(mesh.opposite_halfedge_handle(h));
         if (parent_edge[g] == -2) {
           parent_edge[g] = mesh.edge_handle(h).idx();
-          in_dual_tree[mesh.edge_handle(h).idx()] = 1;
-          q.push_back(g);
+          in_tree[mesh.edge_handle(h).idx()] = 1;
+          order.push_back(g);
         }
         h = mesh.next_halfedge_handle(h);
       } while (h != h0);
     }
   }
-  // Cut graph G = edges not dual to the tree; spanning forest T of G by BFS; X = G \ T.
-  cut_edge_.assign(E, 0);
-  for (std::size_t e = 0; e < E; ++e) cut_edge_[e] = !in_dual_tree[e];
-  std::vector<std::uint8_t> seen(V, 0), in_tree(E, 0);
-  for (std::size_t r = 0; r < V; ++r) {
+}
+
+// Edges of the cut graph outside a breadth-first spanning forest of it (the 2g edges X).
+std::vector<int> cut_graph_leftovers(const Mesh& mesh, const std::vector<std::uint8_t>& cut_edge) {
+  std::vector<std::uint8_t> seen(mesh.n_vertices(), 0), in_tree(mesh.n_edges(), 0);
+  std::vector<int> queue;
+  for (std::size_t r = 0; r < mesh.n_vertices(); ++r) {
     if (seen[r] || mesh.is_isolated(Mesh::VertexHandle(static_cast<int>(r)))) continue;
     seen[r] = 1;
-    std::deque<int> q{static_cast<int>(r)};
-    while (!q.empty()) {
-      const auto v = Mesh::VertexHandle(q.front());
-      q.pop_front();
+    queue.assign(1, static_cast<int>(r));
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const auto v = Mesh::VertexHandle(queue[head]);
       for (auto h : mesh.voh_range(v)) {
         const int e = mesh.edge_handle(h).idx();
-        if (!cut_edge_[e]) continue;
+        if (!cut_edge[e]) continue;
         const int w = mesh.to_vertex_handle(h).idx();
         if (seen[w]) continue;
         seen[w] = 1;
         in_tree[e] = 1;
-        q.push_back(w);
+        queue.push_back(w);
       }
     }
   }
   std::vector<int> x_edges;
-  for (std::size_t e = 0; e < E; ++e)
-    if (cut_edge_[e] && !in_tree[e]) x_edges.push_back(static_cast<int>(e));
+  for (std::size_t e = 0; e < mesh.n_edges(); ++e)
+    if (cut_edge[e] && !in_tree[e]) x_edges.push_back(static_cast<int>(e));
+  return x_edges;
+}
+
+}  // namespace
+
+void HomologyBasis::build(const Mesh& mesh) {
+  const ClosedDual dual(mesh);
+  std::vector<int> parent_edge, order;
+  std::vector<std::uint8_t> in_dual_tree;
+  dual_spanning_forest(dual, parent_edge, order, in_dual_tree);
+  // Cut graph G = edges not dual to the tree; X = G minus a spanning forest of G.
+  cut_edge_.assign(mesh.n_edges(), 0);
+  for (std::size_t e = 0; e < mesh.n_edges(); ++e) cut_edge_[e] = !in_dual_tree[e];
+  const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
-  ann_.assign(E * words_, 0);
+  ann_.assign(mesh.n_edges() * words_, 0);
   for (int i = 0; i < rank_; ++i) ann_[std::size_t(x_edges[i]) * words_ + i / 64] |= (1ull << (i % 64));
   // Leaf peeling of the dual forest: children before parents.
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
@@ -92,7 +115,7 @@ void HomologyBasis::build(const Mesh& mesh) {
     const int pe = parent_edge[f];
     if (pe < 0) continue;
     std::uint64_t* dst = &ann_[std::size_t(pe) * words_];
-    const auto h0 = face_halfedge(f);
+    const auto h0 = dual.face_halfedge(f);
     auto h = h0;
     do {
       const int e = mesh.edge_handle(h).idx();
@@ -100,7 +123,12 @@ void HomologyBasis::build(const Mesh& mesh) {
       h = mesh.next_halfedge_handle(h);
     } while (h != h0);
   }
-  // Pruned cut graph: remove degree-1 vertices recursively.
+  prune_cut_graph(mesh);
+}
+
+// Pruned cut graph: degree-1 vertices removed recursively.
+void HomologyBasis::prune_cut_graph(const Mesh& mesh) {
+  const std::size_t V = mesh.n_vertices(), E = mesh.n_edges();
   pruned_edge_ = cut_edge_;
   std::vector<int> degree(V, 0);
   for (std::size_t e = 0; e < E; ++e) {

@@ -24,32 +24,78 @@ void FundamentalCycleSearch::grow() {
   mark_.resize(cap, 0);
 }
 
-CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, const Accept* accept, bool frontier) {
+void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
   grow();
   ++run_id_;
   if (run_id_ == 0) {  // wrapped: reset stamps
     std::fill(stamp_.begin(), stamp_.end(), 0);
     run_id_ = 1;
   }
-  CycleCandidate best;
-  best.source = s;
   settled_count_ = 0;
+  settled_order_.clear();
   acc_.clear();
   heap_.clear();
-  const std::greater<Item> cmp;
-  auto push = [&](double d, int v) {
-    heap_.emplace_back(d, v);
-    std::push_heap(heap_.begin(), heap_.end(), cmp);
-  };
-  auto touch = [&](int v, double d, int parent) {
-    stamp_[v] = run_id_;
-    settled_flag_[v] = 0;
-    dist_[v] = d;
-    parent_[v] = parent;
-  };
-  touch(s.idx(), 0.0, -1);
-  push(0.0, s.idx());
-  std::vector<Mesh::VertexHandle> loop;
+  relax(s.idx(), 0.0, -1);
+}
+
+// Tentative distance d for w through parent halfedge `parent` (-1 at the source).
+void FundamentalCycleSearch::relax(int w, double d, int parent) {
+  if (stamp_[w] != run_id_) {
+    stamp_[w] = run_id_;
+    settled_flag_[w] = 0;
+  } else if (!(d < dist_[w])) {
+    return;
+  }
+  dist_[w] = d;
+  parent_[w] = parent;
+  heap_.emplace_back(d, w);
+  std::push_heap(heap_.begin(), heap_.end(), std::greater<Item>());
+}
+
+// Marks v settled and stores the class of path(s, v) (the parent's XOR the tree edge's).
+void FundamentalCycleSearch::settle(int v) {
+  settled_flag_[v] = 1;
+  ++settled_count_;
+  settled_order_.push_back(v);
+  slot_[v] = static_cast<int>(acc_.size() / W_);
+  acc_.resize(acc_.size() + W_, 0);
+  if (parent_[v] < 0) return;
+  const auto ph = Mesh::HalfedgeHandle(parent_[v]);
+  const int pu = mesh_.from_vertex_handle(ph).idx();
+  std::uint64_t* mine = &acc_[std::size_t(slot_[v]) * W_];
+  const std::uint64_t* theirs = &acc_[std::size_t(slot_[pu]) * W_];
+  const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(ph));
+  for (int i = 0; i < W_; ++i) mine[i] = theirs[i] ^ e[i];
+}
+
+// The fundamental cycle of the non-tree edge h (v -> w, both settled): kept in `best` when it is
+// shorter, within the limit, outside the span and accepted.
+void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept,
+                                       CycleCandidate& best) {
+  if (value >= best.value || value > limit) return;
+  const int vi = mesh_.from_vertex_handle(h).idx(), wi = mesh_.to_vertex_handle(h).idx();
+  const std::uint64_t* a = &acc_[std::size_t(slot_[vi]) * W_];
+  const std::uint64_t* b = &acc_[std::size_t(slot_[wi]) * W_];
+  const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(h));
+  bool zero = true;
+  for (int i = 0; i < W_; ++i) {
+    tmp_[i] = a[i] ^ b[i] ^ e[i];
+    zero = zero && tmp_[i] == 0;
+  }
+  if (zero || span_.reduce(tmp_.data())) return;
+  CycleCandidate c = best;
+  c.found = true;
+  c.value = value;
+  c.u = Mesh::VertexHandle(vi);
+  c.v = Mesh::VertexHandle(wi);
+  if (accept && !(*accept)(extract(c))) return;
+  best = c;
+}
+
+CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, const Accept* accept, bool frontier) {
+  start(s);
+  CycleCandidate best;
+  best.source = s;
   while (!heap_.empty()) {
     const auto [d, vi] = heap_.front();
     if (d > 0.5 * std::min(limit, best.value)) {
@@ -57,69 +103,23 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
       if (!best.found && frontier) best.frontier_bound = frontier_bound();
       break;
     }
-    std::pop_heap(heap_.begin(), heap_.end(), cmp);
+    std::pop_heap(heap_.begin(), heap_.end(), std::greater<Item>());
     heap_.pop_back();
     if (settled_flag_[vi] || d > dist_[vi]) continue;
-    settled_flag_[vi] = 1;
-    ++settled_count_;
+    settle(vi);
     const auto v = Mesh::VertexHandle(vi);
-    // Class of path(s, v).
-    slot_[vi] = static_cast<int>(acc_.size() / W_);
-    acc_.resize(acc_.size() + W_, 0);
-    if (parent_[vi] >= 0) {
-      const auto ph = Mesh::HalfedgeHandle(parent_[vi]);
-      const int pu = mesh_.from_vertex_handle(ph).idx();
-      std::uint64_t* mine = &acc_[std::size_t(slot_[vi]) * W_];
-      const std::uint64_t* theirs = &acc_[std::size_t(slot_[pu]) * W_];
-      const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(ph));
-      for (int i = 0; i < W_; ++i) mine[i] = theirs[i] ^ e[i];
-    }
     const Vec3& pv = mesh_.point(v);
-    const auto h0 = mesh_.halfedge_handle(v);
-    auto h = h0;
-    do {
-      const auto w = mesh_.to_vertex_handle(h);
-      const int wi = w.idx();
-      const auto this_h = h;
-      h = mesh_.cw_rotated_halfedge_handle(h);
+    const int parent_edge = parent_[vi] >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])).idx() : -1;
+    for (auto h : mesh_.voh_range(v)) {
+      const int wi = mesh_.to_vertex_handle(h).idx();
       if (blocked_[wi]) continue;
-      const double len = (mesh_.point(w) - pv).norm();
-      if (stamp_[wi] == run_id_ && settled_flag_[wi]) {
-        // Non-tree edge between two settled vertices: a fundamental cycle.
-        if (parent_[vi] >= 0 && mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])) == mesh_.edge_handle(this_h)) continue;
-        const double value = d + len + dist_[wi];
-        if (value >= best.value || value > limit) continue;
-        const std::uint64_t* a = &acc_[std::size_t(slot_[vi]) * W_];
-        const std::uint64_t* b = &acc_[std::size_t(slot_[wi]) * W_];
-        const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(this_h));
-        bool zero = true;
-        for (int i = 0; i < W_; ++i) {
-          tmp_[i] = a[i] ^ b[i] ^ e[i];
-          zero = zero && tmp_[i] == 0;
-        }
-        if (zero || span_.reduce(tmp_.data())) continue;
-        CycleCandidate c = best;
-        c.found = true;
-        c.value = value;
-        c.u = v;
-        c.v = w;
-        if (accept) {
-          loop = extract(c);
-          if (!(*accept)(loop)) continue;
-        }
-        best = c;
+      const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
+      if (stamp_[wi] == run_id_ && settled_flag_[wi]) {  // non-tree edge between settled vertices
+        if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + dist_[wi], limit, accept, best);
         continue;
       }
-      const double nd = d + len;
-      if (stamp_[wi] != run_id_) {
-        touch(wi, nd, this_h.idx());
-        push(nd, wi);
-      } else if (nd < dist_[wi]) {
-        dist_[wi] = nd;
-        parent_[wi] = this_h.idx();
-        push(nd, wi);
-      }
-    } while (h != h0);
+      relax(wi, d + len, h.idx());
+    }
   }
   return best;
 }

@@ -34,8 +34,11 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
   auto id = make_int("loop_id"), iteration = make_int("iteration"), count = make_int("vertex_count"),
        type = make_int("type"), sep = make_int("separating"), comp = make_int("component"),
        input_id = make_int("input_vertex_id");
-  vtkNew<vtkDoubleArray> length;
+  vtkNew<vtkDoubleArray> length, diameter, area, caps_x;
   length->SetName("length_mm");
+  diameter->SetName("diameter_mm");
+  area->SetName("cross_section_area_mm2");
+  caps_x->SetName("cap_intersections");
   for (const auto& L : loops) {
     std::vector<vtkIdType> ids;
     for (std::size_t i = 0; i < L.points.size(); ++i) {
@@ -51,6 +54,9 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
     sep->InsertNextValue(L.separating ? 1 : 0);
     comp->InsertNextValue(L.component);
     length->InsertNextValue(L.length);
+    diameter->InsertNextValue(L.diameter_mm);
+    area->InsertNextValue(L.cross_section_area_mm2);
+    caps_x->InsertNextValue(static_cast<double>(L.cap_intersections));
   }
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
@@ -58,7 +64,8 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
   for (vtkDataArray* a : {static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(iteration),
                           static_cast<vtkDataArray*>(count), static_cast<vtkDataArray*>(type),
                           static_cast<vtkDataArray*>(sep), static_cast<vtkDataArray*>(comp),
-                          static_cast<vtkDataArray*>(length.GetPointer())})
+                          static_cast<vtkDataArray*>(length.GetPointer()), static_cast<vtkDataArray*>(diameter.GetPointer()),
+                          static_cast<vtkDataArray*>(area.GetPointer()), static_cast<vtkDataArray*>(caps_x.GetPointer())})
     pd->GetCellData()->AddArray(a);
   pd->GetPointData()->AddArray(input_id);
   tag_polydata_space(pd, "mm", "LPS");
@@ -110,6 +117,9 @@ LoopSet read_loops(const fs::path& path) {
       L.points.emplace_back(p[0], p[1], p[2]);
       L.vertex_ids.push_back(input_id->GetValue(cell->GetId(k)));
     }
+    describe_cross_section(&L);  // centroid, diameter and area follow from the points
+    if (auto* x = vtkDoubleArray::SafeDownCast(cd->GetArray("cap_intersections")))
+      L.cap_intersections = static_cast<std::size_t>(x->GetValue(c));
     loops.push_back(std::move(L));
   }
   return loops;

@@ -1,5 +1,6 @@
 // The seed paper's method, as published (Algorithms 1-4), for comparison.
 #include <algorithm>
+#include <limits>
 #include <queue>
 #include <unordered_map>
 
@@ -12,16 +13,24 @@
 namespace cf::detail {
 namespace {
 
-// Algorithm 2: slice along the pruned cut graph into a disk (wedges = copies of vertices) and
-// return the shortest path between two copies of one cut-graph vertex, as a loop of the mesh.
-std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std::vector<std::uint8_t>& cut,
-                                                    const std::vector<int>& cut_vertices, long long& dijkstras) {
-  const std::size_t H = mesh.n_halfedges();
-  std::vector<int> wedge_of(H, -1);  // per outgoing halfedge: the wedge of corner (from, face)
-  std::vector<int> wedge_vertex;
+// Algorithm 2's disk: the mesh sliced along the pruned cut graph. Its vertices are wedges
+// (copies of mesh vertices: one per side of the cut at a cut-graph vertex, else one).
+struct SlicedDisk {
+  std::vector<int> wedge_of;      // per outgoing halfedge: the wedge of corner (from, face)
+  std::vector<int> wedge_vertex;  // wedge -> mesh vertex
+  std::unordered_map<int, std::vector<int>> copies;  // cut-graph vertex -> its wedges
+  std::vector<int> start, adj;    // CSR adjacency of the disk's graph
+  std::vector<double> weight;
+
+  void build_wedges(const Mesh& mesh, const std::vector<std::uint8_t>& cut, const std::vector<int>& cut_vertices);
+  void build_graph(const Mesh& mesh);
+  std::vector<int> shortest_copy_path(const std::vector<int>& cut_vertices, long long& dijkstras) const;
+};
+
+void SlicedDisk::build_wedges(const Mesh& mesh, const std::vector<std::uint8_t>& cut, const std::vector<int>& cut_vertices) {
+  wedge_of.assign(mesh.n_halfedges(), -1);
   std::vector<std::uint8_t> is_cut_vertex(mesh.n_vertices(), 0);
   for (int v : cut_vertices) is_cut_vertex[v] = 1;
-  std::unordered_map<int, std::vector<int>> copies;
   for (auto v : mesh.vertices()) {
     if (mesh.is_isolated(v)) continue;
     std::vector<Mesh::HalfedgeHandle> ring;
@@ -31,58 +40,68 @@ std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std:
       ring.push_back(h);
       h = mesh.ccw_rotated_halfedge_handle(h);
     } while (h != h0);
-    std::size_t start = 0;
-    if (is_cut_vertex[v.idx()])
+    const bool on_cut = is_cut_vertex[v.idx()];
+    std::size_t first = 0;
+    if (on_cut)
       for (std::size_t i = 0; i < ring.size(); ++i)
         if (cut[mesh.edge_handle(ring[i]).idx()]) {
-          start = i;
+          first = i;
           break;
         }
     int wid = -1;
     for (std::size_t t = 0; t < ring.size(); ++t) {
-      const auto hh = ring[(start + t) % ring.size()];
-      if (wid < 0 || (is_cut_vertex[v.idx()] && cut[mesh.edge_handle(hh).idx()])) {
+      const auto hh = ring[(first + t) % ring.size()];
+      if (wid < 0 || (on_cut && cut[mesh.edge_handle(hh).idx()])) {
         wid = static_cast<int>(wedge_vertex.size());
         wedge_vertex.push_back(v.idx());
-        if (is_cut_vertex[v.idx()]) copies[v.idx()].push_back(wid);
+        if (on_cut) copies[v.idx()].push_back(wid);
       }
       wedge_of[hh.idx()] = wid;
     }
   }
-  const std::size_t NW = wedge_vertex.size();
-  // Graph of the disk: wedge(a, f) -- wedge(b, f) for every edge ab of every face f.
-  std::vector<int> start(NW + 1, 0), adj;
-  std::vector<double> w;
+}
+
+// Graph of the disk: wedge(a, f) -- wedge(b, f) for every edge ab of every face f.
+void SlicedDisk::build_graph(const Mesh& mesh) {
+  const std::size_t n = wedge_vertex.size();
+  start.assign(n + 1, 0);
   for (auto f : mesh.faces())
     for (auto h : mesh.fh_range(f)) {
       ++start[wedge_of[h.idx()] + 1];
       ++start[wedge_of[mesh.next_halfedge_handle(h).idx()] + 1];
     }
-  for (std::size_t i = 0; i < NW; ++i) start[i + 1] += start[i];
-  adj.resize(start[NW]);
-  w.resize(start[NW]);
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  adj.resize(start[n]);
+  weight.resize(start[n]);
   std::vector<int> fill(start.begin(), start.end() - 1);
   for (auto f : mesh.faces())
     for (auto h : mesh.fh_range(f)) {
       const int a = wedge_of[h.idx()], b = wedge_of[mesh.next_halfedge_handle(h).idx()];
       const double len = mesh.calc_edge_length(h);
       adj[fill[a]] = b;
-      w[fill[a]++] = len;
+      weight[fill[a]++] = len;
       adj[fill[b]] = a;
-      w[fill[b]++] = len;
+      weight[fill[b]++] = len;
     }
-  // Dijkstra from each copy; keep the globally shortest copy-to-copy path (early stop at it).
-  double best = std::numeric_limits<double>::infinity();
+}
+
+// Dijkstra from each copy; the globally shortest copy-to-copy path (early stop at it), as mesh
+// vertices from the far copy back to the source copy.
+std::vector<int> SlicedDisk::shortest_copy_path(const std::vector<int>& cut_vertices, long long& dijkstras) const {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double best = kInfinity;
   std::vector<int> best_path;
-  std::vector<double> dist(NW, std::numeric_limits<double>::infinity());
-  std::vector<int> parent(NW, -1), touched;
+  std::vector<double> dist(wedge_vertex.size(), kInfinity);
+  std::vector<int> parent(wedge_vertex.size(), -1), touched;
   using Item = std::pair<double, int>;
   for (int v : cut_vertices) {
-    const auto& cp = copies[v];
+    const auto found = copies.find(v);
+    if (found == copies.end()) continue;
+    const auto& cp = found->second;
     for (std::size_t j = 0; j + 1 < cp.size(); ++j) {
       ++dijkstras;
       for (int t : touched) {
-        dist[t] = std::numeric_limits<double>::infinity();
+        dist[t] = kInfinity;
         parent[t] = -1;
       }
       touched.clear();
@@ -106,9 +125,9 @@ std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std:
           continue;
         }
         for (int i = start[x]; i < start[x + 1]; ++i) {
-          const double nd = d + w[i];
+          const double nd = d + weight[i];
           if (nd < dist[adj[i]]) {
-            if (dist[adj[i]] == std::numeric_limits<double>::infinity()) touched.push_back(adj[i]);
+            if (dist[adj[i]] == kInfinity) touched.push_back(adj[i]);
             dist[adj[i]] = nd;
             parent[adj[i]] = x;
             q.push({nd, adj[i]});
@@ -117,13 +136,16 @@ std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std:
       }
     }
   }
-  if (best_path.empty()) return {};
-  best_path.pop_back();  // the path starts and ends at v: keep one copy
-  // In the mesh the loop may revisit a vertex (two copies of it); keep it simple by cutting out
-  // the sub-loop between repeats (the part through the base vertex stays).
+  return best_path;
+}
+
+// In the mesh the path may revisit a vertex (two copies of it); keep it simple by cutting out
+// the sub-loop between repeats (the part through the base vertex stays).
+std::vector<Mesh::VertexHandle> simple_loop(std::vector<int> path) {
+  path.pop_back();  // the path starts and ends at v: keep one copy
   std::vector<int> simple;
   std::unordered_map<int, std::size_t> pos;
-  for (int x : best_path) {
+  for (int x : path) {
     auto it = pos.find(x);
     if (it != pos.end()) {
       for (std::size_t k = it->second + 1; k < simple.size(); ++k) pos.erase(simple[k]);
@@ -136,6 +158,18 @@ std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std:
   std::vector<Mesh::VertexHandle> loop;
   for (int x : simple) loop.push_back(Mesh::VertexHandle(x));
   return loop;
+}
+
+// Algorithm 2: slice along the pruned cut graph into a disk and return the shortest path
+// between two copies of one cut-graph vertex, as a loop of the mesh.
+std::vector<Mesh::VertexHandle> paper_shortest_loop(const Mesh& mesh, const std::vector<std::uint8_t>& cut,
+                                                    const std::vector<int>& cut_vertices, long long& dijkstras) {
+  SlicedDisk disk;
+  disk.build_wedges(mesh, cut, cut_vertices);
+  disk.build_graph(mesh);
+  const std::vector<int> path = disk.shortest_copy_path(cut_vertices, dijkstras);
+  if (path.empty()) return {};
+  return simple_loop(path);
 }
 
 }  // namespace

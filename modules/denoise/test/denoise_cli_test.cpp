@@ -1,6 +1,7 @@
 // `colonflat denoise` as a command: outputs, report, progress, exit codes and messages.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -45,6 +46,29 @@ TEST(DenoiseCli, WritesMeshLoopsAndReport) {
   EXPECT_GT(res["totals"]["loop_vertices"].get<int>(), 0);
   EXPECT_TRUE(res["time_s"].contains("loop_search"));
   EXPECT_EQ(j["parameters"]["method"], "exact");
+}
+
+// Each loop is described where a reader needs it (LPS centroid, diameter, cross-section area,
+// in the report and in loops.vtp), and --strict passes when every cap is clean.
+TEST(DenoiseCli, LoopDescriptionsAndStrict) {
+  testing::TempDir dir;
+  write_mesh(synthetic::to_mesh(synthetic::torus(3, 1, 24, 10)), dir / "in.off");
+  auto r = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--loops", dir.str("loops.vtp"), "--report",
+                 dir.str("report.json"), "--strict"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir / "report.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& loop = j["result"]["loops"][0];
+  // The meridian of a torus (tube radius 1, centre circle radius 3): a 10-gon of radius 1.
+  const auto c = loop["centroid_lps_mm"];
+  EXPECT_NEAR(std::hypot(c[0].get<double>(), c[1].get<double>()), 3.0, 1e-6);  // .off keeps ~7 digits
+  EXPECT_NEAR(loop["diameter_mm"].get<double>(), 2.0, 1e-6);
+  EXPECT_NEAR(loop["cross_section_area_mm2"].get<double>(), 0.5 * 10 * std::sin(2 * 3.14159265358979 / 10), 1e-6);
+  EXPECT_EQ(j["result"]["totals"]["loops_with_cap_intersections"], 0);
+  EXPECT_EQ(j["parameters"]["strict"], true);
+  const LoopSet loops = read_loops(dir / "loops.vtp");
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_NEAR(loops[0].diameter_mm, 2.0, 1e-6);
 }
 
 // A non-manifold mesh: exit 3 with one line naming the file; nothing written.

@@ -39,6 +39,7 @@ struct DenoiseOptions {
   double initial_radius = 0;         // mm; first search radius for "exact" (0 = 10 x mean edge length)
   bool check_caps = true;            // test each cap for intersections with the surface and try
                                      // other placements until none remains
+  bool strict = false;               // fail (cf::Error) when a cap still intersects the surface
   double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
                                      // stumps up to this long that cutting thin strands leaves
                                      // (stumps.h); changes vertex ids
@@ -54,7 +55,15 @@ struct LoopRecord {
   std::string type;             // "handle" | "tunnel"
   bool separating = false;      // only "paper" can cut separating loops
   std::size_t cap_intersections = 0;  // triangle pairs its caps still intersect (0 unless no placement worked)
+  // Where it is and what it cuts (describe_cross_section):
+  Vec3 centroid{0, 0, 0};              // mean of its points (LPS mm)
+  double diameter_mm = 0;              // largest distance between two of its points
+  double cross_section_area_mm2 = 0;   // |vector area| = area of the loop projected on its best plane
+  Vec3 cross_section_normal{0, 0, 0};  // unit normal of that plane (direction of the cut tube or bridge)
 };
+
+// Fills centroid, diameter_mm, cross_section_area_mm2 and cross_section_normal from `points`.
+void describe_cross_section(LoopRecord* loop);
 
 struct DenoiseResult {
   Mesh mesh;

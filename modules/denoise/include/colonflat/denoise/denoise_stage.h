@@ -1,6 +1,8 @@
 #pragma once
 // `colonflat denoise IN -o OUT [--loops F] [--report F] [--method exact|paper] [--policy P]
-//  [--max-loop-length L] [--target-genus G]` and its pipeline stage.
+//  [--max-loop-length L] [--target-genus G] [--ring-pull F] [--[no-]check-caps] [--strict]
+//  [--remove-stumps MM] [--initial-radius MM]` and its pipeline stage (parameters: table() in
+//  denoise_stage.cpp, the one place they are declared; docs/denoise.md).
 #include <memory>
 
 #include "colonflat/core/stage.h"

@@ -36,6 +36,7 @@ class HomologyBasis {
   std::vector<int> pruned_cut_graph_vertices() const;
 
  private:
+  void prune_cut_graph(const Mesh& mesh);
   int rank_ = 0, words_ = 1;
   std::vector<std::uint64_t> ann_;
   std::vector<std::uint8_t> cut_edge_, pruned_edge_;

@@ -46,9 +46,17 @@ class FundamentalCycleSearch {
   // Class of an edge cycle (XOR of edge classes), `words()` words.
   std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
   std::size_t last_settled() const { return settled_count_; }
+  // Vertices the last run() settled, nearest first, and their distances from its source (mm):
+  // the ball whose geometry and classes the run's result depends on.
+  const std::vector<int>& last_settled_vertices() const { return settled_order_; }
+  double distance(int settled_vertex) const { return dist_[settled_vertex]; }
 
  private:
   void grow();
+  void start(Mesh::VertexHandle s);
+  void relax(int w, double d, int parent);
+  void settle(int v);
+  void try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept, CycleCandidate& best);
   double frontier_bound();
   bool settled(int v) const { return stamp_[v] == run_id_ && settled_flag_[v]; }
   const Mesh& mesh_;
@@ -67,6 +75,7 @@ class FundamentalCycleSearch {
   std::vector<std::uint32_t> mark_;
   std::uint32_t mark_id_ = 0;
   std::size_t settled_count_ = 0;
+  std::vector<int> settled_order_;
   using Item = std::pair<double, int>;
   std::vector<Item> heap_;  // binary min-heap (std::push_heap / pop_heap with std::greater)
 };

@@ -1,0 +1,345 @@
+// Cap placement of cut_and_cap(): steps 6-8 of the Surgery (surgery_steps.h).
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "colonflat/core/error.h"
+#include "colonflat/denoise/cap_triangulation.h"
+#include "colonflat/denoise/face_grid.h"
+#include "surgery_steps.h"
+
+namespace cf::detail {
+
+namespace {
+// Loops up to this many vertices get triangulated caps (O(k^3) time, O(k^2) memory: about 10 s
+// and 0.7 GB at 2000 vertices); longer ones get concentric-ring caps in one placement.
+constexpr std::size_t kMaxTriangulatedLoop = 2000;
+
+Vec3 area_normal(const Mesh& mesh, Mesh::FaceHandle f) {
+  auto it = mesh.cfv_iter(f);
+  const Vec3 a = mesh.point(*it), b = mesh.point(*++it), d = mesh.point(*++it);
+  return OpenMesh::cross(b - a, d - a);
+}
+}  // namespace
+
+// 6. Side targets: after the split, a ring vertex's non-ring neighbours are exactly its own
+//    side's; a ring is pulled towards the centroid of those (face barycentres as a fallback),
+//    projected on the tangent plane.
+std::vector<Vec3> Surgery::side_targets(const std::vector<Mesh::VertexHandle>& ring) const {
+  std::unordered_set<int> in_ring;
+  for (auto v : ring) in_ring.insert(v.idx());
+  std::vector<Vec3> target(ring.size());
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    Vec3 c(0, 0, 0);
+    int n = 0;
+    for (auto w : mesh_.vv_range(ring[i]))
+      if (!in_ring.count(w.idx())) {
+        c += mesh_.point(w);
+        ++n;
+      }
+    if (n == 0) {
+      for (auto f : mesh_.vf_range(ring[i])) {
+        Vec3 b(0, 0, 0);
+        for (auto w : mesh_.fv_range(f)) b += mesh_.point(w);
+        c += b / 3.0;
+        ++n;
+      }
+    }
+    target[i] = n ? c / double(n) : mesh_.point(ring[i]);
+    Vec3 nrm(0, 0, 0);
+    for (auto f : mesh_.vf_range(ring[i])) nrm += area_normal(mesh_, f);
+    if (nrm.norm() > 0) {
+      nrm /= nrm.norm();
+      const Vec3 move = target[i] - mesh_.point(ring[i]);
+      target[i] = mesh_.point(ring[i]) + move - OpenMesh::dot(move, nrm) * nrm;
+    }
+  }
+  return target;
+}
+
+// Edge targets: the far end of the side edge most across the ring (direction least aligned
+// with the ring's tangent). A ring vertex moved along an edge of its own side stays on the old
+// surface, which keeps the faces around it from folding where the surface is creased
+// (marching-cubes junctions) and the averaged normal of the tangential target misleads.
+std::vector<Vec3> Surgery::edge_targets(const std::vector<Mesh::VertexHandle>& ring) const {
+  std::unordered_set<int> in_ring;
+  for (auto v : ring) in_ring.insert(v.idx());
+  std::vector<Vec3> target(ring.size());
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const Vec3 p = mesh_.point(ring[i]);
+    Vec3 tangent = mesh_.point(ring[(i + 1) % k_]) - mesh_.point(ring[(i + k_ - 1) % k_]);
+    if (tangent.norm() > 0) tangent /= tangent.norm();
+    target[i] = p;
+    double best = 2;
+    for (auto w : mesh_.vv_range(ring[i])) {
+      if (in_ring.count(w.idx())) continue;
+      const Vec3 d = mesh_.point(w) - p;
+      const double len = d.norm();
+      if (len == 0) continue;
+      const double align = std::fabs(OpenMesh::dot(d / len, tangent));
+      if (align < best) {
+        best = align;
+        target[i] = mesh_.point(w);
+      }
+    }
+  }
+  return target;
+}
+
+void Surgery::place_rings(double pull, const std::vector<Vec3>& left_target, const std::vector<Vec3>& right_target) {
+  for (std::size_t i = 0; i < k_; ++i) {
+    mesh_.point(result_.left_ring[i]) = original_[i] + pull * (left_target[i] - original_[i]);
+    mesh_.point(result_.right_ring[i]) = original_[i] + pull * (right_target[i] - original_[i]);
+  }
+}
+
+std::vector<Mesh::FaceHandle> Surgery::faces_around_rings() const {
+  std::vector<Mesh::FaceHandle> faces;
+  for (const auto* ring : {&result_.left_ring, &result_.right_ring})
+    for (auto v : *ring)
+      for (auto f : mesh_.vf_range(v)) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+// Minimum-area triangulations of both rings (with `avoid`: only triangles that intersect nothing);
+// true when both exist and together intersect nothing.
+bool Surgery::triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left) {
+  std::vector<Mesh::VertexHandle> order_left{result_.left_ring[0]};
+  for (std::size_t i = k_ - 1; i >= 1; --i) order_left.push_back(result_.left_ring[i]);  // x_(k-1) -> ... -> x_0
+  // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
+  auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
+  const FaceGrid* grid = avoid ? opts_.guard : nullptr;
+  *right = triangulate_ring(mesh_, result_.right_ring, chord, grid, {});
+  if (right->empty()) return false;
+  *left = triangulate_ring(mesh_, order_left, chord, grid, *right);
+  if (left->empty()) return false;
+  std::vector<std::array<int, 3>> all = *right;
+  all.insert(all.end(), left->begin(), left->end());
+  return opts_.guard->count_triangles(mesh_, all) == 0;
+}
+
+// 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area
+//     triangulations of the pulled rings (no interior vertex: on an elongated loop around a thin
+//     curved band they join opposite sides and follow the band), plain first, then restricted to
+//     triangles that intersect nothing; kept when neither the caps nor the faces around the
+//     pulled rings intersect anything; tried for several ring placements.
+bool Surgery::try_triangulated_caps() {
+  if (!opts_.guard || k_ > kMaxTriangulatedLoop) return false;
+  const std::vector<Vec3> edge_left = edge_targets(result_.left_ring), edge_right = edge_targets(result_.right_ring);
+  const std::vector<Mesh::FaceHandle> ring_faces = faces_around_rings();
+  struct Try {
+    double pull;
+    bool along_edge;
+  };
+  const double p1 = opts_.ring_pull;
+  std::vector<std::array<int, 3>> tri_right, tri_left;
+  bool found = false;
+  for (const Try tr : {Try{p1, false}, Try{p1, true}, Try{0.4, false}, Try{0.4, true}, Try{0.15, false},
+                       Try{0.15, true}, Try{0.08, true}}) {
+    if (tr.pull <= 0) continue;
+    place_rings(tr.pull, tr.along_edge ? edge_left : target_left_, tr.along_edge ? edge_right : target_right_);
+    for (auto f : ring_faces) opts_.guard->insert(mesh_, f);
+    if (opts_.guard->count_intersections(mesh_, ring_faces) != 0) continue;
+    for (bool avoid : {false, true})
+      if ((found = triangulate_both(avoid, &tri_right, &tri_left))) break;
+    if (found) break;
+  }
+  if (!found) return false;
+  add_cap(mesh_, tri_right, opts_.guard, "surgery");  // ear order: each face joins the hole's boundary
+  add_cap(mesh_, tri_left, opts_.guard, "surgery");
+  std::vector<Mesh::VertexHandle> order_left{result_.left_ring[0]};
+  for (std::size_t i = k_ - 1; i >= 1; --i) order_left.push_back(result_.left_ring[i]);
+  set_chord_classes(result_.right_ring);
+  set_chord_classes(order_left);
+  result_.right_cap = result_.right_ring[0];
+  result_.left_cap = result_.left_ring[0];
+  result_.intersections = 0;
+  return true;
+}
+
+// Classes of a triangulated cap's chords: ring vertex i gets the potential P_i (prefix XOR of
+// the ring's edge classes) and chord (i, j) the class P_i ^ P_j, so every cap triangle sums to zero.
+void Surgery::set_chord_classes(const std::vector<Mesh::VertexHandle>& ring) {
+  if (!homology_) return;
+  std::unordered_map<int, std::vector<std::uint64_t>> potential;
+  std::vector<std::uint64_t> acc(words_, 0), cls(words_);
+  for (std::size_t i = 0; i < k_; ++i) {
+    potential[ring[i].idx()] = acc;
+    const auto he = mesh_.find_halfedge(ring[i], ring[(i + 1) % k_]);
+    xor_into(acc.data(), homology_->edge_class(mesh_.edge_handle(he)), words_);
+  }
+  for (std::size_t i = 0; i < k_; ++i)
+    for (auto he : mesh_.voh_range(ring[i])) {
+      const auto w = mesh_.to_vertex_handle(he);
+      auto it = potential.find(w.idx());
+      if (it == potential.end()) continue;                                   // not a chord of this ring
+      const std::size_t j = static_cast<std::size_t>(std::find(ring.begin(), ring.end(), w) - ring.begin());
+      if (j == (i + 1) % k_ || i == (j + 1) % k_) continue;                 // a ring edge (old)
+      for (int b = 0; b < words_; ++b) cls[b] = potential[ring[i].idx()][b] ^ it->second[b];
+      homology_->set_edge_class(mesh_.edge_handle(he), cls.data());
+    }
+}
+
+// 7. Concentric caps (topology): a disk spanning each ring, made of m concentric rings around a
+//    centre vertex (m = 1: the paper's fan).
+ConcentricCap Surgery::make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {
+  ConcentricCap cap;
+  const std::size_t n = ring_halfedges.size();
+  std::vector<Mesh::VertexHandle> first(n);
+  for (std::size_t i = 0; i < n; ++i) first[i] = mesh_.from_vertex_handle(ring_halfedges[i]);
+  const int m = std::max(1, std::min(opts_.cap_rings, static_cast<int>(n) / 4));
+  cap.rings.push_back(first);
+  for (int j = 1; j < m; ++j) {
+    std::vector<Mesh::VertexHandle> rj(n);
+    for (std::size_t i = 0; i < n; ++i) rj[i] = mesh_.add_vertex(Vec3(0, 0, 0));
+    cap.rings.push_back(std::move(rj));
+  }
+  cap.centre = mesh_.add_vertex(Vec3(0, 0, 0));
+  auto add = [&](Mesh::VertexHandle a, Mesh::VertexHandle b, Mesh::VertexHandle c) {
+    const auto f = mesh_.add_face(a, b, c);
+    if (!f.is_valid()) throw Error("surgery: could not add a cap triangle");
+    cap.faces.push_back(f);
+  };
+  for (int j = 0; j + 1 < m; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t i1 = (i + 1) % n;
+      add(cap.rings[j][i], cap.rings[j][i1], cap.rings[j + 1][i1]);
+      add(cap.rings[j][i], cap.rings[j + 1][i1], cap.rings[j + 1][i]);
+    }
+  for (std::size_t i = 0; i < n; ++i) add(cap.rings[m - 1][i], cap.rings[m - 1][(i + 1) % n], cap.centre);
+  set_concentric_classes(cap, ring_halfedges);
+  return cap;
+}
+
+// Classes: ring vertex i gets the potential P_i (prefix XOR of the ring's edge classes),
+// interior vertices 0, and each new edge (a, b) the class P(a) ^ P(b), so every cap triangle
+// sums to zero (the closing one to the loop's class, which the caller quotients out).
+void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {
+  if (!homology_) return;
+  std::unordered_map<int, std::vector<std::uint64_t>> potential;
+  std::vector<std::uint64_t> acc(words_, 0);
+  for (std::size_t i = 0; i < ring_halfedges.size(); ++i) {
+    potential[cap.rings[0][i].idx()] = acc;
+    xor_into(acc.data(), homology_->edge_class(mesh_.edge_handle(ring_halfedges[i])), words_);
+  }
+  const std::vector<std::uint64_t> zero(words_, 0);
+  auto pot = [&](Mesh::VertexHandle v) -> const std::vector<std::uint64_t>& {
+    auto it = potential.find(v.idx());
+    return it == potential.end() ? zero : it->second;
+  };
+  std::vector<std::uint64_t> cls(words_);
+  std::vector<Mesh::VertexHandle> inner;
+  for (std::size_t j = 1; j < cap.rings.size(); ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
+  inner.push_back(cap.centre);
+  for (auto v : inner)  // every new edge has an interior endpoint
+    for (auto he : mesh_.voh_range(v)) {
+      const auto& q0 = pot(v);
+      const auto& q1 = pot(mesh_.to_vertex_handle(he));
+      for (int i = 0; i < words_; ++i) cls[i] = q0[i] ^ q1[i];
+      homology_->set_edge_class(mesh_.edge_handle(he), cls.data());
+    }
+}
+
+// 8. Geometry of one concentric cap: interior rings interpolated towards the ring centroid and
+//    relaxed to a discrete minimal surface (uniform Laplacian, ring fixed), then bulged by
+//    `dome` (x mean ring edge) against the cap's normal, i.e. into its own side.
+void Surgery::shape_concentric_cap(ConcentricCap& cap, double dome) {
+  const auto& first = cap.rings[0];
+  const std::size_t n = first.size();
+  const int m = static_cast<int>(cap.rings.size());
+  Vec3 c(0, 0, 0);
+  double edge = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    c += mesh_.point(first[i]);
+    edge += (mesh_.point(first[(i + 1) % n]) - mesh_.point(first[i])).norm();
+  }
+  c /= double(n);
+  edge /= double(n);
+  for (int j = 1; j < m; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = double(j) / m;
+      mesh_.point(cap.rings[j][i]) = (1 - t) * mesh_.point(first[i]) + t * c;
+    }
+  mesh_.point(cap.centre) = c;
+  std::vector<Mesh::VertexHandle> inner;
+  for (int j = 1; j < m; ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
+  inner.push_back(cap.centre);
+  std::vector<Vec3> next(inner.size());
+  for (int it = 0; it < 20 * m && m > 1; ++it) {
+    for (std::size_t q = 0; q < inner.size(); ++q) {
+      Vec3 sum(0, 0, 0);
+      int deg = 0;
+      for (auto nb : mesh_.vv_range(inner[q])) {
+        sum += mesh_.point(nb);
+        ++deg;
+      }
+      next[q] = sum / double(deg);
+    }
+    for (std::size_t q = 0; q < inner.size(); ++q) mesh_.point(inner[q]) = next[q];
+  }
+  if (dome == 0) return;
+  Vec3 nrm(0, 0, 0);
+  for (auto f : cap.faces) nrm += area_normal(mesh_, f);
+  if (nrm.norm() > 0) nrm /= nrm.norm();
+  for (int j = 1; j < m; ++j) {
+    const double t = double(j) / m;
+    for (auto v : cap.rings[j]) mesh_.point(v) -= dome * edge * (1 - (1 - t) * (1 - t)) * nrm;
+  }
+  mesh_.point(cap.centre) -= dome * edge * nrm;
+}
+
+// A placement = ring pull (towards the side targets) + cap shape.
+void Surgery::place_concentric(double pull, double dome) {
+  place_rings(pull, target_left_, target_right_);
+  shape_concentric_cap(cap_left_, dome);
+  shape_concentric_cap(cap_right_, dome);
+}
+
+void Surgery::concentric_caps() {
+  cap_right_ = make_concentric_cap(loop_halfedges_);  // h_0 -> h_1 -> ...
+  cap_left_ = make_concentric_cap(std::vector<Mesh::HalfedgeHandle>(new_opposites_.rbegin(), new_opposites_.rend()));
+  result_.right_cap = cap_right_.centre;
+  result_.left_cap = cap_left_.centre;
+  place_concentric(opts_.ring_pull, 0.0);
+  if (opts_.guard) search_concentric_placement();
+}
+
+// With a guard: the placement with the fewest intersecting pairs among pulls x domes (each a
+// full check of the faces it moves); loops above kMaxTriangulatedLoop keep the first one.
+void Surgery::search_concentric_placement() {
+  std::vector<Mesh::FaceHandle> moving = cap_left_.faces;
+  moving.insert(moving.end(), cap_right_.faces.begin(), cap_right_.faces.end());
+  const std::vector<Mesh::FaceHandle> around = faces_around_rings();
+  moving.insert(moving.end(), around.begin(), around.end());
+  std::sort(moving.begin(), moving.end());
+  moving.erase(std::unique(moving.begin(), moving.end()), moving.end());
+  auto refresh = [&]() {
+    for (auto f : moving) opts_.guard->insert(mesh_, f);
+  };
+  refresh();
+  std::size_t best = opts_.guard->count_intersections(mesh_, moving);
+  double best_pull = opts_.ring_pull, best_dome = 0;
+  if (best > 0 && k_ <= kMaxTriangulatedLoop) {
+    for (double pull : {opts_.ring_pull, 0.4, 0.15})
+      for (double dome : {0.25, 0.5, 1.0, 0.0, -0.25}) {
+        if (pull <= 0 && dome == 0) continue;
+        place_concentric(pull, dome);
+        refresh();
+        const std::size_t n = opts_.guard->count_intersections(mesh_, moving);
+        if (n < best) {
+          best = n;
+          best_pull = pull;
+          best_dome = dome;
+        }
+        if (best == 0) break;
+      }
+    place_concentric(best_pull, best_dome);
+    refresh();
+  }
+  result_.intersections = best;
+}
+
+}  // namespace cf::detail

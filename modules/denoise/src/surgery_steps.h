@@ -1,0 +1,70 @@
+#pragma once
+// Internal to the denoise module: cut_and_cap() as named steps (surgery.cpp: the cut;
+// surgery_caps.cpp: cap placement). One Surgery object per call; each method is one step.
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "colonflat/denoise/homology.h"
+#include "colonflat/denoise/surgery.h"
+
+namespace cf::detail {
+
+// A disk of concentric rings around a centre vertex spanning one cut ring (the fallback cap).
+struct ConcentricCap {
+  std::vector<std::vector<Mesh::VertexHandle>> rings;  // rings[0] = the cut ring, boundary order
+  Mesh::VertexHandle centre;
+  std::vector<Mesh::FaceHandle> faces;
+};
+
+class Surgery {
+ public:
+  Surgery(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts, HomologyBasis* homology)
+      : mesh_(mesh), loop_(loop), opts_(opts), homology_(homology), k_(loop.size()),
+        words_(homology ? homology->words() : 0) {}
+  SurgeryResult run();
+
+ private:
+  // The cut (surgery.cpp).
+  void check_loop();
+  void gather_left_side();
+  void add_left_copies();
+  void repoint_left_fans();
+  void relink_left_faces();
+  void link_boundary_rings();
+  void copy_loop_classes();
+  // Caps (surgery_caps.cpp).
+  std::vector<Vec3> side_targets(const std::vector<Mesh::VertexHandle>& ring) const;
+  std::vector<Vec3> edge_targets(const std::vector<Mesh::VertexHandle>& ring) const;
+  void place_rings(double pull, const std::vector<Vec3>& left_target, const std::vector<Vec3>& right_target);
+  std::vector<Mesh::FaceHandle> faces_around_rings() const;
+  bool try_triangulated_caps();
+  bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
+  void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
+  ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
+  void set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
+  void shape_concentric_cap(ConcentricCap& cap, double dome);
+  void place_concentric(double pull, double dome);
+  void concentric_caps();
+  void search_concentric_placement();
+
+  Mesh& mesh_;
+  const std::vector<Mesh::VertexHandle>& loop_;
+  const SurgeryOptions& opts_;
+  HomologyBasis* homology_;
+  const std::size_t k_;
+  const int words_;
+  std::vector<Mesh::HalfedgeHandle> loop_halfedges_;       // h_i: loop_i -> loop_(i+1), left face = left side
+  std::vector<std::vector<Mesh::HalfedgeHandle>> fan_;     // interior outgoing halfedges of each left fan
+  std::vector<Mesh::FaceHandle> left_faces_;               // faces left of some h_i
+  std::vector<std::array<Mesh::HalfedgeHandle, 3>> face_cycle_;
+  std::vector<Mesh::HalfedgeHandle> new_halfedges_, new_opposites_;  // y_i (copies of h_i) and x_i = opp(y_i)
+  std::unordered_map<int, Mesh::HalfedgeHandle> replaced_;  // h_i -> y_i
+  std::vector<Vec3> original_;                               // loop positions before any move
+  std::vector<Vec3> target_left_, target_right_;
+  ConcentricCap cap_left_, cap_right_;
+  SurgeryResult result_;
+};
+
+}  // namespace cf::detail
