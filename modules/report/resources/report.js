@@ -201,15 +201,16 @@
     showCtAt(hit.lps, "CT at the clicked point: " + hoverText(hit));
   }
 
-  // Shows a finding: selects its card, centres the map on it, CT planes there. scroll: to the card.
-  function focusFinding(key, scroll) {
+  // Shows a finding: selects its card, centres the map on it (unless keepMap), CT planes there.
+  // scroll: to the card.
+  function focusFinding(key, scroll, keepMap) {
     const f = findingByKey(key);
     if (!f) return;
     document.querySelectorAll(".card.selected").forEach((c) => c.classList.remove("selected"));
     const card = $("card-" + key);
     if (card) card.classList.add("selected");
     if (f.pixel && R.image) {
-      centreOn(f.pixel[0], f.pixel[1], Math.max(view.scale, 1.5));
+      if (!keepMap) centreOn(f.pixel[0], f.pixel[1], Math.max(view.scale, 1.5));
       setPin(f.pixel[0], f.pixel[1]);
     }
     showCtAt(f.lps_mm, "CT at " + key + ": " + positionText(f) + " · LPS " + lpsText(f.lps_mm) + " mm · " + sliceText(f.lps_mm));
@@ -370,7 +371,7 @@
     buildCards();
     buildFiles();
     const first = (R.candidates || [])[0] || (R.known || [])[0];
-    if (first) focusFinding(first.key, false);
+    if (first) focusFinding(first.key, false, true);
     else $("ct-title").textContent = "CT: click the map";
     document.body.setAttribute("data-ready", "1");
   }

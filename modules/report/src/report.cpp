@@ -198,8 +198,14 @@ std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
 }  // namespace
 
 ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& opts, std::ostream* log) {
-  Stopwatch clock;
+  Stopwatch clock, phase;
+  std::vector<std::pair<std::string, double>> phases;
+  const auto lap = [&](const char* name) {
+    phases.emplace_back(name, phase.seconds());
+    phase.restart();
+  };
   Builder b(opts, log, load_run(run_dir, {opts.ct, opts.truth}));
+  lap("load");
   TempFolder files(run_dir / (".report_files.tmp-" + std::to_string(::getpid())));
   b.files_dir = files.path();
   b.data["title"] = "ColonFlat review report";
@@ -207,9 +213,12 @@ ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& o
   b.data["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
   b.data["candidates_file"] = b.run.candidates_file;
   b.add_image();
+  lap("image");
   b.add_ct();
+  lap("ct");
   b.progress("CT planes written");
   b.add_findings();
+  lap("cards");
   b.progress(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
              " known-polyp cards");
   b.add_files();
@@ -225,6 +234,8 @@ ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& o
   fs::rename(files.path(), run_dir / "report_files");
   files.release();
   tx.commit();
+  lap("page");
+  b.result.phases = phases;
   b.result.warnings = b.run.warnings;
   b.result.seconds = clock.seconds();
   return b.result;

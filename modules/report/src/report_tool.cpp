@@ -53,8 +53,12 @@ class ReportTool : public Tool {
       report_param_table().validate(opts);
       if (opts.min_fov_mm > opts.max_fov_mm) throw UsageError("--min-fov must not exceed --max-fov");
       const ReportResult r = write_review_report(run_dir, opts, quiet ? nullptr : &err);
-      if (!quiet)
+      if (!quiet) {
         for (const auto& w : r.warnings) err << "colonflat report: warning: " << w << "\n";
+        err << "report: phases";
+        for (const auto& [phase, secs] : r.phases) err << " " << phase << " " << std::fixed << std::setprecision(2) << secs << " s";
+        err << "\n";
+      }
       out << "report: " << (std::filesystem::path(run_dir) / "report.html").string() << " (" << r.candidates
           << " candidates, " << r.known_polyps << " known polyps, " << r.images << " images, "
           << r.endoluminal_views << " endoluminal views) in " << std::fixed << std::setprecision(2) << r.seconds

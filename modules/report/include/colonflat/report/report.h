@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cf {
@@ -34,6 +35,7 @@ struct ReportResult {
   int images = 0;               // PNGs written under report_files/
   int endoluminal_views = 0;
   double seconds = 0;
+  std::vector<std::pair<std::string, double>> phases;  // (phase, seconds): load, image, ct, cards, page
   std::vector<std::string> warnings;  // also shown on the page
 };
 
