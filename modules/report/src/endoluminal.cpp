@@ -3,7 +3,7 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkDoubleArray.h>
+#include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -26,38 +26,63 @@ namespace cf {
 
 struct EndoluminalRenderer::Impl {
   EndoluminalOptions opts;
-  vtkNew<vtkPolyData> surface;
-  vtkNew<vtkStaticCellLocator> locator;
+  TriangleList surface;
+  std::vector<std::array<double, 3>> normals;
+  vtkNew<vtkPolyDataMapper> mapper;
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkRenderWindow> window;
+
+  // The triangles with a corner within radius_mm of `c`, compacted, with lumen-side normals.
+  vtkSmartPointer<vtkPolyData> local_wall(const std::array<double, 3>& c) const;
+  // Distance from `target` into the lumen (along -normal) to the first wall, at most `limit`.
+  double free_distance(vtkPolyData* wall, const std::array<double, 3>& target, const std::array<double, 3>& n,
+                       double limit) const;
 };
 
-namespace {
-
-vtkSmartPointer<vtkPolyData> to_polydata(const TriangleList& s, const std::vector<std::array<double, 3>>& normals) {
+vtkSmartPointer<vtkPolyData> EndoluminalRenderer::Impl::local_wall(const std::array<double, 3>& c) const {
+  const double r2 = opts.radius_mm * opts.radius_mm;
+  std::vector<vtkIdType> new_id(surface.points.size(), -1);
   vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  for (const auto& p : s.points) pts->InsertNextPoint(p.data());
+  vtkNew<vtkFloatArray> nrm;
+  nrm->SetNumberOfComponents(3);
+  nrm->SetName("Normals");
   vtkNew<vtkCellArray> polys;
-  for (const auto& t : s.triangles) {
-    const vtkIdType c[3] = {t[0], t[1], t[2]};
-    polys->InsertNextCell(3, c);
+  auto near = [&](int v) {
+    const auto& p = surface.points[v];
+    return (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]) <= r2;
+  };
+  auto id_of = [&](int v) {
+    if (new_id[v] < 0) {
+      new_id[v] = pts->InsertNextPoint(surface.points[v].data());
+      const auto& n = normals.empty() ? std::array<double, 3>{0, 0, 0} : normals[v];
+      nrm->InsertNextTuple3(-n[0], -n[1], -n[2]);  // the camera sees the lumen side
+    }
+    return new_id[v];
+  };
+  for (const auto& t : surface.triangles) {
+    if (!near(t[0]) && !near(t[1]) && !near(t[2])) continue;
+    const vtkIdType ids[3] = {id_of(t[0]), id_of(t[1]), id_of(t[2])};
+    polys->InsertNextCell(3, ids);
   }
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetPolys(polys);
-  if (normals.size() == s.points.size()) {
-    vtkNew<vtkDoubleArray> n;
-    n->SetNumberOfComponents(3);
-    n->SetName("Normals");
-    // the lumen side is what the camera sees: shade with normals pointing into the lumen
-    for (const auto& v : normals) n->InsertNextTuple3(-v[0], -v[1], -v[2]);
-    pd->GetPointData()->SetNormals(n);
-  }
+  if (!normals.empty()) pd->GetPointData()->SetNormals(nrm);
   return pd;
 }
 
-}  // namespace
+double EndoluminalRenderer::Impl::free_distance(vtkPolyData* wall, const std::array<double, 3>& target,
+                                                const std::array<double, 3>& n, double limit) const {
+  if (wall->GetNumberOfCells() == 0) return limit;
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(wall);
+  locator->BuildLocator();
+  double start[3], end[3], hit[3], pcoords[3], t = 0;
+  int sub = 0;
+  for (int k = 0; k < 3; ++k) start[k] = target[k] - n[k], end[k] = target[k] - (limit + 1) * n[k];
+  if (!locator->IntersectWithLine(start, end, 1e-6, t, hit, pcoords, sub)) return limit;
+  return 1.0 + t * limit;
+}
 
 EndoluminalRenderer::EndoluminalRenderer(const TriangleList& surface,
                                          const std::vector<std::array<double, 3>>& normals,
@@ -65,18 +90,14 @@ EndoluminalRenderer::EndoluminalRenderer(const TriangleList& surface,
     : impl_(std::make_unique<Impl>()) {
   ensure_display();
   impl_->opts = opts;
-  impl_->surface->ShallowCopy(to_polydata(surface, normals));
-  impl_->locator->SetDataSet(impl_->surface);
-  impl_->locator->BuildLocator();
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputData(impl_->surface);
-  mapper->ScalarVisibilityOff();
+  impl_->surface = surface;
+  if (normals.size() == surface.points.size()) impl_->normals = normals;
+  impl_->mapper->ScalarVisibilityOff();
   vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
+  actor->SetMapper(impl_->mapper);
   actor->GetProperty()->SetColor(0.93, 0.64, 0.56);
   actor->GetProperty()->SetSpecular(0.25);
   actor->GetProperty()->SetSpecularPower(25);
-  actor->GetProperty()->BackfaceCullingOff();
   impl_->renderer->AddActor(actor);
   impl_->renderer->SetBackground(0.02, 0.02, 0.03);
   impl_->renderer->SetTwoSidedLighting(true);
@@ -92,14 +113,10 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
                                      double* camera_distance_mm) {
   VtkMessageCapture msgs;
   const EndoluminalOptions& o = impl_->opts;
-  // free distance into the lumen: first wall hit along -normal
-  double start[3], end[3], hit[3], pcoords[3], t = 0;
-  int sub = 0;
-  for (int k = 0; k < 3; ++k) start[k] = target[k] - 1.0 * normal_out[k], end[k] = target[k] - 250.0 * normal_out[k];
-  double free_mm = 250;
-  if (impl_->locator->IntersectWithLine(start, end, 1e-6, t, hit, pcoords, sub))
-    free_mm = 1.0 + t * 249.0;
+  vtkSmartPointer<vtkPolyData> wall = impl_->local_wall(target);
+  const double free_mm = impl_->free_distance(wall, target, normal_out, o.radius_mm);
   const double d = std::max(o.min_distance_mm, std::min(o.distance_mm, 0.6 * free_mm));
+  impl_->mapper->SetInputData(wall);
   double eye[3];
   for (int k = 0; k < 3; ++k) eye[k] = target[k] - d * normal_out[k];
   vtkCamera* cam = impl_->renderer->GetActiveCamera();
@@ -110,7 +127,7 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
   cam->SetViewUp(0, vertical ? -1 : 0, vertical ? 0 : 1);
   cam->OrthogonalizeViewUp();
   cam->SetViewAngle(o.view_angle_deg);
-  cam->SetClippingRange(0.3, 400);  // inside a closed tube: near walls must not be clipped
+  cam->SetClippingRange(0.3, 2 * o.radius_mm + d);  // inside a tube: near walls must not be clipped
   impl_->window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(impl_->window);

@@ -1,7 +1,8 @@
 #pragma once
 // Endoluminal (virtual colonoscopy) views with VTK: the colon surface seen from inside the lumen,
 // the camera placed on the lumen side of a wall point and looking at it along the wall normal,
-// lit by a head light. The surface is uploaded once; each view only moves the camera.
+// lit by a head light. Each view renders only the wall within `radius_mm` of its target (what a
+// camera inside a colon of normal calibre can see), so a view costs the same on any colon size.
 // Needs an X display or Xvfb (render module's ensure_display()).
 #include <array>
 #include <memory>
@@ -17,6 +18,7 @@ struct EndoluminalOptions {
   double distance_mm = 22;       // camera distance from the target, shortened to 60 % of the free
                                  // distance to the opposite wall
   double min_distance_mm = 4;    // closest camera distance
+  double radius_mm = 70;         // wall rendered around the target
 };
 
 class EndoluminalRenderer {
