@@ -164,6 +164,8 @@ class RunTool : public Tool {
       tx.commit();
       out << txt.str();
       // The review report (report module) once the last stage has run: report.html, polyps.mrk.json.
+      // It reads the run folder; the in-memory artifacts are released first.
+      bag = ArtifactBag();
       if (last + 1 == available.size())
         for (auto& t : registered_module_tools())
           if (t->name() == "report")

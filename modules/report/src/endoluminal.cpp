@@ -28,11 +28,8 @@ struct EndoluminalRenderer::Impl {
   EndoluminalOptions opts;
   TriangleList surface;
   std::vector<std::array<double, 3>> normals;
-  vtkNew<vtkPolyDataMapper> mapper;
-  vtkNew<vtkRenderer> renderer;
-  vtkNew<vtkRenderWindow> window;
 
-  // The triangles with a corner within radius_mm of `c`, compacted, with lumen-side normals.
+  // The triangles with a corner within radius_mm of `c`, compacted, with their normals.
   vtkSmartPointer<vtkPolyData> local_wall(const std::array<double, 3>& c) const;
   // Distance from `target` into the lumen (along -normal) to the first wall, at most `limit`.
   double free_distance(vtkPolyData* wall, const std::array<double, 3>& target, const std::array<double, 3>& n,
@@ -55,7 +52,9 @@ vtkSmartPointer<vtkPolyData> EndoluminalRenderer::Impl::local_wall(const std::ar
     if (new_id[v] < 0) {
       new_id[v] = pts->InsertNextPoint(surface.points[v].data());
       const auto& n = normals.empty() ? std::array<double, 3>{0, 0, 0} : normals[v];
-      nrm->InsertNextTuple3(-n[0], -n[1], -n[2]);  // the camera sees the lumen side
+      // as given (consistent with the winding): two-sided lighting flips them for the back faces
+      // the camera sees from inside the lumen
+      nrm->InsertNextTuple3(n[0], n[1], n[2]);
     }
     return new_id[v];
   };
@@ -92,19 +91,6 @@ EndoluminalRenderer::EndoluminalRenderer(const TriangleList& surface,
   impl_->opts = opts;
   impl_->surface = surface;
   if (normals.size() == surface.points.size()) impl_->normals = normals;
-  impl_->mapper->ScalarVisibilityOff();
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(impl_->mapper);
-  actor->GetProperty()->SetColor(0.93, 0.64, 0.56);
-  actor->GetProperty()->SetSpecular(0.25);
-  actor->GetProperty()->SetSpecularPower(25);
-  impl_->renderer->AddActor(actor);
-  impl_->renderer->SetBackground(0.02, 0.02, 0.03);
-  impl_->renderer->SetTwoSidedLighting(true);
-  impl_->window->SetOffScreenRendering(1);
-  impl_->window->SetMultiSamples(0);
-  impl_->window->AddRenderer(impl_->renderer);
-  impl_->window->SetSize(opts.size, opts.size);
 }
 
 EndoluminalRenderer::~EndoluminalRenderer() = default;
@@ -116,10 +102,27 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
   vtkSmartPointer<vtkPolyData> wall = impl_->local_wall(target);
   const double free_mm = impl_->free_distance(wall, target, normal_out, o.radius_mm);
   const double d = std::max(o.min_distance_mm, std::min(o.distance_mm, 0.6 * free_mm));
-  impl_->mapper->SetInputData(wall);
+  // A window per view, as render's snapshots do (a reused off-screen window read back empty).
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(wall);
+  mapper->ScalarVisibilityOff();
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.93, 0.64, 0.56);
+  actor->GetProperty()->SetSpecular(0.25);
+  actor->GetProperty()->SetSpecularPower(25);
+  vtkNew<vtkRenderer> renderer;
+  renderer->AddActor(actor);
+  renderer->SetBackground(0.02, 0.02, 0.03);
+  renderer->SetTwoSidedLighting(true);
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->AddRenderer(renderer);
+  window->SetSize(o.size, o.size);
   double eye[3];
   for (int k = 0; k < 3; ++k) eye[k] = target[k] - d * normal_out[k];
-  vtkCamera* cam = impl_->renderer->GetActiveCamera();
+  vtkCamera* cam = renderer->GetActiveCamera();
   cam->SetPosition(eye);
   cam->SetFocalPoint(target.data());
   // superior up unless the view is nearly vertical, then anterior up
@@ -128,9 +131,9 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
   cam->OrthogonalizeViewUp();
   cam->SetViewAngle(o.view_angle_deg);
   cam->SetClippingRange(0.3, 2 * o.radius_mm + d);  // inside a tube: near walls must not be clipped
-  impl_->window->Render();
+  window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(impl_->window);
+  grab->SetInput(window);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();

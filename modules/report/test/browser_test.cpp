@@ -58,7 +58,7 @@ TEST(ReportBrowser, HeadlessChromiumShowsCardsImageAndCtViews) {
   EXPECT_EQ(count(dom, std::regex("class=\"card candidate[^\"]*\"")), n_cand);
   EXPECT_EQ(count(dom, std::regex("class=\"card known[^\"]*\"")), run.known_polyps);
   EXPECT_EQ(count(dom, std::regex("class=\"tile ct-tile\"")), 3 * (n_cand + run.known_polyps));
-  EXPECT_EQ(count(dom, std::regex("_endoluminal\\.png")), n_cand + run.known_polyps);
+  EXPECT_EQ(count(dom, std::regex("<img src=\"report_files/[A-Z0-9]+_endoluminal\\.png\"")), n_cand + run.known_polyps);
   EXPECT_NE(dom.find("id=\"colon-img\""), std::string::npos);
   EXPECT_NE(dom.find("src=\"colon.png\""), std::string::npos);
   EXPECT_EQ(count(dom, std::regex("class=\"mark (cand|known)\"")), n_cand + run.known_polyps);

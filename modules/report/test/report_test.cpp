@@ -10,7 +10,9 @@
 
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/render/artifacts.h"
+#include "colonflat/core/synthetic.h"
 #include "colonflat/report/ct_views.h"
+#include "colonflat/report/endoluminal.h"
 #include "colonflat/report/image_layout.h"
 #include "colonflat/report/report_tool.h"
 #include "colonflat/report/slicer_markups.h"
@@ -39,8 +41,8 @@ ToolResult run_report_tool(const std::vector<std::string>& args) {
   return {code, out.str(), err.str()};
 }
 
-// The layout rebuilt from flat.vtp matches render's image size and every candidate's pixel on a
-// two-segment map, and it puts each candidate where render drew it.
+// The layout rebuilt from flat.vtp matches render's image size and puts every candidate where
+// render drew it, on a two-segment map with candidates in both bands; a wrong size is reported.
 TEST(ReportLayout, MatchesRenderedImageAndCandidatePixels) {
   testing::TempDir tmp;
   const auto run = testing::make_synthetic_run(tmp / "run");
@@ -52,7 +54,9 @@ TEST(ReportLayout, MatchesRenderedImageAndCandidatePixels) {
   ColonImageLayout layout(flat, run.candidates["image"]["pixel_size_mm"].get<double>());
   layout.set_rolls_from_candidates(run.candidates["candidates"]);
   EXPECT_EQ(layout.check(dims[0], dims[1], run.candidates["candidates"]), "");
-  ASSERT_GE(run.candidates["candidates"].size(), 4u);
+  std::set<int> segments_with_candidates;
+  for (const auto& c : run.candidates["candidates"]) segments_with_candidates.insert(c["segment"].get<int>());
+  EXPECT_EQ(segments_with_candidates.size(), 2u) << "the check must cover both bands";
   // a wrong image size is reported
   EXPECT_NE(layout.check(dims[0] + 5, dims[1], run.candidates["candidates"]), "");
 }
@@ -215,6 +219,38 @@ TEST(ReportTool, RejectsInvalidParameters) {
     EXPECT_EQ(r.code, 2) << bad[0] << ": " << r.err;
     EXPECT_NE(r.err.find("colonflat report: error:"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace cf
+
+namespace cf {
+namespace {
+
+// Inside a straight tube the endoluminal view of a wall point is the lit wall: most pixels are
+// tissue-coloured (red > blue), none of the view is empty background at the centre.
+TEST(ReportEndoluminal, ViewFromInsideTubeShowsLitWall) {
+  const TriangleList tube = synthetic::open_cylinder(15, 200, 96, 200);
+  std::vector<std::array<double, 3>> normals;
+  for (const auto& p : tube.points) {
+    const double r = std::hypot(p[0], p[1]);
+    normals.push_back({p[0] / r, p[1] / r, 0});  // out of the lumen
+  }
+  EndoluminalOptions o;
+  o.size = 64;
+  EndoluminalRenderer endo(tube, normals, o);
+  double d = 0;
+  const ImagePtr img = endo.render({15, 0, 100}, {1, 0, 0}, &d);
+  EXPECT_NEAR(d, 0.6 * 29, 1.0);  // 60 % of the 30 mm free distance (minus the 1 mm start)
+  int lit = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const auto* p = static_cast<unsigned char*>(img->GetScalarPointer(x, y, 0));
+      if (p[0] > 60 && p[0] > p[2]) ++lit;
+    }
+  EXPECT_GT(lit, 64 * 64 * 9 / 10);
+  const auto* centre = static_cast<unsigned char*>(img->GetScalarPointer(32, 32, 0));
+  EXPECT_GT(centre[0], 100);
 }
 
 }  // namespace
