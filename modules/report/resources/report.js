@@ -89,6 +89,9 @@
   function fitView() {
     if (!R.image) return;
     const v = $("viewer");
+    // the viewer as tall as the image at full width (within 260 px .. 62 % of the window)
+    const tall = R.image.height * (v.clientWidth / R.image.width);
+    v.style.height = Math.round(Math.max(260, Math.min(tall, 0.62 * window.innerHeight))) + "px";
     view.scale = Math.min(v.clientWidth / R.image.width, v.clientHeight / R.image.height);
     view.tx = (v.clientWidth - R.image.width * view.scale) / 2;
     view.ty = (v.clientHeight - R.image.height * view.scale) / 2;

@@ -54,15 +54,22 @@ PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0,
   auto interp = Interp::New();
   interp->SetInputImage(ct);
   const PlaneAxes a = plane_axes(plane);
-  Interp::PointType p;
-  p[a.fixed_axis] = fixed;
-  for (int r = 0; r < h; ++r) {
+  // The index is affine in the pixel: per row, the start index and a per-column step.
+  const auto index_of = [&](int r, int c) {
+    Interp::PointType p;
+    p[a.fixed_axis] = fixed;
     p[a.v_axis] = a.v_sign * (v0 + r * pixel_mm);
+    p[a.u_axis] = a.u_sign * (u0 + c * pixel_mm);
+    Interp::ContinuousIndexType idx;
+    ct->TransformPhysicalPointToContinuousIndex(p, idx);
+    return idx;
+  };
+  for (int r = 0; r < h; ++r) {
+    const auto start = index_of(r, 0), next = index_of(r, 1);
+    Interp::ContinuousIndexType idx;
     for (int c = 0; c < w; ++c) {
-      p[a.u_axis] = a.u_sign * (u0 + c * pixel_mm);
-      Interp::ContinuousIndexType idx;
-      if (!ct->TransformPhysicalPointToContinuousIndex(p, idx) || !interp->IsInsideBuffer(idx)) continue;
-      out.hu[std::size_t(r) * w + c] = float(interp->EvaluateAtContinuousIndex(idx));
+      for (int k = 0; k < 3; ++k) idx[k] = start[k] + c * (next[k] - start[k]);
+      if (interp->IsInsideBuffer(idx)) out.hu[std::size_t(r) * w + c] = float(interp->EvaluateAtContinuousIndex(idx));
     }
   }
   return out;
@@ -94,6 +101,7 @@ void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::pat
     vtkNew<vtkPNGWriter> writer;
     writer->SetInputData(img);
     writer->SetFileName(tmp.c_str());
+    writer->SetCompressionLevel(1);  // fast; these images are small
     writer->Write();
     if (writer->GetErrorCode() != 0) throw Error(path.string() + ": cannot write PNG");
   });

@@ -28,6 +28,9 @@ struct EndoluminalRenderer::Impl {
   EndoluminalOptions opts;
   TriangleList surface;
   std::vector<std::array<double, 3>> normals;
+  vtkNew<vtkPolyDataMapper> mapper;
+  vtkNew<vtkRenderer> renderer;
+  vtkNew<vtkRenderWindow> window;  // one off-screen window (GL context) for every view
 
   // The triangles with a corner within radius_mm of `c`, compacted, with their normals.
   vtkSmartPointer<vtkPolyData> local_wall(const std::array<double, 3>& c) const;
@@ -86,11 +89,23 @@ double EndoluminalRenderer::Impl::free_distance(vtkPolyData* wall, const std::ar
 EndoluminalRenderer::EndoluminalRenderer(const TriangleList& surface,
                                          const std::vector<std::array<double, 3>>& normals,
                                          const EndoluminalOptions& opts)
-    : impl_(std::make_unique<Impl>()) {
-  ensure_display();
+    : impl_((ensure_display(), std::make_unique<Impl>())) {  // a display before the window exists
   impl_->opts = opts;
   impl_->surface = surface;
   if (normals.size() == surface.points.size()) impl_->normals = normals;
+  impl_->mapper->ScalarVisibilityOff();
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(impl_->mapper);
+  actor->GetProperty()->SetColor(0.93, 0.64, 0.56);
+  actor->GetProperty()->SetSpecular(0.25);
+  actor->GetProperty()->SetSpecularPower(25);
+  impl_->renderer->AddActor(actor);
+  impl_->renderer->SetBackground(0.02, 0.02, 0.03);
+  impl_->renderer->SetTwoSidedLighting(true);
+  impl_->window->SetOffScreenRendering(1);
+  impl_->window->SetMultiSamples(0);
+  impl_->window->AddRenderer(impl_->renderer);
+  impl_->window->SetSize(opts.size, opts.size);
 }
 
 EndoluminalRenderer::~EndoluminalRenderer() = default;
@@ -102,27 +117,10 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
   vtkSmartPointer<vtkPolyData> wall = impl_->local_wall(target);
   const double free_mm = impl_->free_distance(wall, target, normal_out, o.radius_mm);
   const double d = std::max(o.min_distance_mm, std::min(o.distance_mm, 0.6 * free_mm));
-  // A window per view, as render's snapshots do (a reused off-screen window read back empty).
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputData(wall);
-  mapper->ScalarVisibilityOff();
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
-  actor->GetProperty()->SetColor(0.93, 0.64, 0.56);
-  actor->GetProperty()->SetSpecular(0.25);
-  actor->GetProperty()->SetSpecularPower(25);
-  vtkNew<vtkRenderer> renderer;
-  renderer->AddActor(actor);
-  renderer->SetBackground(0.02, 0.02, 0.03);
-  renderer->SetTwoSidedLighting(true);
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0);
-  window->AddRenderer(renderer);
-  window->SetSize(o.size, o.size);
+  impl_->mapper->SetInputData(wall);
   double eye[3];
   for (int k = 0; k < 3; ++k) eye[k] = target[k] - d * normal_out[k];
-  vtkCamera* cam = renderer->GetActiveCamera();
+  vtkCamera* cam = impl_->renderer->GetActiveCamera();
   cam->SetPosition(eye);
   cam->SetFocalPoint(target.data());
   // superior up unless the view is nearly vertical, then anterior up
@@ -131,9 +129,9 @@ ImagePtr EndoluminalRenderer::render(const std::array<double, 3>& target, const 
   cam->OrthogonalizeViewUp();
   cam->SetViewAngle(o.view_angle_deg);
   cam->SetClippingRange(0.3, 2 * o.radius_mm + d);  // inside a tube: near walls must not be clipped
-  window->Render();
+  impl_->window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
+  grab->SetInput(impl_->window);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -200,9 +201,12 @@ std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
 ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& opts, std::ostream* log) {
   Stopwatch clock, phase;
   std::vector<std::pair<std::string, double>> phases;
+  std::clock_t cpu = std::clock();
   const auto lap = [&](const char* name) {
     phases.emplace_back(name, phase.seconds());
+    phases.emplace_back(std::string(name) + "_cpu", double(std::clock() - cpu) / CLOCKS_PER_SEC);
     phase.restart();
+    cpu = std::clock();
   };
   Builder b(opts, log, load_run(run_dir, {opts.ct, opts.truth}));
   lap("load");

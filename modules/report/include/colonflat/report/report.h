@@ -19,7 +19,7 @@ struct ReportOptions {
   std::string ct;                  // CT volume (empty: ct.nrrd in the run folder, else the run's input)
   std::string truth;               // known polyps JSON (empty: polyps.json beside a phantom CT)
   int lookup_step_px = 6;          // px, cell of the hover/click lookup grid over colon.png
-  double stack_step_mm = 4;        // mm between the pre-rendered CT planes used for clicks on the map
+  double stack_step_mm = 5;        // mm between the pre-rendered CT planes used for clicks on the map
   double stack_pixel_mm = 1.0;     // mm, pixel of those planes
   int tile_pixels = 160;           // px, side of a finding's CT views
   double min_fov_mm = 30;          // mm, smallest field of view of a finding's CT views
@@ -35,7 +35,7 @@ struct ReportResult {
   int images = 0;               // PNGs written under report_files/
   int endoluminal_views = 0;
   double seconds = 0;
-  std::vector<std::pair<std::string, double>> phases;  // (phase, seconds): load, image, ct, cards, page
+  std::vector<std::pair<std::string, double>> phases;  // (phase, wall s) and (phase_cpu, CPU s): load, image, ct, cards, page
   std::vector<std::string> warnings;  // also shown on the page
 };
 
