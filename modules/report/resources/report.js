@@ -249,10 +249,10 @@
     return el("div", { class: "window-buttons" }, [lung, " ", soft]);
   }
   function matchBadge(f) {
-    if (f.known) return f.match ? el("span", { class: "badge hit", text: "detected as " + f.match.key + " (" + fix(f.match.distance_mm) + " mm)" })
+    if (f.known) return f.match ? el("span", { class: "badge hit", text: "detected as " + f.match.key + ", " + fix(f.match.distance_mm) + " mm away" })
                                 : el("span", { class: "badge miss", text: "not detected" });
     if (!(R.known || []).length) return null;
-    return f.match ? el("span", { class: "badge hit", text: "true positive: " + f.match.key + " (" + fix(f.match.distance_mm) + " mm)" })
+    return f.match ? el("span", { class: "badge hit", text: "true positive: " + f.match.key + ", " + fix(f.match.distance_mm) + " mm away" })
                    : el("span", { class: "badge miss", text: "no known polyp within reach: false positive" });
   }
   function factsTable(f) {
@@ -327,9 +327,35 @@
   function stageTable(stages) {
     const rows = stages.map((s) => el("tr", {}, [
       el("td", { text: s.stage }), el("td", { text: fix(s.time_s, 2) + " s" }), el("td", { text: fix(s.peak_memory_mib, 0) + " MiB" }),
-      el("td", {}, [el("table", { class: "kv" }, resultLines(s.result, "", []).map(([k, v]) =>
-        el("tr", { class: /warn|error/i.test(k) ? "warning" : "" }, [el("td", { text: k }), el("td", { text: v })])))])]));
+      el("td", {}, [el("details", {}, [el("summary", { text: "all result fields" }), el("table", { class: "kv" }, resultLines(s.result, "", []).map(([k, v]) =>
+        el("tr", { class: /warn|error/i.test(k) ? "warning" : "" }, [el("td", { text: k }), el("td", { text: v })])))])])]));
     return el("table", { class: "stages" }, [el("tr", {}, ["stage", "time", "peak memory", "result"].map((h) => el("th", { text: h })))].concat(rows));
+  }
+  const num = (v) => (typeof v === "number" ? (Number.isInteger(v) ? String(v) : v.toPrecision(4).replace(/\.?0+$/, "")) : JSON.stringify(v));
+  // The results a reader looks for first, picked by field name from every stage's result.
+  const KEY_FACTS = [
+    [/^(lumen_volume_ml|fluid_volume_ml|segments|segment_volumes_ml)$/, "segmentation"],
+    [/^(genus|faces|manifold|closed|components)$/, "surface"],
+    [/^(genus_before|genus_after|totals\.loops|totals\.loop_length_mm)$/, "topology"],
+    [/(coverage|quasi_conformal_(mean|p95)|area_ratio_median|flipped_triangles|segment_count)/, "flat map"],
+    [/^(candidates|score_vs_known\..*)$/, "candidates"]];
+  function keyFacts(stages) {
+    const rows = [];
+    for (const s of stages)
+      for (const [k, v] of Object.entries(flatResult(s.result, ""))) {
+        const hit = KEY_FACTS.find(([re]) => re.test(k));
+        if (hit) rows.push(el("tr", {}, [el("td", { text: hit[1] }), el("td", { text: s.stage + ": " + k.replace(/_/g, " ") }), el("td", { text: num(v) })]));
+      }
+    return el("table", { class: "kv facts-table" }, rows);
+  }
+  function flatResult(obj, prefix) {
+    const out = {};
+    for (const [k, v] of Object.entries(obj || {})) {
+      const name = prefix ? prefix + "." + k : k;
+      if (v && typeof v === "object" && !Array.isArray(v) && name.split(".").length < 3) Object.assign(out, flatResult(v, name));
+      else out[name] = v;
+    }
+    return out;
   }
   function stageWarnings(stages) {
     const out = [];
@@ -342,17 +368,19 @@
     body.appendChild(el("p", { text: "ColonFlat " + (S.version || "") + " on " + (S.input || "?") + ": total " + fix(S.total_time_s, 1) +
       " s, peak memory " + fix(S.peak_memory_mib, 0) + " MiB" + (S.not_run ? "; stages not run: " + S.not_run : "") + "." }));
     if (S.score_vs_known) body.appendChild(el("p", { text: "Detection vs known polyps: " + JSON.stringify(S.score_vs_known) }));
+    body.appendChild(el("h3", { text: "Key results" }));
+    body.appendChild(keyFacts(stages));
     if ((S.segments || []).length) {
       body.appendChild(el("h3", { text: "Segments of the flat map" }));
       const keys = ["id", "input_kind", "length_mm", "period_mm", "area_3d_mm2", "x0_end", "x1_end", "centreline_length_mm"];
       body.appendChild(el("table", { class: "kv" }, S.segments.map((s) => el("tr", {}, [el("td", { text: "segment " + ((s.id || 0) + 1) }),
-        el("td", { text: Object.entries(s).filter(([k, v]) => typeof v !== "object" || keys.includes(k)).map(([k, v]) => k + ": " + (typeof v === "number" ? fix(v, 2) : v)).join(", ") })]))));
+        el("td", { text: Object.entries(s).filter(([k, v]) => typeof v !== "object" || keys.includes(k)).map(([k, v]) => k + ": " + num(v)).join(", ") })]))));
     }
     if ((S.snapshots || []).length) {
       body.appendChild(el("h3", { text: "3D snapshots: surface before and after topological denoising (cut loops highlighted)" }));
       body.appendChild(el("div", { class: "snapshots" }, S.snapshots.map((f) => el("figure", {}, [el("img", { src: f, alt: f }), el("figcaption", { text: f })]))));
     }
-    body.appendChild(el("h3", { text: "Stages: time, memory, results (genus, volumes, coverage, distortion, ...)" }));
+    body.appendChild(el("h3", { text: "Stages: time, peak memory, every result field" }));
     body.appendChild(stageTable(stages));
     const warnings = (S.warnings || []).concat(stageWarnings(stages));
     for (const w of warnings) $("warnings").appendChild(el("p", { class: "warning", text: "Warning: " + w }));
