@@ -54,7 +54,7 @@ synthetic::Colon two_segment_colon(std::vector<synthetic::ColonPolyp>& polyps) {
   synthetic::ColonOptions o;
   o.length = 200;
   o.radius = 16;
-  o.spacing = 0.8;
+  o.spacing = 1.0;
   o.polyps = {{50, 0.3, 9}, {140, 3.0, 10}};
   synthetic::Colon a = synthetic::colon(o);
   o.polyps = {{70, 5.0, 8}, {150, 1.5, 11}};
