@@ -65,8 +65,8 @@
     const axisName = ["L", "P", "S"][stack.fixed_axis];
     const off = stack.positions[best] - lps[stack.fixed_axis];
     view.appendChild(el("span", { class: "lab", text: stack.plane }));
-    view.appendChild(el("span", { class: "sub", text: axisName + " = " + fix(stack.positions[best], 1) + " mm (" +
-      (Math.abs(off) < 0.05 ? "through the point" : fix(Math.abs(off), 1) + " mm from it") + "), FOV " + fov + " mm" }));
+    view.appendChild(el("span", { class: "sub", text: axisName + " " + fix(stack.positions[best], 1) + " mm (" +
+      (Math.abs(off) < 0.05 ? "at the point" : fix(Math.abs(off), 1) + " mm off") + "), FOV " + fov + " mm" }));
     crosshair(view);
     return view;
   }
