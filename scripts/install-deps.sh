@@ -21,6 +21,7 @@ BUILD_PKGS=(
   xvfb xauth             # off-screen rendering where there is no display
   python3                # small test helpers
   snakemake              # cohort processing (workflow/Snakefile) and its ctest test
+  chromium               # tests only: headless browser check of report.html
 )
 # What the installed `colonflat` needs (checked with ldd on the built binary; every other library
 # it loads comes with these packages' dependencies). libgl1-mesa-dri: the software OpenGL driver

@@ -163,6 +163,13 @@ class RunTool : public Tool {
       if (!params_out.empty()) std::ofstream(tx.stage(params_out)) << all_params.dump(2) << "\n";
       tx.commit();
       out << txt.str();
+      // The review report (report module) once the last stage has run: report.html, polyps.mrk.json.
+      // It reads the run folder; the in-memory artifacts are released first.
+      bag = ArtifactBag();
+      if (last + 1 == available.size())
+        for (auto& t : registered_module_tools())
+          if (t->name() == "report")
+            return t->run(quiet ? std::vector<std::string>{outdir, "-q"} : std::vector<std::string>{outdir}, out, err);
       return kExitOk;
     });
   }

@@ -1,0 +1,69 @@
+#pragma once
+// CT views for the report: axial, coronal and sagittal planes through an LPS point, sampled with
+// trilinear interpolation in patient space (any volume direction), shown in radiological
+// convention (patient right on the viewer's left; axial viewed from the feet, anterior up;
+// coronal and sagittal with superior up, sagittal with anterior on the left), windowed to 8-bit
+// grey PNGs.
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+
+enum class Plane { axial, coronal, sagittal };
+const char* plane_name(Plane p);  // "axial", "coronal", "sagittal"
+
+struct CtWindow {
+  std::string name;  // "lung", "soft tissue"
+  double level = 0, width = 1;  // HU
+};
+const CtWindow& lung_window();         // L -200 / W 1500 (CT colonography 2D reading)
+const CtWindow& soft_tissue_window();  // L 40 / W 400
+
+// On-screen axes of a plane: LPS axis index and sign of the screen's right (u) and down (v)
+// directions, and the LPS axis fixed by the plane (its normal).
+struct PlaneAxes {
+  int u_axis, u_sign, v_axis, v_sign, fixed_axis;
+};
+PlaneAxes plane_axes(Plane p);
+
+// HU values of a plane: `w` x `h` pixels of `pixel_mm`, row-major from the top, pixel (0, 0)'s
+// centre at screen coordinates (u0, v0) mm (u = u_sign * LPS[u_axis], ...), at LPS[fixed_axis] =
+// `fixed`. Outside the volume: -2000.
+struct PlaneImage {
+  Plane plane = Plane::axial;
+  int w = 0, h = 0;
+  double pixel_mm = 1, u0 = 0, v0 = 0, fixed = 0;
+  std::vector<float> hu;
+};
+PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
+                        double pixel_mm);
+// A square plane of side `fov_mm` centred on `lps`.
+PlaneImage sample_plane_around(const CtImage* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
+                               int pixels);
+
+// Writes `image` through `window` as an 8-bit grey PNG (atomic).
+void write_windowed_png(const PlaneImage& image, const CtWindow& window, const std::filesystem::path& path);
+
+// Evenly spaced parallel planes through a box (LPS mm), each written as a PNG
+// `<dir>/<prefix><plane>_<n>.png`. The JSON describes them for the page: {plane, u_axis, u_sign,
+// v_axis, v_sign, fixed_axis, u0, v0, pixel_mm, w, h, positions: [mm], files: [relative paths]}.
+struct SliceStackOptions {
+  double step_mm = 5;      // between planes
+  double pixel_mm = 1;     // in-plane pixel size
+  double margin_mm = 25;   // added around the box
+};
+nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::array<double, 3>& box_min,
+                                 const std::array<double, 3>& box_max, const SliceStackOptions& opts,
+                                 const std::filesystem::path& dir, const std::string& rel_prefix);
+
+// The volume's geometry for the page: size, spacing, origin, direction and the 3x3 matrix taking
+// (LPS - origin) to continuous voxel indices.
+nlohmann::json ct_geometry_json(const CtImage* ct);
+
+}  // namespace cf

@@ -1,0 +1,69 @@
+#pragma once
+// The files of a `colonflat run` output folder, loaded for the review report (contract 3):
+// run_report.json, candidates.json (or the older polyps.json), flat.vtp, the CT the run read and,
+// for a phantom, its truth polyps.json. Every piece but run_report.json is optional: what is
+// missing is listed in `warnings` and the report leaves the matching section out.
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/flatten/flatten.h"
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+
+// A polyp candidate of the run or a known (truth) polyp, with where it sits on the flat map.
+struct ReportFinding {
+  std::string key;                        // "P3" (candidate 3) or "K2" (known polyp 2)
+  int id = 0;
+  bool known = false;                     // truth polyp (else a candidate)
+  std::array<double, 3> lps_mm{0, 0, 0};  // LPS mm
+  double size_mm = 0;                     // estimated (candidate) or true (known) diameter
+  double score = -1;                      // candidates: 0..1; known polyps: -1
+  std::string type;                       // known polyps: "sessile", "pedunculated", ...
+  int flat_vertex = -1;                   // nearest flat-map vertex (-1 without a flat map)
+  double surface_distance_mm = 0;         // distance to that vertex (mm)
+};
+
+struct RunLoadOptions {
+  std::filesystem::path ct;     // CT volume; empty: ct.nrrd in the run folder, else the run's input
+  std::filesystem::path truth;  // known polyps JSON; empty: polyps.json beside a phantom CT
+};
+
+struct RunData {
+  std::filesystem::path dir;
+  nlohmann::json run_report = nlohmann::json::object();
+  std::string candidates_file;                 // "candidates.json", "polyps.json" or "" (none)
+  nlohmann::json candidates_doc = nlohmann::json::object();
+  std::vector<ReportFinding> candidates;       // sorted by decreasing score
+  std::vector<ReportFinding> known;            // truth polyps, by id
+  std::optional<FlatMap> flat;
+  std::vector<double> centreline_mm;           // per flat vertex (contract 1); empty when absent
+  nlohmann::json flat_segments = nlohmann::json::array();  // FlatSegments "segments" (as written)
+  CtImage::Pointer ct;                         // null when no CT was found
+  std::filesystem::path ct_path, truth_path;
+  std::vector<std::string> warnings;           // what is missing or inconsistent, for the page
+};
+
+// Loads a run folder. Throws InputError when `dir` is not a run folder (no run_report.json) or a
+// file that is there cannot be read.
+RunData load_run(const std::filesystem::path& dir, const RunLoadOptions& opts = {});
+
+// The candidates of a candidates.json / polyps.json document (render stage format; LPS under
+// "position_lps_mm" or "center_lps_mm"), sorted by decreasing score. Throws InputError.
+std::vector<ReportFinding> candidates_from_json(const nlohmann::json& doc, const std::string& name_for_errors);
+
+// Position along the colon of flat vertex v: mm from the rectal end (or end A), with the label of
+// the end it is measured from ("rectum", "end A", ...).
+struct ColonPosition {
+  int segment = 0;
+  double mm = 0;
+  std::string from;
+};
+ColonPosition colon_position(const RunData& run, int flat_vertex);
+
+}  // namespace cf

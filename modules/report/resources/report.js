@@ -1,0 +1,410 @@
+// ColonFlat review report: builds the page from window.REPORT (embedded JSON). No network access.
+"use strict";
+(function () {
+  const R = window.REPORT || {};
+  const $ = (id) => document.getElementById(id);
+
+  // ---- small helpers ----------------------------------------------------------------------
+  function el(tag, attrs, children) {
+    const e = document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs || {})) {
+      if (k === "text") e.textContent = v;
+      else if (k === "on") for (const [ev, fn] of Object.entries(v)) e.addEventListener(ev, fn);
+      else if (v !== undefined && v !== null) e.setAttribute(k, v);
+    }
+    for (const c of children || []) if (c) e.appendChild(typeof c === "string" ? document.createTextNode(c) : c);
+    return e;
+  }
+  function svg(tag, attrs) {
+    const e = document.createElementNS("http://www.w3.org/2000/svg", tag);
+    for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+    return e;
+  }
+  const fix = (v, d) => (typeof v === "number" ? v.toFixed(d === undefined ? 1 : d) : String(v));
+  const lpsText = (p) => "(" + p.map((v) => fix(v, 1)).join(", ") + ")";
+  const fromText = (f) => (f === "rectum" ? "the rectal end" : f || "end A");
+  const allFindings = () => (R.candidates || []).concat(R.known || []);
+  const findingByKey = (key) => allFindings().find((f) => f.key === key);
+
+  // CT voxel index (continuous) of an LPS point, and the text shown for it.
+  function ctIndex(lps) {
+    if (!R.ct) return null;
+    const d = [0, 1, 2].map((k) => lps[k] - R.ct.origin_lps_mm[k]);
+    return R.ct.lps_to_index.map((row) => row[0] * d[0] + row[1] * d[1] + row[2] * d[2]);
+  }
+  function sliceText(lps) {
+    const idx = ctIndex(lps);
+    if (!idx) return "no CT";
+    const r = idx.map(Math.round), n = R.ct.size;
+    const inside = r.every((v, k) => v >= 0 && v < n[k]);
+    return "voxel (" + r.join(", ") + "), axial image " + (r[2] + 1) + "/" + n[2] + (inside ? "" : " (outside the CT)");
+  }
+  function positionText(f) {
+    if (f.along_mm === undefined) return "not on the flat map";
+    return fix(f.along_mm / 10, 1) + " cm from " + fromText(f.from) + ", segment " + (f.segment + 1);
+  }
+
+  // ---- CT views -------------------------------------------------------------------------
+  function crosshair(view) {
+    view.appendChild(el("div", { class: "xh-h" }));
+    view.appendChild(el("div", { class: "xh-v" }));
+  }
+  // One plane of the pre-rendered stacks around `lps` (field of view `fov` mm), cross-hair at it.
+  function stackView(stack, lps, fov, size) {
+    let best = 0;
+    stack.positions.forEach((p, i) => {
+      if (Math.abs(p - lps[stack.fixed_axis]) < Math.abs(stack.positions[best] - lps[stack.fixed_axis])) best = i;
+    });
+    const col = (stack.u_sign * lps[stack.u_axis] - stack.u0) / stack.pixel_mm + 0.5;
+    const row = (stack.v_sign * lps[stack.v_axis] - stack.v0) / stack.pixel_mm + 0.5;
+    const zoom = size / (fov / stack.pixel_mm);
+    const view = el("div", { class: "ct-view", "data-plane": stack.plane });
+    view.style.backgroundImage = "url('" + stack.files[best] + "')";
+    view.style.backgroundSize = stack.w * zoom + "px " + stack.h * zoom + "px";
+    view.style.backgroundPosition = size / 2 - col * zoom + "px " + (size / 2 - row * zoom) + "px";
+    const axisName = ["L", "P", "S"][stack.fixed_axis];
+    const off = stack.positions[best] - lps[stack.fixed_axis];
+    view.appendChild(el("span", { class: "lab", text: stack.plane }));
+    view.appendChild(el("span", { class: "sub", text: axisName + " " + fix(stack.positions[best], 1) + " mm (" +
+      (Math.abs(off) < 0.05 ? "at the point" : fix(Math.abs(off), 1) + " mm off") + "), FOV " + fov + " mm" }));
+    crosshair(view);
+    return view;
+  }
+  function showCtAt(lps, title) {
+    const box = $("ct-click");
+    box.textContent = "";
+    $("ct-title").textContent = title;
+    if (!R.stacks) {
+      box.appendChild(el("p", { class: "dim", text: "No CT views (the CT volume was not found)." }));
+      return;
+    }
+    for (const plane of ["axial", "coronal", "sagittal"]) if (R.stacks[plane]) box.appendChild(stackView(R.stacks[plane], lps, 80, 240));
+  }
+
+  // ---- colon map viewer ----------------------------------------------------------------------
+  const view = { scale: 1, tx: 0, ty: 0 };
+  function applyView() {
+    $("stage").style.transform = "translate(" + view.tx + "px," + view.ty + "px) scale(" + view.scale + ")";
+  }
+  function fitView() {
+    if (!R.image) return;
+    const v = $("viewer");
+    // the viewer as tall as the image at full width (within 260 px .. 62 % of the window)
+    const tall = R.image.height * (v.clientWidth / R.image.width);
+    v.style.height = Math.round(Math.max(260, Math.min(tall, 0.62 * window.innerHeight))) + "px";
+    view.scale = Math.min(v.clientWidth / R.image.width, v.clientHeight / R.image.height);
+    view.tx = (v.clientWidth - R.image.width * view.scale) / 2;
+    view.ty = (v.clientHeight - R.image.height * view.scale) / 2;
+    applyView();
+  }
+  function zoomAt(factor, cx, cy) {
+    const s = Math.min(8, Math.max(0.02, view.scale * factor));
+    view.tx = cx - (cx - view.tx) * (s / view.scale);
+    view.ty = cy - (cy - view.ty) * (s / view.scale);
+    view.scale = s;
+    applyView();
+  }
+  function centreOn(px, py, scale) {
+    const v = $("viewer");
+    view.scale = scale;
+    view.tx = v.clientWidth / 2 - px * scale;
+    view.ty = v.clientHeight / 2 - py * scale;
+    applyView();
+  }
+  function imagePixel(ev) {
+    const r = $("viewer").getBoundingClientRect();
+    return [(ev.clientX - r.left - view.tx) / view.scale, (ev.clientY - r.top - view.ty) / view.scale];
+  }
+  // The lookup cell under an image pixel: {segment, along_mm, lps} or null (background).
+  function lookup(px, py) {
+    const L = R.lookup;
+    if (!L) return null;
+    const c = Math.floor(px / L.step_px), r = Math.floor(py / L.step_px);
+    if (c < 0 || r < 0 || c >= L.cols || r >= L.rows) return null;
+    const i = 5 * (r * L.cols + c);
+    if (L.cells[i] < 0) return null;
+    const seg = L.cells[i];
+    const segs = (R.summary && R.summary.segments) || [];
+    const from = (segs[seg] && segs[seg].x0_end) || "end A";
+    return { segment: seg, along_mm: L.cells[i + 1] / 10, from: from,
+             lps: [L.cells[i + 2] / 10, L.cells[i + 3] / 10, L.cells[i + 4] / 10] };
+  }
+  function hoverText(hit) {
+    return "segment " + (hit.segment + 1) + " · " + fix(hit.along_mm / 10, 1) + " cm from " + fromText(hit.from) +
+      " · LPS " + lpsText(hit.lps) + " mm · " + sliceText(hit.lps);
+  }
+  function setPin(px, py) {
+    const old = document.querySelector("#marks .pin");
+    if (old) old.remove();
+    $("marks").appendChild(svg("circle", { class: "pin", cx: px, cy: py, r: 6 }));
+  }
+  function drawMarks() {
+    const m = $("marks");
+    m.setAttribute("width", R.image.width);
+    m.setAttribute("height", R.image.height);
+    for (const f of allFindings()) {
+      if (!f.pixel) continue;
+      const cls = f.known ? "known" : "cand";
+      const r = Math.max(9, (f.size_mm || 6) / R.image.pixel_size_mm / 2 + 7);
+      const c = svg("circle", { class: "mark " + cls, cx: f.pixel[0], cy: f.pixel[1], r: r, "data-key": f.key });
+      c.addEventListener("click", (ev) => { ev.stopPropagation(); focusFinding(f.key, false); });
+      c.appendChild(svg("title", {})).textContent = f.key;
+      m.appendChild(c);
+      const t = svg("text", { class: cls + "-label", x: f.pixel[0] + r * 0.8, y: f.pixel[1] + (f.known ? r + 14 : -r * 0.8) });
+      t.textContent = f.key;
+      m.appendChild(t);
+    }
+  }
+  function setUpViewer() {
+    if (!R.image) {
+      $("viewer").replaceWith(el("p", { class: "dim", text: "No colon image in this run." }));
+      return;
+    }
+    const img = $("colon-img");
+    img.src = R.image.file;
+    img.width = R.image.width;
+    img.height = R.image.height;
+    drawMarks();
+    const v = $("viewer");
+    let drag = null;
+    v.addEventListener("wheel", (ev) => {
+      ev.preventDefault();
+      const r = v.getBoundingClientRect();
+      zoomAt(ev.deltaY < 0 ? 1.2 : 1 / 1.2, ev.clientX - r.left, ev.clientY - r.top);
+    }, { passive: false });
+    v.addEventListener("mousedown", (ev) => { drag = { x: ev.clientX, y: ev.clientY, tx: view.tx, ty: view.ty, moved: false }; });
+    window.addEventListener("mouseup", (ev) => {
+      if (drag && !drag.moved && v.contains(ev.target)) clickMap(imagePixel(ev));
+      drag = null;
+    });
+    v.addEventListener("mousemove", (ev) => {
+      if (drag) {
+        const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+        if (Math.abs(dx) + Math.abs(dy) > 3) drag.moved = true;
+        view.tx = drag.tx + dx;
+        view.ty = drag.ty + dy;
+        applyView();
+      }
+      const hit = lookup(...imagePixel(ev));
+      $("readout").textContent = hit ? hoverText(hit) : R.lookup ? "outside the colon wall" : "no position lookup for this image";
+    });
+    $("zoom-fit").onclick = fitView;
+    $("zoom-in").onclick = () => zoomAt(1.5, v.clientWidth / 2, v.clientHeight / 2);
+    $("zoom-out").onclick = () => zoomAt(1 / 1.5, v.clientWidth / 2, v.clientHeight / 2);
+    $("zoom-1").onclick = () => zoomAt(1 / view.scale, v.clientWidth / 2, v.clientHeight / 2);
+    $("show-candidates").onchange = (ev) => $("marks").classList.toggle("hide-cand", !ev.target.checked);
+    $("show-known").onchange = (ev) => $("marks").classList.toggle("hide-known", !ev.target.checked);
+    fitView();
+    window.addEventListener("resize", fitView);
+  }
+  function clickMap(p) {
+    const hit = lookup(p[0], p[1]);
+    if (!hit) return;
+    setPin(p[0], p[1]);
+    showCtAt(hit.lps, "CT at the clicked point: " + hoverText(hit));
+  }
+
+  // Shows a finding: selects its card, centres the map on it (unless keepMap), CT planes there.
+  // scroll: to the card.
+  function focusFinding(key, scroll, keepMap) {
+    const f = findingByKey(key);
+    if (!f) return;
+    document.querySelectorAll(".card.selected").forEach((c) => c.classList.remove("selected"));
+    const card = $("card-" + key);
+    if (card) card.classList.add("selected");
+    if (f.pixel && R.image) {
+      if (!keepMap) centreOn(f.pixel[0], f.pixel[1], Math.max(view.scale, 1.5));
+      setPin(f.pixel[0], f.pixel[1]);
+    }
+    showCtAt(f.lps_mm, "CT at " + key + ": " + positionText(f) + " · LPS " + lpsText(f.lps_mm) + " mm · " + sliceText(f.lps_mm));
+    if (scroll && card) card.scrollIntoView({ block: "start" });
+  }
+  window.colonflatFocus = focusFinding;
+
+  // ---- cards ----------------------------------------------------------------------------------
+  function tile(src, label, cls, extra) {
+    const t = el("div", { class: "tile" }, [src ? el("img", { src: src, alt: label, class: cls || "" }) : null]);
+    for (const e of extra || []) t.appendChild(e);
+    t.appendChild(el("span", { class: "lab", text: label }));
+    return t;
+  }
+  function ctTiles(f) {
+    const box = el("div", { class: "ct-views" });
+    for (const plane of ["axial", "coronal", "sagittal"]) {
+      const p = f.ct[plane];
+      const t = el("div", { class: "tile ct-tile", "data-plane": plane }, [
+        el("img", { src: p.lung, alt: plane + " lung window", class: "lung" }),
+        el("img", { src: p.soft, alt: plane + " soft-tissue window", class: "soft" })]);
+      crosshair(t);
+      t.appendChild(el("span", { class: "lab", text: plane + " · FOV " + fix(f.fov_mm, 0) + " mm" }));
+      box.appendChild(t);
+    }
+    return box;
+  }
+  function windowButtons(card) {
+    const lung = el("button", { type: "button", class: "active", text: "lung window (L -200 / W 1500)" });
+    const soft = el("button", { type: "button", text: "soft tissue (L 40 / W 400)" });
+    lung.onclick = () => { card.classList.remove("window-soft"); lung.classList.add("active"); soft.classList.remove("active"); };
+    soft.onclick = () => { card.classList.add("window-soft"); soft.classList.add("active"); lung.classList.remove("active"); };
+    return el("div", { class: "window-buttons" }, [lung, " ", soft]);
+  }
+  function matchBadge(f) {
+    if (f.known) return f.match ? el("span", { class: "badge hit", text: "detected as " + f.match.key + ", " + fix(f.match.distance_mm) + " mm away" })
+                                : el("span", { class: "badge miss", text: "not detected" });
+    if (!(R.known || []).length) return null;
+    return f.match ? el("span", { class: "badge hit", text: "true positive: " + f.match.key + ", " + fix(f.match.distance_mm) + " mm away" })
+                   : el("span", { class: "badge miss", text: "no known polyp within reach: false positive" });
+  }
+  function factsTable(f) {
+    const rows = [["position", positionText(f)], ["LPS", lpsText(f.lps_mm) + " mm"], ["CT", sliceText(f.lps_mm)]];
+    if (f.surface_distance_mm !== undefined) rows.push(["to the wall mesh", fix(f.surface_distance_mm) + " mm"]);
+    if (f.type) rows.push(["type", f.type]);
+    if (f.endoluminal_distance_mm !== undefined) rows.push(["3D view from", fix(f.endoluminal_distance_mm) + " mm inside the lumen"]);
+    return el("table", { class: "facts" }, rows.map(([k, v]) => el("tr", {}, [el("td", { text: k }), el("td", { text: v })])));
+  }
+  function card(f) {
+    const head = el("div", { class: "card-head" }, [
+      el("span", { class: "key", text: f.key }),
+      el("span", { text: fix(f.size_mm) + " mm" }),
+      f.known ? null : el("span", { text: "score " + fix(f.score, 2) }),
+      matchBadge(f),
+      el("button", { type: "button", text: "show on map and CT", on: { click: () => focusFinding(f.key, false) } })]);
+    const c = el("div", { class: "card " + (f.known ? "known" : "candidate"), id: "card-" + f.key, "data-key": f.key }, [head]);
+    const body = el("div", { class: "card-body" }, [factsTable(f)]);
+    if (f.flat_thumbnail) {
+      const ring = el("div", { class: "ring" });
+      const d = Math.max(10, (f.size_mm || 6) / R.image.pixel_size_mm * (180 / 200) + 8);
+      ring.style.width = ring.style.height = d + "px";
+      body.appendChild(tile(f.flat_thumbnail, "colon map", "", [ring]));
+    }
+    if (f.ct) body.appendChild(el("div", {}, [ctTiles(f), windowButtons(c)]));
+    if (f.endoluminal) {
+      const t = tile(f.endoluminal, "endoluminal 3D", "endo");
+      crosshair(t);
+      body.appendChild(t);
+    }
+    c.appendChild(body);
+    return c;
+  }
+  function indexTable(list, known) {
+    if (!list.length) return el("p", { class: "dim", text: known ? "No known polyps for this run." : "No polyp candidates." });
+    const head = known ? ["id", "diameter", "type", "position", "detected as"] : ["id", "size", "score", "position", "truth"];
+    const rows = list.map((f) => {
+      const cells = known ? [f.key, fix(f.size_mm) + " mm", f.type || "", positionText(f), f.match ? f.match.key : "missed"]
+                          : [f.key, fix(f.size_mm) + " mm", fix(f.score, 2), positionText(f), f.match ? f.match.key : (R.known || []).length ? "false positive" : ""];
+      const tr = el("tr", { class: "clickable", title: "show " + f.key }, cells.map((v) => el("td", { text: v })));
+      tr.addEventListener("click", () => focusFinding(f.key, true));
+      return tr;
+    });
+    return el("table", {}, [el("tr", {}, head.map((h) => el("th", { text: h })))].concat(rows));
+  }
+  function buildCards() {
+    const cands = R.candidates || [], known = R.known || [];
+    $("candidate-index").appendChild(indexTable(cands, false));
+    for (const f of cands) $("candidate-list").appendChild(card(f));
+    if (!known.length) {
+      $("known-index").appendChild(el("p", { class: "dim", text: "No known polyps (truth) for this run: pass --truth FILE to `colonflat report`." }));
+      return;
+    }
+    $("known-index").appendChild(indexTable(known, true));
+    for (const f of known) $("known-list").appendChild(card(f));
+  }
+
+  // ---- run summary ------------------------------------------------------------------------------
+  // A stage's result as "key: value" lines (nested objects flattened one level, long arrays cut).
+  function resultLines(result, prefix, out) {
+    for (const [k, v] of Object.entries(result || {})) {
+      const name = prefix ? prefix + "." + k : k;
+      if (v && typeof v === "object" && !Array.isArray(v) && !prefix) resultLines(v, name, out);
+      else {
+        let s = JSON.stringify(v);
+        if (s.length > 160) s = s.slice(0, 157) + "...";
+        out.push([name, s]);
+      }
+    }
+    return out;
+  }
+  function stageTable(stages) {
+    const rows = stages.map((s) => el("tr", {}, [
+      el("td", { text: s.stage }), el("td", { text: fix(s.time_s, 2) + " s" }), el("td", { text: fix(s.peak_memory_mib, 0) + " MiB" }),
+      el("td", {}, [el("details", {}, [el("summary", { text: "all result fields" }), el("table", { class: "kv" }, resultLines(s.result, "", []).map(([k, v]) =>
+        el("tr", { class: /warn|error/i.test(k) ? "warning" : "" }, [el("td", { text: k }), el("td", { text: v })])))])])]));
+    return el("table", { class: "stages" }, [el("tr", {}, ["stage", "time", "peak memory", "result"].map((h) => el("th", { text: h })))].concat(rows));
+  }
+  const num = (v) => (typeof v === "number" ? (Number.isInteger(v) ? String(v) : v.toPrecision(4).replace(/\.?0+$/, "")) : JSON.stringify(v));
+  // The results a reader looks for first, picked by field name from every stage's result.
+  const KEY_FACTS = [
+    [/^(lumen_volume_ml|fluid_volume_ml|segments|segment_volumes_ml)$/, "segmentation"],
+    [/^(genus|faces|manifold|closed|components)$/, "surface"],
+    [/^(genus_before|genus_after|totals\.loops|totals\.loop_length_mm)$/, "topology"],
+    [/(coverage|quasi_conformal_(mean|p95)|area_ratio_median|flipped_triangles|segment_count)/, "flat map"],
+    [/^(candidates|score_vs_known\..*)$/, "candidates"]];
+  function keyFacts(stages) {
+    const rows = [];
+    for (const s of stages)
+      for (const [k, v] of Object.entries(flatResult(s.result, ""))) {
+        const hit = KEY_FACTS.find(([re]) => re.test(k));
+        if (hit) rows.push(el("tr", {}, [el("td", { text: hit[1] }), el("td", { text: s.stage + ": " + k.replace(/_/g, " ") }), el("td", { text: num(v) })]));
+      }
+    return el("table", { class: "kv facts-table" }, rows);
+  }
+  function flatResult(obj, prefix) {
+    const out = {};
+    for (const [k, v] of Object.entries(obj || {})) {
+      const name = prefix ? prefix + "." + k : k;
+      if (v && typeof v === "object" && !Array.isArray(v) && name.split(".").length < 3) Object.assign(out, flatResult(v, name));
+      else out[name] = v;
+    }
+    return out;
+  }
+  function stageWarnings(stages) {
+    const out = [];
+    for (const s of stages) for (const [k, v] of resultLines(s.result, "", [])) if (/warn|error/i.test(k)) out.push(s.stage + ": " + k + " = " + v);
+    return out;
+  }
+  function buildSummary() {
+    const S = R.summary || {}, stages = S.stages || [];
+    const body = $("summary-body");
+    body.appendChild(el("p", { text: "ColonFlat " + (S.version || "") + " on " + (S.input || "?") + ": total " + fix(S.total_time_s, 1) +
+      " s, peak memory " + fix(S.peak_memory_mib, 0) + " MiB" + (S.not_run ? "; stages not run: " + S.not_run : "") + "." }));
+    if (S.score_vs_known) body.appendChild(el("p", { text: "Detection vs known polyps: " + JSON.stringify(S.score_vs_known) }));
+    body.appendChild(el("h3", { text: "Key results" }));
+    body.appendChild(keyFacts(stages));
+    if ((S.segments || []).length) {
+      body.appendChild(el("h3", { text: "Segments of the flat map" }));
+      const keys = ["id", "input_kind", "length_mm", "period_mm", "area_3d_mm2", "x0_end", "x1_end", "centreline_length_mm"];
+      body.appendChild(el("table", { class: "kv" }, S.segments.map((s) => el("tr", {}, [el("td", { text: "segment " + ((s.id || 0) + 1) }),
+        el("td", { text: Object.entries(s).filter(([k, v]) => typeof v !== "object" || keys.includes(k)).map(([k, v]) => k + ": " + num(v)).join(", ") })]))));
+    }
+    if ((S.snapshots || []).length) {
+      body.appendChild(el("h3", { text: "3D snapshots: surface before and after topological denoising (cut loops highlighted)" }));
+      body.appendChild(el("div", { class: "snapshots" }, S.snapshots.map((f) => el("figure", {}, [el("img", { src: f, alt: f }), el("figcaption", { text: f })]))));
+    }
+    body.appendChild(el("h3", { text: "Stages: time, peak memory, every result field" }));
+    body.appendChild(stageTable(stages));
+    const warnings = (S.warnings || []).concat(stageWarnings(stages));
+    for (const w of warnings) $("warnings").appendChild(el("p", { class: "warning", text: "Warning: " + w }));
+  }
+  function buildFiles() {
+    const body = $("files-body");
+    body.appendChild(el("p", { text: "Drag these files onto 3D Slicer (LPS millimetres throughout); see docs/slicer.md." }));
+    body.appendChild(el("table", {}, (R.files || []).map((f) => el("tr", {}, [
+      el("td", {}, [el("a", { href: f.file, text: f.file })]), el("td", { text: f.what })]))));
+  }
+
+  // ---- start --------------------------------------------------------------------------------------
+  function start() {
+    $("subtitle").textContent = "run " + (R.run_dir || "") + " · " + (R.candidates || []).length + " candidates" +
+      ((R.known || []).length ? " · " + R.known.length + " known polyps" : "") + " · LPS mm · ColonFlat " + (R.version || "");
+    $("footer").textContent = "Generated by colonflat report " + (R.version || "") + " from " + (R.candidates_file || "no candidates file") + ". Static page: no network access.";
+    buildSummary();
+    setUpViewer();
+    buildCards();
+    buildFiles();
+    const first = (R.candidates || [])[0] || (R.known || [])[0];
+    if (first) focusFinding(first.key, false, true);
+    else $("ct-title").textContent = "CT: click the map";
+    document.body.setAttribute("data-ready", "1");
+  }
+  start();
+})();

@@ -1,0 +1,158 @@
+#include "colonflat/report/ct_views.h"
+
+#include <itkLinearInterpolateImageFunction.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "colonflat/core/atomic_file.h"
+#include "colonflat/core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+
+const char* plane_name(Plane p) {
+  switch (p) {
+    case Plane::axial: return "axial";
+    case Plane::coronal: return "coronal";
+    default: return "sagittal";
+  }
+}
+
+const CtWindow& lung_window() {
+  static const CtWindow w{"lung", -200, 1500};
+  return w;
+}
+
+const CtWindow& soft_tissue_window() {
+  static const CtWindow w{"soft tissue", 40, 400};
+  return w;
+}
+
+PlaneAxes plane_axes(Plane p) {
+  // LPS: +x left, +y posterior, +z superior. Screen right = patient left (+x) or posterior (+y,
+  // sagittal); screen down = posterior (+y, axial) or inferior (-z).
+  switch (p) {
+    case Plane::axial: return {0, +1, 1, +1, 2};
+    case Plane::coronal: return {0, +1, 2, -1, 1};
+    default: return {1, +1, 2, -1, 0};
+  }
+}
+
+PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
+                        double pixel_mm) {
+  if (!ct) throw Error("sample_plane: no CT volume");
+  PlaneImage out;
+  out.plane = plane;
+  out.w = w, out.h = h, out.pixel_mm = pixel_mm, out.u0 = u0, out.v0 = v0, out.fixed = fixed;
+  out.hu.assign(std::size_t(w) * h, -2000.0f);
+  using Interp = itk::LinearInterpolateImageFunction<CtImage, double>;
+  auto interp = Interp::New();
+  interp->SetInputImage(ct);
+  const PlaneAxes a = plane_axes(plane);
+  // The index is affine in the pixel: per row, the start index and a per-column step.
+  const auto index_of = [&](int r, int c) {
+    Interp::PointType p;
+    p[a.fixed_axis] = fixed;
+    p[a.v_axis] = a.v_sign * (v0 + r * pixel_mm);
+    p[a.u_axis] = a.u_sign * (u0 + c * pixel_mm);
+    Interp::ContinuousIndexType idx;
+    ct->TransformPhysicalPointToContinuousIndex(p, idx);
+    return idx;
+  };
+  for (int r = 0; r < h; ++r) {
+    const auto start = index_of(r, 0), next = index_of(r, 1);
+    Interp::ContinuousIndexType idx;
+    for (int c = 0; c < w; ++c) {
+      for (int k = 0; k < 3; ++k) idx[k] = start[k] + c * (next[k] - start[k]);
+      if (interp->IsInsideBuffer(idx)) out.hu[std::size_t(r) * w + c] = float(interp->EvaluateAtContinuousIndex(idx));
+    }
+  }
+  return out;
+}
+
+PlaneImage sample_plane_around(const CtImage* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
+                               int pixels) {
+  const PlaneAxes a = plane_axes(plane);
+  const double pix = fov_mm / pixels;
+  const double u_c = a.u_sign * lps[a.u_axis], v_c = a.v_sign * lps[a.v_axis];
+  // pixel centres symmetric about the point: its position is the image centre
+  const double u0 = u_c - 0.5 * (pixels - 1) * pix, v0 = v_c - 0.5 * (pixels - 1) * pix;
+  return sample_plane(ct, plane, lps[a.fixed_axis], u0, v0, pixels, pixels, pix);
+}
+
+void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
+  vtkNew<vtkImageData> img;
+  img->SetDimensions(im.w, im.h, 1);
+  img->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* px = static_cast<unsigned char*>(img->GetScalarPointer());
+  const double lo = win.level - 0.5 * win.width;
+  for (int r = 0; r < im.h; ++r)
+    for (int c = 0; c < im.w; ++c) {
+      const double v = (im.hu[std::size_t(r) * im.w + c] - lo) / win.width;
+      // VTK rows count from the bottom
+      px[std::size_t(im.h - 1 - r) * im.w + c] = static_cast<unsigned char>(std::lround(255 * std::clamp(v, 0.0, 1.0)));
+    }
+  write_atomically(path, [&](const fs::path& tmp) {
+    vtkNew<vtkPNGWriter> writer;
+    writer->SetInputData(img);
+    writer->SetFileName(tmp.c_str());
+    writer->SetCompressionLevel(1);  // fast; these images are small
+    writer->Write();
+    if (writer->GetErrorCode() != 0) throw Error(path.string() + ": cannot write PNG");
+  });
+}
+
+nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::array<double, 3>& box_min,
+                                 const std::array<double, 3>& box_max, const SliceStackOptions& o,
+                                 const fs::path& dir, const std::string& rel_prefix) {
+  const PlaneAxes a = plane_axes(plane);
+  auto screen_range = [&](int axis, int sign) {
+    const double lo = sign * box_min[axis], hi = sign * box_max[axis];
+    return std::array<double, 2>{std::min(lo, hi) - o.margin_mm, std::max(lo, hi) + o.margin_mm};
+  };
+  const auto ur = screen_range(a.u_axis, a.u_sign), vr = screen_range(a.v_axis, a.v_sign);
+  const int w = std::max(1, int(std::ceil((ur[1] - ur[0]) / o.pixel_mm)));
+  const int h = std::max(1, int(std::ceil((vr[1] - vr[0]) / o.pixel_mm)));
+  const double f0 = box_min[a.fixed_axis], f1 = box_max[a.fixed_axis];
+  const int n = std::max(1, int(std::floor((f1 - f0) / o.step_mm)) + 1);
+  nlohmann::json j = {{"plane", plane_name(plane)}, {"u_axis", a.u_axis}, {"u_sign", a.u_sign},
+                      {"v_axis", a.v_axis}, {"v_sign", a.v_sign}, {"fixed_axis", a.fixed_axis},
+                      {"u0", ur[0]}, {"v0", vr[0]}, {"pixel_mm", o.pixel_mm}, {"w", w}, {"h", h},
+                      {"positions", nlohmann::json::array()}, {"files", nlohmann::json::array()}};
+  for (int i = 0; i < n; ++i) {
+    const double fixed = f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm;
+    const PlaneImage im = sample_plane(ct, plane, fixed, ur[0], vr[0], w, h, o.pixel_mm);
+    const std::string name = std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png";
+    write_windowed_png(im, lung_window(), dir / name);
+    j["positions"].push_back(std::round(fixed * 100) / 100);
+    j["files"].push_back(rel_prefix + name);
+  }
+  return j;
+}
+
+nlohmann::json ct_geometry_json(const CtImage* ct) {
+  const auto region = ct->GetLargestPossibleRegion();
+  const auto sp = ct->GetSpacing();
+  const auto org = ct->GetOrigin();
+  const auto dir = ct->GetDirection();
+  const auto inv = ct->GetInverseDirection();
+  nlohmann::json to_index = nlohmann::json::array(), direction = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    nlohmann::json row = nlohmann::json::array(), drow = nlohmann::json::array();
+    for (int c = 0; c < 3; ++c) row.push_back(inv[r][c] / sp[r]), drow.push_back(dir[r][c]);
+    to_index.push_back(row);
+    direction.push_back(drow);
+  }
+  return {{"size", {region.GetSize()[0], region.GetSize()[1], region.GetSize()[2]}},
+          {"spacing_mm", {sp[0], sp[1], sp[2]}},
+          {"origin_lps_mm", {org[0], org[1], org[2]}},
+          {"direction", direction},
+          {"lps_to_index", to_index}};
+}
+
+}  // namespace cf

@@ -1,0 +1,248 @@
+#include "colonflat/report/report.h"
+
+#include <vtkImageData.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <limits>
+#include <optional>
+
+#include "colonflat/core/atomic_file.h"
+#include "colonflat/core/error.h"
+#include "colonflat/core/run_stats.h"
+#include "colonflat/core/tool.h"
+#include "colonflat/report/ct_views.h"
+#include "colonflat/report/report_data.h"
+#include "colonflat/report/resources.h"
+#include "colonflat/report/slicer_markups.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+namespace {
+
+// A folder that is removed unless release()d.
+class TempFolder {
+ public:
+  explicit TempFolder(fs::path p) : path_(std::move(p)) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempFolder() {
+    std::error_code ec;
+    if (!released_) fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  void release() { released_ = true; }
+
+ private:
+  fs::path path_;
+  bool released_ = false;
+};
+
+struct Builder {
+  Builder(const ReportOptions& o, std::ostream* l, RunData r) : opts(o), log(l), run(std::move(r)) {}
+  const ReportOptions& opts;
+  std::ostream* log;
+  RunData run;
+  fs::path files_dir;
+  nlohmann::json data = nlohmann::json::object();
+  std::optional<ColonImageLayout> layout;
+  ImagePtr colon;
+  ReportResult result;
+
+  void progress(const std::string& line) const {
+    if (log) *log << "report: " << line << "\n";
+  }
+
+  // colon.png, its layout check and the hover/click lookup grid.
+  void add_image() {
+    const fs::path png = run.dir / "colon.png";
+    if (!run.flat || !fs::exists(png)) {
+      if (!fs::exists(png)) run.warnings.push_back("no colon.png in the run folder: no colon image");
+      return;
+    }
+    colon = read_png(png);
+    int dims[3];
+    colon->GetDimensions(dims);
+    layout.emplace(*run.flat, colon_image_pixel_size(run), std::numeric_limits<int>::max());
+    const nlohmann::json cands = run.candidates_doc.value("candidates", nlohmann::json::array());
+    layout->set_rolls_from_candidates(cands);
+    const std::string problem = layout->check(dims[0], dims[1], cands);
+    data["image"] = {{"file", "colon.png"}, {"width", dims[0]}, {"height", dims[1]},
+                     {"pixel_size_mm", layout->pixel_size()}};
+    if (!problem.empty()) {
+      run.warnings.push_back("colon image layout does not match the flat map (" + problem +
+                             "): hover read-out and click-to-CT on the image are off");
+      layout.reset();
+      return;
+    }
+    data["lookup"] = lookup_json(run, build_lookup_grid(*run.flat, *layout, opts.lookup_step_px));
+  }
+
+  // The CT geometry and the stacks of planes a click on the map shows.
+  void add_ct() {
+    if (!run.ct) return;
+    data["ct"] = ct_geometry_json(run.ct);
+    data["ct"]["file"] = run.ct_path.string();
+    std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    const auto grow = [&](const std::array<double, 3>& p) {
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    };
+    if (run.flat) for (const auto& p : run.flat->position) grow(p);
+    for (const auto& f : run.candidates) grow(f.lps_mm);
+    for (const auto& f : run.known) grow(f.lps_mm);
+    if (lo[0] > hi[0]) return;  // nothing to show the CT around
+    SliceStackOptions so;
+    so.step_mm = opts.stack_step_mm;
+    so.pixel_mm = opts.stack_pixel_mm;
+    for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) {
+      data["stacks"][plane_name(p)] = write_slice_stack(run.ct, p, lo, hi, so, files_dir, "report_files/");
+      result.images += int(data["stacks"][plane_name(p)]["files"].size());
+    }
+  }
+
+  std::unique_ptr<EndoluminalRenderer> make_endoluminal() {
+    if (!opts.endoluminal || !run.flat) return nullptr;
+    try {
+      std::vector<int> flat_to_3d;
+      const TriangleList surface = flat_to_surface(*run.flat, &flat_to_3d);
+      std::vector<std::array<double, 3>> normals(surface.points.size());
+      for (std::size_t i = 0; i < flat_to_3d.size(); ++i) normals[flat_to_3d[i]] = run.flat->normal[i];
+      EndoluminalOptions eo;
+      eo.size = opts.endoluminal_pixels;
+      return std::make_unique<EndoluminalRenderer>(surface, normals, eo);
+    } catch (const Error& e) {
+      run.warnings.push_back(std::string("no endoluminal views: ") + e.what());
+      return nullptr;
+    }
+  }
+
+  void add_findings() {
+    auto endo = make_endoluminal();
+    for (const bool known : {false, true}) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const ReportFinding& f : known ? run.known : run.candidates) {
+        nlohmann::json fj = finding_json(run, f, layout ? &*layout : nullptr);
+        result.images += write_finding_images(run, f, opts, files_dir, colon, endo.get(), fj);
+        if (fj.contains("endoluminal")) ++result.endoluminal_views;
+        list.push_back(fj);
+      }
+      data[known ? "known" : "candidates"] = list;
+    }
+    result.candidates = int(run.candidates.size());
+    result.known_polyps = int(run.known.size());
+  }
+
+  void add_files() {
+    nlohmann::json files = nlohmann::json::array();
+    const auto add = [&](const std::string& name, const std::string& what) {
+      files.push_back({{"file", name}, {"what", what}});
+    };
+    add("polyps.mrk.json", "polyp candidates: 3D Slicer point list (LPS, mm)");
+    if (!run.known.empty()) add("known_polyps.mrk.json", "known (truth) polyps: 3D Slicer point list (LPS, mm)");
+    const std::pair<const char*, const char*> outputs[] = {
+        {"lumen_mask.nrrd", "lumen mask: labelmap (0 outside, 1 lumen), load as segmentation"},
+        {"surface.vtp", "reconstructed colon wall (LPS mm)"},
+        {"denoised.vtp", "colon wall after topological denoising (LPS mm)"},
+        {"loops.vtp", "cut handle/tunnel loops (polylines, LPS mm)"},
+        {"flat.vtp", "flat map (x, y mm; point data position_lps_mm)"},
+        {"candidates.json", "candidates (JSON)"},
+        {"polyps.json", "candidates (JSON, older name)"},
+        {"ct.nrrd", "CT volume (HU)"}};
+    for (const auto& [name, what] : outputs)
+      if (fs::exists(run.dir / name)) add(name, what);
+    if (!run.ct_path.empty() && !fs::exists(run.dir / "ct.nrrd")) add(run.ct_path.string(), "CT volume the run read (HU)");
+    data["files"] = files;
+  }
+};
+
+std::string replace_once(std::string text, const std::string& marker, const std::string& with) {
+  const auto at = text.find(marker);
+  if (at == std::string::npos) throw Error("report template has no " + marker);
+  return text.replace(at, marker.size(), with);
+}
+
+std::string page_html(const nlohmann::json& data) {
+  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
+  std::string html = replace_once(report_resources::kHtml, "/*@CSS@*/", report_resources::kCss);
+  html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
+  return replace_once(html, "/*@JS@*/", report_resources::kJs);
+}
+
+std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
+  std::vector<MarkupPoint> points;
+  for (const auto& f : list) {
+    MarkupPoint p;
+    p.label = f["key"].get<std::string>();
+    p.lps_mm = f["lps_mm"].get<std::array<double, 3>>();
+    std::ostringstream d;
+    d << std::fixed << std::setprecision(1) << f["size_mm"].get<double>() << " mm";
+    if (f.contains("score")) d << std::setprecision(2) << ", score " << f["score"].get<double>();
+    if (f.contains("type")) d << ", " << f["type"].get<std::string>();
+    if (f.contains("along_mm"))
+      d << std::setprecision(1) << ", " << f["along_mm"].get<double>() / 10 << " cm from " << f["from"].get<std::string>()
+        << " (segment " << f["segment"].get<int>() + 1 << ")";
+    if (!f["match"].is_null()) d << ", matches " << f["match"]["key"].get<std::string>();
+    p.description = d.str();
+    points.push_back(p);
+  }
+  return points;
+}
+
+}  // namespace
+
+ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& opts, std::ostream* log) {
+  Stopwatch clock, phase;
+  std::vector<std::pair<std::string, double>> phases;
+  std::clock_t cpu = std::clock();
+  const auto lap = [&](const char* name) {
+    phases.emplace_back(name, phase.seconds());
+    phases.emplace_back(std::string(name) + "_cpu", double(std::clock() - cpu) / CLOCKS_PER_SEC);
+    phase.restart();
+    cpu = std::clock();
+  };
+  Builder b(opts, log, load_run(run_dir, {opts.ct, opts.truth}));
+  lap("load");
+  TempFolder files(run_dir / (".report_files.tmp-" + std::to_string(::getpid())));
+  b.files_dir = files.path();
+  b.data["title"] = "ColonFlat review report";
+  b.data["version"] = colonflat_version();
+  b.data["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
+  b.data["candidates_file"] = b.run.candidates_file;
+  b.add_image();
+  lap("image");
+  b.add_ct();
+  lap("ct");
+  b.progress("CT planes written");
+  b.add_findings();
+  lap("cards");
+  b.progress(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
+             " known-polyp cards");
+  b.add_files();
+  b.data["summary"] = summary_json(b.run);
+  OutputTransaction tx;
+  std::ofstream(tx.stage(run_dir / "report.html")) << page_html(b.data);
+  std::ofstream(tx.stage(run_dir / "polyps.mrk.json"))
+      << slicer_point_list("ColonFlat candidates", markup_points(b.data["candidates"]), {1.0, 0.85, 0.0}).dump(2) << "\n";
+  if (!b.run.known.empty())
+    std::ofstream(tx.stage(run_dir / "known_polyps.mrk.json"))
+        << slicer_point_list("Known polyps", markup_points(b.data["known"]), {0.25, 0.9, 0.4}).dump(2) << "\n";
+  fs::remove_all(run_dir / "report_files");
+  fs::rename(files.path(), run_dir / "report_files");
+  files.release();
+  tx.commit();
+  lap("page");
+  b.result.phases = phases;
+  b.result.warnings = b.run.warnings;
+  b.result.seconds = clock.seconds();
+  return b.result;
+}
+
+}  // namespace cf

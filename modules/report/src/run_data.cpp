@@ -1,0 +1,180 @@
+#include "colonflat/report/run_data.h"
+
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/stage.h"
+#include "colonflat/core/vtk_messages.h"
+#include "colonflat/flatten/flat_artifact.h"
+#include "colonflat/render/polyps.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+namespace {
+
+std::array<double, 3> lps_of(const nlohmann::json& c, const std::string& name) {
+  for (const char* key : {"position_lps_mm", "center_lps_mm"})
+    if (c.contains(key) && c[key].is_array() && c[key].size() == 3)
+      return {c[key][0].get<double>(), c[key][1].get<double>(), c[key][2].get<double>()};
+  throw InputError(name, "a candidate has no position_lps_mm [L, P, S]");
+}
+
+// flat.vtp with the optional contract-1 extras (centreline_mm, FlatSegments as written).
+void load_flat(RunData& run, const fs::path& path) {
+  VtkMessageCapture msgs;
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (!msgs.first_problem().empty() || reader->GetErrorCode() != 0)
+    throw InputError(path.string(), "cannot read VTK XML PolyData: " + msgs.first_problem());
+  vtkPolyData* pd = reader->GetOutput();
+  run.flat = polydata_to_flat(pd, path.string());
+  if (vtkDataArray* cl = pd->GetPointData()->GetArray("centreline_mm")) {
+    run.centreline_mm.resize(cl->GetNumberOfTuples());
+    for (vtkIdType i = 0; i < cl->GetNumberOfTuples(); ++i) run.centreline_mm[i] = cl->GetTuple1(i);
+  }
+  if (auto* js = vtkStringArray::SafeDownCast(pd->GetFieldData()->GetAbstractArray("FlatSegments"))) {
+    const auto j = nlohmann::json::parse(js->GetValue(0), nullptr, false);
+    if (!j.is_discarded() && j.contains("segments")) run.flat_segments = j["segments"];
+  }
+}
+
+void attach_to_flat(const FlatMap& flat, std::vector<ReportFinding>& findings) {
+  for (auto& f : findings) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < flat.position.size(); ++i) {
+      const auto& p = flat.position[i];
+      const double d = (p[0] - f.lps_mm[0]) * (p[0] - f.lps_mm[0]) + (p[1] - f.lps_mm[1]) * (p[1] - f.lps_mm[1]) +
+                       (p[2] - f.lps_mm[2]) * (p[2] - f.lps_mm[2]);
+      if (d < best) best = d, f.flat_vertex = int(i);
+    }
+    f.surface_distance_mm = std::sqrt(best);
+  }
+}
+
+fs::path find_ct(const RunData& run, const RunLoadOptions& opts) {
+  if (!opts.ct.empty()) {
+    if (!fs::exists(opts.ct)) throw InputError(opts.ct.string(), "no such file");
+    return opts.ct;
+  }
+  if (fs::exists(run.dir / "ct.nrrd")) return run.dir / "ct.nrrd";
+  const std::string input = run.run_report.value("input", std::string());
+  if (input.empty()) return {};
+  for (const fs::path& p : {fs::path(input), run.dir / input, run.dir / "phantom" / fs::path(input).filename()})
+    if (fs::exists(p) && looks_like_volume(p)) return p;
+  return {};
+}
+
+fs::path find_truth(const RunData& run, const RunLoadOptions& opts) {
+  if (!opts.truth.empty()) {
+    if (!fs::exists(opts.truth)) throw InputError(opts.truth.string(), "no such file");
+    return opts.truth;
+  }
+  if (run.ct_path.empty()) return {};
+  const fs::path folder = fs::is_directory(run.ct_path) ? run.ct_path : run.ct_path.parent_path();
+  if (fs::exists(folder / "phantom.json") && fs::exists(folder / "polyps.json")) return folder / "polyps.json";
+  return {};
+}
+
+void load_candidates(RunData& run) {
+  for (const char* name : {"candidates.json", "polyps.json"}) {
+    if (!fs::exists(run.dir / name)) continue;
+    run.candidates_file = name;
+    run.candidates_doc = read_json_file(run.dir / name);
+    run.candidates = candidates_from_json(run.candidates_doc, (run.dir / name).string());
+    return;
+  }
+  run.warnings.push_back("no candidates.json (nor polyps.json) in the run folder: no candidate cards");
+}
+
+void load_truth(RunData& run, const RunLoadOptions& opts) {
+  run.truth_path = find_truth(run, opts);
+  if (run.truth_path.empty()) return;
+  for (const KnownPolyp& k : read_known_polyps(run.truth_path)) {
+    ReportFinding f;
+    f.id = k.id;
+    f.key = "K" + std::to_string(k.id);
+    f.known = true;
+    f.lps_mm = k.center_lps_mm;
+    f.size_mm = k.diameter_mm;
+    f.type = k.type;
+    run.known.push_back(f);
+  }
+}
+
+}  // namespace
+
+std::vector<ReportFinding> candidates_from_json(const nlohmann::json& doc, const std::string& name) {
+  const nlohmann::json* list = &doc;
+  if (doc.is_object()) {
+    if (!doc.contains("candidates") || !doc["candidates"].is_array())
+      throw InputError(name, "no \"candidates\" list");
+    list = &doc["candidates"];
+  } else if (!doc.is_array()) {
+    throw InputError(name, "expected a JSON object with a \"candidates\" list");
+  }
+  std::vector<ReportFinding> out;
+  for (const auto& c : *list) {
+    if (!c.is_object()) throw InputError(name, "a candidate is not a JSON object");
+    ReportFinding f;
+    f.id = c.value("id", int(out.size()) + 1);
+    f.key = "P" + std::to_string(f.id);
+    f.lps_mm = lps_of(c, name);
+    f.size_mm = c.value("size_mm", 0.0);
+    f.score = c.value("score", 0.0);
+    out.push_back(f);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });
+  return out;
+}
+
+RunData load_run(const fs::path& dir, const RunLoadOptions& opts) {
+  RunData run;
+  run.dir = dir;
+  if (!fs::is_directory(dir)) throw InputError(dir.string(), "no such run folder");
+  if (!fs::exists(dir / "run_report.json"))
+    throw InputError(dir.string(), "not a run folder (no run_report.json; write one with `colonflat run -o DIR`)");
+  run.run_report = read_json_file(dir / "run_report.json");
+  if (!run.run_report.is_object()) throw InputError((dir / "run_report.json").string(), "not a JSON object");
+  load_candidates(run);
+  if (fs::exists(dir / "flat.vtp")) load_flat(run, dir / "flat.vtp");
+  else run.warnings.push_back("no flat.vtp in the run folder: no colon map lookup, no positions along the colon");
+  run.ct_path = find_ct(run, opts);
+  if (!run.ct_path.empty()) run.ct = read_ct_volume(run.ct_path);
+  else run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
+  load_truth(run, opts);
+  if (run.flat) {
+    attach_to_flat(*run.flat, run.candidates);
+    attach_to_flat(*run.flat, run.known);
+  }
+  return run;
+}
+
+ColonPosition colon_position(const RunData& run, int v) {
+  ColonPosition p;
+  const FlatMap& flat = *run.flat;
+  p.segment = flat.segment[v];
+  const FlatSegment& s = flat.segments[p.segment];
+  p.from = "end A";
+  if (p.segment < int(run.flat_segments.size()))
+    p.from = run.flat_segments[p.segment].value("x0_end", std::string("end A"));
+  if (!run.centreline_mm.empty()) {
+    p.mm = run.centreline_mm[v];
+  } else {
+    p.mm = flat.uv[v][0] - s.x0;
+  }
+  return p;
+}
+
+}  // namespace cf
