@@ -19,6 +19,16 @@ struct Region {
   std::vector<char> free_vertex;
 };
 
+constexpr double kMaxAnisotropy = 3.0;  // quasi-conformal ratio that also seeds a region
+
+// Quasi-conformal ratio sigma1 / sigma2 of a face's 3D -> 2D map.
+double anisotropy(const Surface& s, const Embedding& emb, int f) {
+  const Tri& t = s.t[f];
+  const auto c = emb.corners(s, f);
+  const FaceDistortion d = face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]);
+  return std::isfinite(d.qc) ? d.qc : 1e9;
+}
+
 double ratio_of(const Surface& s, const Embedding& emb, const std::vector<double>& area3, int f) {
   return area3[f] > 0 ? emb.area2(s, f) / area3[f] : 1.0;
 }
@@ -33,7 +43,8 @@ Region select_region(const Surface& s, const std::vector<std::vector<int>>& vf, 
   std::vector<int> faces;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
     const double q = ratio_of(s, emb, area3, int(f));
-    if (!degenerate[f] && (q < lo || q > hi)) in[f] = 1, faces.push_back(int(f));
+    if (!degenerate[f] && (q < lo || q > hi || anisotropy(s, emb, int(f)) > kMaxAnisotropy))
+      in[f] = 1, faces.push_back(int(f));
   }
   if (faces.empty()) return r;
   std::size_t done = 0;
@@ -166,7 +177,7 @@ struct SymmetricDirichlet {
 };
 
 SymmetricDirichlet make_energy(const Surface& s, const Embedding& emb, const std::vector<int>& faces) {
-  SymmetricDirichlet sd{s, emb, faces, {}, {}};
+  SymmetricDirichlet sd{s, emb, faces, {}, {}};  // `faces`: the region's faces that are not folded
   std::vector<std::array<V2, 3>> X;
   std::vector<std::array<double, 3>> w;
   local_frames(s, faces, X, w);
@@ -190,7 +201,10 @@ int minimise_region(const Surface& s, Embedding& emb, const Region& r, int itera
   local_frames(s, r.faces, X, w);
   RegionSystem sys;
   if (!sys.build(s, r.free_vertex, r.faces, w)) return 0;
-  const SymmetricDirichlet sd = make_energy(s, emb, r.faces);
+  std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
+  for (int f : r.faces)
+    if (emb.area2(s, f) > 0) unfolded.push_back(f);
+  const SymmetricDirichlet sd = make_energy(s, emb, unfolded);
   double e0 = sd.energy(emb.pos);
   if (e0 >= SymmetricDirichlet::kHugeEnergy) return 0;  // the region is not injective: leave it
   int it = 0;
@@ -202,7 +216,7 @@ int minimise_region(const Surface& s, Embedding& emb, const Region& r, int itera
     if (!(slope < 0)) break;
     std::vector<V2> next = emb.pos;
     for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
-    double t = std::min(1.0, 0.9 * max_step(s, emb, next, r.faces, area3, 0.0));
+    double t = std::min(1.0, 0.9 * max_step(s, emb, next, unfolded, area3, 0.0));
     double e1 = SymmetricDirichlet::kHugeEnergy;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
       trial = emb.pos;

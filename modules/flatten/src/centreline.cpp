@@ -76,6 +76,13 @@ Centreline polyline(const std::vector<V3>& centre, const std::vector<double>& me
 
 }  // namespace
 
+double Centreline::area_fraction_of_u(double u) const {
+  if (area_cdf.size() < 2) return u;
+  const double x = std::clamp(u, 0.0, 1.0) * double(area_cdf.size() - 1);
+  const std::size_t i = std::min(area_cdf.size() - 2, std::size_t(x));
+  return area_cdf[i] + (x - double(i)) * (area_cdf[i + 1] - area_cdf[i]);
+}
+
 double Centreline::s_of_u(double u) const {
   if (knot_u.empty()) return u;
   if (u <= knot_u.front()) return knot_s.front();
@@ -86,23 +93,35 @@ double Centreline::s_of_u(double u) const {
   return knot_s[i - 1] + a * (knot_s[i] - knot_s[i - 1]);
 }
 
-Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const V3& end_a, const V3& end_b) {
-  std::vector<FaceSample> faces(s.t.size());
+Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face,
+                             const V3& end_a, const V3& end_b) {
+  std::vector<FaceSample> faces;
+  faces.reserve(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (!use_face[f]) continue;
     const Tri& t = s.t[f];
     const double uf = (u[t[0]] + u[t[1]] + u[t[2]]) / 3;
-    faces[f] = {uf, uf, face_area_3d(s, int(f)), (s.p[t[0]] + s.p[t[1]] + s.p[t[2]]) / 3};
+    faces.push_back({uf, uf, face_area_3d(s, int(f)), (s.p[t[0]] + s.p[t[1]] + s.p[t[2]]) / 3});
   }
   // Pass 1: 256 slices equal in u give a coarse arc length s1(u).
   std::vector<V3> centre;
   std::vector<double> mean_u;
   slice_centroids(faces, 256, 1.0, centre, mean_u);
   const Centreline coarse = polyline(centre, mean_u, end_a, end_b, 2);
-  // Pass 2: slices about 4 mm apart in s1 (equal in length, not in u).
-  const int bins = std::clamp(int(coarse.length / 4.0), 8, 4000);
+  // Pass 2: slices about 8 mm apart in s1 (equal in length, not in u), smoothed across.
+  const int bins = std::clamp(int(coarse.length / 8.0), 8, 2000);
   for (auto& fs : faces) fs.key = coarse.s_of_u(fs.u);
   slice_centroids(faces, bins, coarse.length, centre, mean_u);
-  return polyline(centre, mean_u, end_a, end_b, 3);
+  Centreline c = polyline(centre, mean_u, end_a, end_b, 8);
+  // Cumulative wall area as a function of u (4096 bins), made strictly increasing.
+  const int nb = 4096;
+  std::vector<double> hist(nb, 0.0);
+  double total = 0;
+  for (const auto& fs : faces) hist[std::clamp(int(fs.u * nb), 0, nb - 1)] += fs.area, total += fs.area;
+  c.area_cdf.assign(nb + 1, 0.0);
+  for (int b = 0; b < nb; ++b) c.area_cdf[b + 1] = c.area_cdf[b] + hist[b] / total + 1e-9;
+  for (double& a : c.area_cdf) a /= c.area_cdf.back();
+  return c;
 }
 
 namespace {

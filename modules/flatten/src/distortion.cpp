@@ -202,6 +202,7 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
   j["map"] = s.map;
   j["centreline_lps_mm"] = s.centreline;
   j["centreline_length_mm"] = s.centreline_length;
+  if (!s.centreline_x.empty()) j["centreline_to_x_mm"] = s.centreline_x;
   j["x0_end"] = s.x0_end;
   j["x1_end"] = s.x1_end;
   j["order"] = s.order;

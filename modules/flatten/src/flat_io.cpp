@@ -60,6 +60,7 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.map = j.value("map", "");
   if (j.contains("centreline_lps_mm")) s.centreline = j["centreline_lps_mm"].get<std::vector<std::array<double, 3>>>();
   s.centreline_length = j.value("centreline_length_mm", 0.0);
+  if (j.contains("centreline_to_x_mm")) s.centreline_x = j["centreline_to_x_mm"].get<std::vector<std::array<double, 2>>>();
   s.x0_end = j.value("x0_end", "end A");
   s.x1_end = j.value("x1_end", "end B");
   s.order = j.value("order", s.id);

@@ -128,8 +128,25 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
   return emb;
 }
 
-// Area-balanced map: x = arc length along the centreline, y scaled so that the band's area is
-// the wall area, fold-overs untangled, then the out-of-bounds regions balanced (ARAP).
+// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
+void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
+  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  std::vector<FaceDistortion> fd;
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
+    const Tri& t = w.ann.t[f];
+    const auto c = w.emb.corners(w.ann, int(f));
+    fd.push_back(face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]));
+    fd.back().degenerate = degenerate[f];
+  }
+  const DistortionStats st = stats_of(fd);
+  std::fprintf(stderr, "flatten debug %s: flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
+               step, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
+}
+
+// Area-balanced map: x = L A(u) / A, with A(u) the wall area below the level set u and L the
+// centreline length (each slice of the colon gets a band width proportional to its wall area;
+// band length = centreline length), y scaled so that the band's area is the wall area, fold-overs
+// untangled, then the regions still out of bounds balanced (symmetric Dirichlet).
 void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
                         const std::vector<char>& fixed, const std::vector<char>& degenerate,
                         const FlattenOptions& o) {
@@ -137,13 +154,16 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   const double conformal_length = w.seg.length;
   const double period = w.seg.area_3d / cl.length;
   const double yscale = period / emb.period;
-  for (auto& q : emb.pos) q = V2(cl.s_of_u(q.x() / conformal_length), q.y() * yscale);
+  for (auto& q : emb.pos) q = V2(cl.length * cl.area_fraction_of_u(q.x() / conformal_length), q.y() * yscale);
+  for (std::size_t i = 0; i < cl.knot_u.size(); ++i)
+    w.seg.centreline_x.push_back({cl.knot_s[i], cl.length * cl.area_fraction_of_u(cl.knot_u[i])});
   for (auto& d : emb.dy)
     for (double& x : d) x *= yscale;
   emb.period = period;
   w.seg.length = cl.length;
   w.seg.period = period;
   w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
+  debug_stats("reparametrised", w, degenerate);
   w.seg.balanced_vertices = balance_area(w.ann, vf, emb, fixed, degenerate, o).vertices;
 }
 
@@ -174,21 +194,6 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   w.seg.coverage = coverage_of(s, E, w.in_map, ratio, o.coverage_min_ratio, cap_area);
 }
 
-// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
-void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
-  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
-  std::vector<FaceDistortion> fd;
-  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
-    const Tri& t = w.ann.t[f];
-    const auto c = w.emb.corners(w.ann, int(f));
-    fd.push_back(face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]));
-    fd.back().degenerate = degenerate[f];
-  }
-  const DistortionStats st = stats_of(fd);
-  std::fprintf(stderr, "flatten debug %s: flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
-               step, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
-}
-
 SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::size_t c, double lumen_sign,
                             const FlattenOptions& o) {
   SegmentWork w;
@@ -217,7 +222,13 @@ SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::
   w.seg.period = w.emb.period;
   std::vector<double> u(ann.p.size());
   for (std::size_t v = 0; v < ann.p.size(); ++v) u[v] = std::clamp(w.emb.pos[v].x() / w.seg.length, 0.0, 1.0);
-  const Centreline cl = centreline_from_u(ann, u, ca, cb);
+  std::vector<char> use_face(ann.t.size(), 1);
+  {
+    const double conformal_scale = w.seg.area_3d / (w.seg.length * w.seg.period);
+    for (std::size_t f = 0; f < ann.t.size(); ++f)
+      use_face[f] = w.emb.area2(ann, int(f)) * conformal_scale >= 0.05 * face_area_3d(ann, int(f));
+  }
+  const Centreline cl = centreline_from_u(ann, u, use_face, ca, cb);
   w.seg.centreline = cl.points;
   w.seg.centreline_length = cl.length;
   w.along.resize(ann.p.size());

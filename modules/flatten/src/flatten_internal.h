@@ -124,9 +124,14 @@ struct Centreline {
   std::vector<std::array<double, 3>> points;  // LPS mm, end A first
   std::vector<double> knot_u, knot_s;         // s(u) piecewise linear through these knots
   double length = 0;                          // mm
+  std::vector<double> area_cdf;               // wall area fraction with u' < k / (size - 1), increasing
   double s_of_u(double u) const;
+  double area_fraction_of_u(double u) const;  // in [0, 1], strictly increasing
 };
-Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const V3& end_a, const V3& end_b);
+// `use_face`: faces taken into the slices and the area function (the conformal map's crowded
+// faces, area ratio < 0.05, are left out: they sit at single u values and would make jumps).
+Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face,
+                             const V3& end_a, const V3& end_b);
 
 // Labels the segments' ends (rectum: inferior, near the midline x; cecum: the patient's right),
 // with a margin of 25 mm, else "end A" / "end B"; orients each segment so that x0 is the rectal

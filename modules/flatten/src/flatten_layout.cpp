@@ -16,6 +16,8 @@ void reverse_segment(SegmentWork& w) {
     for (double& x : d) x = -x;
   for (double& a : w.along) a = C - a;
   std::reverse(w.seg.centreline.begin(), w.seg.centreline.end());
+  for (auto& q : w.seg.centreline_x) q = {C - q[0], L - q[1]};
+  std::reverse(w.seg.centreline_x.begin(), w.seg.centreline_x.end());
 }
 
 void emit_one(const SegmentWork& w, FlatMap& out) {

@@ -170,6 +170,19 @@ double nice_length(double target) {
   return best;
 }
 
+// Band x (mm) of a centreline distance (mm from the band's x0 end): the segment's table when
+// present (area-balanced map: x follows the wall area, not exactly the centreline), else x itself.
+double x_of_centreline(const FlatSegment& s, double d) {
+  const auto& t = s.centreline_x;
+  if (t.size() < 2) return d;
+  if (d <= t.front()[0]) return t.front()[1];
+  if (d >= t.back()[0]) return t.back()[1];
+  std::size_t i = 1;
+  while (t[i][0] < d) ++i;
+  const double a = (d - t[i - 1][0]) / std::max(1e-12, t[i][0] - t[i - 1][0]);
+  return t[i - 1][1] + a * (t[i][1] - t[i - 1][1]);
+}
+
 struct Tick {
   int col = 0, row_bottom = 0, len = 0;  // canvas coordinates (row from the bottom)
   std::string text;
@@ -184,9 +197,10 @@ std::vector<Tick> axis_ticks(const FlatMap& f, const std::vector<Band>& bands, d
     const FlatSegment& s = f.segments[b.seg];
     const double off = s.centreline_offset;
     const double step = 10.0 / px < 4 ? 50.0 : 10.0;  // mm; 1 cm ticks only when they are >= 4 px apart
-    for (double mm = std::ceil(off / step) * step; mm <= off + s.length + 1e-9; mm += step) {
+    const double len = s.centreline_length > 0 ? s.centreline_length : s.length;
+    for (double mm = std::ceil(off / step) * step; mm <= off + len + 1e-9; mm += step) {
       Tick t;
-      t.col = b.col0 + int(std::lround((mm - off) / px));
+      t.col = b.col0 + int(std::lround(x_of_centreline(s, mm - off) / px));
       t.row_bottom = b.row0 - 1;
       const long cm = std::lround(mm / 10);
       t.len = cm % 10 == 0 ? 12 : cm % 5 == 0 ? 8 : 4;

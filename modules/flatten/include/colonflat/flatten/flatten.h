@@ -85,6 +85,7 @@ struct FlatSegment {
   std::string map;                                   // "area-balanced" or "conformal"
   std::vector<std::array<double, 3>> centreline;     // LPS mm, from the x0 end to the x1 end
   double centreline_length = 0;                      // mm
+  std::vector<std::array<double, 2>> centreline_x;   // (centreline mm from the x0 end, band x mm), increasing
   std::string x0_end = "end A", x1_end = "end B";    // "rectum", "cecum", "end A", "end B"
   int order = 0;                                     // position rectum -> cecum among segments
   double centreline_offset = 0;                      // mm of centreline of the segments before it
