@@ -334,6 +334,7 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
         const vtkIdType id = vtkIdType(j) * b.w + i;
         unsigned char* d = pix + (std::size_t(b.row0 + j) * width + b.col0 + i) * 3;
         const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
+        if (!valid->GetValue(id) && (i + 0.5) * px > s.length) continue;  // past the band's end (rounding)
         if (!valid->GetValue(id)) {  // wall not in the map: hatched dark red
           d[0] = stripe ? 120 : 40, d[1] = d[2] = stripe ? 20 : 10;
           ++out.missing_pixels;
