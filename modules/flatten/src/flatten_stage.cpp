@@ -11,7 +11,7 @@ namespace cf {
 const StageSpec& FlattenStage::spec() const {
   static const StageSpec s{
       "flatten",
-      "flattening of the colon wall onto bands: x along the centreline from the rectum, y around; area-balanced "
+      "flattening of the colon wall onto bands: x from the rectum along the centreline, y around; area-balanced "
       "or conformal",
       {{"denoised", &mesh_artifact(), "genus-0 colon surface (after denoise)", "denoised.vtp"}},
       {{"flat", &flat_artifact(), "flat colon map", "flat.vtp"}}};
@@ -31,14 +31,15 @@ const ParamTable<FlattenOptions>& FlattenStage::table() const {
              "Laplacian weights: cotan; clamped (negative cotangents clamped, never flips in practice); auto = "
              "cotan, clamped if cotan flips a triangle");
     t.choice("map", &FlattenOptions::map, {"area-balanced", "conformal"},
-             "area-balanced: x = arc length along the centreline (mm from the rectal end), area ratio corrected "
-             "locally (bijective); conformal: the pure conformal (holomorphic 1-form) map");
+             "area-balanced: x from the rectal end (0) to the cecal end (= centreline length), each slice as wide "
+             "as its wall area, out-of-bounds regions corrected locally (bijective); conformal: the pure conformal "
+             "(holomorphic 1-form) map");
     t.real("area-ratio-low", &FlattenOptions::area_ratio_low, "",
            "area-balanced: faces whose 2D/3D area ratio is below this are corrected", 0.0, 1.0);
     t.real("area-ratio-high", &FlattenOptions::area_ratio_high, "",
            "area-balanced: faces whose 2D/3D area ratio is above this are corrected", 1.0, 1000.0);
     t.integer("balance-iterations", &FlattenOptions::balance_iterations, "",
-              "area-balanced: ARAP iterations per correction pass (0: no correction)", 0, 10000);
+              "area-balanced: symmetric-Dirichlet descent steps per correction pass (0: no correction)", 0, 10000);
     t.real("coverage-min-ratio", &FlattenOptions::coverage_min_ratio, "",
            "a face counts as shown on the image when its 2D/3D area ratio is at least this", 0.0, 1.0);
     return t;

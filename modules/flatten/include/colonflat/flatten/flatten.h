@@ -2,9 +2,9 @@
 // Flattening of a colon surface onto rectangles (one per colon segment).
 //
 // Default map "area-balanced" (see docs/flatten.md): the conformal map below, then x
-// reparametrised to arc length along the centreline (level sets of u -> centroids), y scaled so
-// the band's area is the wall area, then a local, injectivity-preserving ARAP correction of the
-// regions whose area ratio is still out of bounds. `map = "conformal"` keeps the pure
+// reparametrised as L * A(u) / A (L the centreline length from the level sets of u, A(u) the wall
+// area below level u), y scaled so the band's area is the wall area, then a local,
+// injectivity-preserving symmetric-Dirichlet correction of the regions still out of bounds. `map = "conformal"` keeps the pure
 // conformal map.
 //
 // Per segment (connected component of genus 0): the two ends are found as geodesic extremes and
@@ -35,7 +35,7 @@ struct FlattenOptions {
   std::string map = "area-balanced";   // "area-balanced" (x = centreline arc length, area corrected) or "conformal"
   double area_ratio_low = 0.4;         // area-balanced: faces below this 2D/3D area ratio seed a correction region
   double area_ratio_high = 3.0;        // area-balanced: faces above this ratio seed a correction region
-  int balance_iterations = 30;         // area-balanced: ARAP iterations per correction
+  int balance_iterations = 30;         // area-balanced: descent steps per correction pass
   double coverage_min_ratio = 0.1;     // a face counts as shown when its 2D/3D area ratio is at least this
 };
 
