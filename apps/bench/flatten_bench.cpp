@@ -7,17 +7,29 @@
 //                            flatten -> polyp candidates, scored against the phantom's polyps
 //                            (sensitivity for polyps >= 6 mm, false positives per scan); DIR gets
 //                            the colon images (with the known polyps) and the candidate JSON.
+//   flatten_bench --real DIR [--cache DIR2] [--map M] [--out DIR3]
+//                            the real cases in DIR (*.nii.gz lumen masks: reconstruct + denoise;
+//                            *.vtk / *.vtp surfaces: denoise; denoised surfaces cached in DIR2,
+//                            default /tmp/flatten_bench_cache), flattened with map M: faces,
+//                            coverage, area ratio p05/p95, qc mean/p95, flipped, time, peak memory;
+//                            DIR3 gets colon.png per case.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <ctime>
 #include <cstring>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include <filesystem>
 #include <fstream>
 
+#include "colonflat/core/mesh_io.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/stage.h"
+#include "colonflat/denoise/denoise_stage.h"
+#include "colonflat/reconstruct/reconstruct_stage.h"
 #include "colonflat/denoise/denoise.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
@@ -71,7 +83,7 @@ void table() {
 
 void phantom_table(int first, int last, const std::string& size, const std::string& out) {
   std::printf("%-5s %8s %5s %7s %7s %8s %8s %8s %8s %7s %7s %6s %6s %6s %4s %s\n", "seed", "faces", "genus", "flat_s",
-              "flipped", "left_out", "qc_mean", "qc_p95", "qc_max", "area05", "area95", "polyps", "found", "sens", "FP",
+              "flipped", "cover%", "qc_mean", "qc_p95", "qc_max", "area05", "area95", "polyps", "found", "sens", "FP",
               "missed (id:diameter)");
   int tot_p = 0, tot_f = 0, tot_fp = 0;
   for (int seed = first; seed <= last; ++seed) {
@@ -106,10 +118,8 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
       for (const auto& p : ph.polyps)
         if (p.id == id) missed += std::to_string(id) + ":" + std::to_string(int(std::lround(p.diameter_mm))) + " ";
     const auto& st = flat.stats;
-    std::size_t left_out = 0;
-    for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
-    std::printf("%-5d %8zu %5d %7.2f %7zu %8zu %8.4f %8.4f %8.2f %7.3f %7.3f %6d %6d %6.2f %4d %s\n", seed,
-                dn.mesh.n_faces(), dn.before.genus ? *dn.before.genus : -1, t, st.flipped, left_out, st.qc_mean, st.qc_p95,
+    std::printf("%-5d %8zu %5d %7.2f %7zu %8.3f %8.4f %8.4f %8.2f %7.3f %7.3f %6d %6d %6.2f %4d %s\n", seed,
+                dn.mesh.n_faces(), dn.before.genus ? *dn.before.genus : -1, t, st.flipped, 100 * flat.coverage.fraction, st.qc_mean, st.qc_p95,
                 st.qc_max, st.area_p05, st.area_p95, sc.polyps, sc.polyps_detected, sc.sensitivity,
                 sc.false_positives, missed.c_str());
     std::fflush(stdout);
@@ -121,6 +131,68 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
   }
   std::printf("total: %d/%d polyps >= 6 mm found (sensitivity %.3f), %.2f false positives per scan\n", tot_f, tot_p,
               tot_p ? double(tot_f) / tot_p : 1.0, double(tot_fp) / (last - first + 1));
+}
+
+// The denoised surface of a real case, computed once and cached.
+std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache) {
+  std::filesystem::create_directories(cache);
+  std::string stem = in.filename().string();
+  stem = stem.substr(0, stem.find('.'));
+  const auto den = cache / (stem + "_denoised.vtp");
+  if (std::filesystem::exists(den)) return den;
+  auto run = [](std::unique_ptr<cf::Stage> (*make)(), const std::vector<std::string>& args) {
+    std::ostringstream o, e;
+    if (cf::make_stage_tool(make)->run(args, o, e) != 0) throw std::runtime_error(e.str());
+  };
+  std::filesystem::path surface = in;
+  if (in.string().size() > 7 && in.string().substr(in.string().size() - 7) == ".nii.gz") {
+    surface = cache / (stem + "_surface.vtp");
+    run(cf::make_reconstruct_stage, {in.string(), "-o", surface.string(), "-q"});
+  }
+  run(cf::make_denoise_stage, {surface.string(), "-o", den.string(), "-q"});
+  return den;
+}
+
+void real_table(const std::string& dir, const std::string& cache, const std::string& map, const std::string& out) {
+  std::printf("load average %.2f; map %s\n", load_average(), map.c_str());
+  std::printf("%-30s %8s %4s %8s %9s %7s %7s %7s %7s %7s %7s %8s %8s\n", "case", "faces", "segs", "cover%", "notshown",
+              "area05", "area95", "qc_mean", "qc_p95", "flipped", "leftout", "time_s", "peak_MiB");
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.find(".nii.gz") != std::string::npos || e.path().extension() == ".vtk" || e.path().extension() == ".vtp")
+      files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  for (const auto& in : files) {
+    const auto den = denoised_real(in, cache);
+    const cf::Mesh mesh = cf::load_mesh(den).mesh;
+    cf::FlattenOptions fo;
+    fo.map = map;
+    cf::Stopwatch sw;
+    const cf::FlatMap flat = cf::flatten_colon(mesh, fo);
+    const double t = sw.seconds();
+    std::size_t left_out = 0;
+    for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
+    const auto& st = flat.stats;
+    std::printf("%-30s %8zu %4zu %8.3f %9.0f %7.3f %7.3f %7.3f %7.3f %7zu %7zu %8.2f %8.0f\n",
+                in.filename().string().c_str(), mesh.n_faces(), flat.segments.size(), 100 * flat.coverage.fraction,
+                flat.coverage.wall_area_mm2 - flat.coverage.shown_area_mm2, st.area_p05, st.area_p95, st.qc_mean,
+                st.qc_p95, st.flipped, left_out, t, cf::peak_memory_mib());
+    for (const auto& sg : flat.segments)
+      std::printf("    segment %d: %s -> %s, centreline %.0f mm, band %.0f x %.0f mm, balanced %zu vertices\n", sg.id,
+                  sg.x0_end.c_str(), sg.x1_end.c_str(), sg.centreline_length, sg.length, sg.period,
+                  sg.balanced_vertices);
+    std::fflush(stdout);
+    if (!out.empty()) {
+      std::filesystem::create_directories(out);
+      cf::RenderOptions ro;
+      ro.snapshots = false;
+      const cf::RenderResult rr = cf::render_flat(flat, ro);
+      std::string stem = in.filename().string();
+      cf::write_png(rr.colon.image, out + "/" + stem.substr(0, stem.find('.')) + "_colon.png");
+    }
+  }
 }
 
 void BM_FlattenColon(benchmark::State& state) {
@@ -139,7 +211,7 @@ BENCHMARK(BM_FlattenColon)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 int main(int argc, char** argv) {
   bool table_only = false;
   int first = 0, last = -1;
-  std::string size = "full", out;
+  std::string size = "full", out, real, cache = "/tmp/flatten_bench_cache", map = "area-balanced";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--table-only")) table_only = true;
     if (!std::strcmp(argv[i], "--phantom") && i + 1 < argc) {
@@ -150,6 +222,13 @@ int main(int argc, char** argv) {
     }
     if (!std::strcmp(argv[i], "--size") && i + 1 < argc) size = argv[++i];
     if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+    if (!std::strcmp(argv[i], "--real") && i + 1 < argc) real = argv[++i];
+    if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
+    if (!std::strcmp(argv[i], "--map") && i + 1 < argc) map = argv[++i];
+  }
+  if (!real.empty()) {
+    real_table(real, cache, map, out);
+    return 0;
   }
   if (last >= first) {
     phantom_table(first, last, size, out);

@@ -57,6 +57,16 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
     s.stats.area_p95 = d.value("area_ratio_p95", 0.0);
     s.stats.area_log2_mean_abs = d.value("area_log2_mean_abs", 0.0);
   }
+  s.map = j.value("map", "");
+  if (j.contains("centreline_lps_mm")) s.centreline = j["centreline_lps_mm"].get<std::vector<std::array<double, 3>>>();
+  s.centreline_length = j.value("centreline_length_mm", 0.0);
+  if (j.contains("centreline_to_x_mm")) s.centreline_x = j["centreline_to_x_mm"].get<std::vector<std::array<double, 2>>>();
+  s.x0_end = j.value("x0_end", "end A");
+  s.x1_end = j.value("x1_end", "end B");
+  s.order = j.value("order", s.id);
+  s.centreline_offset = j.value("centreline_offset_mm", 0.0);
+  s.balanced_vertices = j.value("balanced_vertices", std::size_t(0));
+  if (j.contains("coverage")) s.coverage = coverage_from_json(j["coverage"]);
   return s;
 }
 
@@ -79,7 +89,13 @@ vtkSmartPointer<vtkPolyData> flat_to_polydata(const FlatMap& flat) {
   seg->SetNumberOfTuples(n);
   src->SetName("source_vertex");
   src->SetNumberOfTuples(n);
+  vtkNew<vtkDoubleArray> along, angle;
+  along->SetName("centreline_mm");
+  angle->SetName("angle_rad");
+  const bool has_along = flat.centreline_mm.size() == flat.uv.size() && flat.angle_rad.size() == flat.uv.size();
+  if (has_along) along->SetNumberOfTuples(n), angle->SetNumberOfTuples(n);
   for (vtkIdType i = 0; i < n; ++i) {
+    if (has_along) along->SetValue(i, flat.centreline_mm[i]), angle->SetValue(i, flat.angle_rad[i]);
     pts->SetPoint(i, flat.uv[i][0], flat.uv[i][1], 0.0);
     pos->SetTuple(i, flat.position[i].data());
     nrm->SetTuple(i, flat.normal[i].data());
@@ -99,6 +115,7 @@ vtkSmartPointer<vtkPolyData> flat_to_polydata(const FlatMap& flat) {
   pd->GetPointData()->SetNormals(nrm);
   pd->GetPointData()->AddArray(seg);
   pd->GetPointData()->AddArray(src);
+  if (has_along) pd->GetPointData()->AddArray(along), pd->GetPointData()->AddArray(angle);
   tag_polydata_space(pd, "mm", "LPS");
   vtkNew<vtkStringArray> js;
   js->SetName("FlatSegments");
@@ -136,6 +153,13 @@ FlatMap polydata_to_flat(vtkPolyData* pd, const std::string& name) {
     f.segment[i] = int(seg->GetTuple1(i));
     f.source_vertex[i] = int(src->GetTuple1(i));
   }
+  auto* along = pd->GetPointData()->GetArray("centreline_mm");
+  auto* angle = pd->GetPointData()->GetArray("angle_rad");
+  if (along && angle && along->GetNumberOfTuples() == n && angle->GetNumberOfTuples() == n) {
+    f.centreline_mm.resize(n);
+    f.angle_rad.resize(n);
+    for (vtkIdType i = 0; i < n; ++i) f.centreline_mm[i] = along->GetTuple1(i), f.angle_rad[i] = angle->GetTuple1(i);
+  }
   vtkNew<vtkIdList> cell;
   vtkCellArray* polys = pd->GetPolys();
   if (!polys || polys->GetNumberOfCells() == 0) throw InputError(name, "flat map has no triangles");
@@ -152,6 +176,7 @@ FlatMap polydata_to_flat(vtkPolyData* pd, const std::string& name) {
   try {
     for (const auto& s : j["segments"]) f.segments.push_back(segment_from_json(s));
     f.skipped_components = j.value("skipped_components", std::size_t(0));
+    if (j.contains("coverage")) f.coverage = coverage_from_json(j["coverage"]);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(name, std::string("FlatSegments field data: ") + e.what());
   }

@@ -11,7 +11,8 @@ namespace cf {
 const StageSpec& FlattenStage::spec() const {
   static const StageSpec s{
       "flatten",
-      "conformal flattening of the colon wall onto rectangles (holomorphic 1-form)",
+      "flattening of the colon wall onto bands: x from the rectum along the centreline, y around; area-balanced "
+      "or conformal",
       {{"denoised", &mesh_artifact(), "genus-0 colon surface (after denoise)", "denoised.vtp"}},
       {{"flat", &flat_artifact(), "flat colon map", "flat.vtp"}}};
   return s;
@@ -29,6 +30,18 @@ const ParamTable<FlattenOptions>& FlattenStage::table() const {
     t.choice("weights", &FlattenOptions::weights, {"auto", "cotan", "clamped"},
              "Laplacian weights: cotan; clamped (negative cotangents clamped, never flips in practice); auto = "
              "cotan, clamped if cotan flips a triangle");
+    t.choice("map", &FlattenOptions::map, {"area-balanced", "conformal"},
+             "area-balanced: x from the rectal end (0) to the cecal end (= centreline length), each slice as wide "
+             "as its wall area, out-of-bounds regions corrected locally (bijective); conformal: the pure conformal "
+             "(holomorphic 1-form) map");
+    t.real("area-ratio-low", &FlattenOptions::area_ratio_low, "",
+           "area-balanced: faces whose 2D/3D area ratio is below this are corrected", 0.0, 1.0);
+    t.real("area-ratio-high", &FlattenOptions::area_ratio_high, "",
+           "area-balanced: faces whose 2D/3D area ratio is above this are corrected", 1.0, 1000.0);
+    t.integer("balance-iterations", &FlattenOptions::balance_iterations, "",
+              "area-balanced: symmetric-Dirichlet descent steps per correction pass (0: no correction)", 0, 10000);
+    t.real("coverage-min-ratio", &FlattenOptions::coverage_min_ratio, "",
+           "a face counts as shown on the image when its 2D/3D area ratio is at least this", 0.0, 1.0);
     return t;
   }();
   return t;
@@ -45,7 +58,10 @@ void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
     line << std::fixed << std::setprecision(1) << "flatten: segment " << s.id << " (" << s.input_kind << ", "
          << s.faces << " faces): " << s.length << " x " << s.period << " mm, flipped " << s.stats.flipped
          << ", quasi-conformal mean " << std::setprecision(3) << s.stats.qc_mean << " p95 " << s.stats.qc_p95
-         << " max " << s.stats.qc_max;
+         << " max " << s.stats.qc_max << ", area p05 " << s.stats.area_p05 << " p95 " << s.stats.area_p95
+         << ", shown " << std::setprecision(2) << 100 * s.coverage.fraction << " % of the wall, ends "
+         << s.x0_end << " (left) / " << s.x1_end << " (right), centreline " << std::setprecision(0)
+         << s.centreline_length << " mm";
     ctx.progress(line.str());
   }
   if (flat.stats.flipped > 0)

@@ -55,7 +55,7 @@ double choose_roll(const FlatSegment& s, const std::vector<ImageMarker>& markers
 
 // The triangles of one segment with y rolled into [c0, c0 + P), plus copies across the cut.
 vtkSmartPointer<vtkPolyData> rolled_segment(const FlatMap& f, const FlatSegment& s, double c0,
-                                            const std::vector<double>& si) {
+                                            const std::vector<double>& si, const std::vector<double>& ratio) {
   const double P = s.period;
   std::map<std::pair<int, int>, vtkIdType> ids;
   vtkNew<vtkPoints> pts;
@@ -66,6 +66,8 @@ vtkSmartPointer<vtkPolyData> rolled_segment(const FlatMap& f, const FlatSegment&
   pos->SetName("p");
   pos->SetNumberOfComponents(3);
   shp->SetName("si");
+  vtkNew<vtkDoubleArray> rat;
+  rat->SetName("ratio");
   vtkNew<vtkCellArray> polys;
   auto vid = [&](int v, int k) {
     auto it = ids.find({v, k});
@@ -74,6 +76,7 @@ vtkSmartPointer<vtkPolyData> rolled_segment(const FlatMap& f, const FlatSegment&
     nrm->InsertNextTuple(f.normal[v].data());
     pos->InsertNextTuple(f.position[v].data());
     shp->InsertNextValue(si.empty() ? 0.0 : si[v]);
+    rat->InsertNextValue(ratio[v]);
     ids.emplace(std::make_pair(v, k), id);
     return id;
   };
@@ -97,7 +100,49 @@ vtkSmartPointer<vtkPolyData> rolled_segment(const FlatMap& f, const FlatSegment&
   pd->GetPointData()->AddArray(nrm);
   pd->GetPointData()->AddArray(pos);
   pd->GetPointData()->AddArray(shp);
+  pd->GetPointData()->AddArray(rat);
   return pd;
+}
+
+// Per flat vertex: the smallest 2D/3D area ratio of its triangles, at each segment's
+// area-preserving scale (1 = true size; small = strongly compressed on the image).
+std::vector<double> vertex_area_ratio(const FlatMap& f) {
+  std::vector<double> a2(f.triangles.size()), a3(f.triangles.size());
+  std::vector<double> seg2(f.segments.size(), 0.0), seg3(f.segments.size(), 0.0);
+  for (std::size_t i = 0; i < f.triangles.size(); ++i) {
+    const auto& t = f.triangles[i];
+    const auto &q0 = f.uv[t[0]], &q1 = f.uv[t[1]], &q2 = f.uv[t[2]];
+    a2[i] = 0.5 * ((q1[0] - q0[0]) * (q2[1] - q0[1]) - (q1[1] - q0[1]) * (q2[0] - q0[0]));
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) e1[k] = f.position[t[1]][k] - f.position[t[0]][k], e2[k] = f.position[t[2]][k] - f.position[t[0]][k];
+    a3[i] = 0.5 * std::sqrt(std::pow(e1[1] * e2[2] - e1[2] * e2[1], 2) + std::pow(e1[2] * e2[0] - e1[0] * e2[2], 2) +
+                            std::pow(e1[0] * e2[1] - e1[1] * e2[0], 2));
+    seg2[f.segment[t[0]]] += std::abs(a2[i]);
+    seg3[f.segment[t[0]]] += a3[i];
+  }
+  std::vector<double> r(f.uv.size(), 1e9);
+  for (std::size_t i = 0; i < f.triangles.size(); ++i) {
+    const int sg = f.segment[f.triangles[i][0]];
+    const double scale = seg2[sg] > 0 ? seg3[sg] / seg2[sg] : 1.0;
+    const double q = a3[i] > 1e-12 ? a2[i] * scale / a3[i] : 1.0;
+    for (int v : f.triangles[i]) r[v] = std::min(r[v], q);
+  }
+  return r;
+}
+
+std::string fmt2(double v) {
+  std::ostringstream t;
+  t.precision(2);
+  t << v;
+  return t.str();
+}
+
+std::string fmt0(double v) {
+  std::ostringstream t;
+  t.setf(std::ios::fixed);
+  t.precision(0);
+  t << v;
+  return t.str();
 }
 
 void colour_of_si(double si, double rgb[3]) {
@@ -123,6 +168,47 @@ double nice_length(double target) {
   for (double v : c)
     if (std::abs(std::log(v / target)) < std::abs(std::log(best / target))) best = v;
   return best;
+}
+
+// Band x (mm) of a centreline distance (mm from the band's x0 end): the segment's table when
+// present (area-balanced map: x follows the wall area, not exactly the centreline), else x itself.
+double x_of_centreline(const FlatSegment& s, double d) {
+  const auto& t = s.centreline_x;
+  if (t.size() < 2) return d;
+  if (d <= t.front()[0]) return t.front()[1];
+  if (d >= t.back()[0]) return t.back()[1];
+  std::size_t i = 1;
+  while (t[i][0] < d) ++i;
+  const double a = (d - t[i - 1][0]) / std::max(1e-12, t[i][0] - t[i - 1][0]);
+  return t[i - 1][1] + a * (t[i][1] - t[i - 1][1]);
+}
+
+struct Tick {
+  int col = 0, row_bottom = 0, len = 0;  // canvas coordinates (row from the bottom)
+  std::string text;
+};
+
+// Ticks below each band: every 1 cm (short), 5 cm (medium) and 10 cm (long, labelled in cm) of
+// x = centreline distance from the band's x0 end plus the centreline length of earlier segments.
+std::vector<Tick> axis_ticks(const FlatMap& f, const std::vector<Band>& bands, double px, int height) {
+  (void)height;
+  std::vector<Tick> ticks;
+  for (const Band& b : bands) {
+    const FlatSegment& s = f.segments[b.seg];
+    const double off = s.centreline_offset;
+    const double step = 10.0 / px < 4 ? 50.0 : 10.0;  // mm; 1 cm ticks only when they are >= 4 px apart
+    const double len = s.centreline_length > 0 ? s.centreline_length : s.length;
+    for (double mm = std::ceil(off / step) * step; mm <= off + len + 1e-9; mm += step) {
+      Tick t;
+      t.col = b.col0 + int(std::lround(x_of_centreline(s, mm - off) / px));
+      t.row_bottom = b.row0 - 1;
+      const long cm = std::lround(mm / 10);
+      t.len = cm % 10 == 0 ? 12 : cm % 5 == 0 ? 8 : 4;
+      if (cm % 10 == 0) t.text = std::to_string(cm);
+      ticks.push_back(t);
+    }
+  }
+  return ticks;
 }
 
 }  // namespace
@@ -174,7 +260,8 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
   double px = o.pixel_size;
   if (maxlen / px > o.max_width) px = maxlen / o.max_width;
   out.pixel_size = px;
-  const int margin = 30, top = 70, gap = 46, bottom = 70;
+  const int margin = 30, top = 70, gap = 64, bottom = 90;
+  const std::vector<double> vratio = vertex_area_ratio(f);
   std::vector<Band> bands;
   int width = 0, rows = bottom;
   // bands from the bottom of the VTK image upwards, last segment lowest
@@ -204,7 +291,7 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
   for (const Band& b : bands) {
     const FlatSegment& s = f.segments[b.seg];
     out.roll[b.seg] = b.c0;
-    auto pd = rolled_segment(f, s, b.c0, si);
+    auto pd = rolled_segment(f, s, b.c0, si, vratio);
     vtkNew<vtkImageData> grid;
     grid->SetDimensions(b.w, b.h, 1);
     grid->SetOrigin(s.x0 + 0.5 * px, b.c0 + 0.5 * px, 0);
@@ -220,7 +307,8 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
     vtkDataArray* N = res->GetPointData()->GetArray("n");
     vtkDataArray* Pp = res->GetPointData()->GetArray("p");
     vtkDataArray* S = res->GetPointData()->GetArray("si");
-    if (!valid || !N || !Pp || !S) throw Error("rasterising the flat map failed: " + msgs.first_problem());
+    vtkDataArray* R = res->GetPointData()->GetArray("ratio");
+    if (!valid || !N || !Pp || !S || !R) throw Error("rasterising the flat map failed: " + msgs.first_problem());
     const vtkIdType n = vtkIdType(b.w) * b.h;
     // view normal (into the lumen) and its large-scale smoothing
     vtkNew<vtkImageData> vn;
@@ -245,8 +333,11 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
       for (int i = 0; i < b.w; ++i) {
         const vtkIdType id = vtkIdType(j) * b.w + i;
         unsigned char* d = pix + (std::size_t(b.row0 + j) * width + b.col0 + i) * 3;
-        if (!valid->GetValue(id)) {
-          d[0] = d[1] = d[2] = 0;
+        const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
+        if (!valid->GetValue(id) && (i + 0.5) * px > s.length) continue;  // past the band's end (rounding)
+        if (!valid->GetValue(id)) {  // wall not in the map: hatched dark red
+          d[0] = stripe ? 120 : 40, d[1] = d[2] = stripe ? 20 : 10;
+          ++out.missing_pixels;
           continue;
         }
         const double* v = vnp + 3 * id;
@@ -271,8 +362,13 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
           colour_of_si(S->GetTuple1(id), c);
           for (int k = 0; k < 3; ++k) base[k] = 0.35 * base[k] + 0.65 * c[k];
         }
-        for (int k = 0; k < 3; ++k)
-          d[k] = static_cast<unsigned char>(std::clamp(255.0 * (base[k] * shade + spec), 0.0, 255.0));
+        const bool compressed = R->GetTuple1(id) < o.compressed_ratio;
+        if (compressed) ++out.compressed_pixels;
+        for (int k = 0; k < 3; ++k) {
+          double val = 255.0 * (base[k] * shade + spec);
+          if (compressed && stripe) val = 0.45 * val + 0.55 * 255.0 * (k == 2 ? 1.0 : k == 1 ? 0.9 : 0.2);
+          d[k] = static_cast<unsigned char>(std::clamp(val, 0.0, 255.0));
+        }
       }
   }
   // Overlays with VTK's canvas.
@@ -320,6 +416,9 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
   canvas->FillBox(margin, margin + bar_px, 28, 34);
   canvas->FillBox(margin, margin + 2, 22, 40);
   canvas->FillBox(margin + bar_px - 2, margin + bar_px, 22, 40);
+  const std::vector<Tick> ticks = axis_ticks(f, bands, px, height);
+  canvas->SetDrawColor(230, 230, 230);
+  for (const Tick& t : ticks) canvas->FillBox(t.col, t.col + 1, t.row_bottom - t.len, t.row_bottom);
   canvas->Update();
   ImagePtr final_img = ImagePtr::New();
   final_img->DeepCopy(canvas->GetOutput());
@@ -333,19 +432,29 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
     q << px;
     return q.str();
   }() + " mm)", margin + bar_px + 80, height - 42, 12, grey);
+  for (const Tick& t : ticks)
+    if (!t.text.empty()) draw_text(final_img, t.text, t.col - 4 * int(t.text.size()), height - t.row_bottom + 2, 12, grey);
+  const double end_col[3] = {1, 0.85, 0.35};
   for (const Band& b : bands) {
     const FlatSegment& s = f.segments[b.seg];
-    std::ostringstream t;
-    t.setf(std::ios::fixed);
-    t.precision(0);
-    t << "segment " << s.id + 1 << ": " << s.length << " mm long x " << s.period << " mm around   (end A left, end B right)";
-    draw_text(final_img, t.str(), b.col0, height - 1 - (b.row0 + b.h) - 24, 15, grey);
+    const bool along = !s.map.empty() && s.map != "conformal";
+    std::string t = "segment " + std::to_string(s.id + 1) + ": " + fmt0(s.length) + " mm long x " + fmt0(s.period) +
+                    " mm around; " + s.x0_end + " (left) to " + s.x1_end + " (right); " +
+                    (along ? "x axis: cm along the centreline from the " + s.x0_end
+                           : "x axis: cm of the conformal map (not centreline length)");
+    draw_text(final_img, t, b.col0, height - 1 - (b.row0 + b.h) - 24, 15, grey);
+    const int top_row = height - 1 - (b.row0 + b.h) + 4;
+    draw_text(final_img, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
+    draw_text(final_img, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
   }
+  draw_text(final_img, "hatched blue: wall compressed below " + fmt2(o.compressed_ratio) +
+                           " x its area; hatched red: wall not in the map", margin, height - 22, 12, grey);
   std::string title = o.title;
   if (title.empty()) {
     int nc = 0, nk = 0;
     for (const auto& m : markers) (m.known ? nk : nc)++;
-    title = "ColonFlat: unrolled colon wall (conformal map), " + std::to_string(nc) + " polyp candidate" +
+    title = "ColonFlat: unrolled colon wall (" +
+            (f.segments.empty() || f.segments[0].map.empty() ? std::string("conformal") : f.segments[0].map) + " map), " + std::to_string(nc) + " polyp candidate" +
             (nc == 1 ? "" : "s") + " (yellow)" + (nk ? ", " + std::to_string(nk) + " known polyps (green, dashed)" : "");
   }
   draw_text(final_img, title, margin, 12, 18, white);

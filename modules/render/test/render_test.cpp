@@ -55,7 +55,8 @@ TEST(RenderImage, ColonImageShowsWallAndCandidates) {
   RenderResult r = render_flat(f, o);
   const auto& s = f.segments[0];
   EXPECT_EQ(r.colon.width, int(std::ceil(s.length / 0.5)) + 60);
-  EXPECT_EQ(r.colon.height, int(std::ceil(s.period / 0.5)) + 70 + 70);
+  EXPECT_EQ(r.colon.height, int(std::ceil(s.period / 0.5)) + 70 + 90);
+  EXPECT_EQ(r.colon.missing_pixels, 0u);
   ASSERT_EQ(r.candidates.size(), 3u);
   // wall pixels: reddish tissue, not the dark background
   const unsigned char* p = at(r.colon.image, r.colon.width / 2, 70 + int(s.period / 0.5 / 2));
@@ -87,6 +88,29 @@ TEST(RenderImage, ColonImageShowsWallAndCandidates) {
   back->GetDimensions(dims);
   EXPECT_EQ(dims[0], r.colon.width);
   EXPECT_EQ(dims[1], r.colon.height);
+}
+
+// Wall left out of the map is hatched, not silently dropped: removing triangles from the flat map
+// gives missing (hatched) pixels in proportion to the removed area.
+TEST(RenderImage, MissingWallIsHatched) {
+  auto c = test_colon();
+  FlatMap f = flatten_colon(c.mesh);
+  ColonImageOptions o;
+  std::vector<ImageMarker> none;
+  const ColonImage full = render_colon_image(f, {}, none, o);
+  EXPECT_EQ(full.missing_pixels, 0u);
+  double removed = 0;
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& t : f.triangles) {
+    const auto &a = f.uv[t[0]], &b = f.uv[t[1]], &d = f.uv[t[2]];
+    const bool inside = a[0] > 100 && a[0] < 120 && b[0] > 100 && b[0] < 120 && d[0] > 100 && d[0] < 120;
+    if (inside) removed += 0.5 * std::abs((b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]));
+    else kept.push_back(t);
+  }
+  f.triangles = kept;
+  const ColonImage holed = render_colon_image(f, {}, none, o);
+  const double px_area = holed.pixel_size * holed.pixel_size;
+  EXPECT_NEAR(double(holed.missing_pixels) * px_area, removed, 0.15 * removed);
 }
 
 // Known polyps are placed on the nearest wall point and scored against the candidates.

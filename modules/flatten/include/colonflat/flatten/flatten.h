@@ -1,5 +1,11 @@
 #pragma once
-// Conformal flattening of a colon surface onto rectangles (one per colon segment).
+// Flattening of a colon surface onto rectangles (one per colon segment).
+//
+// Default map "area-balanced" (see docs/flatten.md): the conformal map below, then x
+// reparametrised as L * A(u) / A (L the centreline length from the level sets of u, A(u) the wall
+// area below level u), y scaled so the band's area is the wall area, then a local,
+// injectivity-preserving symmetric-Dirichlet correction of the regions still out of bounds. `map = "conformal"` keeps the pure
+// conformal map.
 //
 // Per segment (connected component of genus 0): the two ends are found as geodesic extremes and
 // opened (a cap of geodesic radius `end_cut_radius` removed around each), giving an annulus; an
@@ -26,6 +32,27 @@ struct FlattenOptions {
   double min_segment_fraction = 0.02;  // components with fewer faces than this fraction of the largest are skipped
   double segment_gap = 20.0;           // mm between the rectangles of several segments in the 2D layout
   std::string weights = "auto";        // "cotan", "clamped" (negative cotangents clamped), "auto" (cotan; clamped if > 1% crowded)
+  std::string map = "area-balanced";   // "area-balanced" (x = centreline arc length, area corrected) or "conformal"
+  double area_ratio_low = 0.4;         // area-balanced: faces below this 2D/3D area ratio seed a correction region
+  double area_ratio_high = 3.0;        // area-balanced: faces above this ratio seed a correction region
+  int balance_iterations = 30;         // area-balanced: descent steps per correction pass
+  double coverage_min_ratio = 0.1;     // a face counts as shown when its 2D/3D area ratio is at least this
+};
+
+// How much of the 3D wall the map shows.
+struct Coverage {
+  double wall_area_mm2 = 0;      // wall area outside the removed end caps
+  double shown_area_mm2 = 0;     // in the map with area ratio >= coverage_min_ratio
+  double compressed_area_mm2 = 0;  // in the map, area ratio below coverage_min_ratio
+  double missing_area_mm2 = 0;   // not in the map at all (outside the end caps)
+  double end_cap_area_mm2 = 0;   // the removed end caps (not counted as wall)
+  double fraction = 1;           // shown / wall
+  struct Cluster {
+    std::array<double, 3> centroid_lps_mm{0, 0, 0};
+    double area_mm2 = 0;
+    std::size_t faces = 0;
+  };
+  std::vector<Cluster> not_shown;  // largest first (at most 20)
 };
 
 // Distortion of the 3D -> 2D map, per triangle.
@@ -52,8 +79,18 @@ struct FlatSegment {
   double dirichlet_period_ratio = 1;     // period from u's energy / period from v's energy (1 = consistent)
   std::string weights;      // weights used ("cotan" or "clamped")
   std::size_t untangled_vertices = 0;    // vertices re-embedded (Tutte) to undo fold-overs
-  std::size_t crowded_faces = 0;         // faces left out: conformal area factor < 1e-7 (thin protrusions)
+  std::size_t crowded_faces = 0;         // faces left out: area factor < 1e-7 or folded (thin protrusions)
   DistortionStats stats;
+  // area-balanced map (empty / 0 for older files and the conformal map)
+  std::string map;                                   // "area-balanced" or "conformal"
+  std::vector<std::array<double, 3>> centreline;     // LPS mm, from the x0 end to the x1 end
+  double centreline_length = 0;                      // mm
+  std::vector<std::array<double, 2>> centreline_x;   // (centreline mm from the x0 end, band x mm), increasing
+  std::string x0_end = "end A", x1_end = "end B";    // "rectum", "cecum", "end A", "end B"
+  int order = 0;                                     // position rectum -> cecum among segments
+  double centreline_offset = 0;                      // mm of centreline of the segments before it
+  std::size_t balanced_vertices = 0;                 // vertices moved by the area correction
+  Coverage coverage;
 };
 
 // The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices
@@ -64,9 +101,12 @@ struct FlatMap {
   std::vector<std::array<double, 3>> normal;    // unit 3D normal pointing out of the lumen (into the wall)
   std::vector<int> segment;                     // segment id per vertex
   std::vector<int> source_vertex;               // vertex id in the flattened input mesh
+  std::vector<double> centreline_mm;            // arc length of the vertex's centreline slice from the x0 end (mm)
+  std::vector<double> angle_rad;                // angle around the colon, [0, 2 pi) (y / period)
   std::vector<std::array<int, 3>> triangles;    // counter-clockwise in 2D
   std::vector<FlatSegment> segments;
   DistortionStats stats;                        // over all segments
+  Coverage coverage;                            // over all segments
   std::size_t skipped_components = 0;           // small components and cavity walls not flattened
   std::size_t input_vertices = 0, input_faces = 0;
 };
@@ -86,5 +126,7 @@ TriangleList flat_to_surface(const FlatMap& flat, std::vector<int>* flat_to_3d =
 nlohmann::json distortion_to_json(const DistortionStats& s);
 nlohmann::json segment_to_json(const FlatSegment& s);
 nlohmann::json flat_report(const FlatMap& f);
+nlohmann::json coverage_to_json(const Coverage& c);
+Coverage coverage_from_json(const nlohmann::json& j);
 
 }  // namespace cf

@@ -4,8 +4,10 @@
 // is shaded from the 3D normal against a light tilted from the local large-scale wall normal
 // (Gaussian-smoothed normal image) towards the colon axis, so folds and polyps stand out in
 // relief. Optional colouring by shape index. Overlays: polyp candidates outlined with id and
-// size, known polyps (dashed), segment labels and a scale bar in mm (valid at the mean scale:
-// the map is conformal, area-preserving on average). Each band is rolled around the colon so that
+// size, known polyps (dashed), segment labels with the anatomical ends (rectum / cecum or
+// end A / B) at both ends of each band, x-axis ticks in cm along the centreline from the rectal
+// end, hatching where the wall is strongly compressed (blue) or missing from the map (red), and
+// a scale bar in mm (valid at the mean, area-preserving scale). Each band is rolled around the colon so that
 // its cut runs as far as possible from every marker.
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@ struct ColonImageOptions {
   double light_tilt = 0.7;         // tangent component of the light (relief strength)
   int max_width = 12000;           // pixels; pixel_size grows if the colon would be wider
   std::string title;               // top line (empty: automatic)
+  double compressed_ratio = 0.1;   // hatch the wall where the 2D/3D area ratio is below this
 };
 
 struct ImageMarker {
@@ -40,6 +43,8 @@ struct ColonImage {
   double pixel_size = 0;    // mm per pixel actually used
   int width = 0, height = 0;
   std::vector<double> roll; // per segment: y offset of the cut (mm, in [y0, y0 + period))
+  std::size_t missing_pixels = 0;     // band pixels with no wall (hatched red)
+  std::size_t compressed_pixels = 0;  // wall pixels below compressed_ratio (hatched blue)
 };
 
 // `shape_index`: per flat vertex (for color = "curvature"); may be empty.

@@ -1,0 +1,256 @@
+// Local area balancing of the embedding: the symmetric Dirichlet energy (Smith & Schaefer 2015)
+// minimised on the regions whose 2D/3D area ratio is out of bounds, grown until the region has
+// room in 2D, its boundary fixed. Directions come from the cotangent Laplacian (the energy's
+// quadratic proxy, as in SLIM / AQP, factorised once per region); each step is limited so that no
+// face reaches zero area and the energy (infinite for a fold) decreases, so the map stays locally
+// injective inside and, with the fixed boundary, bijective.
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace {
+
+struct Region {
+  std::vector<int> faces;          // faces with a free vertex
+  std::vector<char> free_vertex;
+};
+
+constexpr double kMaxAnisotropy = 3.0;  // quasi-conformal ratio that also seeds a region
+
+// Quasi-conformal ratio sigma1 / sigma2 of a face's 3D -> 2D map.
+double anisotropy(const Surface& s, const Embedding& emb, int f) {
+  const Tri& t = s.t[f];
+  const auto c = emb.corners(s, f);
+  const FaceDistortion d = face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]);
+  return std::isfinite(d.qc) ? d.qc : 1e9;
+}
+
+double ratio_of(const Surface& s, const Embedding& emb, const std::vector<double>& area3, int f) {
+  return area3[f] > 0 ? emb.area2(s, f) / area3[f] : 1.0;
+}
+
+// Seeds: faces out of [lo, hi]; grown by vertex rings (2, 4, 8, ... 64) until the region's 2D
+// area is within [0.6, 1.6] x its 3D area, or it holds half of the faces.
+Region select_region(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
+                     const std::vector<double>& area3, const std::vector<char>& fixed,
+                     const std::vector<char>& degenerate, double lo, double hi) {
+  Region r;
+  std::vector<char> in(s.t.size(), 0);
+  std::vector<int> faces;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    const double q = ratio_of(s, emb, area3, int(f));
+    if (!degenerate[f] && (q < lo || q > hi || anisotropy(s, emb, int(f)) > kMaxAnisotropy))
+      in[f] = 1, faces.push_back(int(f));
+  }
+  if (faces.empty()) return r;
+  std::size_t done = 0;
+  for (int rings = 2; rings <= 64; rings *= 2) {
+    for (int k = 0; k < rings / 2 + (rings == 2); ++k) {
+      const std::size_t n0 = faces.size();
+      for (std::size_t i = done; i < n0; ++i)
+        for (int v : s.t[faces[i]])
+          for (int g : vf[v])
+            if (!in[g]) in[g] = 1, faces.push_back(g);
+      done = n0;
+    }
+    double a2 = 0, a3 = 0;
+    for (int f : faces) a2 += emb.area2(s, f), a3 += area3[f];
+    if ((a2 >= 0.6 * a3 && a2 <= 1.6 * a3) || faces.size() * 2 > s.t.size()) break;
+  }
+  r.free_vertex.assign(s.p.size(), 0);
+  for (int f : faces)
+    for (int v : s.t[f]) r.free_vertex[v] = !fixed[v];
+  for (std::size_t v = 0; v < s.p.size(); ++v)  // vertices on the region's rim stay fixed
+    if (r.free_vertex[v])
+      for (int g : vf[v])
+        if (!in[g]) r.free_vertex[v] = 0;
+  for (int f : faces)
+    for (int v : s.t[f])
+      if (r.free_vertex[v]) {
+        r.faces.push_back(f);
+        break;
+      }
+  return r;
+}
+
+// The 3D triangle in its own plane (2D, mm), and ARAP weights (cotangent of each corner, clamped).
+void local_frames(const Surface& s, const std::vector<int>& faces, std::vector<std::array<V2, 3>>& X,
+                  std::vector<std::array<double, 3>>& w) {
+  X.resize(faces.size());
+  w.resize(faces.size());
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Tri& t = s.t[faces[i]];
+    const V3 e1 = s.p[t[1]] - s.p[t[0]], e2 = s.p[t[2]] - s.p[t[0]];
+    const double l1 = std::max(e1.norm(), 1e-12);
+    const V3 ex = e1 / l1, ey = e1.cross(e2).cross(e1).normalized();
+    X[i] = {V2::Zero(), V2(l1, 0), V2(e2.dot(ex), std::isfinite(e2.dot(ey)) ? e2.dot(ey) : 0.0)};
+    for (int k = 0; k < 3; ++k) {
+      const V2 a = X[i][(k + 1) % 3] - X[i][k], b = X[i][(k + 2) % 3] - X[i][k];
+      const double c = std::abs(a.x() * b.y() - a.y() * b.x());
+      w[i][k] = std::clamp(0.5 * a.dot(b) / std::max(c, 1e-12), 0.01, 100.0);
+    }
+  }
+}
+
+// Largest t in (0, 1] such that along pos + t (next - pos) every face keeps at least
+// min(half its current area, `floor_ratio` x its 3D area): no face can collapse (a barrier in
+// place of the one ARAP lacks), and none that is readable now can become unreadable.
+double max_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
+                const std::vector<double>& area3, double floor_ratio) {
+  auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
+  double tmax = 1.0;
+  for (int f : faces) {
+    const auto c = emb.corners(s, f);
+    const Tri& t = s.t[f];
+    const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
+    const V2 g1 = (next[t[1]] - emb.pos[t[1]]) - (next[t[0]] - emb.pos[t[0]]);
+    const V2 g2 = (next[t[2]] - emb.pos[t[2]]) - (next[t[0]] - emb.pos[t[0]]);
+    const double A = cross(e1, e2), B = cross(e1, g2) + cross(g1, e2), C = cross(g1, g2);
+    if (A <= 0) continue;  // degenerate or already folded: not judged
+    const double floor2 = std::min(0.5 * A, 2 * floor_ratio * area3[f]);  // twice the area, like A
+    // smallest t > 0 with C t^2 + B t + (A - floor2) = 0
+    const double a0 = A - floor2;
+    double root = 1e300;
+    if (std::abs(C) < 1e-300) {
+      if (B < 0) root = -a0 / B;
+    } else {
+      const double disc = B * B - 4 * a0 * C;
+      if (disc >= 0) {
+        const double sq = std::sqrt(disc);
+        for (double r : {(-B - sq) / (2 * C), (-B + sq) / (2 * C)})
+          if (r > 0) root = std::min(root, r);
+      }
+    }
+    tmax = std::min(tmax, root);
+  }
+  return std::max(0.0, tmax);
+}
+
+// Symmetric Dirichlet energy sum_f A3_f (|J|^2 + |J^-1|^2) of the region's faces (Smith &
+// Schaefer 2015; infinite for a folded face), with J the 3D -> 2D Jacobian of each face.
+struct SymmetricDirichlet {
+  const Surface& s;
+  const Embedding& emb;
+  const std::vector<int>& faces;
+  std::vector<Eigen::Matrix2d> x_inv;  // inverse of the 3D triangle's edge matrix in its plane
+  std::vector<double> area3;
+
+  Eigen::Matrix2d jacobian(const std::vector<V2>& pos, std::size_t i) const {
+    const int f = faces[i];
+    const Tri& t = s.t[f];
+    Eigen::Matrix2d D;
+    const V2 c0 = pos[t[0]] + V2(0, emb.dy[f][0]);
+    D.col(0) = pos[t[1]] + V2(0, emb.dy[f][1]) - c0;
+    D.col(1) = pos[t[2]] + V2(0, emb.dy[f][2]) - c0;
+    return D * x_inv[i];
+  }
+  double energy(const std::vector<V2>& pos) const {
+    double e = 0;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      const Eigen::Matrix2d J = jacobian(pos, i);
+      const double det = J.determinant();
+      if (det <= 0) return kHugeEnergy;
+      e += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
+    }
+    return e;
+  }
+  // Gradient with respect to the unknowns of `sys` (n x 2).
+  Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const {
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Eigen::Index(sys.unknowns().size()), 2);
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      const Eigen::Matrix2d J = jacobian(pos, i);
+      const double det = J.determinant(), n2 = J.squaredNorm();
+      const Eigen::Matrix2d dJ = 2 * J * (1 + 1 / (det * det)) - 2 * n2 / (det * det) * J.inverse().transpose();
+      const Eigen::Matrix2d G = area3[i] * dJ * x_inv[i].transpose();
+      const Tri& t = s.t[faces[i]];
+      const V2 grad[3] = {-(G.col(0) + G.col(1)), G.col(0), G.col(1)};
+      for (int k = 0; k < 3; ++k)
+        if (sys.index(t[k]) >= 0) g.row(sys.index(t[k])) += grad[k].transpose();
+    }
+    return g;
+  }
+  static constexpr double kHugeEnergy = 1e300;
+};
+
+SymmetricDirichlet make_energy(const Surface& s, const Embedding& emb, const std::vector<int>& faces) {
+  SymmetricDirichlet sd{s, emb, faces, {}, {}};  // `faces`: the region's faces that are not folded
+  std::vector<std::array<V2, 3>> X;
+  std::vector<std::array<double, 3>> w;
+  local_frames(s, faces, X, w);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    Eigen::Matrix2d M;
+    M.col(0) = X[i][1] - X[i][0];
+    M.col(1) = X[i][2] - X[i][0];
+    const double det = M.determinant();
+    sd.x_inv.push_back(std::abs(det) > 1e-300 ? Eigen::Matrix2d(M.inverse()) : Eigen::Matrix2d::Identity());
+    sd.area3.push_back(0.5 * std::abs(det));
+  }
+  return sd;
+}
+
+// Minimises the symmetric Dirichlet energy on one region: direction = -L^-1 grad (L the
+// cotangent Laplacian of the 3D triangles: the energy's quadratic proxy, factorised once), step =
+// 0.9 x the largest step keeping every face positive, halved until the energy decreases enough.
+int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3) {
+  std::vector<std::array<V2, 3>> X;
+  std::vector<std::array<double, 3>> w;
+  local_frames(s, r.faces, X, w);
+  RegionSystem sys;
+  if (!sys.build(s, r.free_vertex, r.faces, w)) return 0;
+  std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
+  for (int f : r.faces)
+    if (emb.area2(s, f) > 0) unfolded.push_back(f);
+  const SymmetricDirichlet sd = make_energy(s, emb, unfolded);
+  double e0 = sd.energy(emb.pos);
+  if (e0 >= SymmetricDirichlet::kHugeEnergy) return 0;  // the region is not injective: leave it
+  int it = 0;
+  std::vector<V2> trial;
+  for (; it < iterations; ++it) {
+    const Eigen::MatrixXd g = sd.gradient(emb.pos, sys);
+    const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
+    const double slope = (g.array() * d.array()).sum();
+    if (!(slope < 0)) break;
+    std::vector<V2> next = emb.pos;
+    for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
+    double t = std::min(1.0, 0.9 * max_step(s, emb, next, unfolded, area3, 0.0));
+    double e1 = SymmetricDirichlet::kHugeEnergy;
+    for (int half = 0; half < 30; ++half, t *= 0.5) {
+      trial = emb.pos;
+      for (std::size_t i = 0; i < sys.unknowns().size(); ++i) trial[sys.unknowns()[i]] += t * V2(d(i, 0), d(i, 1));
+      e1 = sd.energy(trial);
+      if (e1 <= e0 + 1e-4 * t * slope) break;
+    }
+    if (!(e1 < e0)) break;
+    emb.pos.swap(trial);
+    const double gain = (e0 - e1) / e0;
+    e0 = e1;
+    if (gain < 1e-4) break;
+  }
+  return it;
+}
+
+}  // namespace
+
+BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                           const std::vector<char>& fixed, const std::vector<char>& degenerate,
+                           const FlattenOptions& o) {
+  BalanceResult res;
+  std::vector<double> area3(s.t.size());
+  for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
+  std::vector<char> moved(s.p.size(), 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    const Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
+    if (r.faces.empty()) break;
+    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3));
+    res.faces = std::max(res.faces, r.faces.size());
+    for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || r.free_vertex[v];
+  }
+  res.vertices = std::size_t(std::count(moved.begin(), moved.end(), 1));
+  return res;
+}
+
+}  // namespace cf::flat_detail

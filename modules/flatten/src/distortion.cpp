@@ -1,0 +1,227 @@
+// Distortion measures of the flat map (quasi-conformal ratio, area ratio), its coverage of the
+// 3D wall, and their JSON form.
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "colonflat/core/params.h"
+#include "colonflat/core/union_find.h"
+#include "flatten_internal.h"
+
+namespace cf {
+namespace flat_detail {
+
+FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0,
+                               const V2& q1, const V2& q2) {
+  const V3 e1 = p1 - p0, e2 = p2 - p0;
+  const V3 n = e1.cross(e2);
+  const double a3 = 0.5 * n.norm();
+  const double l1 = e1.norm();
+  FaceDistortion d{kInf, a3, 0, false};
+  const Eigen::Vector2d d1 = q1 - q0, d2 = q2 - q0;
+  d.area2 = 0.5 * (d1.x() * d2.y() - d1.y() * d2.x());
+  if (a3 <= 0 || l1 <= 0) return d;
+  const V3 x = e1 / l1, y = n.normalized().cross(x);
+  Eigen::Matrix2d S, Q;
+  S << l1, e2.dot(x), 0, e2.dot(y);
+  Q << d1.x(), d2.x(), d1.y(), d2.y();
+  const Eigen::Matrix2d J = Q * S.inverse();
+  const double E_ = (J(0, 0) + J(1, 1)) / 2, F = (J(0, 0) - J(1, 1)) / 2, G = (J(1, 0) + J(0, 1)) / 2,
+               H = (J(1, 0) - J(0, 1)) / 2;
+  const double Qn = std::hypot(E_, H), R = std::hypot(F, G);
+  d.qc = std::abs(Qn - R) > 0 ? (Qn + R) / std::abs(Qn - R) : kInf;
+  return d;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(p * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+DistortionStats stats_of(const std::vector<FaceDistortion>& fd) {
+  DistortionStats s;
+  s.faces = fd.size();
+  if (fd.empty()) return s;
+  std::vector<double> qc, ar;
+  qc.reserve(fd.size());
+  ar.reserve(fd.size());
+  double a3 = 0, a2 = 0;
+  for (const auto& d : fd) a3 += d.area3, a2 += std::abs(d.area2);
+  const double scale = a2 > 0 ? a3 / a2 : 1;
+  double qsum = 0, lsum = 0, wsum = 0;
+  for (const auto& d : fd) {
+    if (d.degenerate) {
+      ++s.degenerate;
+      continue;
+    }
+    if (d.area2 <= 0) ++s.flipped;
+    const double q = std::isfinite(d.qc) ? d.qc : 1e9;
+    qc.push_back(q);
+    qsum += q;
+    s.qc_max = std::max(s.qc_max, q);
+    if (d.area3 > 0) {
+      const double r = std::abs(d.area2) * scale / d.area3;
+      ar.push_back(r);
+      if (r > 0) lsum += d.area3 * std::abs(std::log2(r)), wsum += d.area3;
+    }
+  }
+  s.qc_mean = qc.empty() ? 0 : qsum / double(qc.size());
+  s.qc_p95 = percentile(qc, 0.95);
+  s.area_p05 = percentile(ar, 0.05);
+  s.area_median = percentile(ar, 0.5);
+  s.area_p95 = percentile(ar, 0.95);
+  s.area_log2_mean_abs = wsum > 0 ? lsum / wsum : 0;
+  return s;
+}
+
+
+Coverage coverage_of(const Surface& s, const Edges& E, const std::vector<char>& in_map,
+                     const std::vector<double>& ratio, double min_ratio, double removed_cap_area) {
+  Coverage c;
+  c.end_cap_area_mm2 = removed_cap_area;
+  UnionFind uf(s.t.size());
+  std::vector<char> hidden(s.t.size(), 0);
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    const double a = face_area_3d(s, int(f));
+    c.wall_area_mm2 += a;
+    if (!in_map[f]) c.missing_area_mm2 += a, hidden[f] = 1;
+    else if (ratio[f] < min_ratio) c.compressed_area_mm2 += a, hidden[f] = 1;
+    else c.shown_area_mm2 += a;
+  }
+  c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (E.ef[e][1] >= 0 && hidden[E.ef[e][0]] && hidden[E.ef[e][1]]) uf.unite(E.ef[e][0], E.ef[e][1]);
+  std::unordered_map<std::size_t, Coverage::Cluster> clusters;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (!hidden[f]) continue;
+    auto& cl = clusters[uf.find(f)];
+    const double a = face_area_3d(s, int(f));
+    const Tri& t = s.t[f];
+    const V3 m = (s.p[t[0]] + s.p[t[1]] + s.p[t[2]]) / 3 * a;
+    for (int k = 0; k < 3; ++k) cl.centroid_lps_mm[k] += m[k];
+    cl.area_mm2 += a;
+    ++cl.faces;
+  }
+  for (auto& [root, cl] : clusters) {
+    for (double& x : cl.centroid_lps_mm) x /= std::max(cl.area_mm2, 1e-300);
+    c.not_shown.push_back(cl);
+  }
+  std::sort(c.not_shown.begin(), c.not_shown.end(), [](const auto& a, const auto& b) { return a.area_mm2 > b.area_mm2; });
+  if (c.not_shown.size() > 20) c.not_shown.resize(20);
+  return c;
+}
+
+}  // namespace flat_detail
+
+using flat_detail::FaceDistortion;
+using flat_detail::V3;
+
+DistortionStats distortion_stats(const FlatMap& flat, int segment) {
+  std::vector<FaceDistortion> fd;
+  for (const auto& t : flat.triangles) {
+    if (segment >= 0 && flat.segment[t[0]] != segment) continue;
+    auto P = [&](int i) { return V3(flat.position[i][0], flat.position[i][1], flat.position[i][2]); };
+    auto Q = [&](int i) { return flat_detail::V2(flat.uv[i][0], flat.uv[i][1]); };
+    fd.push_back(flat_detail::face_distortion(P(t[0]), P(t[1]), P(t[2]), Q(t[0]), Q(t[1]), Q(t[2])));
+  }
+  double mean = 0;
+  for (const auto& d : fd) mean += d.area3;
+  mean /= std::max<std::size_t>(1, fd.size());
+  for (auto& d : fd) d.degenerate = d.area3 <= 1e-6 * mean;
+  return flat_detail::stats_of(fd);
+}
+
+nlohmann::json distortion_to_json(const DistortionStats& s) {
+  return {{"faces", s.faces},
+          {"flipped_triangles", s.flipped},
+          {"degenerate_triangles", s.degenerate},
+          {"quasi_conformal_mean", s.qc_mean},
+          {"quasi_conformal_p95", s.qc_p95},
+          {"quasi_conformal_max", s.qc_max},
+          {"area_ratio_p05", s.area_p05},
+          {"area_ratio_median", s.area_median},
+          {"area_ratio_p95", s.area_p95},
+          {"area_log2_mean_abs", s.area_log2_mean_abs}};
+}
+
+
+nlohmann::json coverage_to_json(const Coverage& c) {
+  nlohmann::json cl = nlohmann::json::array();
+  for (const auto& k : c.not_shown)
+    cl.push_back({{"centroid_lps_mm", k.centroid_lps_mm}, {"area_mm2", k.area_mm2}, {"faces", k.faces}});
+  return {{"fraction_shown", c.fraction},
+          {"wall_area_mm2", c.wall_area_mm2},
+          {"shown_area_mm2", c.shown_area_mm2},
+          {"compressed_area_mm2", c.compressed_area_mm2},
+          {"missing_area_mm2", c.missing_area_mm2},
+          {"end_cap_area_mm2", c.end_cap_area_mm2},
+          {"not_shown_clusters", cl}};
+}
+
+Coverage coverage_from_json(const nlohmann::json& j) {
+  Coverage c;
+  c.fraction = j.value("fraction_shown", 1.0);
+  c.wall_area_mm2 = j.value("wall_area_mm2", 0.0);
+  c.shown_area_mm2 = j.value("shown_area_mm2", 0.0);
+  c.compressed_area_mm2 = j.value("compressed_area_mm2", 0.0);
+  c.missing_area_mm2 = j.value("missing_area_mm2", 0.0);
+  c.end_cap_area_mm2 = j.value("end_cap_area_mm2", 0.0);
+  if (j.contains("not_shown_clusters"))
+    for (const auto& k : j["not_shown_clusters"]) {
+      Coverage::Cluster cl;
+      cl.centroid_lps_mm = k.at("centroid_lps_mm").get<std::array<double, 3>>();
+      cl.area_mm2 = k.value("area_mm2", 0.0);
+      cl.faces = k.value("faces", std::size_t(0));
+      c.not_shown.push_back(cl);
+    }
+  return c;
+}
+
+nlohmann::json segment_to_json(const FlatSegment& s) {
+  nlohmann::json j = {{"id", s.id},
+                      {"component", s.component},
+                      {"input", s.input_kind},
+                      {"rectangle_mm", {{"x0", s.x0}, {"y0", s.y0}, {"length", s.length}, {"period", s.period}}},
+                      {"area_3d_mm2", s.area_3d},
+                      {"faces", s.faces},
+                      {"vertices", s.vertices},
+                      {"removed_end_faces", s.removed_faces},
+                      {"end_a_lps_mm", s.end_a},
+                      {"end_b_lps_mm", s.end_b},
+                      {"weights", s.weights},
+                      {"untangled_vertices", s.untangled_vertices},
+                      {"crowded_faces_left_out", s.crowded_faces},
+                      {"period_consistency", s.dirichlet_period_ratio},
+                      {"distortion", distortion_to_json(s.stats)}};
+  if (s.map.empty()) return j;
+  j["map"] = s.map;
+  j["centreline_lps_mm"] = s.centreline;
+  j["centreline_length_mm"] = s.centreline_length;
+  if (!s.centreline_x.empty()) j["centreline_to_x_mm"] = s.centreline_x;
+  j["x0_end"] = s.x0_end;
+  j["x1_end"] = s.x1_end;
+  j["order"] = s.order;
+  j["centreline_offset_mm"] = s.centreline_offset;
+  j["balanced_vertices"] = s.balanced_vertices;
+  j["coverage"] = coverage_to_json(s.coverage);
+  return j;
+}
+
+nlohmann::json flat_report(const FlatMap& f) {
+  nlohmann::json segs = nlohmann::json::array();
+  for (const auto& s : f.segments) segs.push_back(segment_to_json(s));
+  return {{"segments", segs},
+          {"segment_count", f.segments.size()},
+          {"skipped_components", f.skipped_components},
+          {"flat_vertices", f.uv.size()},
+          {"flat_triangles", f.triangles.size()},
+          {"coverage", coverage_to_json(f.coverage)},
+          {"distortion", distortion_to_json(f.stats)}};
+}
+
+}  // namespace cf

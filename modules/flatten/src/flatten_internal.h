@@ -1,0 +1,180 @@
+#pragma once
+// Internal pieces of the flatten stage (not installed): the local surface of one colon segment,
+// its edge graph, the harmonic (conformal) solve, the 2D embedding on the periodic cylinder,
+// the centreline, the area balancing and the distortion measures. See docs/flatten.md.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "colonflat/flatten/flatten.h"
+
+namespace cf::flat_detail {
+
+using V3 = Eigen::Vector3d;
+using V2 = Eigen::Vector2d;
+using Tri = std::array<int, 3>;
+
+// One colon segment as an indexed triangle surface (LPS mm).
+struct Surface {
+  std::vector<V3> p;
+  std::vector<Tri> t;
+  std::vector<int> src;  // input vertex id of each local vertex
+};
+
+// Edge graph: edges lo < hi, their one or two faces, and the edge opposite each face corner.
+struct Edges {
+  std::vector<std::array<int, 2>> ev;
+  std::vector<std::array<int, 2>> ef;  // [1] = -1 on the boundary
+  std::vector<std::array<int, 3>> fe;
+};
+Edges build_edges(const std::vector<Tri>& t);  // throws PreconditionError on a non-manifold edge
+
+struct Csr {  // vertex adjacency with edge lengths (mm)
+  std::vector<int> start, nbr;
+  std::vector<double> len;
+};
+Csr build_csr(const Surface& s, const Edges& E);
+std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources);
+int argmax_finite(const std::vector<double>& d);
+std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E);
+double face_area_3d(const Surface& s, int f);
+
+// The segment opened into an annulus: caps of geodesic radius <= `radius` removed at closed ends.
+struct Opened {
+  Surface annulus;
+  std::size_t removed = 0;
+};
+Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
+
+// Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
+// eta the cut cocycle (per edge, lo -> hi), period = the conformal period in u units.
+struct Harmonic {
+  Eigen::VectorXd u, v;
+  std::vector<signed char> eta;
+  double period = 0;
+  double energy_u = 0;
+  std::string weights;
+};
+Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
+                        const std::vector<int>& loop_b, bool clamp);
+
+// A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
+// per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.
+struct Embedding {
+  std::vector<V2> pos;
+  std::vector<std::array<double, 3>> dy;
+  double period = 0;
+  std::array<V2, 3> corners(const Surface& s, int f) const {
+    const Tri& t = s.t[f];
+    return {pos[t[0]] + V2(0, dy[f][0]), pos[t[1]] + V2(0, dy[f][1]), pos[t[2]] + V2(0, dy[f][2])};
+  }
+  double area2(const Surface& s, int f) const {  // signed 2D area
+    const auto c = corners(s, f);
+    const V2 a = c[1] - c[0], b = c[2] - c[0];
+    return 0.5 * (a.x() * b.y() - a.y() * b.x());
+  }
+};
+// (u, sign * v * period) * scale, corners lifted so that each face's centroid y lies in [0, P).
+Embedding embed_conformal(const Surface& s, const Edges& E, const Harmonic& h, double sign, double scale);
+// Re-places each corner offset so that every face's centroid y lies in [0, period).
+void normalise_corner_offsets(const Surface& s, Embedding& emb);
+
+// Vertex -> incident faces.
+std::vector<std::vector<int>> vertex_faces(const Surface& s);
+
+// Re-embeds the vertices of flipped faces and rings around them with uniform (Tutte) weights,
+// the ends and the ring around the region fixed. Returns the number of vertices moved.
+std::size_t untangle(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                     const std::vector<char>& fixed, const std::vector<char>& degenerate);
+
+// Per-face quadratic system on a region: minimises sum_f sum_k w_fk |c_a - c_b - t_fk|^2 over the
+// free vertices (c = corner positions, (a, b) = the corners after k), the others fixed.
+class RegionSystem {
+ public:
+  // `free_vertex[v]` true for unknowns; `faces`: faces with at least one free vertex; `w`: per face
+  // of `faces`, the weight of the edge opposite each corner (> 0).
+  bool build(const Surface& s, const std::vector<char>& free_vertex, const std::vector<int>& faces,
+             const std::vector<std::array<double, 3>>& w);
+  // New positions of the free vertices for targets t (per face of `faces`, per corner k: the
+  // target of c_{k+1} - c_{k+2}); returns them as a full-size copy of emb.pos.
+  std::vector<V2> solve(const Surface& s, const Embedding& emb, const std::vector<std::array<V2, 3>>& t) const;
+  // x = A^-1 b for the system matrix A (n x 2, rows in the order of unknowns()).
+  Eigen::MatrixXd solve_raw(const Eigen::MatrixXd& b) const;
+  // Unknown index of a vertex (-1 when fixed).
+  int index(int v) const { return index_[v]; }
+  const std::vector<int>& faces() const { return faces_; }
+  const std::vector<int>& unknowns() const { return vars_; }
+
+ private:
+  struct Impl;
+  std::vector<int> faces_, vars_, index_;
+  std::vector<std::array<double, 3>> w_;
+  std::shared_ptr<Impl> impl_;
+};
+
+// Centreline of a segment from the level sets of u (per vertex in [0,1]): area-weighted
+// centroids of slices, smoothed; s_of_u maps u to arc length (mm), strictly increasing.
+struct Centreline {
+  std::vector<std::array<double, 3>> points;  // LPS mm, end A first
+  std::vector<double> knot_u, knot_s;         // s(u) piecewise linear through these knots
+  double length = 0;                          // mm
+  std::vector<double> area_cdf;               // wall area fraction with u' < k / (size - 1), increasing
+  double s_of_u(double u) const;
+  double area_fraction_of_u(double u) const;  // in [0, 1], strictly increasing
+};
+// `use_face`: faces taken into the slices and the area function (the conformal map's crowded
+// faces, area ratio < 0.05, are left out: they sit at single u values and would make jumps).
+Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face,
+                             const V3& end_a, const V3& end_b);
+
+// Labels the segments' ends (rectum: inferior, near the midline x; cecum: the patient's right),
+// with a margin of 25 mm, else "end A" / "end B"; orients each segment so that x0 is the rectal
+// end (`reversed`: swap x, end_a/end_b already swapped) and orders the segments rectum -> cecum.
+void label_ends(std::vector<FlatSegment>& segs, double midline_x, std::vector<char>& reversed);
+
+// Local area balancing: symmetric Dirichlet energy minimised on the regions whose area ratio is
+// out of [lo, hi], grown until their 2D area is comparable to their 3D area, boundary fixed;
+// Laplacian-preconditioned descent with a flip-preventing, Armijo line search.
+struct BalanceResult {
+  std::size_t vertices = 0, faces = 0, iterations = 0;
+};
+BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                           const std::vector<char>& fixed, const std::vector<char>& degenerate,
+                           const FlattenOptions& o);
+
+// Per-face distortion of a map triangle.
+struct FaceDistortion {
+  double qc, area3, area2;
+  bool degenerate = false;
+};
+FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0, const V2& q1, const V2& q2);
+DistortionStats stats_of(const std::vector<FaceDistortion>& fd);
+double percentile(std::vector<double> v, double p);
+
+// Coverage of the 3D wall by the map (faces shown: in the map, area ratio >= min_ratio).
+Coverage coverage_of(const Surface& s, const Edges& E, const std::vector<char>& in_map,
+                     const std::vector<double>& ratio, double min_ratio, double removed_cap_area);
+
+// One flattened segment before the layout.
+struct SegmentWork {
+  FlatSegment seg;
+  Surface ann;
+  Embedding emb;
+  std::vector<char> in_map;   // per face: in the map (positive area)
+  std::vector<double> along;  // per vertex: centreline arc length from end A (mm)
+  double lumen_sign = 1;      // face normals x sign point out of the lumen
+};
+
+// Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those
+// flagged (x -> L - x, y -> P - y), and writes vertices (one per vertex and sheet), triangles,
+// per-vertex data, overall distortion and coverage into `out`.
+void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reversed, const FlattenOptions& o,
+                   FlatMap& out);
+
+}  // namespace cf::flat_detail

@@ -1,0 +1,101 @@
+// Layout of the flattened segments and the output FlatMap.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace {
+
+void reverse_segment(SegmentWork& w) {
+  const double L = w.seg.length, P = w.seg.period, C = w.seg.centreline_length;
+  for (auto& q : w.emb.pos) q = V2(L - q.x(), P - q.y());
+  for (auto& d : w.emb.dy)
+    for (double& x : d) x = -x;
+  for (double& a : w.along) a = C - a;
+  std::reverse(w.seg.centreline.begin(), w.seg.centreline.end());
+  for (auto& q : w.seg.centreline_x) q = {C - q[0], L - q[1]};
+  std::reverse(w.seg.centreline_x.begin(), w.seg.centreline_x.end());
+}
+
+void emit_one(const SegmentWork& w, FlatMap& out) {
+  const Surface& ann = w.ann;
+  const FlatSegment& seg = w.seg;
+  std::vector<V3> nrm(ann.p.size(), V3::Zero());
+  for (const Tri& t : ann.t) {
+    const V3 n = (ann.p[t[1]] - ann.p[t[0]]).cross(ann.p[t[2]] - ann.p[t[0]]);
+    for (int v : t) nrm[v] += n;
+  }
+  std::unordered_map<long long, int> vid;
+  vid.reserve(ann.p.size() * 11 / 10);
+  const double P = seg.period;
+  for (std::size_t f = 0; f < ann.t.size(); ++f) {
+    if (!w.in_map[f]) continue;
+    const auto c = w.emb.corners(ann, int(f));
+    Tri ot;
+    for (int k = 0; k < 3; ++k) {
+      const int v = ann.t[f][k];
+      const long long sheet = std::llround(w.emb.dy[f][k] / P);
+      const long long key = (long long)v * 64 + (sheet + 32);
+      auto it = vid.find(key);
+      if (it == vid.end()) {
+        it = vid.emplace(key, int(out.uv.size())).first;
+        out.uv.push_back({seg.x0 + c[k].x(), seg.y0 + c[k].y()});
+        out.position.push_back({ann.p[v].x(), ann.p[v].y(), ann.p[v].z()});
+        const V3 n = (w.lumen_sign * nrm[v]).normalized();
+        out.normal.push_back({n.x(), n.y(), n.z()});
+        out.segment.push_back(seg.id);
+        out.source_vertex.push_back(ann.src[v]);
+        out.centreline_mm.push_back(w.along[v]);
+        const double a = std::fmod(c[k].y() / P, 1.0);
+        out.angle_rad.push_back(2 * M_PI * (a < 0 ? a + 1 : a >= 1 ? 0 : a));
+      }
+      ot[k] = it->second;
+    }
+    out.triangles.push_back(ot);
+  }
+}
+
+Coverage total_coverage(const std::vector<FlatSegment>& segs) {
+  Coverage c;
+  for (const auto& s : segs) {
+    c.wall_area_mm2 += s.coverage.wall_area_mm2;
+    c.shown_area_mm2 += s.coverage.shown_area_mm2;
+    c.compressed_area_mm2 += s.coverage.compressed_area_mm2;
+    c.missing_area_mm2 += s.coverage.missing_area_mm2;
+    c.end_cap_area_mm2 += s.coverage.end_cap_area_mm2;
+    c.not_shown.insert(c.not_shown.end(), s.coverage.not_shown.begin(), s.coverage.not_shown.end());
+  }
+  c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
+  std::sort(c.not_shown.begin(), c.not_shown.end(), [](const auto& a, const auto& b) { return a.area_mm2 > b.area_mm2; });
+  if (c.not_shown.size() > 20) c.not_shown.resize(20);
+  return c;
+}
+
+}  // namespace
+
+void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reversed, const FlattenOptions& o,
+                   FlatMap& out) {
+  std::vector<int> order(work.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return work[a].seg.order < work[b].seg.order; });
+  double y_cursor = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    SegmentWork& w = work[order[k]];
+    if (reversed[order[k]]) reverse_segment(w);
+    normalise_corner_offsets(w.ann, w.emb);
+    w.seg.id = int(k);
+    w.seg.order = int(k);
+    w.seg.x0 = 0;
+    w.seg.y0 = y_cursor;
+    y_cursor += w.seg.period + o.segment_gap;
+    emit_one(w, out);
+    out.segments.push_back(w.seg);
+  }
+  out.stats = distortion_stats(out);
+  out.coverage = total_coverage(out.segments);
+}
+
+}  // namespace cf::flat_detail

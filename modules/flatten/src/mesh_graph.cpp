@@ -1,0 +1,226 @@
+// Edge graph, geodesic distances, boundary loops and the opening of closed ends into an annulus.
+#include "flatten_internal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <unordered_map>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/params.h"
+#include "colonflat/core/union_find.h"
+
+namespace cf::flat_detail {
+
+Edges build_edges(const std::vector<Tri>& t) {
+  Edges E;
+  std::vector<std::pair<std::uint64_t, int>> keys;
+  keys.reserve(3 * t.size());
+  for (std::size_t f = 0; f < t.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::uint64_t a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
+      if (a > b) std::swap(a, b);
+      keys.push_back({(a << 32) | b, int(3 * f + k)});
+    }
+  std::sort(keys.begin(), keys.end());
+  E.fe.assign(t.size(), {-1, -1, -1});
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i;
+    while (j < keys.size() && keys[j].first == keys[i].first) ++j;
+    if (j - i > 2) throw PreconditionError("non-manifold edge in a colon segment; flatten needs a 2-manifold");
+    const int e = int(E.ev.size());
+    E.ev.push_back({int(keys[i].first >> 32), int(keys[i].first & 0xffffffffu)});
+    E.ef.push_back({keys[i].second / 3, j - i == 2 ? keys[i + 1].second / 3 : -1});
+    for (std::size_t q = i; q < j; ++q) E.fe[keys[q].second / 3][keys[q].second % 3] = e;
+    i = j;
+  }
+  return E;
+}
+
+Csr build_csr(const Surface& s, const Edges& E) {
+  Csr g;
+  const std::size_t nv = s.p.size();
+  g.start.assign(nv + 1, 0);
+  for (const auto& e : E.ev) ++g.start[e[0] + 1], ++g.start[e[1] + 1];
+  for (std::size_t i = 0; i < nv; ++i) g.start[i + 1] += g.start[i];
+  g.nbr.resize(g.start[nv]);
+  g.len.resize(g.start[nv]);
+  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  for (const auto& e : E.ev) {
+    const double l = (s.p[e[0]] - s.p[e[1]]).norm();
+    g.nbr[fill[e[0]]] = e[1], g.len[fill[e[0]]++] = l;
+    g.nbr[fill[e[1]]] = e[0], g.len[fill[e[1]]++] = l;
+  }
+  return g;
+}
+
+std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources) {
+  std::vector<double> d(g.start.size() - 1, kInf);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
+  for (int s : sources) d[s] = 0, q.push({0.0, s});
+  while (!q.empty()) {
+    auto [dv, v] = q.top();
+    q.pop();
+    if (dv > d[v]) continue;
+    for (int k = g.start[v]; k < g.start[v + 1]; ++k) {
+      const double nd = dv + g.len[k];
+      if (nd < d[g.nbr[k]]) d[g.nbr[k]] = nd, q.push({nd, g.nbr[k]});
+    }
+  }
+  return d;
+}
+
+int argmax_finite(const std::vector<double>& d) {
+  int best = 0;
+  for (std::size_t i = 0; i < d.size(); ++i)
+    if (std::isfinite(d[i]) && (!std::isfinite(d[best]) || d[i] > d[best])) best = int(i);
+  return best;
+}
+
+namespace {
+
+// Keeps the largest edge-connected set of faces among `keep`.
+void keep_largest_component(const Edges& E, std::vector<char>& keep) {
+  const std::size_t nf = keep.size();
+  std::vector<int> comp(nf, -1);
+  int best = -1;
+  std::size_t best_size = 0;
+  int ncomp = 0;
+  std::vector<int> stack;
+  for (std::size_t f0 = 0; f0 < nf; ++f0) {
+    if (!keep[f0] || comp[f0] >= 0) continue;
+    std::size_t size = 0;
+    stack.push_back(int(f0));
+    comp[f0] = ncomp;
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      ++size;
+      for (int e : E.fe[f])
+        for (int g : E.ef[e])
+          if (g >= 0 && keep[g] && comp[g] < 0) comp[g] = ncomp, stack.push_back(g);
+    }
+    if (size > best_size) best_size = size, best = ncomp;
+    ++ncomp;
+  }
+  for (std::size_t f = 0; f < nf; ++f) keep[f] = keep[f] && comp[f] == best;
+}
+
+// Surface made of the kept faces, reindexed; `old_of_new` maps new vertex ids to old ones.
+Surface sub_surface(const Surface& s, const std::vector<char>& keep) {
+  Surface r;
+  std::vector<int> map(s.p.size(), -1);
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (!keep[f]) continue;
+    Tri t;
+    for (int k = 0; k < 3; ++k) {
+      int& m = map[s.t[f][k]];
+      if (m < 0) {
+        m = int(r.p.size());
+        r.p.push_back(s.p[s.t[f][k]]);
+        r.src.push_back(s.src[s.t[f][k]]);
+      }
+      t[k] = m;
+    }
+    r.t.push_back(t);
+  }
+  return r;
+}
+
+}  // namespace
+
+// Boundary vertex sets (one per loop) of a surface, via its boundary edges.
+std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E) {
+  UnionFind uf(s.p.size());
+  std::vector<char> on(s.p.size(), 0);
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (E.ef[e][1] < 0) uf.unite(E.ev[e][0], E.ev[e][1]), on[E.ev[e][0]] = on[E.ev[e][1]] = 1;
+  std::unordered_map<int, int> id;
+  std::vector<std::vector<int>> loops;
+  for (std::size_t v = 0; v < s.p.size(); ++v) {
+    if (!on[v]) continue;
+    const int r = int(uf.find(v));
+    auto it = id.find(r);
+    if (it == id.end()) it = id.emplace(r, int(loops.size())).first, loops.emplace_back();
+    loops[it->second].push_back(int(v));
+  }
+  return loops;
+}
+
+// Removes caps around the ends of a segment with b boundary loops (b = 0 or 1) so that an annulus
+// remains. Returns the annulus and which of its loops is end A.
+Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius) {
+  const Csr g = build_csr(s, E);
+  std::vector<char> remove(s.t.size(), 0);
+  auto cap = [&](const std::vector<double>& d, int apex, double r) {
+    for (std::size_t f = 0; f < s.t.size(); ++f) {
+      const Tri& t = s.t[f];
+      const double m = (d[t[0]] + d[t[1]] + d[t[2]]) / 3;
+      if (m < r || t[0] == apex || t[1] == apex || t[2] == apex) remove[f] = 1;
+    }
+  };
+  if (nloops == 2) {
+    // a tube: nothing to open, only the boundary clean-up below
+  } else if (nloops == 0) {
+    const auto d0 = dijkstra(g, {0});
+    const int a = argmax_finite(d0);
+    const auto da = dijkstra(g, {a});
+    const int b = argmax_finite(da);
+    const auto db = dijkstra(g, {b});
+    const double r = std::min(radius, 0.1 * da[b]);
+    cap(da, a, r);
+    cap(db, b, r);
+  } else {
+    std::vector<int> bverts;
+    for (std::size_t e = 0; e < E.ev.size(); ++e)
+      if (E.ef[e][1] < 0) bverts.push_back(E.ev[e][0]), bverts.push_back(E.ev[e][1]);
+    const auto dl = dijkstra(g, bverts);
+    const int b = argmax_finite(dl);
+    const auto db = dijkstra(g, {b});
+    cap(db, b, std::min(radius, 0.1 * dl[b]));
+  }
+  std::vector<char> keep(s.t.size());
+  for (std::size_t f = 0; f < s.t.size(); ++f) keep[f] = !remove[f];
+  // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
+  // faces around them and keep the largest piece, until the boundary is clean.
+  for (int iter = 0; iter < 200; ++iter) {
+    keep_largest_component(E, keep);
+    std::vector<int> bcount(s.p.size(), 0);
+    for (std::size_t e = 0; e < E.ev.size(); ++e) {
+      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
+      const int k = (f0 >= 0 && keep[f0]) + (f1 >= 0 && keep[f1]);
+      if (k == 1) ++bcount[E.ev[e][0]], ++bcount[E.ev[e][1]];
+    }
+    // Also faces with all three corners on the boundary: the harmonic function, constant along
+    // each end, would collapse them.
+    bool changed = false;
+    std::vector<char> bad(s.p.size(), 0);
+    for (std::size_t v = 0; v < s.p.size(); ++v) bad[v] = bcount[v] > 2;
+    for (std::size_t f = 0; f < s.t.size(); ++f) {
+      if (!keep[f]) continue;
+      const Tri& t = s.t[f];
+      const bool all_on = bcount[t[0]] > 0 && bcount[t[1]] > 0 && bcount[t[2]] > 0;
+      if (all_on || bad[t[0]] || bad[t[1]] || bad[t[2]]) keep[f] = 0, changed = true;
+    }
+    if (!changed) break;
+  }
+  Opened o;
+  o.annulus = sub_surface(s, keep);
+  o.removed = s.t.size() - o.annulus.t.size();
+  return o;
+}
+
+double face_area_3d(const Surface& s, int f) {
+  const Tri& t = s.t[f];
+  return 0.5 * (s.p[t[1]] - s.p[t[0]]).cross(s.p[t[2]] - s.p[t[0]]).norm();
+}
+
+std::vector<std::vector<int>> vertex_faces(const Surface& s) {
+  std::vector<std::vector<int>> vf(s.p.size());
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    for (int v : s.t[f]) vf[v].push_back(int(f));
+  return vf;
+}
+
+}  // namespace cf::flat_detail
