@@ -30,6 +30,10 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 namespace cf {
 namespace {
 
+// The image's margins (pixels): left/right, above the top band (title), between bands (labels),
+// below the bottom band (ticks, scale bar, legend); and the narrowest image.
+constexpr int kMargin = 30, kTop = 70, kGap = 64, kBottom = 90, kMinWidth = 400;
+
 struct Band {
   int seg = 0;
   int w = 0, h = 0;   // pixels
@@ -249,37 +253,51 @@ void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int
     }
 }
 
+ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, int max_width) {
+  ColonImageGeometry g;
+  double max_length = 0;
+  for (const auto& s : flat.segments) max_length = std::max(max_length, s.length);
+  g.pixel_size = max_length / pixel_size > max_width ? max_length / max_width : pixel_size;
+  int rows = kBottom, width = kMinWidth;
+  for (int i = int(flat.segments.size()) - 1; i >= 0; --i) {
+    const FlatSegment& s = flat.segments[i];
+    ColonImageBand b;
+    b.segment = i;
+    b.w = std::max(1, int(std::ceil(s.length / g.pixel_size)));
+    b.h = std::max(1, int(std::ceil(s.period / g.pixel_size)));
+    b.col0 = kMargin;
+    b.row_bottom = rows;
+    rows += b.h + kGap;
+    width = std::max(width, b.w + 2 * kMargin);
+    g.bands.push_back(b);
+  }
+  g.width = width;
+  g.height = rows - kGap + kTop;
+  return g;
+}
+
 ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, std::vector<ImageMarker>& markers,
                               const ColonImageOptions& o) {
   if (o.color != "shading" && o.color != "curvature")
     throw UsageError("--color must be shading or curvature (got '" + o.color + "')");
   VtkMessageCapture msgs;
   ColonImage out;
-  double maxlen = 0;
-  for (const auto& s : f.segments) maxlen = std::max(maxlen, s.length);
-  double px = o.pixel_size;
-  if (maxlen / px > o.max_width) px = maxlen / o.max_width;
+  const ColonImageGeometry geo = colon_image_geometry(f, o.pixel_size, o.max_width);
+  const double px = geo.pixel_size;
+  const int margin = kMargin, width = geo.width, height = geo.height;
   out.pixel_size = px;
-  const int margin = 30, top = 70, gap = 64, bottom = 90;
   const std::vector<double> vratio = vertex_area_ratio(f);
   std::vector<Band> bands;
-  int width = 0, rows = bottom;
-  // bands from the bottom of the VTK image upwards, last segment lowest
-  for (int i = int(f.segments.size()) - 1; i >= 0; --i) {
-    const auto& s = f.segments[i];
+  for (const ColonImageBand& g : geo.bands) {
     Band b;
-    b.seg = i;
-    b.w = std::max(1, int(std::ceil(s.length / px)));
-    b.h = std::max(1, int(std::ceil(s.period / px)));
-    b.col0 = margin;
-    b.row0 = rows;
-    rows += b.h + gap;
-    b.c0 = choose_roll(s, markers);
-    width = std::max(width, b.w + 2 * margin);
+    b.seg = g.segment;
+    b.w = g.w;
+    b.h = g.h;
+    b.col0 = g.col0;
+    b.row0 = g.row_bottom;
+    b.c0 = choose_roll(f.segments[g.segment], markers);
     bands.push_back(b);
   }
-  const int height = rows - gap + top;
-  width = std::max(width, 400);
   out.width = width;
   out.height = height;
   out.roll.assign(f.segments.size(), 0);

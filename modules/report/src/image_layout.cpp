@@ -5,36 +5,30 @@
 #include <limits>
 #include <sstream>
 
+#include "colonflat/render/colon_image.h"
+
 namespace cf {
 namespace {
-
-// The render stage's margins (colon_image.cpp): left/right margin, top, gap between bands, bottom.
-constexpr int kMargin = 30, kTop = 70, kGap = 46, kBottom = 70, kMinWidth = 400;
 
 double wrap(double v, double period) { return std::fmod(std::fmod(v, period) + period, period); }
 
 }  // namespace
 
 ColonImageLayout::ColonImageLayout(const FlatMap& flat, double pixel_size, int max_width) : flat_(flat) {
-  double max_length = 0;
-  for (const auto& s : flat.segments) max_length = std::max(max_length, s.length);
-  pixel_size_ = max_length / pixel_size > max_width ? max_length / max_width : pixel_size;
-  int rows = kBottom, width = kMinWidth;
-  for (int i = int(flat.segments.size()) - 1; i >= 0; --i) {
-    const FlatSegment& s = flat.segments[i];
+  const ColonImageGeometry geometry = colon_image_geometry(flat, pixel_size, max_width);
+  pixel_size_ = geometry.pixel_size;
+  width_ = geometry.width;
+  height_ = geometry.height;
+  for (const ColonImageBand& g : geometry.bands) {
     ImageBand b;
-    b.segment = i;
-    b.w = std::max(1, int(std::ceil(s.length / pixel_size_)));
-    b.h = std::max(1, int(std::ceil(s.period / pixel_size_)));
-    b.col0 = kMargin;
-    b.row_bottom = rows;
-    b.roll = s.y0;
-    rows += b.h + kGap;
-    width = std::max(width, b.w + 2 * kMargin);
+    b.segment = g.segment;
+    b.col0 = g.col0;
+    b.row_bottom = g.row_bottom;
+    b.w = g.w;
+    b.h = g.h;
+    b.roll = flat.segments[g.segment].y0;  // render's roll when a band has no marker
     bands_.push_back(b);
   }
-  width_ = width;
-  height_ = rows - kGap + kTop;
 }
 
 const ImageBand* ColonImageLayout::band_of(int segment) const {

@@ -47,6 +47,22 @@ struct ColonImage {
   std::size_t compressed_pixels = 0;  // wall pixels below compressed_ratio (hatched blue)
 };
 
+// Where each segment's band lies in the image: one band per segment, stacked from the image bottom
+// (last segment lowest), x along the colon from the band's left edge. The one place that sets the
+// image's margins and size; the review report uses it to map pixels back to the flat map.
+struct ColonImageBand {
+  int segment = 0;
+  int col0 = 0;        // left column of the band
+  int row_bottom = 0;  // bottom row of the band, counted from the image bottom (VTK rows)
+  int w = 0, h = 0;    // band size in pixels
+};
+struct ColonImageGeometry {
+  double pixel_size = 0;  // mm per pixel actually used (grows when the colon exceeds max_width)
+  int width = 0, height = 0;
+  std::vector<ColonImageBand> bands;  // bottom band first
+};
+ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, int max_width);
+
 // `shape_index`: per flat vertex (for color = "curvature"); may be empty.
 ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& shape_index,
                               std::vector<ImageMarker>& markers, const ColonImageOptions& opts);

@@ -4,7 +4,7 @@
 //
 // The render stage stacks one band per segment (last segment lowest), x along the colon from the
 // band's left edge, y around it starting at a per-segment roll (the cut), at `pixel_size` mm per
-// pixel. ColonImageLayout reproduces that layout (same margins) and takes the rolls from the
+// pixel. ColonImageLayout takes the bands from render's colon_image_geometry() and the rolls from the
 // candidates' (flat position, pixel) pairs written by render; check() compares the result with the
 // image's real size and every candidate's pixel.
 #include <array>
