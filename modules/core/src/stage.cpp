@@ -1,5 +1,6 @@
 #include "colonflat/core/stage.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 
@@ -36,13 +37,20 @@ struct StageFiles {
   bool quiet = false;
 };
 
+// Option name of a secondary port: kebab-case ("snapshot_before" -> "--snapshot-before").
+std::string port_option(const Port& p) {
+  std::string n = p.name;
+  std::replace(n.begin(), n.end(), '_', '-');
+  return "--" + n;
+}
+
 void add_port_options(CLI::App& app, const StageSpec& spec, StageFiles& f) {
   for (std::size_t i = 0; i < spec.inputs.size(); ++i) {
     const Port& p = spec.inputs[i];
     const std::string desc = p.help + ": " + p.type->description;
     if (i == 0) app.add_option("input", f.inputs[p.name], desc)->required()->type_name("FILE");
     else {
-      auto* o = app.add_option("--" + p.name, f.inputs[p.name], desc)->type_name("FILE");
+      auto* o = app.add_option(port_option(p), f.inputs[p.name], desc)->type_name("FILE");
       if (p.required) o->required();
     }
   }
@@ -50,7 +58,7 @@ void add_port_options(CLI::App& app, const StageSpec& spec, StageFiles& f) {
     const Port& p = spec.outputs[i];
     const std::string desc = p.help + ": " + p.type->description;
     if (i == 0) app.add_option("-o,--output", f.outputs[p.name], desc)->required()->type_name("FILE");
-    else app.add_option("--" + p.name, f.outputs[p.name], desc + " (optional)")->type_name("FILE");
+    else app.add_option(port_option(p), f.outputs[p.name], desc + " (optional)")->type_name("FILE");
   }
   app.add_option("--report", f.report, "write the stage report (parameters, counts, time, memory) as JSON")
       ->type_name("FILE.json");
@@ -68,7 +76,7 @@ void check_stage_paths(const StageSpec& spec, const StageFiles& f) {
   for (std::size_t i = 0; i < spec.outputs.size(); ++i) {
     const Port& p = spec.outputs[i];
     const std::string& file = f.outputs.at(p.name);
-    if (i == 0 || !file.empty()) plan_port_output(plan, p, file, i == 0 ? "-o" : "--" + p.name);
+    if (i == 0 || !file.empty()) plan_port_output(plan, p, file, i == 0 ? "-o" : port_option(p));
   }
   if (!f.report.empty()) plan.output(f.report, "--report", {".json"});
   if (!f.params_out.empty()) plan.output(f.params_out, "--params-out", {".json"});
