@@ -28,6 +28,7 @@
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
 
+#include "colonflat/core/library_output.h"
 #include "volume_internal.h"
 
 namespace cf {
@@ -141,9 +142,7 @@ void check_geometry(const itk::ImageBase<3>* img, const std::string& where) {
   }
 }
 
-}  // namespace
-
-FloatImage::Pointer read_any(const fs::path& p, const VolumeReadOptions& opts) {
+FloatImage::Pointer read_any_uncaptured(const fs::path& p, const VolumeReadOptions& opts) {
   quiet_libraries();
   fs::path dir;
   std::string uid;
@@ -158,6 +157,27 @@ FloatImage::Pointer read_any(const fs::path& p, const VolumeReadOptions& opts) {
     return read_dicom_series(choose_series(p, "", opts, *f), *f, opts);
   }
   return read_image_file(p);
+}
+
+
+}  // namespace
+
+// Reads with the libraries' own printing captured: it is folded into the error, and a read that
+// "succeeded" while the library reported an error is refused.
+FloatImage::Pointer read_any(const fs::path& p, const VolumeReadOptions& opts) {
+  LibraryOutputCapture capture;
+  FloatImage::Pointer img;
+  try {
+    img = read_any_uncaptured(p, opts);
+  } catch (const InputError& e) {
+    const std::string said = capture.text();
+    if (said.empty()) throw;
+    throw InputError(e.file(), e.problem() + " (library: " + said.substr(0, 160) + ")");
+  }
+  const std::string said = capture.text();
+  if (said.find("rror") != std::string::npos || said.find("not read") != std::string::npos)
+    throw InputError(p.string(), "the reader reported a problem: " + said.substr(0, 200));
+  return img;
 }
 
 }  // namespace vio
