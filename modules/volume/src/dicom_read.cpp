@@ -27,6 +27,8 @@
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
 
+#include <set>
+
 #include "colonflat/core/memory_budget.h"
 #include "volume_internal.h"
 
@@ -59,26 +61,7 @@ std::vector<std::string> sorted_checked_series(const fs::path& dir, const Scanne
     throw InputError(where, fname(first) + " is an enhanced multi-frame CT (" +
                                 (frames.empty() ? std::string("several") : frames) +
                                 " frames), which is not supported; export a classic single-frame CT series");
-  // A truncated file (uncompressed transfer syntaxes).
-  for (const auto& file : files) {
-    const std::string ts = trim(f.scanner.GetValue(file.c_str(), kTransferSyntax));
-    if (ts != "1.2.840.10008.1.2" && ts != "1.2.840.10008.1.2.1" && ts != "1.2.840.10008.1.2.2") continue;
-    if (!has_dicom_magic(file)) continue;  // without a preamble the meta length below is not comparable
-    // GDCM pads truncated pixel data silently: compare the file size with the length its data set
-    // declares (meta header with preamble, plus the data set with its pixel data).
-    gdcm::Reader r;
-    r.SetFileName(file.c_str());
-    const bool ok = r.Read();
-    const gdcm::DataSet& ds = r.GetFile().GetDataSet();
-    const double declared = double(r.GetFile().GetHeader().GetFullLength()) +
-                            double(ts == "1.2.840.10008.1.2" ? ds.GetLength<gdcm::ImplicitDataElement>()
-                                                             : ds.GetLength<gdcm::ExplicitDataElement>());
-    std::error_code ec;
-    const double have = double(fs::file_size(file, ec));
-    if (!ok || (!ec && have < declared))
-      throw InputError(where, fname(file) + " is truncated (" + format_number(have) + " bytes; its header declares " +
-                                  format_number(declared) + ")");
-  }
+  for (const auto& file : files) check_dicom_length(file, where, trim(f.scanner.GetValue(file.c_str(), kTransferSyntax)));
   if (files.size() == 1) return files;
   const std::vector<double> iop = ds_values(trim(f.scanner.GetValue(first.c_str(), kIop)));
   if (iop.size() != 6) throw InputError(where, fname(first) + ": no valid ImageOrientationPatient (0020,0037)");
@@ -120,6 +103,38 @@ std::vector<std::string> sorted_checked_series(const fs::path& dir, const Scanne
   for (const auto& d : v) out.push_back(d.name);
   return out;
 }
+
+}  // namespace
+
+// GDCM pads truncated pixel data silently: compare the file size with the length its data set
+// declares (meta header with preamble, plus the data set with its pixel data). Uncompressed
+// transfer syntaxes with a preamble only (else the lengths are not comparable).
+void check_dicom_length(const fs::path& file, const std::string& where, const std::string& ts) {
+  if (ts != "1.2.840.10008.1.2" && ts != "1.2.840.10008.1.2.1" && ts != "1.2.840.10008.1.2.2") return;
+  if (!has_dicom_magic(file)) return;
+  gdcm::Reader r;
+  r.SetFileName(file.c_str());
+  const bool ok = r.Read();
+  const gdcm::DataSet& ds = r.GetFile().GetDataSet();
+  const double declared = double(r.GetFile().GetHeader().GetFullLength()) +
+                          double(ts == "1.2.840.10008.1.2" ? ds.GetLength<gdcm::ImplicitDataElement>()
+                                                           : ds.GetLength<gdcm::ExplicitDataElement>());
+  std::error_code ec;
+  const double have = double(fs::file_size(file, ec));
+  if (!ok || (!ec && have < declared))
+    throw InputError(where, file.filename().string() + " is truncated (" + format_number(have) +
+                                " bytes; its header declares " + format_number(declared) + ")");
+}
+
+std::string dicom_transfer_syntax(const fs::path& file) {
+  gdcm::Reader r;
+  r.SetFileName(file.c_str());
+  std::set<gdcm::Tag> tags{gdcm::Tag(0x0002, 0x0010)};
+  if (!r.ReadSelectedTags(tags)) return "";
+  return r.GetFile().GetHeader().GetDataSetTransferSyntax().GetString() ? trim(r.GetFile().GetHeader().GetDataSetTransferSyntax().GetString()) : "";
+}
+
+namespace {
 
 std::string series_list_text(const ScannedFolder& f) {
   std::string s;

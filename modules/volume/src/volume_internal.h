@@ -48,6 +48,10 @@ std::unique_ptr<ScannedFolder> scan_folder(const fs::path& dir);
 // "DIR/UID" where DIR exists and UID looks like a DICOM UID.
 bool split_series_path(const fs::path& p, fs::path& dir, std::string& uid);
 DicomChoice choose_series(const fs::path& dir, std::string uid, const VolumeReadOptions& opts, const ScannedFolder& f);
+// Throws InputError(where, "<file> is truncated ...") when an uncompressed DICOM file is shorter
+// than its data set declares; `ts` is its transfer syntax UID.
+void check_dicom_length(const fs::path& file, const std::string& where, const std::string& ts);
+std::string dicom_transfer_syntax(const fs::path& file);
 FloatImage::Pointer read_dicom_series(const DicomChoice& c, const ScannedFolder& f, const VolumeReadOptions& opts);
 
 // Files (volume_read.cpp): any readable volume as float voxels, sizes checked before allocation.

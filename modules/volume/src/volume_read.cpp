@@ -122,6 +122,7 @@ FloatImage::Pointer read_image_file(const fs::path& p) {
                                   " frames) is not supported; export a classic single-frame CT series");
   }
   check_declared_volume(p, *io);
+  if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer())) check_dicom_length(p, where, dicom_transfer_syntax(p));
   auto reader = itk::ImageFileReader<FloatImage>::New();
   reader->SetImageIO(io);
   reader->SetFileName(p.string());
