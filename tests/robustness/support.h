@@ -3,7 +3,13 @@
 // snapshots, leftover detection and the one-line error check.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <map>
+#include <sstream>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -11,6 +17,7 @@
 #include <vector>
 
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/output_check.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/pipeline/registry.h"
