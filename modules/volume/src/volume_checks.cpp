@@ -99,13 +99,14 @@ void check_declared_volume(const fs::path& p, const itk::ImageIOBase& io) {
   const double stored = voxels * double(io.GetComponentSize()) * double(io.GetNumberOfComponents());
   const std::string what = "the header (" + dims + " voxels of " +
                            itk::ImageIOBase::GetComponentTypeAsString(io.GetComponentType()) + ")";
+  const DataSource src = data_source(p);
+  if (src.max_ratio > 0) {
+    std::error_code ec;
+    if (!fs::exists(src.file, ec)) throw InputError(p.string(), "its data file " + src.file.string() + " does not exist");
+    check_declared_data(src.file, what, stored / src.max_ratio);
+  }
   // The file's voxels as read, plus the float copy every reader makes.
   check_memory_budget(p.string(), what, stored + voxels * double(sizeof(float)));
-  const DataSource src = data_source(p);
-  if (src.max_ratio <= 0) return;
-  std::error_code ec;
-  if (!fs::exists(src.file, ec)) throw InputError(p.string(), "its data file " + src.file.string() + " does not exist");
-  check_declared_data(src.file, what, stored / src.max_ratio);
 }
 
 void check_finite_voxels(const FloatImage* img, const std::string& where) {
