@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "colonflat/core/library_output.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/vtk_messages.h"
 #include "info_outputs.h"
@@ -51,6 +52,7 @@ nlohmann::json loops_info(vtkPolyData* pd) {
 OwnOutput inspect_own_output(const std::string& file) {
   OwnOutput out;
   if (mesh_format_from_path(file) != MeshFormat::kVTP) return out;
+  LibraryOutputCapture printed;  // VTK's logger prints to stderr besides the output window
   VtkMessageCapture quiet;
   vtkNew<vtkXMLPolyDataReader> reader;
   reader->SetFileName(file.c_str());

@@ -54,7 +54,7 @@ std::string enlarge(const Sample& s, std::mt19937& rng) {
     return b;
   }
   std::smatch m;
-  const std::string head = b.substr(0, 4096);
+  const std::string head = ext == ".obj" ? b : b.substr(0, 4096);  // OBJ: faces come after every vertex
   if (!std::regex_search(head, m, size_fields().at(ext))) return b;
   const long long value = std::stoll(m[1].str());
   const long long bigger = value * std::uniform_int_distribution<long long>(2, 1000000)(rng) + 10;
@@ -99,6 +99,7 @@ std::vector<Sample> samples(const testing::TempDir& dir) {
   ascii.binary = false;
   write_mesh(mesh, dir / "m.obj", ascii);
   add("m.obj", true);
+  v.back().magic_at = v.back().bytes.find("\nv ") + 1;  // OBJ has no magic: break the first vertex
   write_mesh(mesh, dir / "m.ply");
   add("m.ply", false);
   write_mesh(mesh, dir / "m.stl");
@@ -113,13 +114,15 @@ std::vector<Sample> samples(const testing::TempDir& dir) {
   write_itk(ct.GetPointer(), dir / "vz.nrrd", true);
   add("vz.nrrd", false);
   write_itk(ct.GetPointer(), dir / "v.nii", false);
-  add("v.nii", false);
+  add("v.nii", false, 344);  // NIfTI-1 magic "n+1" at byte 344
   write_itk(ct.GetPointer(), dir / "v.nii.gz", true);
   add("v.nii.gz", false);
   write_itk(ct.GetPointer(), dir / "v.mha", false);
   add("v.mha", false);
+  v.back().magic_at = v.back().bytes.find("ElementType = ") + 14;  // MetaImage: no magic; break the voxel type
   write_itk(ct.GetPointer(), dir / "vz.mha", true);
   add("vz.mha", false);
+  v.back().magic_at = v.back().bytes.find("ElementType = ") + 14;  // MetaImage: no magic; break the voxel type
   write_dicom_series(ct.GetPointer(), dir / "dicom");
   fs::copy_file(dir / "dicom" / "IM00001.dcm", dir / "v.dcm");
   add("v.dcm", false, 128);

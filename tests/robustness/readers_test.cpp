@@ -53,7 +53,7 @@ TEST(RobustReaders, VolumesCutInHalfRefused) {
 TEST(RobustReaders, HugeDeclaredNrrdRefusedFast) {
   testing::TempDir dir;
   spit(dir / "big.nrrd", "NRRD0004\ntype: short\ndimension: 3\nsizes: 1500 1500 1500\nencoding: raw\n"
-                         "endian: little\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nspace: left-posterior-superior\n\n" +
+                         "endian: little\nspace: left-posterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n\n" +
                              std::string(1000, '\0'));
   expect_bad_input(dir / "big.nrrd", "1500 x 1500 x 1500");
   spit(dir / "bigz.nrrd", "NRRD0004\ntype: short\ndimension: 3\nsizes: 1500 1500 1500\nencoding: gzip\n"

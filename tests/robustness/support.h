@@ -43,7 +43,7 @@ inline std::vector<std::string> listing(const fs::path& dir) {
   std::vector<std::string> v;
   std::error_code ec;
   if (!fs::exists(dir, ec)) return v;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) v.push_back(fs::relative(e.path(), dir).string());
+  for (const auto& e : fs::recursive_directory_iterator(dir)) v.push_back(e.path().lexically_relative(dir).string());
   std::sort(v.begin(), v.end());
   return v;
 }

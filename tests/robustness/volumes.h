@@ -1,6 +1,9 @@
 #pragma once
 // Tiny volumes for the robustness suite, written through ITK (the formats' own writers).
 #include <itkImageFileWriter.h>
+#include <itkMetaImageIO.h>
+#include <itkNiftiImageIO.h>
+#include <itkNrrdImageIO.h>
 
 #include "colonflat/volume/volume_io.h"
 #include "support.h"
@@ -29,6 +32,10 @@ inline CtImage::Pointer small_ct() {
 template <class TImage>
 void write_itk(const TImage* img, const fs::path& path, bool compress) {
   auto w = itk::ImageFileWriter<TImage>::New();
+  const std::string ext = full_extension(path);  // IO chosen here: the build registers no factories
+  if (ext == ".nrrd") w->SetImageIO(itk::NrrdImageIO::New());
+  else if (ext == ".mha") w->SetImageIO(itk::MetaImageIO::New());
+  else w->SetImageIO(itk::NiftiImageIO::New());
   w->SetInput(img);
   w->SetFileName(path.string());
   w->SetUseCompression(compress);

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "colonflat/core/error.h"
 #include "colonflat/core/memory_budget.h"
 
 namespace cf {
@@ -79,7 +80,30 @@ void check_stl(const std::filesystem::path& path, const std::string& head) {
   check_counts(path, 3.0 * n, n, 84.0 + 50.0 * n);
 }
 
+// True when `word` occurs anywhere in the file (read in 1 MiB chunks).
+bool file_contains(const std::filesystem::path& path, const std::string& word) {
+  std::ifstream in(path, std::ios::binary);
+  std::string carry, chunk(1 << 20, '\0');
+  while (in.read(&chunk[0], static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    const std::string window = carry + chunk.substr(0, static_cast<std::size_t>(in.gcount()));
+    if (window.find(word) != std::string::npos) return true;
+    carry = window.substr(window.size() > word.size() ? window.size() - word.size() : 0);
+  }
+  return false;
+}
+
+// VTK 9.1's legacy reader can crash on a file cut before its sections (e.g. inside FIELD), so a
+// file without a POINTS and a cell section is refused before VTK sees it.
+void check_vtk_legacy_sections(const std::filesystem::path& path) {
+  if (!file_contains(path, "POINTS "))
+    throw InputError(path.string(), "no POINTS section (truncated or not a VTK PolyData file)");
+  for (const char* cells : {"POLYGONS ", "TRIANGLE_STRIPS ", "LINES ", "VERTICES "})
+    if (file_contains(path, cells)) return;
+  throw InputError(path.string(), "no cell section (POLYGONS, LINES, ...): truncated file?");
+}
+
 void check_vtk_legacy(const std::filesystem::path& path, const std::string& head) {
+  check_vtk_legacy_sections(path);
   const double np = largest_match(head, std::regex(R"(POINTS\s+(\d+))"));
   const double nc = largest_match(head, std::regex(R"((?:POLYGONS|TRIANGLE_STRIPS|LINES|VERTICES)\s+\d+\s+(\d+))"));
   check_counts(path, np, nc, 3.0 * std::max(np, 0.0) + 1.0 * std::max(nc, 0.0));

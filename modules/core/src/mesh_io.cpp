@@ -29,6 +29,7 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/library_output.h"
 #include "colonflat/core/memory_budget.h"
 #include "colonflat/core/vtk_convert.h"
 #include "colonflat/core/vtk_messages.h"
@@ -129,6 +130,7 @@ std::string first_line(std::string s) {
 }
 
 PolygonSoup read_vtk_polydata(const fs::path& path, MeshFormat fmt) {
+  LibraryOutputCapture printed;  // VTK's logger prints errors to stderr besides the output window
   VtkMessageCapture vtk_messages;
   vtkSmartPointer<vtkPolyData> pd;
   if (fmt == MeshFormat::kVTP) {
@@ -222,6 +224,8 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
     const std::string warn = captured.str();
     if (warn.find("nexpected end") != std::string::npos || warn.find("runcat") != std::string::npos)
       throw InputError(name, "truncated file: " + first_line(warn));
+    if (warn.find("rror") != std::string::npos)  // a reader that skipped what it could not parse
+      throw InputError(name, "cannot parse as " + path.extension().string().substr(1) + " file: " + first_line(warn));
   }
   if (soup.points.empty() && soup.num_faces() == 0) throw InputError(name, "empty mesh: no vertices and no faces");
   return soup;
@@ -281,6 +285,7 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
     }
     OpenMesh::IO::Options opt;
     if (wo.binary && (*fmt == MeshFormat::kPLY || *fmt == MeshFormat::kSTL)) opt += OpenMesh::IO::Options::Binary;
+    LibraryOutputCapture printed;  // OpenMesh's writers log "[OBJWriter] : write file"
     if (!OpenMesh::IO::write_mesh(mesh, tmp.string(), opt, static_cast<std::streamsize>(wo.ascii_precision)))
       throw Error(path.string() + ": cannot write mesh");
   });

@@ -126,6 +126,19 @@ void check_dicom_length(const fs::path& file, const std::string& where, const st
                                 " bytes; its header declares " + format_number(declared) + ")");
 }
 
+bool dicom_meta_complete(const fs::path& file) {
+  // Preamble (128) + "DICM" + (0002,0000) UL group length: tag 4 + VR 2 + length 2 + value 4.
+  std::ifstream in(file, std::ios::binary);
+  unsigned char head[144] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  if (in.gcount() != 144 || std::memcmp(head + 128, "DICM", 4) != 0) return false;
+  if (!(head[132] == 2 && head[133] == 0 && head[134] == 0 && head[135] == 0 && head[136] == 'U' && head[137] == 'L'))
+    return true;  // no group length: GDCM parses element by element
+  const std::uint32_t group = head[140] | (head[141] << 8) | (head[142] << 16) | (std::uint32_t(head[143]) << 24);
+  std::error_code ec;
+  return double(fs::file_size(file, ec)) >= 144.0 + double(group) + 8.0;  // meta group + one data element tag
+}
+
 std::string dicom_transfer_syntax(const fs::path& file) {
   gdcm::Reader r;
   r.SetFileName(file.c_str());
@@ -154,8 +167,14 @@ std::unique_ptr<ScannedFolder> scan_folder(const fs::path& dir) {
   for (const auto& t : {kSeriesUid, kIpp, kIop, kSopClass, kModality, kFrames, kDescription, kTransferSyntax})
     f->scanner.AddTag(t);
   if (files.empty()) return f;
-  f->scanner.Scan(files);
-  for (const auto& file : files) {
+  // GDCM (Debian's build keeps assertions) aborts on a file cut inside its meta header: such files
+  // are left out here, so a series with one shows a missing slice.
+  std::vector<std::string> complete;
+  for (const auto& file : files)
+    if (dicom_meta_complete(file)) complete.push_back(file);
+  if (complete.empty()) return f;
+  f->scanner.Scan(complete);
+  for (const auto& file : complete) {
     if (!f->scanner.IsKey(file.c_str())) continue;
     const std::string uid = trim(f->scanner.GetValue(file.c_str(), kSeriesUid));
     f->series[uid].push_back(file);

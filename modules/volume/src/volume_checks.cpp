@@ -2,11 +2,14 @@
 // the file(s) and against the memory budget (before ITK allocates anything), non-finite voxels,
 // and whether a volume is a mask at all.
 #include <itkImageIOBase.h>
+#include <zlib.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/memory_budget.h"
@@ -87,9 +90,52 @@ DataSource data_source(const fs::path& p) {
   return {p, 0.0};  // DICOM file: transfer syntax decides; GDCM checks its own lengths
 }
 
+// A single-file NIfTI carries "n+1\0" at byte 344 (NIfTI-1) or "n+2\0" at byte 4 (NIfTI-2);
+// without it the NIfTI library falls back to reading the header as ANALYZE 7.5, which a .nii is not.
+void check_nifti_magic(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  char head[348] = {};
+  in.read(head, sizeof head);
+  const bool nifti1 = in.gcount() == 348 && std::memcmp(head + 344, "n+1\0", 4) == 0;
+  const bool nifti2 = in.gcount() >= 8 && std::memcmp(head + 4, "n+2\0", 4) == 0;
+  if (!nifti1 && !nifti2) throw InputError(p.string(), "not a NIfTI file: no 'n+1' or 'n+2' magic (corrupt header?)");
+}
+
+// A gzip file must decompress to its end without error and hold at least `needed` bytes: the
+// NIfTI library zero-fills a truncated .nii.gz silently. Streams through zlib, 64 KiB at a time.
+void check_gzip_complete(const fs::path& p, double needed, const std::string& what) {
+  gzFile gz = gzopen(p.c_str(), "rb");
+  if (!gz) throw InputError(p.string(), "cannot open for reading");
+  std::vector<char> buf(1 << 16);
+  double total = 0;
+  int n = 0;
+  while ((n = gzread(gz, buf.data(), static_cast<unsigned>(buf.size()))) > 0) total += n;
+  int code = Z_OK;
+  const std::string why = n < 0 ? gzerror(gz, &code) : "";
+  gzclose(gz);
+  if (n < 0) throw InputError(p.string(), "corrupt or truncated gzip data (" + why + ")");
+  // The trailer's ISIZE (last 4 bytes) is the decompressed length mod 2^32: a file cut inside its
+  // trailer still decompresses, but this no longer matches.
+  std::ifstream tail(p, std::ios::binary | std::ios::ate);
+  unsigned char isize[4] = {};
+  if (tail.tellg() >= 4) {
+    tail.seekg(-4, std::ios::end);
+    tail.read(reinterpret_cast<char*>(isize), 4);
+  }
+  const std::uint32_t declared = isize[0] | (isize[1] << 8) | (isize[2] << 16) | (std::uint32_t(isize[3]) << 24);
+  if (declared != static_cast<std::uint32_t>(static_cast<std::uint64_t>(total)))
+    throw InputError(p.string(), "truncated gzip file (its trailer does not match the data)");
+  if (total < needed)
+    throw InputError(p.string(), what + " declares " + human_bytes(needed) + " of data but the file decompresses to " +
+                                     human_bytes(total) + " (truncated file or wrong header)");
+}
+
 }  // namespace
 
 void check_declared_volume(const fs::path& p, const itk::ImageIOBase& io) {
+  if (full_ext(p) == ".nii") check_nifti_magic(p);
+  if (io.GetComponentType() == itk::IOComponentEnum::UNKNOWNCOMPONENTTYPE)
+    throw InputError(p.string(), "unknown voxel type in the header (corrupt header?)");
   double voxels = 1;
   std::string dims;
   for (unsigned d = 0; d < io.GetNumberOfDimensions(); ++d) {
@@ -107,6 +153,7 @@ void check_declared_volume(const fs::path& p, const itk::ImageIOBase& io) {
   }
   // The file's voxels as read, plus the float copy every reader makes.
   check_memory_budget(p.string(), what, stored + voxels * double(sizeof(float)));
+  if (full_ext(p) == ".nii.gz") check_gzip_complete(p, stored + 348.0, what);
 }
 
 void check_finite_voxels(const FloatImage* img, const std::string& where) {

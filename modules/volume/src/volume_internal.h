@@ -52,6 +52,9 @@ DicomChoice choose_series(const fs::path& dir, std::string uid, const VolumeRead
 // than its data set declares; `ts` is its transfer syntax UID.
 void check_dicom_length(const fs::path& file, const std::string& where, const std::string& ts);
 std::string dicom_transfer_syntax(const fs::path& file);
+// False when a DICOM Part-10 file lacks its preamble/magic or is cut inside its meta header
+// (GDCM would abort on it).
+bool dicom_meta_complete(const fs::path& file);
 FloatImage::Pointer read_dicom_series(const DicomChoice& c, const ScannedFolder& f, const VolumeReadOptions& opts);
 
 // Files (volume_read.cpp): any readable volume as float voxels, sizes checked before allocation.

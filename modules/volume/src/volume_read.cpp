@@ -85,6 +85,8 @@ FloatImage::Pointer read_image_file(const fs::path& p) {
   const std::string where = p.string();
   auto io = io_for(p, false);
   if (!io) throw InputError(where, "unknown volume format (expected " + std::string(kReadFormats) + ")");
+  if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer()) && !dicom_meta_complete(p))
+    throw InputError(where, "not a complete DICOM file (no 'DICM' preamble, or cut inside its meta header)");
   if (!io->CanReadFile(p.c_str()))
     throw InputError(where, std::string("not a readable ") + io->GetNameOfClass() + " file");
   io->SetFileName(p.string());
