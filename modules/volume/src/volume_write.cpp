@@ -125,6 +125,39 @@ std::string derived_uid(std::uint64_t seed, const std::string& purpose) {
   return "2.25." + std::to_string(a) + std::to_string(b % 100000000000ull);
 }
 
+// The DICOM tags of slice k (0-based) at patient position `pt` (LPS mm).
+std::unique_ptr<itk::MetaDataDictionary> slice_dictionary(const DicomWriteOptions& opt, unsigned k, const double pt[3],
+                                                          const std::string& study, const std::string& series,
+                                                          const std::string& frame, const std::string& iop,
+                                                          const CtImage::SpacingType& sp) {
+  auto d = std::make_unique<itk::MetaDataDictionary>();
+  auto put = [&](const char* tag, const std::string& v) { itk::EncapsulateMetaData<std::string>(*d, tag, v); };
+  put("0008|0016", kCtSop);
+  put("0008|0018", derived_uid(opt.uid_seed, "instance-" + series + "-" + std::to_string(k)));
+  put("0008|0008", "ORIGINAL\\PRIMARY\\AXIAL");
+  put("0008|0060", "CT");
+  put("0008|0070", "ColonFlat");
+  put("0008|103e", opt.series_description);
+  put("0010|0010", opt.patient_name);
+  put("0010|0020", opt.patient_id);
+  put("0020|000d", study);
+  put("0020|000e", series);
+  put("0020|0052", frame);
+  put("0020|0010", "1");
+  put("0020|0011", "1");
+  put("0020|0013", std::to_string(k + 1));
+  put("0020|0032", fmt(pt[0], 10) + "\\" + fmt(pt[1], 10) + "\\" + fmt(pt[2], 10));
+  put("0020|0037", iop);
+  put("0020|1041", fmt(pt[2], 10));
+  put("0028|0030", fmt(sp[1], 10) + "\\" + fmt(sp[0], 10));
+  put("0018|0050", fmt(sp[2], 10));
+  put("0018|0088", fmt(sp[2], 10));
+  put("0028|1052", "0");
+  put("0028|1053", "1");
+  put("0028|1054", "HU");
+  return d;
+}
+
 void write_dicom_series(const CtImage* image, const fs::path& dir, const DicomWriteOptions& opt) {
   quiet_libraries();
   if (!image) throw Error(dir.string() + ": no volume to write");
@@ -170,31 +203,8 @@ void write_dicom_series(const CtImage* image, const fs::path& dir, const DicomWr
     ShortImage::IndexType idx{{0, 0, static_cast<itk::IndexValueType>(k)}};
     ShortImage::PointType pt;
     image->TransformIndexToPhysicalPoint(idx, pt);
-    auto d = std::make_unique<itk::MetaDataDictionary>();
-    auto put = [&](const char* tag, const std::string& v) { itk::EncapsulateMetaData<std::string>(*d, tag, v); };
-    put("0008|0016", kCtSop);
-    put("0008|0018", derived_uid(opt.uid_seed, "instance-" + series + "-" + std::to_string(k)));
-    put("0008|0008", "ORIGINAL\\PRIMARY\\AXIAL");
-    put("0008|0060", "CT");
-    put("0008|0070", "ColonFlat");
-    put("0008|103e", opt.series_description);
-    put("0010|0010", opt.patient_name);
-    put("0010|0020", opt.patient_id);
-    put("0020|000d", study);
-    put("0020|000e", series);
-    put("0020|0052", frame);
-    put("0020|0010", "1");
-    put("0020|0011", "1");
-    put("0020|0013", std::to_string(k + 1));
-    put("0020|0032", fmt(pt[0], 10) + "\\" + fmt(pt[1], 10) + "\\" + fmt(pt[2], 10));
-    put("0020|0037", iop);
-    put("0020|1041", fmt(pt[2], 10));
-    put("0028|0030", fmt(sp[1], 10) + "\\" + fmt(sp[0], 10));
-    put("0018|0050", fmt(sp[2], 10));
-    put("0018|0088", fmt(sp[2], 10));
-    put("0028|1052", "0");
-    put("0028|1053", "1");
-    put("0028|1054", "HU");
+    const double position[3] = {pt[0], pt[1], pt[2]};
+    auto d = slice_dictionary(opt, k, position, study, series, frame, iop, sp);
     arr.push_back(d.get());
     dicts.push_back(std::move(d));
   }
