@@ -6,6 +6,7 @@
 // triangles), masks voxel for voxel (same geometry), anything else byte for byte.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -34,6 +35,12 @@ namespace {
 
 using Call = testing::CommandResult;
 Call colonflat(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
+
+// The CLI option of a secondary port: kebab-case ("snapshot_before" -> "--snapshot-before").
+std::string option(std::string port) {
+  std::replace(port.begin(), port.end(), '_', '-');
+  return "--" + port;
+}
 
 std::string join(const std::vector<std::string>& v) {
   std::string s;
@@ -178,12 +185,12 @@ void check_alone_equals_chained(const std::string& start) {
         continue;
       }
       if (i == 0) args.push_back(f->second.string());
-      else args.insert(args.end(), {"--" + p.name, f->second.string()});
+      else args.insert(args.end(), {option(p.name), f->second.string()});
     }
     for (std::size_t i = 0; i < spec.outputs.size(); ++i) {
       const Port& p = spec.outputs[i];
       const fs::path out = alone / p.file_name;
-      args.insert(args.end(), {i == 0 ? "-o" : "--" + p.name, out.string()});
+      args.insert(args.end(), {i == 0 ? "-o" : option(p.name), out.string()});
       files[p.name] = out;
       outputs.push_back({p.type->name, p.file_name});
     }

@@ -5,6 +5,7 @@
 #include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/pipeline/registry.h"
+#include "info_outputs.h"
 #if __has_include("colonflat/volume/volume_io.h")
 #include "colonflat/volume/volume_io.h"
 #define COLONFLAT_HAS_VOLUME 1
@@ -39,6 +40,16 @@ class InfoTool : public Tool {
 #ifdef COLONFLAT_HAS_VOLUME
       if (!mesh_format_from_path(file) && try_volume_info(file, json, out, series)) return kExitOk;
 #endif
+      const OwnOutput own = inspect_own_output(file);
+      if (own.kind == OwnKind::kLoops) {
+        if (json) out << nlohmann::json{{"file", file}, {"valid", true}, {"loops", own.info}}.dump(2) << "\n";
+        else out << file << "\n" << own_output_text(own);
+        return kExitOk;
+      }
+      if (own.kind == OwnKind::kFlat) {
+        allow_boundary = true;  // a flat map is an open surface by construction
+        if (!json) out << own_output_text(own);
+      }
       PolygonSoup soup = read_polygon_soup(file);
       MeshDiagnosis diag = diagnose_soup(soup);
       std::optional<TopologyReport> topo;
@@ -51,6 +62,7 @@ class InfoTool : public Tool {
       const bool ok = !diag.has_at_least(Severity::kDefect);
       if (json) {
         nlohmann::json j = {{"file", file},
+                            {"kind", own.kind == OwnKind::kFlat ? own.info : nlohmann::json("mesh")},
                             {"valid", ok},
                             {"topology", topo ? topology_to_json(*topo) : nlohmann::json(nullptr)},
                             {"findings", diagnosis_to_json(diag)}};

@@ -1,8 +1,10 @@
 #include "colonflat/core/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <fstream>
 #include <system_error>
 
@@ -12,21 +14,27 @@ namespace fs = std::filesystem;
 
 namespace cf {
 
-fs::path temp_sibling(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  return dir / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                std::to_string(counter++) + target.extension().string());
+namespace {
+
+constexpr const char* kStagingPrefix = ".colonflat-staging-";
+
+fs::path parent_or_dot(const fs::path& p) { return p.has_parent_path() ? p.parent_path() : fs::path("."); }
+
+// Creates the missing folders of `dir`; returns those it created (outermost first).
+std::vector<fs::path> create_folders(const fs::path& dir, const fs::path& for_target) {
+  std::vector<fs::path> missing;
+  for (fs::path d = dir; !d.empty() && !fs::exists(d); d = d.parent_path()) {
+    missing.insert(missing.begin(), d);
+    if (d == d.parent_path()) break;
+  }
+  for (const auto& d : missing) {
+    std::error_code ec;
+    fs::create_directory(d, ec);
+    if (ec) throw Error(for_target.string() + ": cannot create folder " + d.string() + ": " + ec.message());
+  }
+  return missing;
 }
 
-namespace {
-void ensure_parent(const fs::path& target) {
-  if (target.has_parent_path() && !fs::exists(target.parent_path())) {
-    std::error_code ec;
-    fs::create_directories(target.parent_path(), ec);
-    if (ec) throw Error(target.string() + ": cannot create folder " + target.parent_path().string() + ": " + ec.message());
-  }
-}
 void commit_rename(const fs::path& tmp, const fs::path& target) {
   std::error_code ec;
   fs::rename(tmp, target, ec);
@@ -35,40 +43,135 @@ void commit_rename(const fs::path& tmp, const fs::path& target) {
     throw Error(target.string() + ": cannot write: " + ec.message());
   }
 }
+
+// The pid in ".colonflat-staging-<pid>" or ".<stem>.tmp-<pid>-<n><ext>"; 0 when the name is neither.
+long temporary_owner(const std::string& name) {
+  std::size_t at = std::string::npos;
+  if (name.rfind(kStagingPrefix, 0) == 0) at = std::string(kStagingPrefix).size();
+  else if (!name.empty() && name[0] == '.' && name.find(".tmp-") != std::string::npos) at = name.find(".tmp-") + 5;
+  if (at == std::string::npos) return 0;
+  long pid = 0;
+  std::size_t k = at;
+  for (; k < name.size() && std::isdigit(static_cast<unsigned char>(name[k])); ++k) pid = pid * 10 + (name[k] - '0');
+  return k > at ? pid : 0;
+}
+
+bool process_gone(long pid) { return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH; }
+
 }  // namespace
 
+fs::path temp_sibling(const fs::path& target) {
+  static std::atomic<unsigned> counter{0};
+  return parent_or_dot(target) / ("." + target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                                  std::to_string(counter++) + target.extension().string());
+}
+
+std::size_t remove_stale_temporaries(const fs::path& dir) {
+  std::size_t removed = 0;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return 0;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const long pid = temporary_owner(e.path().filename().string());
+    if (!pid || pid == ::getpid() || !process_gone(pid)) continue;
+    std::error_code rec;
+    fs::remove_all(e.path(), rec);
+    if (!rec) ++removed;
+  }
+  return removed;
+}
+
 void write_atomically(const fs::path& target, const std::function<void(const fs::path&)>& write) {
-  ensure_parent(target);
+  create_folders(parent_or_dot(target), target);
+  remove_stale_temporaries(parent_or_dot(target));
   const fs::path tmp = temp_sibling(target);
+  register_for_cleanup(tmp);
   try {
     write(tmp);
     if (!fs::exists(tmp)) throw Error(target.string() + ": the writer produced no file");
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);
+    unregister_for_cleanup(tmp);
     throw;
   }
   commit_rename(tmp, target);
+  unregister_for_cleanup(tmp);
 }
 
+OutputTransaction::OutputTransaction(fs::path staging_root) : root_(std::move(staging_root)) {}
+
 OutputTransaction::~OutputTransaction() {
-  if (committed_) return;
-  for (auto& [tmp, target] : staged_) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
+  std::error_code ec;
+  if (!committed_)
+    for (auto& [tmp, target] : staged_) fs::remove(tmp, ec);
+  for (auto& [tmp, target] : staged_) unregister_for_cleanup(tmp);
+  if (!staging_.empty()) {
+    fs::remove_all(staging_, ec);
+    unregister_for_cleanup(staging_);
+  }
+  for (auto it = created_dirs_.rbegin(); it != created_dirs_.rend(); ++it) {
+    if (!committed_) fs::remove(*it, ec);  // only removes a folder left empty
+    unregister_for_cleanup(*it);
   }
 }
 
 fs::path OutputTransaction::stage(const fs::path& target) {
-  ensure_parent(target);
-  staged_.emplace_back(temp_sibling(target), target);
-  return staged_.back().first;
+  const fs::path dir = parent_or_dot(target);
+  for (const auto& d : create_folders(dir, target)) {
+    created_dirs_.push_back(d);
+    register_for_cleanup(d);
+  }
+  remove_stale_temporaries(dir);
+  fs::path tmp;
+  std::error_code ec;
+  if (!root_.empty() && fs::exists(root_, ec) && fs::equivalent(dir, root_, ec)) {
+    if (staging_.empty()) {
+      staging_ = root_ / (kStagingPrefix + std::to_string(::getpid()));
+      register_for_cleanup(staging_);
+      fs::create_directories(staging_, ec);
+      if (ec) throw Error(target.string() + ": cannot create staging folder " + staging_.string() + ": " + ec.message());
+    }
+    tmp = staging_ / target.filename();
+  } else {
+    tmp = temp_sibling(target);
+  }
+  register_for_cleanup(tmp);
+  staged_.emplace_back(tmp, target);
+  return tmp;
+}
+
+void OutputTransaction::rollback(std::size_t renamed) {
+  std::error_code ec;
+  for (std::size_t i = 0; i < renamed; ++i) fs::remove(staged_[i].second, ec);
+  for (auto& [backup, target] : backups_) fs::rename(backup, target, ec);
+  backups_.clear();
 }
 
 void OutputTransaction::commit() {
   for (auto& [tmp, target] : staged_)
     if (!fs::exists(tmp)) throw Error(target.string() + ": the writer produced no file");
-  for (auto& [tmp, target] : staged_) commit_rename(tmp, target);
+  std::size_t renamed = 0;
+  try {
+    for (auto& [tmp, target] : staged_) {
+      std::error_code ec;
+      if (fs::exists(target, ec) && !fs::is_directory(target, ec)) {
+        const fs::path backup = temp_sibling(target);  // not removed on a signal: it is the old file
+        fs::rename(target, backup, ec);
+        if (!ec) backups_.emplace_back(backup, target);
+      }
+      commit_rename(tmp, target);
+      ++renamed;
+    }
+  } catch (...) {
+    rollback(renamed);
+    throw;
+  }
+  std::error_code ec;
+  for (auto& [backup, target] : backups_) {
+    fs::remove(backup, ec);
+    unregister_for_cleanup(backup);
+  }
+  backups_.clear();
   committed_ = true;
 }
 

@@ -10,12 +10,19 @@ namespace cf {
 const ArtifactType& mesh_artifact() {
   static const ArtifactType t{
       "mesh", "triangle mesh (" + mesh_format_list() + "), LPS mm",
-      [](const std::filesystem::path& p) { return std::any(load_mesh(p).mesh); },
+      // Stage inputs are read strictly: a degenerate face (fewer than 3 vertices, a repeated
+      // corner) is refused with its count and examples rather than silently dropped.
+      [](const std::filesystem::path& p) {
+        LoadPolicy strict;
+        strict.drop_degenerate = false;
+        return std::any(load_mesh(p, strict).mesh);
+      },
       [](const std::any& v, const std::filesystem::path& tmp, const std::filesystem::path& target) {
         // write_mesh renames atomically itself; the caller's transaction renames tmp later.
         (void)target;
         write_mesh(std::any_cast<const Mesh&>(v), tmp);
-      }};
+      },
+      {".vtp", ".vtk", ".off", ".obj", ".ply", ".stl"}};
   return t;
 }
 

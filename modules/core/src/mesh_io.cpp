@@ -29,8 +29,11 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/library_output.h"
+#include "colonflat/core/memory_budget.h"
 #include "colonflat/core/vtk_convert.h"
 #include "colonflat/core/vtk_messages.h"
+#include "mesh_header_check.h"
 
 namespace fs = std::filesystem;
 
@@ -41,7 +44,7 @@ namespace {
 // non-manifold and broken data reach the diagnosis instead of being silently dropped.
 class SoupImporter : public OpenMesh::IO::BaseImporter {
  public:
-  explicit SoupImporter(PolygonSoup& soup) : soup_(soup) {}
+  SoupImporter(PolygonSoup& soup, fs::path file) : soup_(soup), file_(std::move(file)) {}
   using VH = OpenMesh::VertexHandle;
   using FH = OpenMesh::FaceHandle;
   using HH = OpenMesh::HalfedgeHandle;
@@ -93,7 +96,12 @@ class SoupImporter : public OpenMesh::IO::BaseImporter {
   void set_color(FH, const OpenMesh::Vec4f&) override {}
   void set_status(FH, const OpenMesh::Attributes::StatusInfo&) override {}
   void add_texture_information(int, std::string) override {}
+  // Called with the header's counts before any element: the file must be able to hold them (at
+  // least 3 bytes a vertex, 4 a face in any format) and they must fit the memory budget.
   void reserve(unsigned int nv, unsigned int, unsigned int nf) override {
+    const std::string what = "the header (" + std::to_string(nv) + " vertices, " + std::to_string(nf) + " faces)";
+    check_declared_data(file_, what, 3.0 * nv + 4.0 * nf);
+    check_memory_budget(file_.string(), what, 120.0 * nv + 120.0 * nf);
     soup_.points.reserve(nv);
     soup_.face_start.reserve(nf + 1);
     soup_.corners.reserve(3ull * nf);
@@ -108,6 +116,7 @@ class SoupImporter : public OpenMesh::IO::BaseImporter {
     return VH(static_cast<int>(soup_.points.size() - 1));
   }
   PolygonSoup& soup_;
+  fs::path file_;
   std::vector<std::int64_t> ids_;
 };
 
@@ -121,6 +130,7 @@ std::string first_line(std::string s) {
 }
 
 PolygonSoup read_vtk_polydata(const fs::path& path, MeshFormat fmt) {
+  LibraryOutputCapture printed;  // VTK's logger prints errors to stderr besides the output window
   VtkMessageCapture vtk_messages;
   vtkSmartPointer<vtkPolyData> pd;
   if (fmt == MeshFormat::kVTP) {
@@ -178,25 +188,32 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
     if (!probe) throw InputError(name, "cannot open for reading (permissions?)");
     if (probe.peek() == std::ifstream::traits_type::eof()) throw InputError(name, "empty file");
   }
+  check_declared_mesh_size(path, *fmt);
   PolygonSoup soup;
   if (*fmt == MeshFormat::kVTP || *fmt == MeshFormat::kVTK) {
     soup = read_vtk_polydata(path, *fmt);
   } else {
-    SoupImporter importer(soup);
+    SoupImporter importer(soup, path);
     OpenMesh::IO::Options opt;
     // OpenMesh prints parse problems to its own error stream; capture them for the message.
     std::ostringstream captured;
     omerr().disconnect(std::cerr);
     omerr().connect(captured);
     bool ok = false;
+    auto restore = [&] {
+      omerr().flush();
+      omerr().disconnect(captured);
+      omerr().connect(std::cerr);
+    };
     try {
       ok = OpenMesh::IO::IOManager().read(path.string(), importer, opt);
+    } catch (const InputError&) {
+      restore();
+      throw;
     } catch (const std::exception& e) {
       captured << e.what();
     }
-    omerr().flush();
-    omerr().disconnect(captured);
-    omerr().connect(std::cerr);
+    restore();
     if (!ok) {
       std::string why = first_line(captured.str());
       throw InputError(name, "cannot parse as " + path.extension().string().substr(1) + " file" +
@@ -207,6 +224,8 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
     const std::string warn = captured.str();
     if (warn.find("nexpected end") != std::string::npos || warn.find("runcat") != std::string::npos)
       throw InputError(name, "truncated file: " + first_line(warn));
+    if (warn.find("rror") != std::string::npos)  // a reader that skipped what it could not parse
+      throw InputError(name, "cannot parse as " + path.extension().string().substr(1) + " file: " + first_line(warn));
   }
   if (soup.points.empty() && soup.num_faces() == 0) throw InputError(name, "empty mesh: no vertices and no faces");
   return soup;
@@ -266,6 +285,7 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
     }
     OpenMesh::IO::Options opt;
     if (wo.binary && (*fmt == MeshFormat::kPLY || *fmt == MeshFormat::kSTL)) opt += OpenMesh::IO::Options::Binary;
+    LibraryOutputCapture printed;  // OpenMesh's writers log "[OBJWriter] : write file"
     if (!OpenMesh::IO::write_mesh(mesh, tmp.string(), opt, static_cast<std::streamsize>(wo.ascii_precision)))
       throw Error(path.string() + ": cannot write mesh");
   });

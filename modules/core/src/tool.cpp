@@ -1,5 +1,6 @@
 #include "colonflat/core/tool.h"
 
+#include <cstring>
 #include <exception>
 #include <ostream>
 
@@ -9,7 +10,17 @@ namespace cf {
 
 std::string colonflat_version() { return COLONFLAT_VERSION; }
 
-std::string tool_help(CLI::App& app) { return app.help(); }
+namespace {
+// CLI11 shows the default of a negated flag ("--fluid,!--no-fluid") as "{false}": a parser
+// leftover that means nothing to a reader; the help text states the default itself.
+std::string clean_help(std::string help) {
+  for (const char* junk : {"{false}", "{true}"})
+    for (auto at = help.find(junk); at != std::string::npos; at = help.find(junk)) help.erase(at, std::strlen(junk));
+  return help;
+}
+}  // namespace
+
+std::string tool_help(CLI::App& app) { return clean_help(app.help()); }
 
 int run_cli(CLI::App& app, const std::string& tool, const std::vector<std::string>& args, std::ostream& out,
             std::ostream& err, const std::function<int()>& body) {
@@ -18,10 +29,10 @@ int run_cli(CLI::App& app, const std::string& tool, const std::vector<std::strin
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 parses from the back
     app.parse(reversed);
   } catch (const CLI::CallForHelp&) {
-    out << app.help();
+    out << clean_help(app.help());
     return kExitOk;
   } catch (const CLI::CallForAllHelp&) {
-    out << app.help("", CLI::AppFormatMode::All);
+    out << clean_help(app.help("", CLI::AppFormatMode::All));
     return kExitOk;
   } catch (const CLI::CallForVersion&) {
     out << "colonflat " << colonflat_version() << "\n";

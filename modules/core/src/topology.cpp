@@ -66,216 +66,258 @@ void push_example(std::vector<T>& v, const T& x) {
   if (v.size() < TopologyReport::kMaxExamples) v.push_back(x);
 }
 
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+// The steps of analyze_topology over one triangle list, sharing their state (geometry-central
+// style: one short method per step, run in order by run()).
+class TopologyAnalysis {
+ public:
+  explicit TopologyAnalysis(const TriangleList& m)
+      : m_(m), P_(m.points.size()), F_(m.triangles.size()), face_uf_(F_), corner_uf_(3 * F_), orient_(F_),
+        boundary_uf_(P_) {}
+
+  TopologyReport run() {
+    r_.faces = F_;
+    if (!count_vertices_and_bounds()) return std::move(r_);
+    sort_directed_edges();
+    classify_edges();
+    find_fans();
+    build_components();
+    count_component_elements();
+    count_boundary_loops();
+    compute_genera();
+    sort_components();
+    finish_totals();
+    return std::move(r_);
+  }
+
+ private:
+  // Referenced vertices and bounding box; false when no vertex is referenced.
+  bool count_vertices_and_bounds() {
+    referenced_.assign(P_, 0);
+    for (const auto& t : m_.triangles)
+      for (int v : t) referenced_[v] = 1;
+    const double inf = std::numeric_limits<double>::infinity();
+    r_.bbox_min = {inf, inf, inf};
+    r_.bbox_max = {-inf, -inf, -inf};
+    for (std::size_t v = 0; v < P_; ++v) {
+      if (!referenced_[v]) {
+        ++r_.unreferenced_vertices;
+        continue;
+      }
+      ++r_.vertices;
+      for (int a = 0; a < 3; ++a) {
+        r_.bbox_min[a] = std::min(r_.bbox_min[a], m_.points[v][a]);
+        r_.bbox_max[a] = std::max(r_.bbox_max[a], m_.points[v][a]);
+      }
+    }
+    if (r_.vertices == 0) r_.bbox_min = r_.bbox_max = {0, 0, 0};
+    return r_.vertices != 0;
+  }
+
+  // Directed edges grouped by undirected key (then by face).
+  void sort_directed_edges() {
+    recs_.resize(3 * F_);
+    for (std::size_t f = 0; f < F_; ++f) {
+      const auto& t = m_.triangles[f];
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        std::uint64_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
+        if (a > b) std::swap(a, b);
+        recs_[3 * f + k] = {(a << 32) | b, static_cast<std::uint32_t>(f), k};
+      }
+    }
+    std::sort(recs_.begin(), recs_.end(), [](const HalfRecord& x, const HalfRecord& y) {
+      return x.key < y.key || (x.key == y.key && x.face < y.face);
+    });
+  }
+
+  // Each undirected edge: length, boundary / manifold / non-manifold, face connectivity.
+  void classify_edges() {
+    on_boundary_.assign(P_, 0);
+    on_nonmanifold_edge_.assign(P_, 0);
+    face_bad_.assign(F_, 0);
+    edge_face_.reserve(3 * F_ / 2 + 16);
+    edge_is_boundary_.reserve(3 * F_ / 2 + 16);
+    double length_sum = 0;
+    for (std::size_t i = 0; i < recs_.size();) {
+      std::size_t j = i + 1;
+      while (j < recs_.size() && recs_[j].key == recs_[i].key) ++j;
+      const int a = static_cast<int>(recs_[i].key >> 32), b = static_cast<int>(recs_[i].key & 0xffffffffu);
+      const auto& pa = m_.points[a];
+      const auto& pb = m_.points[b];
+      length_sum += std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
+                              (pa[2] - pb[2]) * (pa[2] - pb[2]));
+      edge_face_.push_back(recs_[i].face);
+      edge_is_boundary_.push_back(j - i == 1);
+      for (std::size_t q = i + 1; q < j; ++q) face_uf_.unite(recs_[i].face, recs_[q].face);
+      if (j - i == 1) boundary_edge(a, b);
+      else if (j - i == 2) manifold_edge(a, b, recs_[i], recs_[i + 1]);
+      else nonmanifold_edge(a, b, i, j);
+      i = j;
+    }
+    r_.edges = edge_face_.size();
+    r_.mean_edge_length = r_.edges ? length_sum / static_cast<double>(r_.edges) : 0.0;
+    recs_.clear();
+    recs_.shrink_to_fit();
+  }
+
+  void boundary_edge(int a, int b) {
+    ++r_.boundary_edges;
+    push_example(r_.example_boundary_edges, {a, b});
+    on_boundary_[a] = on_boundary_[b] = 1;
+    boundary_uf_.unite(a, b);
+  }
+
+  // Two faces: orientation consistency and the fans through both end vertices.
+  void manifold_edge(int a, int b, const HalfRecord& x, const HalfRecord& y) {
+    const auto& tx = m_.triangles[x.face];
+    const auto& ty = m_.triangles[y.face];
+    const bool same_dir = tx[x.k] == ty[y.k];  // same direction: oppositely oriented faces
+    if (same_dir) {
+      ++r_.inconsistent_edges;
+      push_example(r_.example_inconsistent_edges, {a, b});
+    }
+    if (!orient_.unite(x.face, y.face, same_dir ? 1 : 0)) {
+      orientable_ = false;
+      contradiction_faces_.push_back(x.face);
+    }
+    corner_uf_.unite(3 * x.face + corner_of(tx, a), 3 * y.face + corner_of(ty, a));
+    corner_uf_.unite(3 * x.face + corner_of(tx, b), 3 * y.face + corner_of(ty, b));
+  }
+
+  void nonmanifold_edge(int a, int b, std::size_t i, std::size_t j) {
+    ++r_.nonmanifold_edges;
+    push_example(r_.example_nonmanifold_edges, {a, b});
+    on_nonmanifold_edge_[a] = on_nonmanifold_edge_[b] = 1;
+    for (std::size_t q = i; q < j; ++q) face_bad_[recs_[q].face] = 1;
+  }
+
+  // Fans per vertex (more than one: non-manifold vertex); faces sharing a vertex join.
+  void find_fans() {
+    first_face_.assign(P_, kNone);
+    std::vector<std::uint32_t> first_fan(P_, kNone);
+    vertex_bad_.assign(P_, 0);
+    for (std::size_t f = 0; f < F_; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const int v = m_.triangles[f][k];
+        if (first_face_[v] == kNone) first_face_[v] = static_cast<std::uint32_t>(f);
+        else face_uf_.unite(first_face_[v], static_cast<std::uint32_t>(f));
+        const std::uint32_t fan = corner_uf_.find(static_cast<std::uint32_t>(3 * f + k));
+        if (first_fan[v] == kNone) first_fan[v] = fan;
+        else if (first_fan[v] != fan) vertex_bad_[v] = 1;
+      }
+    }
+    for (std::size_t v = 0; v < P_; ++v)
+      if (referenced_[v] && (vertex_bad_[v] || on_nonmanifold_edge_[v])) {
+        ++r_.nonmanifold_vertices;
+        push_example(r_.example_nonmanifold_vertices, static_cast<int>(v));
+      }
+  }
+
+  // Components numbered by root of the face union-find.
+  void build_components() {
+    std::vector<int> root_id(F_, -1);
+    r_.face_component.assign(F_, -1);
+    for (std::size_t f = 0; f < F_; ++f) {
+      const std::uint32_t root = face_uf_.find(static_cast<std::uint32_t>(f));
+      if (root_id[root] < 0) {
+        root_id[root] = static_cast<int>(comps_.size());
+        comps_.emplace_back();
+        comps_.back().manifold = true;
+        comps_.back().orientable = true;
+      }
+      const int c = root_id[root];
+      r_.face_component[f] = c;
+      ++comps_[c].faces;
+      if (face_bad_[f]) comps_[c].manifold = false;
+    }
+  }
+
+  void count_component_elements() {
+    for (std::size_t v = 0; v < P_; ++v) {
+      if (!referenced_[v]) continue;
+      auto& c = comps_[r_.face_component[first_face_[v]]];
+      ++c.vertices;
+      if (vertex_bad_[v] || on_nonmanifold_edge_[v]) c.manifold = false;
+    }
+    for (std::size_t e = 0; e < edge_face_.size(); ++e) {
+      auto& c = comps_[r_.face_component[edge_face_[e]]];
+      ++c.edges;
+      if (edge_is_boundary_[e]) ++c.boundary_edges;
+    }
+    for (std::uint32_t f : contradiction_faces_) comps_[r_.face_component[f]].orientable = false;
+  }
+
+  // Boundary loops: connected sets of boundary vertices.
+  void count_boundary_loops() {
+    std::vector<std::uint8_t> loop_counted(P_, 0);
+    for (std::size_t v = 0; v < P_; ++v) {
+      if (!on_boundary_[v]) continue;
+      const std::uint32_t root = boundary_uf_.find(static_cast<std::uint32_t>(v));
+      if (loop_counted[root]) continue;
+      loop_counted[root] = 1;
+      ++comps_[r_.face_component[first_face_[v]]].boundary_loops;
+    }
+  }
+
+  // Per component: chi = V - E + F and g = (2 - chi - b) / 2 where defined.
+  void compute_genera() {
+    for (auto& c : comps_) {
+      c.euler = static_cast<long long>(c.vertices) - static_cast<long long>(c.edges) +
+                static_cast<long long>(c.faces);
+      c.closed = c.boundary_edges == 0;
+      if (c.manifold && c.orientable) {
+        c.genus = static_cast<int>((2 - c.euler - static_cast<long long>(c.boundary_loops)) / 2);
+        genus_sum_ += *c.genus;
+      } else {
+        all_genus_ = false;
+      }
+    }
+  }
+
+  // Largest component first; face_component renumbered.
+  void sort_components() {
+    std::vector<int> order(comps_.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return comps_[x].faces > comps_[y].faces; });
+    std::vector<int> new_id(comps_.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      new_id[order[i]] = static_cast<int>(i);
+      r_.components.push_back(comps_[order[i]]);
+    }
+    for (auto& c : r_.face_component) c = new_id[c];
+  }
+
+  void finish_totals() {
+    r_.euler = static_cast<long long>(r_.vertices) - static_cast<long long>(r_.edges) +
+               static_cast<long long>(r_.faces);
+    for (const auto& c : r_.components) r_.boundary_loops += c.boundary_loops;
+    r_.closed = r_.boundary_edges == 0;
+    r_.manifold = r_.nonmanifold_edges == 0 && r_.nonmanifold_vertices == 0;
+    r_.orientable = orientable_;
+    r_.consistently_oriented = r_.inconsistent_edges == 0 && r_.manifold;
+    if (all_genus_) r_.genus = genus_sum_;
+  }
+
+  const TriangleList& m_;
+  const std::size_t P_, F_;  // #points, #triangles
+  TopologyReport r_;
+  std::vector<HalfRecord> recs_;
+  UnionFind face_uf_, corner_uf_;  // faces by shared vertex/edge; corners by fan around a vertex
+  ParityUnionFind orient_;
+  UnionFind boundary_uf_;
+  std::vector<std::uint8_t> referenced_, on_boundary_, on_nonmanifold_edge_, face_bad_, vertex_bad_;
+  std::vector<std::uint32_t> edge_face_;  // one face per unique edge (per-component counts)
+  std::vector<std::uint8_t> edge_is_boundary_;
+  std::vector<std::uint32_t> first_face_, contradiction_faces_;
+  std::vector<ComponentTopology> comps_;
+  bool orientable_ = true, all_genus_ = true;
+  int genus_sum_ = 0;
+};
+
 }  // namespace
 
-TopologyReport analyze_topology(const TriangleList& m) {
-  TopologyReport r;
-  const std::size_t P = m.points.size();
-  const std::size_t F = m.triangles.size();
-  r.faces = F;
-
-  // Referenced vertices and bounding box.
-  std::vector<std::uint8_t> referenced(P, 0);
-  for (const auto& t : m.triangles)
-    for (int v : t) referenced[v] = 1;
-  r.bbox_min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                std::numeric_limits<double>::infinity()};
-  r.bbox_max = {-r.bbox_min[0], -r.bbox_min[1], -r.bbox_min[2]};
-  for (std::size_t v = 0; v < P; ++v) {
-    if (!referenced[v]) {
-      ++r.unreferenced_vertices;
-      continue;
-    }
-    ++r.vertices;
-    for (int a = 0; a < 3; ++a) {
-      r.bbox_min[a] = std::min(r.bbox_min[a], m.points[v][a]);
-      r.bbox_max[a] = std::max(r.bbox_max[a], m.points[v][a]);
-    }
-  }
-  if (r.vertices == 0) {
-    r.bbox_min = r.bbox_max = {0, 0, 0};
-    return r;
-  }
-
-  // Group directed edges by undirected key.
-  std::vector<HalfRecord> recs(3 * F);
-  for (std::size_t f = 0; f < F; ++f) {
-    const auto& t = m.triangles[f];
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      std::uint64_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
-      if (a > b) std::swap(a, b);
-      recs[3 * f + k] = {(a << 32) | b, static_cast<std::uint32_t>(f), k};
-    }
-  }
-  std::sort(recs.begin(), recs.end(), [](const HalfRecord& x, const HalfRecord& y) {
-    return x.key < y.key || (x.key == y.key && x.face < y.face);
-  });
-
-  UnionFind face_uf(F);
-  UnionFind corner_uf(3 * F);  // fans around vertices
-  ParityUnionFind orient(F);
-  UnionFind boundary_uf(P);
-  std::vector<std::uint8_t> on_boundary(P, 0), on_nonmanifold_edge(P, 0);
-  std::vector<std::uint8_t> face_bad(F, 0);  // touches a non-manifold edge
-  std::vector<std::uint32_t> edge_face;      // one face per unique edge (for per-component counts)
-  std::vector<std::uint8_t> edge_is_boundary;
-  edge_face.reserve(3 * F / 2 + 16);
-  edge_is_boundary.reserve(3 * F / 2 + 16);
-  double length_sum = 0;
-  bool orientable = true;
-  std::vector<std::uint32_t> contradiction_faces;
-
-  for (std::size_t i = 0; i < recs.size();) {
-    std::size_t j = i + 1;
-    while (j < recs.size() && recs[j].key == recs[i].key) ++j;
-    const std::size_t n = j - i;
-    const int a = static_cast<int>(recs[i].key >> 32), b = static_cast<int>(recs[i].key & 0xffffffffu);
-    const auto& pa = m.points[a];
-    const auto& pb = m.points[b];
-    length_sum += std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
-                            (pa[2] - pb[2]) * (pa[2] - pb[2]));
-    edge_face.push_back(recs[i].face);
-    edge_is_boundary.push_back(n == 1);
-    for (std::size_t q = i + 1; q < j; ++q) face_uf.unite(recs[i].face, recs[q].face);
-    if (n == 1) {
-      ++r.boundary_edges;
-      push_example(r.example_boundary_edges, {a, b});
-      on_boundary[a] = on_boundary[b] = 1;
-      boundary_uf.unite(a, b);
-    } else if (n == 2) {
-      const HalfRecord& x = recs[i];
-      const HalfRecord& y = recs[i + 1];
-      const auto& tx = m.triangles[x.face];
-      const auto& ty = m.triangles[y.face];
-      // Same direction in both triangles -> the two faces are oppositely oriented.
-      const bool same_dir = tx[x.k] == ty[y.k];
-      if (same_dir) {
-        ++r.inconsistent_edges;
-        push_example(r.example_inconsistent_edges, {a, b});
-      }
-      if (!orient.unite(x.face, y.face, same_dir ? 1 : 0)) {
-        orientable = false;
-        contradiction_faces.push_back(x.face);
-      }
-      corner_uf.unite(3 * x.face + corner_of(tx, a), 3 * y.face + corner_of(ty, a));
-      corner_uf.unite(3 * x.face + corner_of(tx, b), 3 * y.face + corner_of(ty, b));
-    } else {
-      ++r.nonmanifold_edges;
-      push_example(r.example_nonmanifold_edges, {a, b});
-      on_nonmanifold_edge[a] = on_nonmanifold_edge[b] = 1;
-      for (std::size_t q = i; q < j; ++q) face_bad[recs[q].face] = 1;
-    }
-    i = j;
-  }
-  r.edges = edge_face.size();
-  r.mean_edge_length = r.edges ? length_sum / static_cast<double>(r.edges) : 0.0;
-  recs.clear();
-  recs.shrink_to_fit();
-
-  // Fans per vertex; faces sharing a vertex are in one component.
-  std::vector<std::uint32_t> first_face(P, std::numeric_limits<std::uint32_t>::max());
-  std::vector<std::uint32_t> first_fan(P, std::numeric_limits<std::uint32_t>::max());
-  std::vector<std::uint8_t> vertex_bad(P, 0);
-  for (std::size_t f = 0; f < F; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int v = m.triangles[f][k];
-      if (first_face[v] == std::numeric_limits<std::uint32_t>::max()) {
-        first_face[v] = static_cast<std::uint32_t>(f);
-      } else {
-        face_uf.unite(first_face[v], static_cast<std::uint32_t>(f));
-      }
-      const std::uint32_t fan = corner_uf.find(static_cast<std::uint32_t>(3 * f + k));
-      if (first_fan[v] == std::numeric_limits<std::uint32_t>::max()) {
-        first_fan[v] = fan;
-      } else if (first_fan[v] != fan) {
-        vertex_bad[v] = 1;
-      }
-    }
-  }
-  for (std::size_t v = 0; v < P; ++v) {
-    if (referenced[v] && (vertex_bad[v] || on_nonmanifold_edge[v])) {
-      ++r.nonmanifold_vertices;
-      push_example(r.example_nonmanifold_vertices, static_cast<int>(v));
-    }
-  }
-
-  // Components, numbered by root, then sorted largest first.
-  std::vector<int> root_id(F, -1);
-  std::vector<ComponentTopology> comps;
-  r.face_component.assign(F, -1);
-  for (std::size_t f = 0; f < F; ++f) {
-    const std::uint32_t root = face_uf.find(static_cast<std::uint32_t>(f));
-    if (root_id[root] < 0) {
-      root_id[root] = static_cast<int>(comps.size());
-      comps.emplace_back();
-      comps.back().manifold = true;
-      comps.back().orientable = true;
-    }
-    const int c = root_id[root];
-    r.face_component[f] = c;
-    ++comps[c].faces;
-    if (face_bad[f]) comps[c].manifold = false;
-  }
-  for (std::size_t v = 0; v < P; ++v) {
-    if (!referenced[v]) continue;
-    auto& c = comps[r.face_component[first_face[v]]];
-    ++c.vertices;
-    if (vertex_bad[v] || on_nonmanifold_edge[v]) c.manifold = false;
-  }
-  for (std::size_t e = 0; e < edge_face.size(); ++e) {
-    auto& c = comps[r.face_component[edge_face[e]]];
-    ++c.edges;
-    if (edge_is_boundary[e]) ++c.boundary_edges;
-  }
-  // Boundary loops: connected sets of boundary vertices.
-  std::vector<std::uint8_t> loop_counted(P, 0);
-  for (std::size_t v = 0; v < P; ++v) {
-    if (!on_boundary[v]) continue;
-    const std::uint32_t root = boundary_uf.find(static_cast<std::uint32_t>(v));
-    if (loop_counted[root]) continue;
-    loop_counted[root] = 1;
-    ++comps[r.face_component[first_face[v]]].boundary_loops;
-  }
-  // Orientability per component: a parity contradiction marks its component.
-  for (std::uint32_t f : contradiction_faces) comps[r.face_component[f]].orientable = false;
-
-  // Per-component Euler characteristic and genus.
-  bool all_genus = true;
-  int genus_sum = 0;
-  for (auto& c : comps) {
-    c.euler = static_cast<long long>(c.vertices) - static_cast<long long>(c.edges) +
-              static_cast<long long>(c.faces);
-    c.closed = c.boundary_edges == 0;
-    if (c.manifold && c.orientable) {
-      const long long twice = 2 - c.euler - static_cast<long long>(c.boundary_loops);
-      c.genus = static_cast<int>(twice / 2);
-      genus_sum += *c.genus;
-    } else {
-      all_genus = false;
-    }
-  }
-  // Sort components largest first and renumber face_component.
-  std::vector<int> order(comps.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int x, int y) { return comps[x].faces > comps[y].faces; });
-  std::vector<int> new_id(comps.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    new_id[order[i]] = static_cast<int>(i);
-    r.components.push_back(comps[order[i]]);
-  }
-  for (auto& c : r.face_component) c = new_id[c];
-
-  r.euler = static_cast<long long>(r.vertices) - static_cast<long long>(r.edges) +
-            static_cast<long long>(r.faces);
-  for (const auto& c : r.components) r.boundary_loops += c.boundary_loops;
-  r.closed = r.boundary_edges == 0;
-  r.manifold = r.nonmanifold_edges == 0 && r.nonmanifold_vertices == 0;
-  r.orientable = orientable;
-  r.consistently_oriented = r.inconsistent_edges == 0 && r.manifold;
-  if (all_genus) r.genus = genus_sum;
-  return r;
-}
+TopologyReport analyze_topology(const TriangleList& m) { return TopologyAnalysis(m).run(); }
 
 TriangleList to_triangle_list(const Mesh& mesh) {
   TriangleList t;

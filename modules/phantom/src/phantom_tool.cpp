@@ -28,7 +28,8 @@ class PhantomTool : public Tool {
     std::string dir, format = "nrrd";
     bool quiet = false;
     app.add_option("-o,--output", dir, "output folder")->required()->type_name("DIR");
-    app.add_option("--seed", o.seed, "random seed (default 1)")->type_name("N");
+    app.add_option("--seed", o.seed, "random seed (default 1)")->type_name("N")->check(
+        CLI::Validator([](std::string& v) { return v.rfind('-', 0) == 0 ? "must be >= 0 (got " + v + ")" : std::string(); }, ""));
     app.add_option("--size", o.size, "small: 128^3 at 2.8 x 2.8 x 3.125 mm (seconds); full: 512 x 512 x 400 at "
                                      "0.7 x 0.7 x 1 mm (default small)")
         ->type_name("small|full");

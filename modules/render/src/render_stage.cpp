@@ -171,7 +171,7 @@ const StageSpec& RenderStage::spec() const {
        {"loops", &polylines_artifact(), "cut loops of denoise (snapshot)", "loops.vtp", false},
        {"denoised", &mesh_artifact(), "surface after denoising (snapshot)", "denoised.vtp", false}},
       {{"colon_image", &png_image_artifact(), "2D colon-wall image", "colon.png"},
-       {"candidates", &json_artifact(), "polyp candidates (3D and 2D positions, size, score)", "polyps.json"},
+       {"candidates", &json_artifact(), "polyp candidates (3D and 2D positions, size, score)", "candidates.json"},
        {"snapshot_before", &png_image_artifact(), "3D snapshot of the surface before denoising, loops highlighted",
         "snapshot_before.png", false},
        {"snapshot_after", &png_image_artifact(), "3D snapshot of the surface after denoising, loops highlighted",
@@ -182,7 +182,7 @@ const StageSpec& RenderStage::spec() const {
 const ParamTable<RenderOptions>& RenderStage::table() const {
   static const ParamTable<RenderOptions> t = [] {
     ParamTable<RenderOptions> t;
-    t.real("pixel-size", &RenderOptions::pixel_size, "mm", "pixel size of the colon image", 0.05, 10);
+    t.real("pixel-size", &RenderOptions::pixel_size, "mm", "pixel size of the colon image", 0.15, 10);
     t.choice("color", &RenderOptions::color, {"shading", "curvature"},
              "colon image colouring: shading (virtual dissection) or curvature (shape index) on top");
     t.real("smooth-normal", &RenderOptions::smooth_normal, "mm", "scale of the reference normal for shading", 0.5, 100);

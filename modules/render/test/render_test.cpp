@@ -186,8 +186,8 @@ TEST(RenderCli, WritesImageJsonAndSnapshots) {
   write_mesh(synthetic::to_mesh(c.mesh), tmp / "surface.vtp");
   write_flat(flatten_colon(c.mesh), tmp / "flat.vtp");
   auto r = render_cli({tmp.str("flat.vtp"), "-o", tmp.str("colon.png"), "--candidates", tmp.str("polyps.json"),
-                       "--surface", tmp.str("surface.vtp"), "--snapshot_before", tmp.str("before.png"),
-                       "--snapshot_after", tmp.str("after.png"), "--snapshot-size", "256", "-q"});
+                       "--surface", tmp.str("surface.vtp"), "--snapshot-before", tmp.str("before.png"),
+                       "--snapshot-after", tmp.str("after.png"), "--snapshot-size", "256", "-q"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(read_json_file(tmp / "polyps.json")["candidates"].size(), 3u);
   int d[3];

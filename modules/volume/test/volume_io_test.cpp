@@ -91,15 +91,24 @@ TEST(VolumeIoFormats, CtIsStoredAsRoundedInt16) {
   EXPECT_EQ(back->GetPixel({{1, 0, 0}}), 32767.f);
 }
 
-// A mask of any voxel type reads as 0/1; masks round-trip through every written format.
+// A label volume (small non-negative integers) reads as 0/1, a CT read as a mask is refused (issue
+// 14: reconstruct must not turn a CT into a box), and masks round-trip through every written format.
 TEST(VolumeIoFormats, MaskRoundTripAndBinarisation) {
   testing::TempDir tmp;
   auto ct = make_ct(6, 5, 4);
-  write_ct_volume(ct, tmp / "values.nrrd");  // non-binary values, some zero
-  auto m = read_mask(tmp / "values.nrrd");
+  write_ct_volume(ct, tmp / "values.nrrd");  // HU values: not a mask
+  EXPECT_THROW(read_mask(tmp / "values.nrrd"), InputError);
+  auto labels = MaskImage::New();
+  labels->CopyInformation(ct);
+  labels->SetRegions(ct->GetLargestPossibleRegion());
+  labels->Allocate();
+  for (std::size_t i = 0; i < labels->GetLargestPossibleRegion().GetNumberOfPixels(); ++i)
+    labels->GetBufferPointer()[i] = static_cast<unsigned char>(i % 4 == 0 ? 0 : i % 3 + 1);  // labels 0..3
+  write_mask(labels, tmp / "labels.nrrd");
+  auto m = read_mask(tmp / "labels.nrrd");
   std::size_t ones = 0;
   for (std::size_t i = 0; i < m->GetLargestPossibleRegion().GetNumberOfPixels(); ++i) {
-    EXPECT_LE(m->GetBufferPointer()[i], 1);
+    EXPECT_EQ(m->GetBufferPointer()[i], labels->GetBufferPointer()[i] != 0 ? 1 : 0);
     ones += m->GetBufferPointer()[i];
   }
   EXPECT_GT(ones, 0u);

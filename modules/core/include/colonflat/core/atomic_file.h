@@ -1,7 +1,9 @@
 #pragma once
 // Atomic output: write to a temporary file next to the target (same extension, so format
 // detection by extension still works), then rename over the target. A failure removes the
-// temporary and leaves any existing target untouched.
+// temporary and leaves any existing target untouched. Temporaries and staging folders are also
+// removed when the process is interrupted (SIGINT, SIGTERM, SIGHUP), and those a killed run left
+// behind (their process no longer exists) are removed the next time outputs go to that folder.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -18,21 +20,40 @@ void write_atomically(const std::filesystem::path& target,
 
 // Several outputs that must appear together or not at all: stage() returns a temp path for
 // each target; commit() renames them all; the destructor removes any that were not committed.
+// With a staging folder root R, targets directly inside R are written into the hidden folder
+// "R/.colonflat-staging-<pid>/" (removed at the end, on failure and on interruption); other
+// targets get temporary siblings. commit() checks every temporary first, then renames; if a
+// rename fails, the targets already renamed are restored to their previous content.
 class OutputTransaction {
  public:
-  OutputTransaction() = default;
+  explicit OutputTransaction(std::filesystem::path staging_root = {});
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
   ~OutputTransaction();
   std::filesystem::path stage(const std::filesystem::path& target);
   void commit();
+  const std::filesystem::path& staging_folder() const { return staging_; }
 
  private:
+  void rollback(std::size_t renamed);
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, target
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> backups_; // backup, target
+  std::vector<std::filesystem::path> created_dirs_;
+  std::filesystem::path root_, staging_;
   bool committed_ = false;
 };
 
 // Writes text atomically (reports, JSON).
 void write_text_atomically(const std::filesystem::path& target, const std::string& text);
+
+// Removes, in `dir`, staging folders and temporary files left by processes that no longer run.
+// Returns how many were removed.
+std::size_t remove_stale_temporaries(const std::filesystem::path& dir);
+
+// The signal-time cleanup list (used by the above; exposed for tests): paths registered here are
+// unlinked (files) or removed (empty folders) when SIGINT/SIGTERM/SIGHUP arrives, after which
+// the signal's default action runs (the exit status says which signal).
+void register_for_cleanup(const std::filesystem::path& path);
+void unregister_for_cleanup(const std::filesystem::path& path);
 
 }  // namespace cf

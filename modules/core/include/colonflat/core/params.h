@@ -67,7 +67,12 @@ class ParamTable {
   }
   ParamTable& text(const std::string& name, std::string O::*m, const std::string& help) {
     ParamInfo pi{name, "text", "", help, O{}.*m, std::nullopt, std::nullopt, {}};
-    add(pi, [m, pi](CLI::App& app, O& o) { app.add_option("--" + pi.name, o.*m, pi.describe())->type_name("TEXT"); },
+    // A text naming a file (its help says "file" or "JSON") shows FILE in --help.
+    const bool is_file = help.find("file") != std::string::npos || help.find("JSON") != std::string::npos;
+    add(pi,
+        [m, pi, is_file](CLI::App& app, O& o) {
+          app.add_option("--" + pi.name, o.*m, pi.describe())->type_name(is_file ? "FILE" : "TEXT");
+        },
         [m](const O& o) { return nlohmann::json(o.*m); },
         [m, name](const nlohmann::json& j, O& o) {
           if (!j.is_string()) throw UsageError("parameter '" + name + "' must be a string");
@@ -101,7 +106,12 @@ class ParamTable {
   }
   ParamTable& flag(const std::string& name, bool O::*m, const std::string& help) {
     ParamInfo pi{name, "flag", "", help, (O{}.*m) ? "on" : "off", std::nullopt, std::nullopt, {}};
-    add(pi, [m, pi](CLI::App& app, O& o) { app.add_flag("--" + pi.name + ",!--no-" + pi.name, o.*m, pi.describe()); },
+    add(pi,
+        [m, pi](CLI::App& app, O& o) {
+          // Two plain flags (CLI11's "!--no-x" form shows parser leftovers like "{false}" in --help).
+          app.add_flag_function("--" + pi.name, [&o, m](std::int64_t) { o.*m = true; }, pi.describe());
+          app.add_flag_function("--no-" + pi.name, [&o, m](std::int64_t) { o.*m = false; }, "turn --" + pi.name + " off");
+        },
         [m](const O& o) { return nlohmann::json(o.*m); },
         [m, name](const nlohmann::json& j, O& o) {
           if (!j.is_boolean()) throw UsageError("parameter '" + name + "' must be true or false");

@@ -29,6 +29,9 @@ struct ArtifactType {
   // Writes a value to `tmp` (a temporary path with the target's extension); `target` names the
   // final file for messages. The caller renames tmp -> target when every output is written.
   std::function<void(const std::any&, const std::filesystem::path& tmp, const std::filesystem::path& target)> write;
+  // Output extensions the writer knows (lower case with the dot, e.g. ".vtp", ".nii.gz"); empty =
+  // not declared (then the writer itself refuses an unknown one, after the work).
+  std::vector<std::string> extensions = {};
 };
 
 struct Port {
@@ -73,9 +76,8 @@ class ArtifactBag {
 struct RunContext {
   std::ostream* log = nullptr;  // progress lines; null = quiet
   nlohmann::json report = nlohmann::json::object();
-  void progress(const std::string& line) const {
-    if (log) *log << line << std::endl;
-  }
+  // Writes one progress line (thread-safe: the runner's "still running" heartbeat shares `log`).
+  void progress(const std::string& line) const;
 };
 
 class Stage {
@@ -113,7 +115,8 @@ class StageWithOptions : public Stage {
 using StageFactory = std::function<std::unique_ptr<Stage>()>;
 
 // The stand-alone command of a stage: `colonflat <stage> INPUT -o OUTPUT [--<port> FILE]...
-// [--report FILE.json] [--params-in F] [--params-out F] [--quiet] [params]`.
+// [--report FILE.json] [--params-in F] [--params-out F] [--quiet] [params]`. It runs the stage
+// through the same runner as `colonflat run` (core/stage_runner.h).
 std::unique_ptr<Tool> make_stage_tool(StageFactory factory);
 
 // Reads a JSON file (InputError on failure).

@@ -1,6 +1,6 @@
 #pragma once
-// `colonflat render FLAT -o colon.png [--candidates polyps.json] [--surface S.vtp] [--loops L.vtp]
-//  [--denoised D.vtp] [--snapshot_before B.png] [--snapshot_after A.png]`: polyp candidates on the
+// `colonflat render FLAT -o colon.png [--candidates candidates.json] [--surface S.vtp] [--loops L.vtp]
+//  [--denoised D.vtp] [--snapshot-before B.png] [--snapshot-after A.png]`: polyp candidates on the
 // 3D wall, the 2D colon image with overlays, their JSON, and 3D snapshots.
 #include <memory>
 #include <string>

@@ -1,0 +1,212 @@
+// Reading volume files (NRRD, NIfTI, MetaImage, single DICOM files) and DICOM series as float
+// voxels: declared sizes are checked against the file and the memory budget before allocation.
+#include <gdcmDirectory.h>
+#include <gdcmReader.h>
+#include <gdcmScanner.h>
+#include <gdcmTrace.h>
+#include <itkGDCMImageIO.h>
+#include <itkImageFileReader.h>
+#include <itkImageFileWriter.h>
+#include <itkImageRegionConstIterator.h>
+#include <itkImageSeriesReader.h>
+#include <itkImageSeriesWriter.h>
+#include <itkMetaDataObject.h>
+#include <itkMetaImageIO.h>
+#include <itkNiftiImageIO.h>
+#include <itkNrrdImageIO.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include "colonflat/core/atomic_file.h"
+#include "colonflat/core/error.h"
+
+#include "colonflat/core/library_output.h"
+#include "volume_internal.h"
+
+namespace cf {
+namespace vio {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+// A NRRD header with per-axis "spacings" and a "space" field is not valid NRRD and teem (ITK's
+// NrrdIO) refuses it, yet such headers exist (VTK's headsq quarter.nhdr: "space: 3D-left-handed",
+// "spacings: 3.2 3.2 1.5", detached slices). The header is copied to a temporary file without its
+// "space" line (so the spacings are valid, with an identity direction) and with the data file path
+// made absolute, and that copy is read by ITK. Returns false when the header is not of this kind.
+bool sanitized_nrrd_header(const fs::path& p, fs::path& out) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return false;
+  std::string line, text;
+  bool has_space = false, has_spacings = false;
+  std::vector<std::string> lines;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;  // end of the header (attached data follows)
+    lines.push_back(line);
+    if (lines.size() > 200) return false;
+  }
+  if (lines.empty() || lines[0].rfind("NRRD", 0) != 0) return false;
+  for (const auto& l : lines) {
+    if (l.rfind("space:", 0) == 0) has_space = true;
+    if (l.rfind("spacings:", 0) == 0) has_spacings = true;
+  }
+  if (!(has_space && has_spacings)) return false;
+  const fs::path dir = fs::absolute(p).parent_path();
+  for (const auto& l : lines) {
+    if (l.rfind("space:", 0) == 0) continue;
+    if (l.rfind("data file:", 0) == 0 || l.rfind("datafile:", 0) == 0) {
+      std::string v = l.substr(l.find(':') + 1);
+      while (!v.empty() && v.front() == ' ') v.erase(v.begin());
+      if (v.rfind("LIST", 0) == 0) return false;
+      if (!v.empty() && v.front() != '/') v = (dir / v).string();
+      text += "data file: " + v + "\n";
+      continue;
+    }
+    text += l + "\n";
+  }
+  if (text.find("data file:") == std::string::npos) return false;  // attached data: cannot be split off
+  out = temp_sibling(fs::temp_directory_path() / "colonflat_header.nhdr");
+  std::ofstream o(out, std::ios::binary);
+  o << text;
+  return bool(o);
+}
+
+FloatImage::Pointer read_image_file(const fs::path& p) {
+  const std::string where = p.string();
+  auto io = io_for(p, false);
+  if (!io) throw InputError(where, "unknown volume format (expected " + std::string(kReadFormats) + ")");
+  if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer()) && !dicom_meta_complete(p))
+    throw InputError(where, "not a complete DICOM file (no 'DICM' preamble, or cut inside its meta header)");
+  if (!io->CanReadFile(p.c_str()))
+    throw InputError(where, std::string("not a readable ") + io->GetNameOfClass() + " file");
+  io->SetFileName(p.string());
+  try {
+    io->ReadImageInformation();
+  } catch (const itk::ExceptionObject& e) {
+    fs::path fixed;
+    if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer()) && sanitized_nrrd_header(p, fixed)) {
+      struct Remove {
+        fs::path f;
+        ~Remove() {
+          std::error_code ec;
+          fs::remove(f, ec);
+        }
+      } remove{fixed};
+      try {
+        return read_image_file(fixed);
+      } catch (const InputError&) {
+      }
+    }
+    throw InputError(where, itk_message(e));
+  }
+  if (io->GetNumberOfDimensions() < 2 || io->GetNumberOfDimensions() > 3)
+    throw InputError(where, "not a 3D volume (" + std::to_string(io->GetNumberOfDimensions()) + " dimensions)");
+  if (io->GetNumberOfComponents() != 1)
+    throw InputError(where, "not a scalar volume (" + std::to_string(io->GetNumberOfComponents()) +
+                                " components per voxel)");
+  if (auto* g = dynamic_cast<itk::GDCMImageIO*>(io.GetPointer())) {
+    std::string sop, frames;
+    g->GetValueFromTag("0008|0016", sop);
+    g->GetValueFromTag("0028|0008", frames);
+    sop = trim(sop.c_str());
+    if (sop == kEnhancedCtSop || std::atoi(frames.c_str()) > 1)
+      throw InputError(where, "enhanced multi-frame CT (" + (frames.empty() ? std::string("several") : trim(frames.c_str())) +
+                                  " frames) is not supported; export a classic single-frame CT series");
+  }
+  check_declared_volume(p, *io);
+  if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer())) check_dicom_length(p, where, dicom_transfer_syntax(p));
+  auto reader = itk::ImageFileReader<FloatImage>::New();
+  reader->SetImageIO(io);
+  reader->SetFileName(p.string());
+  try {
+    reader->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError(where, itk_message(e));
+  }
+  return reader->GetOutput();
+}
+
+
+void check_geometry(const itk::ImageBase<3>* img, const std::string& where) {
+  for (int d = 0; d < 3; ++d) {
+    const double s = img->GetSpacing()[d];
+    if (!std::isfinite(s) || s <= 0) throw InputError(where, "invalid voxel spacing " + format_number(s));
+    if (!std::isfinite(img->GetOrigin()[d])) throw InputError(where, "invalid origin");
+  }
+}
+
+FloatImage::Pointer read_any_uncaptured(const fs::path& p, const VolumeReadOptions& opts) {
+  quiet_libraries();
+  fs::path dir;
+  std::string uid;
+  if (split_series_path(p, dir, uid)) {
+    auto f = scan_folder(dir);
+    if (!f->series.count(uid)) throw InputError(p.string(), "no such file, and no DICOM series " + uid + " in " + dir.string());
+    return read_dicom_series(choose_series(dir, uid, opts, *f), *f, opts);
+  }
+  if (!fs::exists(p)) throw InputError(p.string(), "no such file");
+  if (fs::is_directory(p)) {
+    auto f = scan_folder(p);
+    return read_dicom_series(choose_series(p, "", opts, *f), *f, opts);
+  }
+  return read_image_file(p);
+}
+
+
+}  // namespace
+
+// Reads with the libraries' own printing captured: it is folded into the error, and a read that
+// "succeeded" while the library reported an error is refused.
+FloatImage::Pointer read_any(const fs::path& p, const VolumeReadOptions& opts) {
+  LibraryOutputCapture capture;
+  FloatImage::Pointer img;
+  try {
+    img = read_any_uncaptured(p, opts);
+  } catch (const InputError& e) {
+    const std::string said = capture.text();
+    if (said.empty()) throw;
+    throw InputError(e.file(), e.problem() + " (library: " + said.substr(0, 160) + ")");
+  }
+  const std::string said = capture.text();
+  if (said.find("rror") != std::string::npos || said.find("not read") != std::string::npos)
+    throw InputError(p.string(), "the reader reported a problem: " + said.substr(0, 200));
+  return img;
+}
+
+}  // namespace vio
+
+using namespace vio;
+
+CtImage::Pointer read_ct_volume(const fs::path& p, const VolumeReadOptions& opts) {
+  auto img = read_any(p, opts);
+  check_geometry(img, p.string());
+  check_finite_voxels(img, p.string());
+  return img;
+}
+
+MaskImage::Pointer read_mask(const fs::path& p) {
+  auto f = read_any(p, {});
+  check_geometry(f, p.string());
+  check_mask_values(f, p.string());
+  auto m = MaskImage::New();
+  m->CopyInformation(f);
+  m->SetRegions(f->GetLargestPossibleRegion());
+  m->Allocate();
+  const std::size_t n = f->GetLargestPossibleRegion().GetNumberOfPixels();
+  const float* src = f->GetBufferPointer();
+  unsigned char* dst = m->GetBufferPointer();
+  for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] != 0.f ? 1 : 0;
+  return m;
+}
+
+}  // namespace cf
