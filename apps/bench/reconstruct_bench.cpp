@@ -5,6 +5,7 @@
 //                                   the reconstruction alone, distance to the mask's voxel boundary
 //                                   (mm and voxels); then the Google Benchmark cases.
 //   reconstruct_bench --table-only  the table without Google Benchmark.
+//   reconstruct_bench --real-only   only the real mask's rows of the table.
 //   reconstruct_bench --closeup DIR the real mask's flattest wall patch: ripple measures (RMS dihedral
 //                                   angle, RMS residual of a quadric fit) for each surface mode, and
 //                                   a shaded close-up PNG of each into DIR (VTK off-screen; needs X,
@@ -99,10 +100,11 @@ void rows_for(const std::string& name, const cf::MaskImage* mask, const cf::CtIm
   if (ct) row(name + ", ct + sinc 20", mask, ct, mode("ct", 20));
 }
 
-void table() {
+void table(bool real_only) {
   std::printf("%-38s %7s %6s %6s %6s %6s %6s %9s %5s %5s %9s %7s %6s %6s %6s\n", "case", "time_s", "field", "extr",
               "check", "smooth", "decim", "faces", "comps", "genus", "peak_MiB", "+MiB", "dmax", "dmean", "dmax_vx");
   for (const std::string size : {"small", "full"}) {
+    if (real_only) break;
     const cf::Phantom& p = phantom(size);
     rows_for(size + " phantom", p.lumen.GetPointer(), p.ct.GetPointer());
     cf::ReconstructOptions o;
@@ -336,12 +338,14 @@ BENCHMARK_CAPTURE(BM_ReconstructPhantom, full_decimated_200k, std::string("full"
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool table_only = false;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
+  bool table_only = false, real_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--table-only") == 0) table_only = true;
+    if (std::strcmp(argv[i], "--real-only") == 0) table_only = real_only = true;
     if (std::strcmp(argv[i], "--closeup") == 0 && i + 1 < argc) return closeup(argv[i + 1]);
   }
-  table();
+  table(real_only);
   if (table_only) return 0;
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();

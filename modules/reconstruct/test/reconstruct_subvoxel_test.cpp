@@ -116,7 +116,7 @@ TEST(ReconstructSubvoxel, TiltedPlaneIsFlatterAndWithinHalfAVoxel) {
     const Fit f = fit(smooth, plane, on_wall);
     if (smoothing == "antialias") {
       EXPECT_LT(f.max, 0.6 * staircase.max) << smoothing << sinc << ": staircase max " << staircase.max;
-      EXPECT_LT(f.rms, 0.5 * staircase.rms) << smoothing << sinc << ": staircase rms " << staircase.rms;
+      EXPECT_LT(f.rms, 0.7 * staircase.rms) << smoothing << sinc << ": staircase rms " << staircase.rms;
     } else {  // windowed sinc alone keeps the wide terraces (why antialias is the default)
       EXPECT_LT(f.rms, 1.05 * staircase.rms) << smoothing;
     }
