@@ -1,25 +1,17 @@
 #include "colonflat/reconstruct/reconstruct.h"
 
-#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/McDecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
+#include <Eigen/Dense>
 #include <vtkCellArray.h>
-#include <vtkCellArrayIterator.h>
-#include <vtkDiscreteFlyingEdges3D.h>
-#include <vtkDoubleArray.h>
-#include <vtkFlyingEdges3D.h>
-#include <vtkImageData.h>
-#include <vtkMarchingCubes.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkSmartPointer.h>
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <sstream>
 
 #include "colonflat/core/error.h"
@@ -27,6 +19,7 @@
 #include "colonflat/core/soup.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/core/vtk_messages.h"
+#include "reconstruct_internal.h"
 
 namespace cf {
 
@@ -37,8 +30,26 @@ const ParamTable<ReconstructOptions>& reconstruct_param_table() {
              "VTK isosurface filter run on the binary mask (all give the same closed manifold surface)");
     t.real("min-component-volume", &ReconstructOptions::min_component_volume, "mm^3",
            "drop surface components enclosing less than this (noise, tiny air pockets or cavities)", 0.0);
+    t.choice("subvoxel", &ReconstructOptions::subvoxel, {"auto", "ct", "mask", "off"},
+             "sub-voxel surface: ct = the CT's air/tissue boundary inside the mask, mask = the constrained-"
+             "smoothed mask, auto = ct when a CT is given else mask, off = the binary staircase; the surface "
+             "stays < 1/2 voxel from the staircase");
+    t.choice("mask-smoothing", &ReconstructOptions::mask_smoothing, {"sinc", "antialias"},
+             "sub-voxel surface of the mask: sinc = windowed-sinc smoothing of the staircase mesh, antialias = "
+             "Whitaker's constrained curvature flow on the voxels (ITK, slower) before it; both kept within "
+             "1/2 voxel");
+    t.integer("antialias-iterations", &ReconstructOptions::antialias_iterations, "",
+              "mask field: at most this many iterations of Whitaker's constrained curvature flow (ITK anti-alias)",
+              1, 2000);
+    t.real("antialias-rms", &ReconstructOptions::antialias_rms, "voxel",
+           "mask field: stop when the RMS level-set change per iteration falls below this", 0.0001, 0.5);
+    t.real("air-tissue-hu", &ReconstructOptions::air_tissue_hu, "HU",
+           "CT boundary between lumen air and the wall (partial-volume midpoint)", -950.0, -100.0);
+    t.real("fluid-hu", &ReconstructOptions::fluid_hu, "HU",
+           "lumen voxels at or above are tagged fluid: near them the smoothed mask is used, not the CT", -100.0, 3000.0);
     t.integer("smoothing-iterations", &ReconstructOptions::smoothing_iterations, "",
-              "windowed-sinc smoothing iterations (moves points only; 0 = off)", 0, 1000);
+              "windowed-sinc mesh smoothing iterations after extraction (moves points only; with a sub-voxel "
+              "surface each vertex is kept within 1/2 voxel of its staircase position; 0 = off)", 0, 1000);
     t.real("pass-band", &ReconstructOptions::pass_band, "", "windowed-sinc pass band (smaller = smoother)", 0.001,
            2.0);
     t.integer("target-faces", &ReconstructOptions::target_faces, "",
@@ -48,7 +59,11 @@ const ParamTable<ReconstructOptions>& reconstruct_param_table() {
   return t;
 }
 
-void validate(const ReconstructOptions& o) { reconstruct_param_table().validate(o); }
+void validate(const ReconstructOptions& o) {
+  reconstruct_param_table().validate(o);
+  if (o.method == "discrete-flying-edges" && o.subvoxel != "off")
+    throw UsageError("--method discrete-flying-edges extracts labels only: use it with --subvoxel off");
+}
 
 nlohmann::json ReconstructStats::to_json() const {
   auto comp = [](const ReconstructComponent& c) {
@@ -76,6 +91,10 @@ nlohmann::json ReconstructStats::to_json() const {
           {"dropped_volume_mm3", dropped_volume},
           {"kept_components", kept_j},
           {"largest_dropped_components", dropped_j},
+          {"subvoxel_source", field_source},
+          {"fluid_voxels", fluid_voxels},
+          {"field_clamped_lumen_voxels", field_clamped_voxels},
+          {"smoothing_clamped_vertices", clamped_vertices},
           {"smoothed", smoothed},
           {"decimated", decimated},
           {"vertices", vertices},
@@ -85,6 +104,7 @@ nlohmann::json ReconstructStats::to_json() const {
           {"manifold", true},
           {"units", "mm"},
           {"coordinate_system", "LPS"},
+          {"time_field_s", time_field_s},
           {"time_extract_s", time_extract_s},
           {"time_check_s", time_check_s},
           {"time_smooth_s", time_smooth_s},
@@ -94,167 +114,7 @@ nlohmann::json ReconstructStats::to_json() const {
 
 namespace {
 
-// Contribution of one 2x2x2 block (bit b = corner (b&1, b>>1&1, b>>2&1)) anchored at its lowest
-// corner to the (6,18) Euler characteristic: the anchor voxel, its three face-adjacent pairs,
-// three 2x2 squares and the block, plus one for a block whose only two background voxels are
-// opposite corners (marching cubes closes that block: the background is 18-, not 26-connected).
-struct EulerTable {
-  int v[256];
-  EulerTable() {
-    for (int c = 0; c < 256; ++c) {
-      auto b = [c](int i) { return (c >> i) & 1; };
-      int x = b(0);
-      x -= (b(0) & b(1)) + (b(0) & b(2)) + (b(0) & b(4));
-      x += (b(0) & b(1) & b(2) & b(3)) + (b(0) & b(1) & b(4) & b(5)) + (b(0) & b(2) & b(4) & b(6));
-      x -= (c == 255);
-      int bg = 0;
-      for (int i = 0; i < 8; ++i) bg += !b(i);
-      if (bg == 2)
-        for (int i = 0; i < 4; ++i)
-          if (!b(i) && !b(7 - i)) x += 1;
-      v[c] = x;
-    }
-  }
-};
-
-// Euler characteristic of a binary volume (values 0/1, x fastest) whose last slice in each
-// direction is background.
-long long euler_6_18(const unsigned char* d, std::size_t nx, std::size_t ny, std::size_t nz) {
-  static const EulerTable table;
-  long long chi = 0;
-  const std::size_t sy = nx, sz = nx * ny;
-  for (std::size_t k = 0; k + 1 < nz; ++k)
-    for (std::size_t j = 0; j + 1 < ny; ++j) {
-      const unsigned char* r = d + k * sz + j * sy;
-      for (std::size_t i = 0; i + 1 < nx; ++i) {
-        const unsigned char* p = r + i;
-        const int c = p[0] | p[1] << 1 | p[sy] << 2 | p[sy + 1] << 3 | p[sz] << 4 | p[sz + 1] << 5 | p[sz + sy] << 6 |
-                      p[sz + sy + 1] << 7;
-        chi += table.v[c];
-      }
-    }
-  return chi;
-}
-
-struct Box {
-  std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};  // inclusive lumen bounding box (buffer indices)
-  std::size_t count = 0;
-};
-
-Box lumen_box(const unsigned char* d, const std::array<std::size_t, 3>& n) {
-  Box b;
-  b.lo = n;
-  for (std::size_t k = 0; k < n[2]; ++k)
-    for (std::size_t j = 0; j < n[1]; ++j) {
-      const unsigned char* r = d + (k * n[1] + j) * n[0];
-      std::size_t first = n[0], last = 0, cnt = 0;
-      for (std::size_t i = 0; i < n[0]; ++i)
-        if (r[i]) {
-          if (first == n[0]) first = i;
-          last = i;
-          ++cnt;
-        }
-      if (!cnt) continue;
-      b.count += cnt;
-      b.lo = {std::min(b.lo[0], first), std::min(b.lo[1], j), std::min(b.lo[2], k)};
-      b.hi = {std::max(b.hi[0], last), std::max(b.hi[1], j), std::max(b.hi[2], k)};
-    }
-  return b;
-}
-
-// The cropped lumen, binarised, with one voxel of background on every side, as VTK image data
-// in index space (origin = buffer index of its first voxel, spacing 1).
-vtkSmartPointer<vtkImageData> padded_crop(const unsigned char* d, const std::array<std::size_t, 3>& n, const Box& b) {
-  const int px = int(b.hi[0] - b.lo[0] + 3), py = int(b.hi[1] - b.lo[1] + 3), pz = int(b.hi[2] - b.lo[2] + 3);
-  auto img = vtkSmartPointer<vtkImageData>::New();
-  img->SetDimensions(px, py, pz);
-  img->SetOrigin(double(b.lo[0]) - 1, double(b.lo[1]) - 1, double(b.lo[2]) - 1);
-  img->SetSpacing(1, 1, 1);
-  img->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
-  auto* out = static_cast<unsigned char*>(img->GetScalarPointer());
-  std::memset(out, 0, std::size_t(px) * py * pz);
-  const std::size_t w = b.hi[0] - b.lo[0] + 1;
-  for (std::size_t k = b.lo[2]; k <= b.hi[2]; ++k)
-    for (std::size_t j = b.lo[1]; j <= b.hi[1]; ++j) {
-      const unsigned char* src = d + (k * n[1] + j) * n[0] + b.lo[0];
-      unsigned char* dst = out + ((k - b.lo[2] + 1) * py + (j - b.lo[1] + 1)) * std::size_t(px) + 1;
-      for (std::size_t i = 0; i < w; ++i) dst[i] = src[i] != 0;
-    }
-  return img;
-}
-
-vtkSmartPointer<vtkPolyData> isosurface(vtkImageData* img, const std::string& method) {
-  VtkMessageCapture capture;
-  vtkSmartPointer<vtkPolyData> out;
-  if (method == "flying-edges") {
-    vtkNew<vtkFlyingEdges3D> f;
-    f->SetInputData(img);
-    f->SetValue(0, 0.5);
-    f->ComputeNormalsOff();
-    f->ComputeGradientsOff();
-    f->ComputeScalarsOff();
-    f->InterpolateAttributesOff();
-    f->Update();
-    out = f->GetOutput();
-  } else if (method == "discrete-flying-edges") {
-    vtkNew<vtkDiscreteFlyingEdges3D> f;
-    f->SetInputData(img);
-    f->SetValue(0, 1);
-    f->ComputeNormalsOff();
-    f->ComputeGradientsOff();
-    f->ComputeScalarsOff();
-    f->Update();
-    out = f->GetOutput();
-  } else if (method == "marching-cubes") {
-    vtkNew<vtkMarchingCubes> f;
-    f->SetInputData(img);
-    f->SetValue(0, 0.5);
-    f->ComputeNormalsOff();
-    f->ComputeGradientsOff();
-    f->ComputeScalarsOff();
-    f->Update();
-    out = f->GetOutput();
-  } else {
-    throw UsageError("unknown reconstruction method '" + method + "'");
-  }
-  if (!capture.errors().empty()) throw Error(method + " failed: " + capture.first_problem());
-  return out;
-}
-
-// Index -> LPS mm: p = origin + direction * diag(spacing) * index.
-struct IndexToLps {
-  double m[3][3], o[3];
-  std::array<double, 3> operator()(const double* x) const {
-    std::array<double, 3> p;
-    for (int r = 0; r < 3; ++r) p[r] = o[r] + m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2];
-    return p;
-  }
-};
-
-// Points mapped to LPS; triangles reversed when the map reverses orientation.
-TriangleList to_lps(vtkPolyData* pd, const IndexToLps& map, bool flip) {
-  TriangleList t;
-  vtkPoints* pts = pd->GetPoints();
-  const vtkIdType np = pts ? pts->GetNumberOfPoints() : 0;
-  t.points.resize(std::size_t(np));
-  for (vtkIdType i = 0; i < np; ++i) {
-    double x[3];
-    pts->GetPoint(i, x);
-    t.points[std::size_t(i)] = map(x);
-  }
-  vtkCellArray* polys = pd->GetPolys();
-  t.triangles.reserve(std::size_t(polys->GetNumberOfCells()));
-  auto it = vtk::TakeSmartPointer(polys->NewIterator());
-  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell()) {
-    vtkIdType n;
-    const vtkIdType* ids;
-    it->GetCurrentCell(n, ids);
-    if (n != 3) throw Error("isosurface produced a polygon with " + std::to_string(n) + " vertices");
-    if (flip) t.triangles.push_back({int(ids[0]), int(ids[2]), int(ids[1])});
-    else t.triangles.push_back({int(ids[0]), int(ids[1]), int(ids[2])});
-  }
-  return t;
-}
+using namespace reconstruct_detail;
 
 using P3 = std::array<double, 3>;
 P3 sub(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
@@ -297,139 +157,187 @@ Mesh to_openmesh(const TriangleList& t) {
   return m;
 }
 
-}  // namespace
 
-long long mask_euler_characteristic_6_18(const MaskImage* mask) {
-  if (!mask) throw PreconditionError("no mask");
-  const auto size = mask->GetBufferedRegion().GetSize();
-  const std::array<std::size_t, 3> n{size[0], size[1], size[2]};
-  const Box b = lumen_box(mask->GetBufferPointer(), n);
-  if (!b.count) return 0;
-  auto img = padded_crop(mask->GetBufferPointer(), n, b);
-  int dims[3];
-  img->GetDimensions(dims);
-  return euler_6_18(static_cast<const unsigned char*>(img->GetScalarPointer()), dims[0], dims[1], dims[2]);
-}
+// The steps of reconstruct_surface, sharing the mask's geometry and the surface being built.
+class SurfaceReconstruction {
+ public:
+  SurfaceReconstruction(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options)
+      : mask_(mask), ct_(ct), opts_(options) {}
 
-Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& options, ReconstructStats* stats_out) {
-  validate(options);
-  if (!mask) throw PreconditionError("no mask");
-  Stopwatch total;
-  ReconstructStats st;
-  st.method = options.method;
-  const auto region = mask->GetBufferedRegion();
-  const std::array<std::size_t, 3> n{region.GetSize()[0], region.GetSize()[1], region.GetSize()[2]};
-  st.image_size = n;
-  if (n[0] == 0 || n[1] == 0 || n[2] == 0 || !mask->GetBufferPointer())
-    throw PreconditionError("mask: the image has no voxels");
-
-  // Geometry: buffer index b corresponds to ITK index start + b.
-  const auto spacing = mask->GetSpacing();
-  const auto origin = mask->GetOrigin();
-  const auto dir = mask->GetDirection();
-  IndexToLps map;
-  for (int r = 0; r < 3; ++r) {
-    if (!(spacing[r] > 0) || !std::isfinite(spacing[r]))
-      throw PreconditionError("mask: spacing must be positive (got " + format_number(spacing[r]) + " along axis " +
-                              std::to_string(r) + ")");
-    for (int c = 0; c < 3; ++c) map.m[r][c] = dir(r, c) * spacing[c];
+  Mesh run(ReconstructStats* stats_out) {
+    read_geometry();
+    check_ct();
+    extract();
+    verify_extracted();
+    drop_small_components();
+    smooth_mesh();
+    mesh_ = to_openmesh(tris_);
+    tris_ = TriangleList{};
+    staircase_ = {};
+    decimate();
+    final_check();
+    st_.time_total_s = total_.seconds();
+    if (stats_out) *stats_out = std::move(st_);
+    return std::move(mesh_);
   }
-  for (int r = 0; r < 3; ++r) {
-    map.o[r] = origin[r];
-    for (int c = 0; c < 3; ++c) map.o[r] += map.m[r][c] * double(region.GetIndex()[c]);
-  }
-  const double det = dir(0, 0) * (dir(1, 1) * dir(2, 2) - dir(1, 2) * dir(2, 1)) -
-                     dir(0, 1) * (dir(1, 0) * dir(2, 2) - dir(1, 2) * dir(2, 0)) +
-                     dir(0, 2) * (dir(1, 0) * dir(2, 1) - dir(1, 1) * dir(2, 0));
-  if (!(std::abs(det) > 1e-6)) throw PreconditionError("mask: direction matrix is singular");
-  st.direction_flips_orientation = det < 0;
 
-  // 1. Crop to the lumen, pad, extract.
-  Stopwatch t;
-  const Box box = lumen_box(mask->GetBufferPointer(), n);
-  st.lumen_voxels = box.count;
-  if (!box.count) throw PreconditionError("mask: no lumen voxels (the mask is empty)");
-  for (int a = 0; a < 3; ++a) st.crop_size[a] = box.hi[a] - box.lo[a] + 1;
-  TriangleList tris;
-  {
-    auto img = padded_crop(mask->GetBufferPointer(), n, box);
+ private:
+  // The index -> LPS map (region start included) and whether it reverses orientation.
+  void read_geometry() {
+    st_.method = opts_.method;
+    const auto region = mask_->GetBufferedRegion();
+    size_ = {region.GetSize()[0], region.GetSize()[1], region.GetSize()[2]};
+    st_.image_size = size_;
+    if (size_[0] == 0 || size_[1] == 0 || size_[2] == 0 || !mask_->GetBufferPointer())
+      throw PreconditionError("mask: the image has no voxels");
+    const auto spacing = mask_->GetSpacing();
+    const auto origin = mask_->GetOrigin();
+    const auto dir = mask_->GetDirection();
+    for (int r = 0; r < 3; ++r) {
+      if (!(spacing[r] > 0) || !std::isfinite(spacing[r]))
+        throw PreconditionError("mask: spacing must be positive (got " + format_number(spacing[r]) + " along axis " +
+                                std::to_string(r) + ")");
+      spacing_[r] = spacing[r];
+      for (int c = 0; c < 3; ++c) map_.m[r][c] = dir(r, c) * spacing[c];
+    }
+    for (int r = 0; r < 3; ++r) {
+      map_.o[r] = origin[r];
+      for (int c = 0; c < 3; ++c) map_.o[r] += map_.m[r][c] * double(region.GetIndex()[c]);
+    }
+    const double det = dir(0, 0) * (dir(1, 1) * dir(2, 2) - dir(1, 2) * dir(2, 1)) -
+                       dir(0, 1) * (dir(1, 0) * dir(2, 2) - dir(1, 2) * dir(2, 0)) +
+                       dir(0, 2) * (dir(1, 0) * dir(2, 1) - dir(1, 1) * dir(2, 0));
+    if (!(std::abs(det) > 1e-6)) throw PreconditionError("mask: direction matrix is singular");
+    st_.direction_flips_orientation = det < 0;
+  }
+
+  // The CT, when used, must be the volume the mask was segmented from: the same voxel grid.
+  void check_ct() {
+    if (opts_.subvoxel == "ct" && !ct_)
+      throw PreconditionError("--subvoxel ct needs the CT (--ct CT, or `colonflat run` on a CT)");
+    if (!ct_ || opts_.subvoxel == "mask" || opts_.subvoxel == "off") {
+      ct_ = nullptr;
+      return;
+    }
+    const auto region = ct_->GetBufferedRegion();
+    const auto sp = ct_->GetSpacing();
+    const auto org = ct_->GetOrigin();
+    const auto dir = ct_->GetDirection(), mask_dir = mask_->GetDirection();
+    bool same = ct_->GetBufferPointer() != nullptr;
+    for (int a = 0; a < 3; ++a) {
+      same = same && region.GetSize()[a] == size_[a] && region.GetIndex()[a] == mask_->GetBufferedRegion().GetIndex()[a];
+      same = same && std::abs(sp[a] - spacing_[a]) <= 1e-4 * spacing_[a];
+      same = same && std::abs(org[a] - mask_->GetOrigin()[a]) <= 1e-3 * spacing_[a];
+      for (int c = 0; c < 3; ++c) same = same && std::abs(dir(a, c) - mask_dir(a, c)) <= 1e-4;
+    }
+    if (!same)
+      throw PreconditionError("ct: its voxel grid (size, origin, spacing, direction) differs from the mask's; give the "
+                              "CT the mask was segmented from");
+  }
+
+  // 1. Crop to the lumen, pad, build the sub-voxel field, extract its isosurface in LPS mm.
+  void extract() {
+    Stopwatch watch;
+    box_ = lumen_box(mask_->GetBufferPointer(), size_);
+    st_.lumen_voxels = box_.count;
+    if (!box_.count) throw PreconditionError("mask: no lumen voxels (the mask is empty)");
+    for (int a = 0; a < 3; ++a) st_.crop_size[a] = box_.hi[a] - box_.lo[a] + 1;
+    auto binary = padded_crop(mask_->GetBufferPointer(), size_, box_);
     int dims[3];
-    img->GetDimensions(dims);
-    st.mask_euler_6_18 = euler_6_18(static_cast<const unsigned char*>(img->GetScalarPointer()), dims[0], dims[1], dims[2]);
-    auto pd = isosurface(img, options.method);
-    img = nullptr;
-    tris = to_lps(pd, map, st.direction_flips_orientation);
+    binary->GetDimensions(dims);
+    st_.mask_euler_6_18 =
+        euler_6_18(static_cast<const unsigned char*>(binary->GetScalarPointer()), dims[0], dims[1], dims[2]);
+    vtkSmartPointer<vtkImageData> source = binary;
+    if (opts_.subvoxel != "off" && !ct_ && opts_.mask_smoothing == "sinc") {
+      st_.field_source = "mask (sinc)";  // the staircase itself; smoothed and clamped on the mesh
+    } else if (opts_.subvoxel != "off") {
+      source = subvoxel_field(binary, ct_, box_, spacing_, opts_, st_);
+      binary = nullptr;
+    }
+    auto pd = isosurface(source, opts_.method);
+    source = nullptr;
+    tris_ = to_lps(pd, map_, st_.direction_flips_orientation);
+    if (opts_.subvoxel != "off") staircase_ = staircase_positions(pd, map_);
+    st_.extracted_vertices = tris_.points.size();
+    st_.extracted_faces = tris_.triangles.size();
+    st_.time_extract_s = watch.seconds() - st_.time_field_s;
   }
-  st.extracted_vertices = tris.points.size();
-  st.extracted_faces = tris.triangles.size();
-  st.time_extract_s = t.seconds();
 
-  // 2. Verify: closed, manifold, consistently oriented, same topology as the mask.
-  t.restart();
-  TopologyReport topo = analyze_topology(tris);
-  st.surface_euler = topo.euler;
-  if (topo.unreferenced_vertices || !topo.closed || !topo.manifold || !topo.consistently_oriented)
-    throw Error("reconstruct: the extracted surface is not a closed oriented 2-manifold (" +
-                describe_topology_failure(topo) + ")");
-  if (topo.euler != 2 * st.mask_euler_6_18)
-    throw Error("reconstruct: surface Euler characteristic " + std::to_string(topo.euler) +
-                " differs from twice the mask's (6,18) Euler characteristic " + std::to_string(st.mask_euler_6_18));
-  st.components_found = topo.components.size();
+  // 2. Closed, manifold, consistently oriented, and the topology of the mask.
+  void verify_extracted() {
+    Stopwatch watch;
+    topo_ = analyze_topology(tris_);
+    st_.surface_euler = topo_.euler;
+    if (topo_.unreferenced_vertices || !topo_.closed || !topo_.manifold || !topo_.consistently_oriented)
+      throw Error("reconstruct: the extracted surface is not a closed oriented 2-manifold (" +
+                  describe_topology_failure(topo_) + ")");
+    if (topo_.euler != 2 * st_.mask_euler_6_18)
+      throw Error("reconstruct: surface Euler characteristic " + std::to_string(topo_.euler) +
+                  " differs from twice the mask's (6,18) Euler characteristic " + std::to_string(st_.mask_euler_6_18));
+    st_.components_found = topo_.components.size();
+    ref_ = {0.5 * (topo_.bbox_min[0] + topo_.bbox_max[0]), 0.5 * (topo_.bbox_min[1] + topo_.bbox_max[1]),
+            0.5 * (topo_.bbox_min[2] + topo_.bbox_max[2])};
+    st_.time_check_s += watch.seconds();
+  }
 
-  // 3. Drop small components (by enclosed volume).
-  std::vector<ReconstructComponent> comps;
-  const P3 ref = {0.5 * (topo.bbox_min[0] + topo.bbox_max[0]), 0.5 * (topo.bbox_min[1] + topo.bbox_max[1]),
-                  0.5 * (topo.bbox_min[2] + topo.bbox_max[2])};
-  measure(tris, topo.face_component, topo.components.size(), ref, comps);
-  std::vector<char> keep(comps.size());
-  for (std::size_t c = 0; c < comps.size(); ++c) {
-    comps[c].genus = topo.components[c].genus.value_or(0);
-    keep[c] = std::abs(comps[c].volume_mm3) >= options.min_component_volume;
-    if (!keep[c]) st.dropped.push_back(comps[c]);
+  // 3. Components enclosing less than min_component_volume are dropped (and reported).
+  void drop_small_components() {
+    Stopwatch watch;
+    measure(tris_, topo_.face_component, topo_.components.size(), ref_, comps_);
+    keep_.assign(comps_.size(), 0);
+    for (std::size_t c = 0; c < comps_.size(); ++c) {
+      comps_[c].genus = topo_.components[c].genus.value_or(0);
+      keep_[c] = std::abs(comps_[c].volume_mm3) >= opts_.min_component_volume;
+      if (!keep_[c]) st_.dropped.push_back(comps_[c]);
+    }
+    std::sort(st_.dropped.begin(), st_.dropped.end(), by_volume);
+    if (st_.dropped.size() == comps_.size()) {
+      double largest = 0;
+      for (const auto& c : comps_) largest = std::max(largest, std::abs(c.volume_mm3));
+      throw PreconditionError("mask: no lumen component encloses at least " + format_number(opts_.min_component_volume) +
+                              " mm^3 (--min-component-volume; the largest encloses " + format_number(largest) + " mm^3)");
+    }
+    if (!st_.dropped.empty()) tris_ = kept_triangles();
+    topo_ = TopologyReport{};
+    st_.time_check_s += watch.seconds();
   }
-  auto by_volume = [](const ReconstructComponent& a, const ReconstructComponent& b) {
-    return std::abs(a.volume_mm3) > std::abs(b.volume_mm3);
-  };
-  std::sort(st.dropped.begin(), st.dropped.end(), by_volume);
-  if (st.dropped.size() == comps.size()) {
-    double largest = 0;
-    for (const auto& c : comps) largest = std::max(largest, std::abs(c.volume_mm3));
-    throw PreconditionError("mask: no lumen component encloses at least " + format_number(options.min_component_volume) +
-                            " mm^3 (--min-component-volume; the largest encloses " + format_number(largest) + " mm^3)");
-  }
-  if (!st.dropped.empty()) {
-    std::vector<int> new_id(tris.points.size(), -1);
+
+  // The triangles of the kept components, with their vertices renumbered (staircase_ too).
+  TriangleList kept_triangles() {
+    std::vector<int> new_id(tris_.points.size(), -1);
+    std::vector<P3> staircase;
     TriangleList kept;
-    kept.triangles.reserve(tris.triangles.size());
-    for (std::size_t f = 0; f < tris.triangles.size(); ++f) {
-      if (!keep[std::size_t(topo.face_component[f])]) continue;
+    kept.triangles.reserve(tris_.triangles.size());
+    for (std::size_t f = 0; f < tris_.triangles.size(); ++f) {
+      if (!keep_[std::size_t(topo_.face_component[f])]) continue;
       std::array<int, 3> tri;
       for (int k = 0; k < 3; ++k) {
-        int& id = new_id[std::size_t(tris.triangles[f][k])];
+        int& id = new_id[std::size_t(tris_.triangles[f][k])];
         if (id < 0) {
           id = int(kept.points.size());
-          kept.points.push_back(tris.points[std::size_t(tris.triangles[f][k])]);
+          kept.points.push_back(tris_.points[std::size_t(tris_.triangles[f][k])]);
+          if (!staircase_.empty()) staircase.push_back(staircase_[std::size_t(tris_.triangles[f][k])]);
         }
         tri[k] = id;
       }
       kept.triangles.push_back(tri);
     }
-    tris = std::move(kept);
+    staircase_ = std::move(staircase);
+    return kept;
   }
-  topo = TopologyReport{};
-  st.time_check_s = t.seconds();
 
-  // 4. Smoothing: windowed sinc moves points only (connectivity, hence topology, unchanged).
-  if (options.smoothing_iterations > 0) {
-    t.restart();
+  // 4. Optional windowed-sinc smoothing: moves points only (connectivity, hence topology, unchanged).
+  void smooth_mesh() {
+    if (opts_.smoothing_iterations <= 0) return;
+    Stopwatch watch;
     VtkMessageCapture capture;
     vtkNew<vtkPoints> pts;
     pts->SetDataTypeToDouble();
-    pts->SetNumberOfPoints(vtkIdType(tris.points.size()));
-    for (std::size_t i = 0; i < tris.points.size(); ++i) pts->SetPoint(vtkIdType(i), tris.points[i].data());
+    pts->SetNumberOfPoints(vtkIdType(tris_.points.size()));
+    for (std::size_t i = 0; i < tris_.points.size(); ++i) pts->SetPoint(vtkIdType(i), tris_.points[i].data());
     vtkNew<vtkCellArray> polys;
-    polys->AllocateExact(vtkIdType(tris.triangles.size()), vtkIdType(3 * tris.triangles.size()));
-    for (const auto& tri : tris.triangles) {
+    polys->AllocateExact(vtkIdType(tris_.triangles.size()), vtkIdType(3 * tris_.triangles.size()));
+    for (const auto& tri : tris_.triangles) {
       const vtkIdType ids[3] = {tri[0], tri[1], tri[2]};
       polys->InsertNextCell(3, ids);
     }
@@ -438,8 +346,8 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
     pd->SetPolys(polys);
     vtkNew<vtkWindowedSincPolyDataFilter> smooth;
     smooth->SetInputData(pd);
-    smooth->SetNumberOfIterations(options.smoothing_iterations);
-    smooth->SetPassBand(options.pass_band);
+    smooth->SetNumberOfIterations(opts_.smoothing_iterations);
+    smooth->SetPassBand(opts_.pass_band);
     smooth->NormalizeCoordinatesOn();
     smooth->BoundarySmoothingOff();
     smooth->FeatureEdgeSmoothingOff();
@@ -447,27 +355,44 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
     smooth->Update();
     if (!capture.errors().empty()) throw Error("smoothing failed: " + capture.first_problem());
     vtkPoints* out = smooth->GetOutput()->GetPoints();
-    if (!out || out->GetNumberOfPoints() != vtkIdType(tris.points.size()))
+    if (!out || out->GetNumberOfPoints() != vtkIdType(tris_.points.size()))
       throw Error("smoothing failed: the point count changed");
-    for (std::size_t i = 0; i < tris.points.size(); ++i) out->GetPoint(vtkIdType(i), tris.points[i].data());
-    st.smoothed = true;
-    st.time_smooth_s = t.seconds();
+    for (std::size_t i = 0; i < tris_.points.size(); ++i) out->GetPoint(vtkIdType(i), tris_.points[i].data());
+    if (!staircase_.empty()) keep_within_half_voxel();
+    st_.smoothed = true;
+    st_.time_smooth_s = watch.seconds();
   }
 
-  Mesh mesh = to_openmesh(tris);
-  tris = TriangleList{};
+  // A sub-voxel surface stays within 1/2 voxel (index space) of the staircase: a vertex the
+  // smoothing moved farther is pulled back along its displacement.
+  void keep_within_half_voxel() {
+    Eigen::Matrix3d index_to_lps;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) index_to_lps(r, c) = map_.m[r][c];
+    const Eigen::Matrix3d lps_to_index = index_to_lps.inverse();
+    const double limit = 0.5 * (1 - 1e-6);
+    for (std::size_t i = 0; i < tris_.points.size(); ++i) {
+      const Eigen::Vector3d moved(tris_.points[i][0] - staircase_[i][0], tris_.points[i][1] - staircase_[i][1],
+                                  tris_.points[i][2] - staircase_[i][2]);
+      const double voxels = (lps_to_index * moved).norm();
+      if (voxels <= limit) continue;
+      ++st_.clamped_vertices;
+      for (int a = 0; a < 3; ++a) tris_.points[i][a] = staircase_[i][a] + moved[a] * (limit / voxels);
+    }
+  }
 
-  // 5. Decimation: OpenMesh's quadric decimater; its collapse test (link condition, no
+  // 5. Optional decimation: OpenMesh's quadric decimater; its collapse test (link condition, no
   // tetrahedron collapse) keeps a closed manifold's topology; normal flips are refused.
-  if (options.target_faces > 0 && mesh.n_faces() > std::size_t(options.target_faces)) {
-    t.restart();
+  void decimate() {
+    if (opts_.target_faces <= 0 || mesh_.n_faces() <= std::size_t(opts_.target_faces)) return;
+    Stopwatch watch;
     using Decimater = OpenMesh::Decimater::McDecimaterT<Mesh>;
     using Quadric = OpenMesh::Decimater::ModQuadricT<Mesh>::Handle;
     using NormalFlip = OpenMesh::Decimater::ModNormalFlippingT<Mesh>::Handle;
-    mesh.request_face_normals();
-    mesh.update_face_normals();
+    mesh_.request_face_normals();
+    mesh_.update_face_normals();
     {
-      Decimater dec(mesh);
+      Decimater dec(mesh_);
       Quadric hq;
       NormalFlip hn;
       dec.add(hq);
@@ -475,109 +400,76 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
       dec.module(hn).set_max_normal_deviation(60.0);
       dec.set_samples(8);
       if (!dec.initialize()) throw Error("decimation failed to initialise");
-      dec.decimate_to_faces(0, std::size_t(options.target_faces));
+      dec.decimate_to_faces(0, std::size_t(opts_.target_faces));
     }
-    mesh.garbage_collection();
-    mesh.release_face_normals();
-    st.decimated = true;
-    st.time_decimate_s = t.seconds();
+    mesh_.garbage_collection();
+    mesh_.release_face_normals();
+    st_.decimated = true;
+    st_.time_decimate_s = watch.seconds();
   }
 
-  // 6. Final check and statistics.
-  t.restart();
-  const TopologyReport fin = analyze_topology(mesh);
-  if (fin.unreferenced_vertices || !fin.closed || !fin.manifold || !fin.consistently_oriented)
-    throw Error("reconstruct: the final surface is not a closed oriented 2-manifold (" + describe_topology_failure(fin) +
-                ")");
-  std::size_t kept_count = 0;
-  int kept_genus = 0;
-  for (std::size_t c = 0; c < comps.size(); ++c)
-    if (keep[c]) {
-      ++kept_count;
-      kept_genus += comps[c].genus;
-    }
-  if (fin.components.size() != kept_count || !fin.genus || *fin.genus != kept_genus)
-    throw Error("reconstruct: topology changed after smoothing/decimation (" + std::to_string(fin.components.size()) +
-                " components, genus " + (fin.genus ? std::to_string(*fin.genus) : std::string("undefined")) +
-                "; expected " + std::to_string(kept_count) + " components, genus " + std::to_string(kept_genus) + ")");
-  {
-    const TriangleList fl = to_triangle_list(mesh);
-    measure(fl, fin.face_component, fin.components.size(), ref, st.kept);
-    for (std::size_t c = 0; c < st.kept.size(); ++c) st.kept[c].genus = fin.components[c].genus.value_or(0);
-    std::sort(st.kept.begin(), st.kept.end(), by_volume);
+  // 6. The result is a closed oriented manifold with the kept components and their genus.
+  void final_check() {
+    Stopwatch watch;
+    const TopologyReport fin = analyze_topology(mesh_);
+    if (fin.unreferenced_vertices || !fin.closed || !fin.manifold || !fin.consistently_oriented)
+      throw Error("reconstruct: the final surface is not a closed oriented 2-manifold (" +
+                  describe_topology_failure(fin) + ")");
+    std::size_t kept_count = 0;
+    int kept_genus = 0;
+    for (std::size_t c = 0; c < comps_.size(); ++c)
+      if (keep_[c]) {
+        ++kept_count;
+        kept_genus += comps_[c].genus;
+      }
+    if (fin.components.size() != kept_count || !fin.genus || *fin.genus != kept_genus)
+      throw Error("reconstruct: topology changed after smoothing/decimation (" +
+                  std::to_string(fin.components.size()) + " components, genus " +
+                  (fin.genus ? std::to_string(*fin.genus) : std::string("undefined")) + "; expected " +
+                  std::to_string(kept_count) + " components, genus " + std::to_string(kept_genus) + ")");
+    const TriangleList final_triangles = to_triangle_list(mesh_);
+    measure(final_triangles, fin.face_component, fin.components.size(), ref_, st_.kept);
+    for (std::size_t c = 0; c < st_.kept.size(); ++c) st_.kept[c].genus = fin.components[c].genus.value_or(0);
+    std::sort(st_.kept.begin(), st_.kept.end(), by_volume);
+    st_.vertices = mesh_.n_vertices();
+    st_.faces = mesh_.n_faces();
+    st_.genus = *fin.genus;
+    st_.time_check_s += watch.seconds();
   }
-  st.vertices = mesh.n_vertices();
-  st.faces = mesh.n_faces();
-  st.genus = *fin.genus;
-  st.time_check_s += t.seconds();
-  st.time_total_s = total.seconds();
-  if (stats_out) *stats_out = std::move(st);
-  return mesh;
-}
 
-nlohmann::json BoundaryDistance::to_json() const {
-  return {{"max_mm", max_mm}, {"mean_mm", mean_mm}, {"vertices", vertices}, {"far", far}, {"max_spacing_mm", max_spacing_mm}};
-}
+  static bool by_volume(const ReconstructComponent& a, const ReconstructComponent& b) {
+    return std::abs(a.volume_mm3) > std::abs(b.volume_mm3);
+  }
 
-BoundaryDistance distance_to_mask_boundary(const Mesh& surface, const MaskImage* mask) {
+  const MaskImage* mask_;
+  const CtImage* ct_;
+  const ReconstructOptions& opts_;
+  ReconstructStats st_;
+  Stopwatch total_;
+  std::array<std::size_t, 3> size_{0, 0, 0};
+  std::array<double, 3> spacing_{1, 1, 1};
+  IndexToLps map_{};
+  Box box_;
+  TriangleList tris_;
+  std::vector<P3> staircase_;  // staircase position of each point of tris_ (sub-voxel surfaces only)
+  TopologyReport topo_;
+  std::vector<ReconstructComponent> comps_;
+  std::vector<char> keep_;
+  P3 ref_{0, 0, 0};
+  Mesh mesh_;
+};
+
+}  // namespace
+
+Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
+                         ReconstructStats* stats) {
+  validate(options);
   if (!mask) throw PreconditionError("no mask");
-  const auto region = mask->GetBufferedRegion();
-  const long n[3] = {long(region.GetSize()[0]), long(region.GetSize()[1]), long(region.GetSize()[2])};
-  const unsigned char* d = mask->GetBufferPointer();
-  const auto sp = mask->GetSpacing();
-  const auto org = mask->GetOrigin();
-  const auto dir = mask->GetDirection();
-  auto at = [&](long i, long j, long k) -> bool {
-    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return false;
-    return d[(k * n[1] + j) * n[0] + i] != 0;
-  };
-  BoundaryDistance out;
-  out.max_spacing_mm = std::max({sp[0], sp[1], sp[2]});
-  const int R = 3;
-  double sum = 0;
-  for (auto v : surface.vertices()) {
-    const auto& p = surface.point(v);
-    // Continuous buffer index: x = diag(1/s) D^T (p - origin) - start.
-    double x[3];
-    for (int a = 0; a < 3; ++a) {
-      double t = 0;
-      for (int r = 0; r < 3; ++r) t += dir(r, a) * (p[r] - org[r]);
-      x[a] = t / sp[a] - double(region.GetIndex()[a]);
-    }
-    const long c[3] = {std::lround(x[0]), std::lround(x[1]), std::lround(x[2])};
-    double best = kInf;
-    for (long k = c[2] - R; k <= c[2] + R; ++k)
-      for (long j = c[1] - R; j <= c[1] + R; ++j)
-        for (long i = c[0] - R; i <= c[0] + R; ++i) {
-          if (!at(i, j, k)) continue;
-          const long q[3] = {i, j, k};
-          for (int a = 0; a < 3; ++a)
-            for (int s = -1; s <= 1; s += 2) {
-              long nb[3] = {i, j, k};
-              nb[a] += s;
-              if (at(nb[0], nb[1], nb[2])) continue;
-              // The face between q and nb: plane x_a = q_a + s/2, the other two coordinates
-              // within half a voxel of q.
-              double d2 = 0;
-              for (int b = 0; b < 3; ++b) {
-                const double e = b == a ? x[b] - (double(q[b]) + 0.5 * s)
-                                        : std::max(0.0, std::abs(x[b] - double(q[b])) - 0.5);
-                d2 += (e * sp[b]) * (e * sp[b]);
-              }
-              best = std::min(best, d2);
-            }
-        }
-    ++out.vertices;
-    if (!std::isfinite(best)) {
-      ++out.far;
-      continue;
-    }
-    const double dd = std::sqrt(best);
-    out.max_mm = std::max(out.max_mm, dd);
-    sum += dd;
-  }
-  if (out.vertices > out.far) out.mean_mm = sum / double(out.vertices - out.far);
-  return out;
+  return SurfaceReconstruction(mask, ct, options).run(stats);
+}
+
+Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& options, ReconstructStats* stats) {
+  return reconstruct_surface(mask, nullptr, options, stats);
 }
 
 }  // namespace cf

@@ -12,21 +12,24 @@ const StageSpec& ReconstructStage::spec() const {
   static const StageSpec s{
       "reconstruct",
       "lumen mask -> closed manifold colon surface (LPS mm, normals out of the lumen)",
-      {{"mask", &mask_artifact(), "lumen mask", "lumen_mask.nrrd"}},
+      {{"mask", &mask_artifact(), "lumen mask", "lumen_mask.nrrd"},
+       {"ct", &volume_artifact(), "the CT the mask was segmented from (HU, same grid): surface at its air/tissue boundary",
+        "ct.nrrd", false}},
       {{"surface", &mesh_artifact(), "colon surface (LPS mm)", "surface.vtp"}}};
   return s;
 }
 
 void ReconstructStage::run(ArtifactBag& bag, RunContext& ctx) {
   const auto& mask = bag.get<MaskImage::Pointer>("mask");
+  const CtImage* ct = bag.has("ct") ? bag.get<CtImage::Pointer>("ct").GetPointer() : nullptr;
   ReconstructStats st;
-  Mesh surface = reconstruct_surface(mask.GetPointer(), opts_, &st);
+  Mesh surface = reconstruct_surface(mask.GetPointer(), ct, opts_, &st);
   ctx.report = st.to_json();
   std::ostringstream line;
   line << "  reconstruct: " << st.lumen_voxels << " lumen voxels -> " << st.extracted_faces << " triangles ("
        << st.components_found << " components, " << st.dropped.size() << " dropped below "
        << format_number(opts_.min_component_volume) << " mm^3) -> " << st.faces << " triangles, " << st.kept.size()
-       << " components, genus " << st.genus << std::fixed << std::setprecision(2) << ", " << st.time_total_s << " s";
+       << " components, genus " << st.genus << ", surface " << st.field_source << std::fixed << std::setprecision(2) << ", " << st.time_total_s << " s";
   ctx.progress(line.str());
   bag.put("surface", std::move(surface));
 }

@@ -48,16 +48,18 @@ void check_phantom(bool collapsed) {
   EXPECT_EQ(st.kept.size(), segments);
   if (collapsed) EXPECT_GE(segments, 2u);
   for (const auto& c : st.kept) EXPECT_GT(c.volume_mm3, 0);  // no cavity, outward normals
-  // Within a voxel of the true lumen boundary.
+  // Within half a voxel of the true lumen boundary (the sub-voxel constraint).
   const BoundaryDistance bd = distance_to_mask_boundary(s, gt);
   EXPECT_EQ(bd.far, 0u);
-  EXPECT_LE(bd.max_mm, std::min({sp[0], sp[1], sp[2]})) << bd.to_json().dump();
+  EXPECT_LE(bd.max_voxels, 0.5) << bd.to_json().dump();
   EXPECT_LE(bd.mean_mm, 0.25 * std::min({sp[0], sp[1], sp[2]})) << bd.to_json().dump();
-  // Enclosed volume ~ the lumen volume.
+  // Enclosed volume ~ the lumen volume (the curvature flow of the default anti-aliasing pulls the
+  // coarse 2.8 mm tube slightly inwards: -5.4 % measured with 50 iterations; the default 20 stay
+  // within 5 %).
   double lumen = 0, surf = 0;
   for (std::size_t n : testing::component_sizes_6(gt)) lumen += double(n) * sp[0] * sp[1] * sp[2];
   for (const auto& c : st.kept) surf += c.volume_mm3;
-  EXPECT_NEAR(surf, lumen, 0.03 * lumen);
+  EXPECT_NEAR(surf, lumen, 0.05 * lumen);
 }
 
 // The small phantom's surface is closed, manifold, one component per segment and within a voxel
@@ -99,7 +101,7 @@ TEST(ReconstructStageCli, WritesSurfaceAndReport) {
   testing::TempDir tmp;
   write_mask(block_mask(false), tmp / "mask.nrrd");
   auto r = call({tmp.str("mask.nrrd"), "-o", tmp.str("surface.vtp"), "--report", tmp.str("r.json"),
-                 "--smoothing-iterations", "0", "--min-component-volume", "100", "-q"});
+                 "--smoothing-iterations", "0", "--subvoxel", "off", "--min-component-volume", "100", "-q"});
   ASSERT_EQ(r.code, 0) << r.err;
   const LoadedMesh m = load_mesh(tmp / "surface.vtp");
   EXPECT_TRUE(m.topology.closed && m.topology.manifold);
@@ -108,6 +110,8 @@ TEST(ReconstructStageCli, WritesSurfaceAndReport) {
   std::ifstream in(tmp / "r.json");
   const auto j = nlohmann::json::parse(in);
   EXPECT_EQ(j["parameters"]["smoothing-iterations"], 0);
+  EXPECT_EQ(j["parameters"]["subvoxel"], "off");
+  EXPECT_EQ(j["result"]["subvoxel_source"], "off");
   EXPECT_EQ(j["parameters"]["min-component-volume"], 100.0);
   EXPECT_EQ(j["result"]["components"], 1);
   EXPECT_EQ(j["result"]["faces"], m.mesh.n_faces());

@@ -14,54 +14,12 @@
 #include "colonflat/core/topology.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include "mask_components.h"
+#include "synthetic_masks.h"
 
 namespace cf {
 namespace {
 
-using Geometry = std::function<bool(const std::array<double, 3>&)>;
-
-struct MaskSpec {
-  std::array<std::size_t, 3> size{32, 32, 32};
-  std::array<double, 3> spacing{1, 1, 1};
-  std::array<double, 3> origin{0, 0, 0};
-  std::array<double, 9> direction{1, 0, 0, 0, 1, 0, 0, 0, 1};  // row major
-  std::array<long, 3> start{0, 0, 0};
-};
-
-MaskImage::Pointer make_mask(const MaskSpec& s) {
-  auto m = MaskImage::New();
-  MaskImage::RegionType r;
-  for (int a = 0; a < 3; ++a) {
-    r.SetIndex(a, s.start[a]);
-    r.SetSize(a, s.size[a]);
-  }
-  m->SetRegions(r);
-  MaskImage::SpacingType sp;
-  MaskImage::PointType o;
-  MaskImage::DirectionType d;
-  for (int a = 0; a < 3; ++a) {
-    sp[a] = s.spacing[a];
-    o[a] = s.origin[a];
-    for (int c = 0; c < 3; ++c) d(a, c) = s.direction[3 * a + c];
-  }
-  m->SetSpacing(sp);
-  m->SetOrigin(o);
-  m->SetDirection(d);
-  m->Allocate(true);
-  return m;
-}
-
-// Sets every voxel whose centre (LPS mm, through ITK's own index->point map) satisfies `inside`.
-MaskImage::Pointer rasterize(const MaskSpec& s, const Geometry& inside) {
-  auto m = make_mask(s);
-  itk::ImageRegionIteratorWithIndex<MaskImage> it(m, m->GetBufferedRegion());
-  for (; !it.IsAtEnd(); ++it) {
-    MaskImage::PointType p;
-    m->TransformIndexToPhysicalPoint(it.GetIndex(), p);
-    if (inside({p[0], p[1], p[2]})) it.Set(1);
-  }
-  return m;
-}
+using namespace testing::masks;
 
 // A mask from an explicit voxel list on an n^3 unit grid.
 MaskImage::Pointer voxels(std::size_t n, const std::vector<std::array<int, 3>>& on) {
@@ -97,6 +55,7 @@ std::array<double, 3> rotation(double ax, double ay, double az, std::array<doubl
 
 ReconstructOptions raw() {
   ReconstructOptions o;
+  o.subvoxel = "off";
   o.smoothing_iterations = 0;
   o.min_component_volume = 0;
   return o;

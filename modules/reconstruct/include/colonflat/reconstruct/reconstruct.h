@@ -12,6 +12,12 @@
 //     background voxels through faces and edges. Exactly, before decimation:
 //     chi(extracted surface) == 2 * mask_euler_characteristic_6_18(mask), before small components
 //     are dropped. Smoothing moves points only; decimation keeps every component's genus.
+//   * sub-voxel placement (subvoxel != "off"): the surface is the 0.5 isosurface of a field that is
+//     > 0.5 exactly at lumen voxels: the CT's air/tissue boundary (air_tissue_hu) where a CT is
+//     given and no tagged fluid is near, otherwise the constrained-smoothed mask. The triangles
+//     are those of the binary mask's surface; every vertex stays on its lattice edge strictly
+//     between the two voxel centres; the optional windowed-sinc smoothing after it is clamped so that
+//     no vertex ends more than 1/2 voxel from its staircase position (index space).
 //   * one surface component per 6-connected lumen component (plus one per enclosed background
 //     cavity), components enclosing less than min_component_volume mm^3 dropped and reported.
 #include <itkImage.h>
@@ -27,13 +33,20 @@
 
 namespace cf {
 
-// Same alias as colonflat/volume/volume_io.h (0 outside, 1 lumen; any non-zero value is lumen).
+// Same aliases as colonflat/volume/volume_io.h (0 outside, 1 lumen; any non-zero value is lumen).
 using MaskImage = itk::Image<unsigned char, 3>;
+using CtImage = itk::Image<float, 3>;  // HU, on the mask's voxel grid
 
 struct ReconstructOptions {
   std::string method = "flying-edges";  // flying-edges | discrete-flying-edges | marching-cubes
   double min_component_volume = 500.0;  // mm^3; smaller surface components are dropped
-  int smoothing_iterations = 20;        // windowed-sinc iterations; 0 = no smoothing
+  std::string subvoxel = "auto";          // auto (CT if given, else mask) | ct | mask | off
+  std::string mask_smoothing = "antialias";  // antialias (Whitaker field, then sinc) | sinc (windowed sinc only)
+  int antialias_iterations = 20;        // mask field: at most this many Whitaker (ITK anti-alias) iterations
+  double antialias_rms = 0.001;         // mask field: stop when the RMS level-set change per iteration is below
+  double air_tissue_hu = -500.0;        // HU; the CT boundary placed between air and the wall
+  double fluid_hu = 150.0;              // HU; lumen voxels at or above are tagged fluid (mask field near them)
+  int smoothing_iterations = 20;        // windowed-sinc iterations on the mesh; 0 = no smoothing
   double pass_band = 0.1;               // windowed-sinc pass band (smaller = smoother)
   int target_faces = 0;                 // quadric decimation to this many triangles; 0 = none
 };
@@ -63,10 +76,14 @@ struct ReconstructStats {
   std::size_t components_found = 0;
   std::vector<ReconstructComponent> kept;     // largest |volume| first
   std::vector<ReconstructComponent> dropped;  // below min_component_volume
+  std::string field_source = "off";          // ct | mask | off
+  std::size_t clamped_vertices = 0;           // vertices the smoothing moved > 1/2 voxel, pulled back
+  std::size_t fluid_voxels = 0;               // lumen voxels >= fluid_hu (ct field only)
+  std::size_t field_clamped_voxels = 0;       // lumen voxels the field would have put outside
   bool smoothed = false, decimated = false;
   std::size_t vertices = 0, faces = 0;
   int genus = 0;  // total over kept components
-  double time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_decimate_s = 0, time_total_s = 0;
+  double time_field_s = 0, time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_decimate_s = 0, time_total_s = 0;
   nlohmann::json to_json() const;
 };
 
@@ -74,6 +91,12 @@ struct ReconstructStats {
 // mask, a mask without a component above min_component_volume, or non-positive spacing;
 // UsageError for invalid options; cf::Error if a guarantee fails to hold.
 Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& options,
+                         ReconstructStats* stats = nullptr);
+// The same with the CT the mask was segmented from (null = none): with subvoxel auto or ct the
+// surface follows the CT's air/tissue boundary inside the segmented lumen. The CT must have the
+// mask's size, origin, spacing and direction (PreconditionError otherwise); subvoxel ct without a
+// CT is a PreconditionError.
+Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
                          ReconstructStats* stats = nullptr);
 
 // Euler characteristic of the lumen (non-zero voxels) in the (6,18) digital topology, i.e. of
@@ -89,6 +112,7 @@ struct BoundaryDistance {
   double max_mm = 0, mean_mm = 0;
   std::size_t vertices = 0, far = 0;
   double max_spacing_mm = 0;  // largest voxel spacing of the mask
+  double max_voxels = 0, mean_voxels = 0;  // the same distances in voxel (index) units
   nlohmann::json to_json() const;
 };
 BoundaryDistance distance_to_mask_boundary(const Mesh& surface, const MaskImage* mask);

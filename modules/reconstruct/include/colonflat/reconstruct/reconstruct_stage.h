@@ -1,7 +1,9 @@
 #pragma once
 // The `reconstruct` pipeline stage: "mask" (lumen_mask.nrrd) -> "surface" (surface.vtp).
-// `colonflat reconstruct MASK -o SURFACE [--method ...] [--min-component-volume MM3]
-//  [--smoothing-iterations N] [--pass-band F] [--target-faces N] [--report stats.json]`.
+// Optional input "ct" (the CT the mask was segmented from; `colonflat run` passes it on when it
+// starts at segment): the surface then follows the CT's air/tissue boundary.
+// `colonflat reconstruct MASK -o SURFACE [--ct CT] [parameters, see --help or docs/reconstruct.md]
+//  [--report stats.json]`.
 #include <memory>
 
 #include "colonflat/core/stage.h"
