@@ -41,7 +41,7 @@ struct ReconstructOptions {
   std::string method = "flying-edges";  // flying-edges | discrete-flying-edges | marching-cubes
   double min_component_volume = 500.0;  // mm^3; smaller surface components are dropped
   std::string subvoxel = "auto";          // auto (CT if given, else mask) | ct | mask | off
-  std::string mask_smoothing = "antialias";  // antialias (Whitaker field, then sinc) | sinc (windowed sinc only)
+  std::string mask_smoothing = "sinc";  // sinc (windowed sinc, clamped to 1/2 voxel) | antialias (Whitaker field, then sinc)
   int antialias_iterations = 20;        // mask field: at most this many Whitaker (ITK anti-alias) iterations
   double antialias_rms = 0.001;         // mask field: stop when the RMS level-set change per iteration is below
   double air_tissue_hu = -500.0;        // HU; the CT boundary placed between air and the wall
