@@ -16,6 +16,7 @@
 #include <itkNrrdImageIO.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -279,7 +280,10 @@ typename TImage::Pointer read_dicom_series(const DicomChoice& c, const ScannedFo
   } catch (const itk::ExceptionObject& e) {
     throw InputError(c.dir.string(), "cannot read DICOM series " + c.uid + ": " + itk_message(e));
   }
-  return reader->GetOutput();
+  typename TImage::Pointer out = reader->GetOutput();
+  std::string position;  // PatientPosition of the (last read) slice: one value per series
+  if (io->GetValueFromTag("0018|5100", position)) set_patient_position(out.GetPointer(), trim(position.c_str()));
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -443,6 +447,7 @@ void write_image_file(const TImage* img, const fs::path& tmp, const fs::path& ta
 ShortImage::Pointer to_short(const CtImage* img) {
   auto out = ShortImage::New();
   out->CopyInformation(img);
+  set_patient_position(out.GetPointer(), patient_position(img));  // the only metadata carried along
   out->SetRegions(img->GetLargestPossibleRegion());
   out->Allocate();
   const float* src = img->GetBufferPointer();
@@ -497,6 +502,24 @@ std::vector<DicomSeriesInfo> list_dicom_series(const fs::path& dir) {
                    trim(f->scanner.GetValue(first, kDescription))});
   }
   return out;
+}
+
+std::string patient_position(const itk::ImageBase<3>* image) {
+  std::string v;
+  if (!image || !itk::ExposeMetaData<std::string>(image->GetMetaDataDictionary(), "0018|5100", v)) return "";
+  v.erase(std::remove_if(v.begin(), v.end(), [](unsigned char c) { return std::isspace(c) || c == 0; }), v.end());
+  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  return v;
+}
+
+void set_patient_position(itk::ImageBase<3>* image, const std::string& position) {
+  if (!image) return;
+  auto& d = image->GetMetaDataDictionary();
+  if (position.empty()) {
+    if (d.HasKey("0018|5100")) d.Erase("0018|5100");
+    return;
+  }
+  itk::EncapsulateMetaData<std::string>(d, "0018|5100", position);
 }
 
 CtImage::Pointer read_ct_volume(const fs::path& p, const VolumeReadOptions& opts) {
@@ -604,6 +627,8 @@ void write_dicom_series(const CtImage* image, const fs::path& dir, const DicomWr
     put("0028|1052", "0");
     put("0028|1053", "1");
     put("0028|1054", "HU");
+    const std::string position = opt.patient_position.empty() ? patient_position(image) : opt.patient_position;
+    if (!position.empty()) put("0018|5100", position);
     arr.push_back(d.get());
     dicts.push_back(std::move(d));
   }
