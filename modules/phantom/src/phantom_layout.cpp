@@ -164,7 +164,7 @@ void PhantomLayout::place_near_touch() {
 // lowest point and fills the lumen below it connected to that point (communicating vessels).
 void PhantomLayout::place_pools(Rng& rng, bool prone) {
   const Path& P = md_.path;
-  const double g = md_.gravity;
+  const double g = prone ? -1.0 : 1.0;  // the legacy supine pools are placed in both positions
   const std::vector<int> segs = prone ? std::vector<int>{1, 3, 4} : std::vector<int>{0, 2, 4};
   for (int ps : segs) {
     const double a = seg_start(ps), b = ps == 4 ? P.length : seg_end(ps);  // ascending + cecum

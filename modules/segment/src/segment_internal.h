@@ -102,6 +102,7 @@ class ColonSegmenter {
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
   void link_tagged_stretches();
+  std::size_t link_pass(bool last);
   void nearest_colon(const std::vector<BodyStats>& bodies, std::vector<std::size_t>& from, std::vector<std::size_t>& to,
                      std::vector<double>& gap) const;
   std::size_t local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
@@ -133,6 +134,7 @@ class ColonSegmenter {
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
   std::vector<std::uint32_t> cand_label_;  // fully tagged candidates (during link_tagged_stretches)
   std::vector<std::uint32_t> seg_label_;   // kept colon segments (until the stretches are linked)
+  int linked_ = 0;                         // candidates linked so far
   std::vector<unsigned char> state_;   // crop: final 0/1 (after the graph cut)
   std::vector<unsigned char> lumen0_;  // crop: initial lumen
   std::vector<Decision> decisions_;

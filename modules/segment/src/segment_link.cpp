@@ -62,8 +62,8 @@ void ColonSegmenter::select_segments() {
       fate[l] = 1;
       vols.push_back(ml);
       decide("segment", ml, c, true, "colon segment (" + fixed1(gas_ml) + " mL gas)");
-    } else if (ml - gas_ml >= opts_.min_tagged_volume && gas_ml < opts_.min_segment_volume) {
-      fate[l] = 2;  // decided with the fully tagged candidates
+    } else if (ml - gas_ml >= opts_.min_tagged_volume || gas_ml >= opts_.min_segment_volume) {
+      fate[l] = 2;  // decided with the fully tagged candidates: kept if it continues the colon
     } else {
       ++st_.removed_components;
       decide(b.gas == b.voxels ? "gas body" : "segment", ml, c, false, reason);
@@ -84,9 +84,18 @@ void ColonSegmenter::select_segments() {
                             " mL (an insufflated colon holds several hundred mL)");
 }
 
-// Candidates (lab 4): kept as fully tagged stretches when they continue a colon segment's end
-// within link-gap; every other candidate is rejected with its reason.
+// Candidates (lab 4): kept when they continue a colon segment's end within link-gap, in passes
+// (a stretch kept in one pass is colon for the next: chains of stretches and small gas pieces
+// between them); the last pass rejects every other candidate with its reason.
 void ColonSegmenter::link_tagged_stretches() {
+  for (int pass = 0; pass < 6; ++pass)
+    if (link_pass(false) == 0) break;
+  link_pass(true);
+  std::vector<std::uint32_t>().swap(cand_label_);
+  std::vector<std::uint32_t>().swap(seg_label_);
+}
+
+std::size_t ColonSegmenter::link_pass(bool last) {
   MaskImage::Pointer work = mask_of_size(d_.n);
   unsigned char* w = work->GetBufferPointer();
   for (std::size_t q = 0; q < d_.total; ++q) w[q] = lab_[q] == kCandidate;
@@ -107,30 +116,38 @@ void ColonSegmenter::link_tagged_stretches() {
       }
   std::vector<std::size_t> from(n + 1, SIZE_MAX), to(n + 1, SIZE_MAX);
   std::vector<double> gap(n + 1, 1e9);
-  nearest_colon(bodies, from, to, gap);
-  std::vector<unsigned char> keep(n + 1, 0);
+  if (n > 0) nearest_colon(bodies, from, to, gap);
+  std::vector<std::uint32_t> keep(n + 1, 0);  // new segment label of a kept candidate
+  std::size_t kept = 0;
   for (std::uint32_t l = 1; l <= n; ++l) {
     const BodyStats& b = bodies[l];
     const double ml = double(b.voxels) * voxel_ml_;
     const double c[3] = {b.sum[0] / double(b.voxels), b.sum[1] / double(b.voxels), b.sum[2] / double(b.voxels)};
+    const std::string what = 2 * b.gas > b.voxels ? "gas body" : (b.gas > 0 ? "fluid body with gas" : "fluid body");
     std::string why;
     if (ml < opts_.min_tagged_volume) why = "smaller than --min-tagged-volume";
     else if (b.touches_face) why = "reaches beyond the colon's region (bone, vessel, bladder)";
     else if (from[l] == SIZE_MAX) why = "no colon segment end within --link-gap";
     else if (continues_colon(l, from[l], to[l], why)) {
-      keep[l] = 1;
-      ++st_.tagged_stretches;
-      st_.tagged_stretch_volume_ml += ml;
-      decide("fluid body", ml, c, true, "fully tagged colon stretch continuing a segment's end (gap " + fixed1(gap[l]) + " mm)");
+      keep[l] = 0x80000000u + std::uint32_t(++linked_);
+      ++kept;
+      if (what != "gas body") ++st_.tagged_stretches, st_.tagged_stretch_volume_ml += ml;
+      decide(what, ml, c, true,
+             (what == "gas body" ? "colon segment continuing a segment's end (gap " : "fully tagged colon stretch continuing a segment's end (gap ") +
+                 fixed1(gap[l]) + " mm)");
       continue;
     }
+    if (!last) continue;
     ++st_.rejected_fluid_components;
-    decide(b.gas > 0 ? "fluid body with gas" : "fluid body", ml, c, false, why);
+    decide(what, ml, c, false, why);
   }
-  for (std::size_t q = 0; q < d_.total; ++q)
-    if (lab_[q] == kCandidate) lab_[q] = keep[cand_label_[q]] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
-  std::vector<std::uint32_t>().swap(cand_label_);
-  std::vector<std::uint32_t>().swap(seg_label_);
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    if (lab_[q] != kCandidate) continue;
+    const std::uint32_t l = cand_label_[q];
+    if (keep[l]) lab_[q] = hu_[q] < opts_.air_threshold ? kGas : kPool, seg_label_[q] = keep[l];
+    else if (last) lab_[q] = 0;
+  }
+  return kept;
 }
 
 // Breadth-first growth from the colon segments through everything else, up to link-gap: per
