@@ -3,6 +3,7 @@
 // trimmed; then the crop around the remaining gas.
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/params.h"
@@ -98,16 +99,70 @@ void ColonSegmenter::trim_rectal_tube(const std::uint32_t* glb, std::uint32_t ng
   std::size_t trimmed = 0;
   double sum[3] = {0, 0, 0};
   for_each_voxel([&](std::size_t q, const std::size_t* c, std::size_t s) {
-    if (!gas[q] || s >= cut[glb[q]]) return;
+    if (!gas[q] || s >= cut[glb[q]]) return;  // sum: coordinate sums of the trimmed voxels
     gas[q] = 0;
     ++trimmed;
     for (int a = 0; a < 3; ++a) sum[a] += double(c[a]);
   });
   if (trimmed == 0) return;
+  for (std::uint32_t l = 1; l <= ngas; ++l)
+    if (cut[l] > 0 && cut[l] < ns) trimmed += follow_tube_lumen(glb, l, cut[l], gas, sum);
   st_.rectal_tube_trimmed_ml = double(trimmed) * voxel_ml_;
   for (double& v : sum) v /= double(trimmed);
   decide("gas channel", st_.rectal_tube_trimmed_ml, sum, false,
          "rectal tube / anal canal: thinner than --tube-area from the inferior face up to the rectum");
+}
+
+// Above the trimmed channel the catheter's air lumen runs on inside the rectum, walled off from the
+// rectal gas by the plastic: slice by slice, the in-plane gas component over the previous slice's
+// trimmed voxels is trimmed while it stays thinner than tube-area. Returns the voxels trimmed.
+std::size_t ColonSegmenter::follow_tube_lumen(const std::uint32_t* glb, std::uint32_t label, std::size_t first_slice,
+                                              unsigned char* gas, double sum[3]) {
+  const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
+  const std::size_t ns = full_.n[sup_axis_];
+  double pixel_mm2 = full_.sp[u] * full_.sp[v];
+  auto index = [&](std::size_t s, std::size_t a, std::size_t b) {
+    std::size_t c[3];
+    c[sup_axis_] = sup_pos_ ? s : ns - 1 - s;
+    c[u] = a;
+    c[v] = b;
+    return full_.idx(c[0], c[1], c[2]);
+  };
+  std::vector<std::pair<std::size_t, std::size_t>> prev;  // trimmed (a, b) of the slice below
+  for (std::size_t a = 0; a < full_.n[u]; ++a)
+    for (std::size_t b = 0; b < full_.n[v]; ++b)
+      if (glb[index(first_slice - 1, a, b)] == label) prev.emplace_back(a, b);
+  std::size_t trimmed = 0;
+  for (std::size_t s = first_slice; s < ns && !prev.empty(); ++s) {
+    std::vector<std::pair<std::size_t, std::size_t>> comp, stack;
+    for (const auto& p : prev)
+      if (gas[index(s, p.first, p.second)] && glb[index(s, p.first, p.second)] == label) stack.push_back(p);
+    std::set<std::pair<std::size_t, std::size_t>> visited(stack.begin(), stack.end());
+    while (!stack.empty() && double(comp.size()) * pixel_mm2 < opts_.tube_area) {
+      const auto p = stack.back();
+      stack.pop_back();
+      comp.push_back(p);
+      const long da[4] = {-1, 1, 0, 0}, db[4] = {0, 0, -1, 1};
+      for (int t = 0; t < 4; ++t) {
+        const long a = long(p.first) + da[t], b = long(p.second) + db[t];
+        if (a < 0 || b < 0 || a >= long(full_.n[u]) || b >= long(full_.n[v])) continue;
+        const std::size_t q = index(s, std::size_t(a), std::size_t(b));
+        if (gas[q] && glb[q] == label && visited.insert({std::size_t(a), std::size_t(b)}).second)
+          stack.emplace_back(std::size_t(a), std::size_t(b));
+      }
+    }
+    if (comp.empty() || double(comp.size()) * pixel_mm2 >= opts_.tube_area) break;  // the tube's tip: rectal gas
+    for (const auto& p : comp) {
+      const std::size_t q = index(s, p.first, p.second);
+      gas[q] = 0;
+      std::size_t c[3];
+      full_.coords(q, c[0], c[1], c[2]);
+      for (int k = 0; k < 3; ++k) sum[k] += double(c[k]);
+    }
+    trimmed += comp.size();
+    prev.swap(comp);
+  }
+  return trimmed;
 }
 
 // Crop to the candidate gas plus a margin (fluid below the gas, the band, the tissue shell).

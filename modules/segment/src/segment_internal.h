@@ -87,6 +87,8 @@ class ColonSegmenter {
   void find_gas_bodies();
   void trim_rectal_tube(const std::uint32_t* labels, std::uint32_t count, std::vector<unsigned char>& drop,
                         unsigned char* gas);
+  std::size_t follow_tube_lumen(const std::uint32_t* labels, std::uint32_t label, std::size_t first_slice,
+                                unsigned char* gas, double sum[3]);
   void crop_to_gas(const unsigned char* gas);
   void class_means();
   void refine_boundary();
