@@ -110,6 +110,7 @@ class ColonSegmenter {
   std::size_t local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
                           std::array<double, 3>& centroid, std::array<double, 3>& axis) const;
   bool continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const;
+  bool continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius, std::string& why) const;
   // Helpers.
   std::array<double, 3> lps_of(const double crop_voxel[3]) const;
   void decide(const std::string& what, double ml, const double centroid_crop[3], bool kept, const std::string& reason);

@@ -223,7 +223,14 @@ std::size_t ColonSegmenter::local_shape(const std::function<bool(std::size_t)>& 
 // The candidate continues the colon: at the link, both bodies end (their local mass lies behind
 // the link point along their own axis) and point at each other.
 bool ColonSegmenter::continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const {
-  const double radius = std::max(45.0, 1.5 * opts_.link_gap);  // a tube piece longer than the colon is wide
+  // Two ball radii: 45 mm (a tube piece longer than the colon is wide) and 30 mm (a bending sigmoid).
+  for (double radius : {std::max(45.0, 1.5 * opts_.link_gap), 30.0})
+    if (continues_colon_at(cand, from, to, radius, why)) return true;
+  return false;
+}
+
+bool ColonSegmenter::continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius,
+                                        std::string& why) const {
   std::array<double, 3> cg{}, ag{}, cf{}, af{};
   const std::uint32_t segment = seg_label_[to];
   const std::size_t ng = local_shape([&](std::size_t q) { return seg_label_[q] == segment; }, to, radius, cg, ag);
@@ -232,14 +239,13 @@ bool ColonSegmenter::continues_colon(std::uint32_t cand, std::size_t from, std::
   std::size_t a[3], b[3];
   d_.coords(to, a[0], a[1], a[2]);
   d_.coords(from, b[0], b[1], b[2]);
-  Eigen::Vector3d link, ug, uf, axg(ag[0], ag[1], ag[2]), axf(af[0], af[1], af[2]);
+  Eigen::Vector3d link, axg(ag[0], ag[1], ag[2]), axf(af[0], af[1], af[2]);
   for (int k = 0; k < 3; ++k) link[k] = (double(b[k]) - double(a[k])) * d_.sp[k];
-  ug = -Eigen::Vector3d(cg[0], cg[1], cg[2]);                    // colon end -> out of the colon
-  uf = Eigen::Vector3d(cf[0], cf[1], cf[2]);                     // candidate end -> into the candidate
+  const Eigen::Vector3d ug = -Eigen::Vector3d(cg[0], cg[1], cg[2]);  // colon end -> out of the colon
+  const Eigen::Vector3d uf(cf[0], cf[1], cf[2]);                      // candidate end -> into the candidate
   if (ug.norm() < 0.15 * radius || uf.norm() < 0.15 * radius) return why = "touches the colon's side, not an end", false;
-  const double end_g = std::abs(ug.normalized().dot(axg)), end_f = std::abs(uf.normalized().dot(axf));
-  if (end_g < 0.6) return why = "lies beside a colon segment, not at its end", false;
-  if (end_f < 0.6) return why = "meets the colon with its side (not tube-shaped there)", false;
+  if (std::abs(ug.normalized().dot(axg)) < 0.6) return why = "lies beside a colon segment, not at its end", false;
+  if (std::abs(uf.normalized().dot(axf)) < 0.6) return why = "meets the colon with its side (not tube-shaped there)", false;
   if (ug.normalized().dot(uf.normalized()) < 0.5) return why = "does not continue the colon's direction", false;
   if (link.norm() > 1e-9 && ug.normalized().dot(link.normalized()) < 0.3) return why = "does not continue the colon's direction", false;
   return true;
