@@ -42,9 +42,9 @@ std::vector<std::vector<std::size_t>> tagged_stretches(const Phantom& p, std::si
 }
 
 // Full-size supine and prone phantoms of one seed with all the hard anatomy.
-// DISABLED (measured 2026-12-01, seed 2): prone passes every check; supine keeps the descending
-// stretch but rejects the sigmoid stretch ("lies beside a colon segment, not at its end") and keeps
-// 1.2 mL of rectal tube. Enable once the end test handles the bending sigmoid (docs/segment.md).
+// DISABLED (measured 2026-12-01, seed 2): prone passes every check except the tube (1.02 mL kept);
+// supine keeps the descending stretch but rejects the sigmoid stretch ("lies beside a colon segment,
+// not at its end") and keeps 1.21 mL of rectal tube. Enable once the end test handles the bending sigmoid (docs/segment.md).
 TEST(SegmentAcceptance, DISABLED_RealisticPhantomsSupineAndProne) {
   for (const char* position : {"supine", "prone"}) {
     SCOPED_TRACE(position);
