@@ -6,9 +6,14 @@
 //   segment_bench --table-only        the table without Google Benchmark.
 //   segment_bench --size small --seeds 1,2 --no-dicom   other sizes / seeds.
 //   segment_bench --collapsed --seeds 1 --no-dicom      phantoms with a collapsed stretch (2 segments).
+//   segment_bench --realistic --seeds 1,2 [--pad-to 450] issue 13: supine and prone phantoms with 2 fully
+//                                     tagged stretches, oral contrast, bladder, aorta, rectal tube (written
+//                                     and read as NRRD, PatientPosition included); --pad-to N appends copies
+//                                     of the inferior slice so the scan has N slices (timing of 512x512xN).
 // Peak memory: the process's peak resident set is reset (/proc/self/clear_refs) before each step,
 // so "peak" is the high-water mark of that step alone (segmentation: reading ct.nrrd included).
 #include <benchmark/benchmark.h>
+#include <itkConnectedComponentImageFilter.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -124,6 +129,36 @@ Quality evaluate(const cf::MaskImage* seg, const cf::Phantom& p) {
   return q;
 }
 
+// The CT with copies of its inferior slice appended below, up to `slices` slices (timing only).
+cf::CtImage::Pointer pad_inferior(const cf::CtImage* ct, int slices) {
+  const auto sz = ct->GetLargestPossibleRegion().GetSize();
+  const std::size_t extra = std::size_t(slices) > sz[2] ? std::size_t(slices) - sz[2] : 0, slice = sz[0] * sz[1];
+  auto out = cf::CtImage::New();
+  out->SetRegions(cf::CtImage::SizeType{{sz[0], sz[1], sz[2] + extra}});
+  out->SetSpacing(ct->GetSpacing());
+  auto org = ct->GetOrigin();
+  org[2] -= double(extra) * ct->GetSpacing()[2];
+  out->SetOrigin(org);
+  out->SetDirection(ct->GetDirection());
+  out->Allocate();
+  cf::set_patient_position(out.GetPointer(), cf::patient_position(ct));
+  for (std::size_t k = 0; k < extra; ++k) std::memcpy(out->GetBufferPointer() + k * slice, ct->GetBufferPointer(), slice * sizeof(float));
+  std::memcpy(out->GetBufferPointer() + extra * slice, ct->GetBufferPointer(), sz[2] * slice * sizeof(float));
+  return out;
+}
+
+// The mask's last slices, the size of `like` (undoes pad_inferior).
+cf::MaskImage::Pointer crop_to(const cf::MaskImage* m, const cf::MaskImage* like) {
+  const std::size_t n = like->GetLargestPossibleRegion().GetNumberOfPixels();
+  const std::size_t off = m->GetLargestPossibleRegion().GetNumberOfPixels() - n;
+  auto out = cf::MaskImage::New();
+  out->CopyInformation(like);
+  out->SetRegions(like->GetLargestPossibleRegion());
+  out->Allocate();
+  std::memcpy(out->GetBufferPointer(), m->GetBufferPointer() + off, n);
+  return out;
+}
+
 bool same_mask(const cf::MaskImage* x, const cf::MaskImage* y) {
   const std::size_t n = x->GetLargestPossibleRegion().GetNumberOfPixels();
   if (n != y->GetLargestPossibleRegion().GetNumberOfPixels()) return false;
@@ -192,6 +227,81 @@ void table(const std::string& size, const std::vector<int>& seeds, bool dicom, b
               "polyps kept as wall; iface = true lumen within 1 mm of the fluid levels that is segmented as lumen\n");
 }
 
+// Truth-based scores of a realistic phantom: fully tagged stretches kept (>= 95 % of their voxels)
+// and voxels kept per truth label (3/4 small bowel, 5 bladder, 6 tube, 8 aorta).
+struct RealisticScore {
+  int stretches = 0, stretches_kept = 0;
+  std::size_t kept_by_label[9] = {};
+};
+RealisticScore score_realistic(const cf::MaskImage* seg, const cf::Phantom& p) {
+  RealisticScore r;
+  const std::size_t n = p.lumen->GetLargestPossibleRegion().GetNumberOfPixels();
+  const unsigned char* lab = p.labels->GetBufferPointer();
+  const unsigned char* m = seg->GetBufferPointer();
+  for (std::size_t q = 0; q < n; ++q)
+    if (m[q]) ++r.kept_by_label[lab[q]];
+  // Stretches: components of the true lumen without colon gas.
+  auto cc = itk::ConnectedComponentImageFilter<cf::MaskImage, itk::Image<std::uint32_t, 3>>::New();
+  cc->SetInput(p.lumen);
+  cc->Update();
+  const std::uint32_t* cl = cc->GetOutput()->GetBufferPointer();
+  std::vector<unsigned char> gas(cc->GetObjectCount() + 1, 0);
+  std::vector<std::size_t> size(gas.size(), 0), kept(gas.size(), 0);
+  for (std::size_t q = 0; q < n; ++q) {
+    if (lab[q] == 1) gas[cl[q]] = 1;
+    ++size[cl[q]];
+    kept[cl[q]] += m[q] != 0;
+  }
+  for (std::size_t l = 1; l < gas.size(); ++l)
+    if (!gas[l]) ++r.stretches, r.stretches_kept += double(kept[l]) >= 0.95 * double(size[l]);
+  return r;
+}
+
+void realistic_table(const std::vector<int>& seeds, int pad_to) {
+  const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_r" + std::to_string(::getpid()));
+  std::printf("segment_bench --realistic: full-size phantoms, 2 fully tagged stretches, oral contrast, bladder, aorta, "
+              "rectal tube%s\n", pad_to > 0 ? (", padded to " + std::to_string(pad_to) + " slices").c_str() : "");
+  std::printf("%4s %7s %7s %7s %7s %7s %8s %7s %9s %8s %7s %7s %6s %s\n", "seed", "pos", "slices", "gen_s", "read_s", "seg_s",
+              "seg_MiB", "dice", "stretches", "sb_vox", "bl_vox", "ao_vox", "tube", "gravity");
+  for (int seed : seeds)
+    for (const char* position : {"supine", "prone"}) {
+      fs::remove_all(tmp);
+      cf::Stopwatch t;
+      cf::PhantomOptions o;
+      o.size = "full";
+      o.seed = std::uint64_t(seed);
+      o.position = position;
+      o.fully_tagged_segments = 2;
+      o.oral_contrast = o.excreted_contrast = o.enhanced_vessels = o.rectal_tube = true;
+      cf::Phantom p = cf::generate_phantom(o);
+      const double gen_s = t.seconds();
+      cf::write_phantom(p, tmp, "nrrd");
+      p.ct = nullptr;
+      reset_peak_memory();
+      t.restart();
+      cf::CtImage::Pointer ct = cf::read_ct_volume(tmp / "ct.nrrd");
+      if (pad_to > 0) ct = pad_inferior(ct, pad_to);
+      const double read_s = t.seconds();
+      cf::SegmentStats st;
+      t.restart();
+      cf::MaskImage::Pointer mask = cf::segment_colon(ct, {}, &st);
+      const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
+      const std::size_t slices = ct->GetLargestPossibleRegion().GetSize()[2];
+      ct = nullptr;
+      if (pad_to > 0) mask = crop_to(mask, p.lumen);
+      const RealisticScore r = score_realistic(mask, p);
+      const double dice = evaluate(mask, p).dice;
+      std::printf("%4d %7s %7zu %7.2f %7.2f %7.2f %8.0f %7.4f %6d/%-2d %8zu %7zu %7zu %6zu %s (%s)\n", seed, position, slices,
+                  gen_s, read_s, seg_s, seg_mib, dice, r.stretches_kept, r.stretches,
+                  r.kept_by_label[3] + r.kept_by_label[4], r.kept_by_label[5], r.kept_by_label[8], r.kept_by_label[6],
+                  st.gravity.c_str(), st.gravity_source.c_str());
+      std::fflush(stdout);
+    }
+  fs::remove_all(tmp);
+  std::printf("columns: stretches = fully tagged stretches with >= 95 %% of their voxels segmented / in the phantom; sb_vox, bl_vox, "
+              "ao_vox, tube = segmented voxels that are small bowel (contrast or gas), bladder, aorta, rectal tube\n");
+}
+
 void BM_SegmentSmallPhantom(benchmark::State& state) {
   cf::PhantomOptions o;
   o.size = "small";
@@ -217,7 +327,8 @@ BENCHMARK(BM_GenerateSmallPhantom)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool table_only = false, dicom = true, collapsed = false;
+  bool table_only = false, dicom = true, collapsed = false, realistic = false;
+  int pad_to = 0;
   std::string size = "full";
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
@@ -226,6 +337,8 @@ int main(int argc, char** argv) {
     if (a == "--table-only") table_only = true;
     else if (a == "--no-dicom") dicom = false;
     else if (a == "--collapsed") collapsed = true;
+    else if (a == "--realistic") realistic = true;
+    else if (a == "--pad-to" && i + 1 < argc) pad_to = std::stoi(argv[++i]);
     else if (a == "--size" && i + 1 < argc) size = argv[++i];
     else if (a == "--seeds" && i + 1 < argc) {
       seeds.clear();
@@ -233,7 +346,8 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  table(size, seeds, dicom, collapsed);
+  if (realistic) realistic_table(seeds, pad_to);
+  else table(size, seeds, dicom, collapsed);
   if (table_only) return 0;
   int n = int(rest.size());
   benchmark::Initialize(&n, rest.data());

@@ -20,7 +20,7 @@ class PhantomTool : public Tool {
     CLI::App app(
         "Writes a synthetic abdominal CT (HU, LPS mm) with an insufflated colon, tagged fluid, polyps and "
         "deliberate topological noise, plus its ground truth: DIR/ct.nrrd (or DIR/dicom/ with --format dicom), "
-        "lumen_mask.nrrd, polyps.json, centerline.json, noise_sites.json, phantom.json. Deterministic for a "
+        "lumen_mask.nrrd, labels.nrrd, polyps.json, centerline.json, noise_sites.json, phantom.json. Deterministic for a "
         "given seed.",
         "colonflat phantom");
     app.set_version_flag("--version", colonflat_version());
@@ -44,9 +44,28 @@ class PhantomTool : public Tool {
     app.add_option("--noise", o.noise_hu, "noise standard deviation [HU] (default 20; range [0, 500])")->type_name("HU");
     app.add_option("--blur", o.blur_mm, "partial-volume blur sigma [mm] (default 0 = automatic; range [0, 5])")
         ->type_name("MM");
+    app.add_option("--position", o.position, "patient position: supine (posterior down, DICOM HFS) or prone (anterior "
+                                             "down, HFP; same colon and polyps as supine, mobile colon displaced) "
+                                             "(default supine)")
+        ->type_name("supine|prone");
+    app.add_option("--fully-tagged-segments", o.fully_tagged_segments,
+                   "colon stretches completely filled with tagged fluid, between collapsed necks (default 0; range [0, 3])")
+        ->type_name("K");
+    app.add_flag("--oral-contrast", o.oral_contrast, "small-bowel loops with positive oral contrast and gas bubbles");
+    app.add_flag("--excreted-contrast", o.excreted_contrast, "bladder with excreted contrast");
+    app.add_flag("--enhanced-vessels", o.enhanced_vessels, "contrast-enhanced aorta");
+    app.add_flag("--rectal-tube", o.rectal_tube, "rectal catheter (air lumen) through the anus into the rectum");
+    bool realistic = false;
+    app.add_flag("--realistic", realistic,
+                 "all of the above: oral and excreted contrast, enhanced aorta, rectal tube and (unless given) 2 fully "
+                 "tagged stretches");
     app.add_flag("-q,--quiet", quiet, "no progress output");
     return run_cli(app, name(), args, out, err, [&]() -> int {
       if (format != "nrrd" && format != "dicom") throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
+      if (realistic) {
+        o.oral_contrast = o.excreted_contrast = o.enhanced_vessels = o.rectal_tube = true;
+        if (app.count("--fully-tagged-segments") == 0) o.fully_tagged_segments = 2;
+      }
       Stopwatch t;
       Phantom p = generate_phantom(o);
       const double gen = t.seconds();

@@ -35,6 +35,13 @@ const ParamTable<SegmentOptions>& SegmentStage::table() const {
            "less gas and fluid than this in all segments: no insufflated colon", 0, 10000);
     t.integer("max-segments", &O::max_segments, "", "at most this many colon segments kept", 1, 100);
     t.flag("graph-cut", &O::graph_cut, "refine the boundary by graph cut (off: thresholds only)");
+    t.choice("position", &O::position, {"auto", "levels", "supine", "prone", "left-down", "right-down"},
+             "gravity: auto = DICOM PatientPosition, else the fluid levels; levels = fluid levels only; or fixed");
+    t.real("min-tagged-volume", &O::min_tagged_volume, "mL", "smallest fully tagged colon stretch (no gas) kept", 0.5, 1000);
+    t.real("link-gap", &O::link_gap, "mm",
+           "widest gap between a fully tagged stretch and the end of the colon segment it continues", 0, 100);
+    t.real("tube-area", &O::tube_area, "mm^2",
+           "gas channels thinner than this reaching the inferior face (rectal tube) are trimmed; 0 = off", 0, 2000);
     return t;
   }();
   return t;
@@ -45,7 +52,8 @@ void SegmentStage::run(ArtifactBag& bag, RunContext& ctx) {
   SegmentStats stats;
   MaskImage::Pointer mask = segment_colon(ct.GetPointer(), opts_, &stats);
   std::ostringstream s;
-  s << "segment: " << stats.segments << " segment(s), lumen " << format_number(stats.lumen_volume_ml) << " mL in "
+  s << "segment: " << stats.segments << " segment(s) (" << stats.tagged_stretches << " fully tagged stretch(es)), lumen "
+    << format_number(stats.lumen_volume_ml) << " mL, gravity " << stats.gravity << " from " << stats.gravity_source << ", in "
     << format_number(stats.time_s) << " s";
   ctx.progress(s.str());
   ctx.report = stats.to_json();

@@ -233,7 +233,10 @@ FloatImage::Pointer read_dicom_series(const DicomChoice& c, const ScannedFolder&
   } catch (const itk::ExceptionObject& e) {
     throw InputError(c.dir.string(), "cannot read DICOM series " + c.uid + ": " + itk_message(e));
   }
-  return reader->GetOutput();
+  FloatImage::Pointer out = reader->GetOutput();
+  std::string position;  // PatientPosition of the (last read) slice: one value per series
+  if (io->GetValueFromTag("0018|5100", position)) set_patient_position(out.GetPointer(), trim(position.c_str()));
+  return out;
 }
 
 }  // namespace vio

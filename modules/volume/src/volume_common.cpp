@@ -15,6 +15,7 @@
 #include <itkNrrdImageIO.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -121,4 +122,22 @@ std::string fmt(double v, int prec) {
 }
 
 }  // namespace vio
+std::string patient_position(const itk::ImageBase<3>* image) {
+  std::string v;
+  if (!image || !itk::ExposeMetaData<std::string>(image->GetMetaDataDictionary(), "0018|5100", v)) return "";
+  v.erase(std::remove_if(v.begin(), v.end(), [](unsigned char c) { return std::isspace(c) || c == 0; }), v.end());
+  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  return v;
+}
+
+void set_patient_position(itk::ImageBase<3>* image, const std::string& position) {
+  if (!image) return;
+  auto& d = image->GetMetaDataDictionary();
+  if (position.empty()) {
+    if (d.HasKey("0018|5100")) d.Erase("0018|5100");
+    return;
+  }
+  itk::EncapsulateMetaData<std::string>(d, "0018|5100", position);
+}
+
 }  // namespace cf

@@ -82,6 +82,7 @@ std::uint64_t hash64(const std::string& s, std::uint64_t h = 1469598103934665603
 ShortImage::Pointer to_short(const CtImage* img) {
   auto out = ShortImage::New();
   out->CopyInformation(img);
+  set_patient_position(out.GetPointer(), patient_position(img));  // the only metadata carried along
   out->SetRegions(img->GetLargestPossibleRegion());
   out->Allocate();
   const float* src = img->GetBufferPointer();
@@ -205,6 +206,8 @@ void write_dicom_series(const CtImage* image, const fs::path& dir, const DicomWr
     image->TransformIndexToPhysicalPoint(idx, pt);
     const double position[3] = {pt[0], pt[1], pt[2]};
     auto d = slice_dictionary(opt, k, position, study, series, frame, iop, sp);
+    const std::string patient_pos = opt.patient_position.empty() ? patient_position(image) : opt.patient_position;
+    if (!patient_pos.empty()) itk::EncapsulateMetaData<std::string>(*d, "0018|5100", patient_pos);
     arr.push_back(d.get());
     dicts.push_back(std::move(d));
   }

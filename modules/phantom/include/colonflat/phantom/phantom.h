@@ -29,6 +29,15 @@ struct PhantomOptions {
   bool topological_noise = true;  // strands, near-touching segments, holes through folds
   double noise_hu = 20;           // HU, standard deviation of the added Gaussian noise
   double blur_mm = 0.0;           // mm, sigma of the partial-volume blur; 0 = automatic (0.6 x in-plane spacing, >= 0.45 mm)
+  // Patient position: "supine" (posterior down, DICOM HFS) or "prone" (anterior down, HFP). The same
+  // seed gives the same colon, polyps and folds; prone moves the mobile transverse and sigmoid colon
+  // (smooth displacement) and puts the fluid pools on the anterior side.
+  std::string position = "supine";
+  int fully_tagged_segments = 0;  // 0..3 colon stretches completely filled with tagged fluid (no gas)
+  bool oral_contrast = false;     // small-bowel loops with positive oral contrast and a few gas bubbles
+  bool excreted_contrast = false; // bladder with excreted contrast (dependent layer) and urine
+  bool enhanced_vessels = false;  // contrast-enhanced aorta (+260 HU) in front of the spine
+  bool rectal_tube = false;       // rectal catheter (plastic wall, air lumen) through the anus into the rectum
 };
 
 struct PhantomPolyp {
@@ -37,13 +46,14 @@ struct PhantomPolyp {
   double diameter_mm = 0;
   std::string type;                       // "sessile" or "pedunculated"
   std::string segment;                    // anatomical segment name
-  double arclength_mm = 0;                // position along the centreline from the rectum
+  double arclength_mm = 0;                // material position along the centreline (supine arc length, mm)
+  double centreline_mm = 0;               // arc length from the rectal end along this case's true centreline
 };
 
 struct CenterlinePoint {
   std::array<double, 3> p_lps_mm{};
   double radius_mm = 0;     // nominal lumen radius (without folds)
-  double arclength_mm = 0;  // from the rectal end
+  double arclength_mm = 0;  // from the rectal end, along this case's centreline
   std::string segment;
 };
 
@@ -58,6 +68,10 @@ struct NoiseSite {
 struct Phantom {
   CtImage::Pointer ct;       // HU, integer valued (as written to disk)
   MaskImage::Pointer lumen;  // ground-truth lumen (air and tagged fluid), 1 = lumen
+  // Ground-truth labels: 0 other, 1 colon gas, 2 colon fluid, 3 small-bowel contrast, 4 small-bowel
+  // gas, 5 bladder (urine, excreted contrast), 6 rectal tube, 7 other gas, 8 enhanced vessel.
+  MaskImage::Pointer labels;
+  std::string patient_position = "HFS";  // DICOM PatientPosition (0018,5100): HFS supine, HFP prone
   std::vector<PhantomPolyp> polyps;
   std::vector<CenterlinePoint> centerline;
   std::vector<NoiseSite> noise_sites;
@@ -67,8 +81,9 @@ struct Phantom {
 // Builds the phantom in memory. Throws UsageError for invalid options.
 Phantom generate_phantom(const PhantomOptions& opts);
 
-// Writes DIR/ct.nrrd (or DIR/dicom/ with format "dicom"), lumen_mask.nrrd, polyps.json,
-// centerline.json, noise_sites.json and phantom.json; all files appear together or not at all.
+// Writes DIR/ct.nrrd (or DIR/dicom/ with format "dicom"; both carry PatientPosition),
+// lumen_mask.nrrd, labels.nrrd, polyps.json, centerline.json, noise_sites.json and phantom.json;
+// all files appear together or not at all.
 void write_phantom(const Phantom& p, const std::filesystem::path& dir, const std::string& format = "nrrd");
 
 // JSON forms of the ground truth (as written to the files).

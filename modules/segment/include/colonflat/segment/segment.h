@@ -30,6 +30,12 @@ struct SegmentOptions {
   double min_colon_volume = 100;      // mL; less gas + fluid in all kept segments: no (insufflated) colon
   int max_segments = 6;               // at most this many colon segments kept
   bool graph_cut = true;              // refine the boundary by graph cut (off: thresholds only)
+  // Gravity: "auto" = from the DICOM PatientPosition (0018,5100) and the image direction, else from
+  // the fluid levels; "levels" = from the fluid levels only; or fixed: supine, prone, left-down, right-down.
+  std::string position = "auto";
+  double min_tagged_volume = 5;       // mL; smallest fully tagged colon stretch considered
+  double link_gap = 25;               // mm; widest gap between a fully tagged stretch and the gas segment it continues
+  double tube_area = 150;             // mm^2; thinner gas channels reaching the inferior face (rectal tube) are trimmed (0: off)
 };
 
 struct SegmentStats {
@@ -41,7 +47,14 @@ struct SegmentStats {
   std::size_t band_voxels = 0, graph_edges = 0;
   double flow = 0;
   std::size_t removed_components = 0;
-  std::size_t rejected_fluid_components = 0;  // bright bodies touching gas without a level surface
+  std::size_t rejected_fluid_components = 0;  // bright bodies not kept as colon fluid
+  std::string gravity;                        // e.g. "+y (posterior)"
+  std::string gravity_source;                 // "PatientPosition HFP", "fluid levels", "option", "default (supine)"
+  int tagged_stretches = 0;                   // fully tagged colon stretches kept
+  double tagged_stretch_volume_ml = 0;
+  double rectal_tube_trimmed_ml = 0;          // thin gas channel trimmed at the inferior face
+  nlohmann::json decisions = nlohmann::json::array();  // kept/rejected bodies >= 1 mL: what, volume, LPS, reason
+  nlohmann::json decision_counts = nlohmann::json::array();  // every decision, grouped by reason: count, mL
   double time_s = 0, graph_cut_time_s = 0;
   double peak_memory_mib = 0;
   nlohmann::json timings;  // seconds per step

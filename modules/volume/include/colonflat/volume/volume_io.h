@@ -47,6 +47,12 @@ std::vector<DicomSeriesInfo> list_dicom_series(const std::filesystem::path& dir)
 // missing slices or uneven slice spacing, enhanced multi-frame CT, non-scalar or non-3D data).
 CtImage::Pointer read_ct_volume(const std::filesystem::path& file_or_dicom_dir, const VolumeReadOptions& = {});
 
+// DICOM PatientPosition (0018,5100) carried with a volume: "HFS", "HFP", "FFS", "FFP", "HFDR",
+// "HFDL", "FFDR", "FFDL" or "" when unknown. Read from DICOM series (first slice) and from the NRRD
+// key "0018|5100"; written by write_ct_volume (NRRD, MetaImage) and write_dicom_series.
+std::string patient_position(const itk::ImageBase<3>* image);
+void set_patient_position(itk::ImageBase<3>* image, const std::string& position);
+
 // Reads a mask (any voxel type; non-zero = 1). Throws InputError.
 MaskImage::Pointer read_mask(const std::filesystem::path& file);
 
@@ -65,6 +71,7 @@ struct DicomWriteOptions {
   std::string patient_name = "PHANTOM^COLONFLAT";
   std::string patient_id = "CF-PHANTOM";
   std::string series_description = "ColonFlat synthetic CT colonography";
+  std::string patient_position;  // DICOM PatientPosition (0018,5100); empty: the image's own (patient_position())
 };
 // Writes `dir` atomically (a temporary sibling folder renamed at the end); `dir` must not exist or
 // be empty.

@@ -1,0 +1,130 @@
+// Voxel-grid helpers of the segmentation: dims, threads, connected components, box dilation and
+// erosion, the 3 x 3 x 3 mean, line enumeration.
+#include <itkConnectedComponentImageFilter.h>
+
+#include <algorithm>
+#include <cstring>
+#include <thread>
+
+#include "segment_internal.h"
+
+namespace cf::segment_detail {
+
+Dims make_dims(const std::size_t n[3], const double sp[3]) {
+  Dims d;
+  for (int a = 0; a < 3; ++a) {
+    d.n[a] = n[a];
+    d.sp[a] = sp[a];
+  }
+  d.stride[0] = 1;
+  d.stride[1] = d.n[0];
+  d.stride[2] = d.n[0] * d.n[1];
+  d.total = d.n[0] * d.n[1] * d.n[2];
+  return d;
+}
+
+void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body) {
+  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(2, std::thread::hardware_concurrency()));
+  if (threads == 1 || n < 2) return body(0, n);
+  std::vector<std::thread> ts;
+  for (std::size_t t = 0; t < threads; ++t) ts.emplace_back([&, t] { body(n * t / threads, n * (t + 1) / threads); });
+  for (auto& t : ts) t.join();
+}
+
+LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count) {
+  using CC = itk::ConnectedComponentImageFilter<MaskImage, LabelImage>;
+  auto cc = CC::New();
+  cc->SetInput(m);
+  cc->SetFullyConnected(false);
+  cc->SetNumberOfWorkUnits(2);
+  cc->Update();
+  count = cc->GetObjectCount();
+  LabelImage::Pointer out = cc->GetOutput();
+  out->DisconnectPipeline();
+  return out;
+}
+
+MaskImage::Pointer mask_of_size(const std::size_t n[3]) {
+  auto m = MaskImage::New();
+  MaskImage::SizeType sz{{n[0], n[1], n[2]}};
+  m->SetRegions(sz);
+  m->Allocate();
+  return m;
+}
+
+void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
+  std::vector<unsigned char> tmp(v.size());
+  const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
+  for (int ax = 0; ax < 3; ++ax) {
+    if (r[ax] <= 0) continue;
+    const long R = r[ax];
+    // Rows (x lines) are contiguous: along y and z whole rows are OR-ed (cache friendly).
+    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+      for (std::size_t k = k0; k < k1; ++k)
+        for (std::size_t j = 0; j < ny; ++j) {
+          unsigned char* out = tmp.data() + (k * ny + j) * nx;
+          if (ax == 0) {
+            const unsigned char* in = v.data() + (k * ny + j) * nx;
+            long last = -1000000;
+            for (long i = 0; i < long(nx); ++i) {
+              if (in[i]) last = i;
+              out[i] = (i - last <= R) ? 1 : 0;
+            }
+            last = 1000000;
+            for (long i = long(nx) - 1; i >= 0; --i) {
+              if (in[i]) last = i;
+              if (last - i <= R) out[i] = 1;
+            }
+            continue;
+          }
+          std::memset(out, 0, nx);
+          const long c = ax == 1 ? long(j) : long(k), n = ax == 1 ? long(ny) : long(nz);
+          for (long o = std::max(0L, c - R); o <= std::min(n - 1, c + R); ++o) {
+            const unsigned char* in = v.data() + (ax == 1 ? (k * ny + std::size_t(o)) : (std::size_t(o) * ny + j)) * nx;
+            for (std::size_t i = 0; i < nx; ++i) out[i] |= in[i];
+          }
+        }
+    });
+    v.swap(tmp);
+  }
+}
+
+void erode_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
+  for (auto& x : v) x = !x;
+  dilate_box(v, d, r);
+  for (auto& x : v) x = !x;
+}
+
+std::vector<float> box_mean3(const std::vector<float>& in, const Dims& d) {
+  std::vector<float> sm(in), tmp(d.total);
+  const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
+  for (int ax = 0; ax < 3; ++ax) {
+    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+      for (std::size_t k = k0; k < k1; ++k)
+        for (std::size_t j = 0; j < ny; ++j) {
+          float* out = tmp.data() + (k * ny + j) * nx;
+          const float* mid = sm.data() + (k * ny + j) * nx;
+          if (ax == 0) {
+            for (std::size_t i = 0; i < nx; ++i)
+              out[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
+            continue;
+          }
+          const std::size_t rs = ax == 1 ? nx : nx * ny;  // row stride along the axis
+          const std::size_t c = ax == 1 ? j : k, n = ax == 1 ? ny : nz;
+          const float* lo = c > 0 ? mid - rs : mid;
+          const float* hi = c + 1 < n ? mid + rs : mid;
+          for (std::size_t i = 0; i < nx; ++i) out[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
+        }
+    });
+    sm.swap(tmp);
+  }
+  return sm;
+}
+
+std::size_t line_base(const Dims& d, int ax, std::size_t l) {
+  if (ax == 0) return l * d.n[0];
+  if (ax == 1) return (l % d.n[0]) + (l / d.n[0]) * d.n[0] * d.n[1];
+  return l;
+}
+
+}  // namespace cf::segment_detail

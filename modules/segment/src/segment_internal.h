@@ -1,0 +1,146 @@
+#pragma once
+// Internal pieces of segment_colon (docs/segment.md): voxel-grid helpers, the band graph cut, and
+// the ColonSegmenter holding the state of one segmentation with one method per step.
+#include <itkImage.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/run_stats.h"
+#include "colonflat/segment/segment.h"
+
+namespace cf::segment_detail {
+
+using LabelImage = itk::Image<std::uint32_t, 3>;
+
+struct Dims {
+  std::size_t n[3];
+  std::size_t stride[3];
+  std::size_t total;
+  double sp[3];
+  std::size_t idx(std::size_t i, std::size_t j, std::size_t k) const { return i + n[0] * (j + n[1] * k); }
+  void coords(std::size_t q, std::size_t& i, std::size_t& j, std::size_t& k) const {
+    i = q % n[0];
+    j = (q / n[0]) % n[1];
+    k = q / (n[0] * n[1]);
+  }
+};
+
+Dims make_dims(const std::size_t n[3], const double sp[3]);
+void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
+// Face-connected components of a 0/1 image; labels 1..count (0 background).
+LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count);
+MaskImage::Pointer mask_of_size(const std::size_t n[3]);
+// In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
+void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]);
+void erode_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]);
+// 3 x 3 x 3 box mean (edges clamped).
+std::vector<float> box_mean3(const std::vector<float>& in, const Dims& d);
+// Base index of line `l` along axis `ax` (lines enumerate the other two axes).
+std::size_t line_base(const Dims& d, int ax, std::size_t l);
+
+// Graph cut on the band: state 0 fixed wall, 1 fixed lumen, 2 free; free voxels get 0/1.
+struct GraphCutInput {
+  const Dims* d = nullptr;
+  const float* hu = nullptr;
+  const std::vector<unsigned char>* near_fluid = nullptr;  // where bright voxels count as lumen
+  double air = -1000, tissue = 40, fluid = 450;            // class means (HU)
+  double smoothness = 0.5, edge_sigma = 60;
+};
+struct GraphCutOutput {
+  double flow = 0;
+  std::size_t edges = 0;
+  double build_cpu_s = 0, flow_cpu_s = 0;
+};
+GraphCutOutput graph_cut_band(const GraphCutInput& in, std::vector<unsigned char>& state);
+
+// One decision about a gas or fluid body, for the report.
+struct Decision {
+  std::string what;    // "gas body", "fluid body", "segment", "rectal tube"
+  double volume_ml = 0;
+  std::array<double, 3> position_lps_mm{};
+  bool kept = false;
+  std::string reason;
+};
+
+// Per-label voxel count, centroid (crop voxel coordinates) and whether it touches the crop's faces.
+struct BodyStats {
+  std::size_t voxels = 0, gas = 0;
+  double sum[3] = {0, 0, 0};
+  bool touches_face = false;
+};
+
+class ColonSegmenter {
+ public:
+  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts) : ct_(ct), opts_(opts) {}
+  MaskImage::Pointer run(SegmentStats* stats);
+
+ private:
+  // Steps (segment.cpp).
+  void check_input();
+  void gravity_from_metadata();
+  void find_gas_bodies();
+  void trim_rectal_tube(const std::uint32_t* labels, std::uint32_t count, std::vector<unsigned char>& drop,
+                        unsigned char* gas);
+  std::size_t follow_tube_lumen(const std::uint32_t* labels, std::uint32_t label, std::size_t first_slice,
+                                unsigned char* gas, double sum[3]);
+  void crop_to_gas(const unsigned char* gas);
+  void class_means();
+  void refine_boundary();
+  void final_segments();
+  MaskImage::Pointer paste() const;
+  // Tagged fluid (segment_fluid.cpp).
+  void find_fluid_bodies();
+  void scan_contacts(int axis, std::vector<unsigned char>* contact, bool layer);
+  std::vector<std::array<std::size_t, 2>> level_contacts(int axis);
+  void gravity_from_levels();
+  void keep_level_pools();
+  void mark_layer();
+  // Segments and fully tagged stretches (segment_link.cpp).
+  void select_segments();
+  void link_tagged_stretches();
+  std::size_t link_pass(bool last);
+  void nearest_colon(const std::vector<BodyStats>& bodies, std::vector<std::size_t>& from, std::vector<std::size_t>& to,
+                     std::vector<double>& gap) const;
+  std::size_t local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
+                          std::array<double, 3>& centroid, std::array<double, 3>& axis) const;
+  bool continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const;
+  bool continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius, std::string& why) const;
+  // Helpers.
+  std::array<double, 3> lps_of(const double crop_voxel[3]) const;
+  void decide(const std::string& what, double ml, const double centroid_crop[3], bool kept, const std::string& reason);
+  void lap(const char* name);
+  void summarize_decisions();
+
+  const CtImage* ct_;
+  SegmentOptions opts_;
+  SegmentStats st_;
+  nlohmann::json timings_ = nlohmann::json::object();
+  Stopwatch clock_, step_;
+  Dims full_{}, d_{};
+  double voxel_ml_ = 0;
+  int grav_axis_ = 1, sup_axis_ = 2;
+  int grav_sign_ = 1;  // +1: gravity towards increasing index along grav_axis_
+  bool sup_pos_ = true;
+  bool gravity_known_ = false;
+  std::string gravity_source_;
+  std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
+  std::vector<float> hu_;              // CT in the crop
+  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate
+  std::vector<std::uint32_t> fluid_label_;  // fluid components in the crop
+  std::uint32_t fluid_count_ = 0;
+  std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
+  std::vector<std::uint32_t> cand_label_;  // fully tagged candidates (during link_tagged_stretches)
+  std::vector<std::uint32_t> seg_label_;   // kept colon segments (until the stretches are linked)
+  int linked_ = 0;                         // candidates linked so far
+  std::vector<unsigned char> state_;   // crop: final 0/1 (after the graph cut)
+  std::vector<unsigned char> lumen0_;  // crop: initial lumen
+  std::vector<Decision> decisions_;
+};
+
+}  // namespace cf::segment_detail

@@ -1,0 +1,121 @@
+// After the lumen is chosen: class means, the band graph cut, the final segments and the paste
+// of the crop into a mask of the CT's geometry.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "colonflat/core/error.h"
+#include "segment_internal.h"
+
+namespace cf::segment_detail {
+
+// Gas (kept gas below -800 HU), tissue (0-2.5 mm outside the lumen, -150..150 HU), fluid (pools).
+void ColonSegmenter::class_means() {
+  double as = 0, fs = 0;
+  std::size_t an = 0, fn = 0;
+  lumen0_.assign(d_.total, 0);
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    lumen0_[q] = lab_[q] != 0;
+    if (lab_[q] == 1 && hu_[q] < -800) as += hu_[q], ++an;
+    if (lab_[q] == 2 && hu_[q] >= opts_.fluid_threshold) fs += hu_[q], ++fn;
+  }
+  st_.air_hu = an ? as / double(an) : -1000.0;
+  st_.fluid_hu = fn ? fs / double(fn) : 0.0;
+  std::vector<unsigned char> shell = lumen0_;
+  const int r2[3] = {int(std::ceil(2.5 / d_.sp[0])), int(std::ceil(2.5 / d_.sp[1])), int(std::ceil(2.5 / d_.sp[2]))};
+  dilate_box(shell, d_, r2);
+  double ts = 0;
+  std::size_t tn = 0;
+  for (std::size_t q = 0; q < d_.total; ++q)
+    if (shell[q] && !lumen0_[q] && hu_[q] > -150 && hu_[q] < 150) ts += hu_[q], ++tn;
+  st_.tissue_hu = tn ? ts / double(tn) : 40.0;
+  if (st_.fluid_hu <= st_.tissue_hu + 50) st_.fluid_hu = std::max(st_.tissue_hu + 300, 450.0);
+}
+
+// Band of band-width around the initial boundary: eroded lumen and the gas/fluid layer fixed lumen,
+// everything else outside the band fixed wall; the graph cut decides the band.
+void ColonSegmenter::refine_boundary() {
+  state_.assign(d_.total, 0);
+  if (!opts_.graph_cut) {
+    state_ = lumen0_;
+    return;
+  }
+  Stopwatch clock;
+  const int rb[3] = {std::max(1, int(std::round(opts_.band_width / d_.sp[0]))),
+                     std::max(1, int(std::round(opts_.band_width / d_.sp[1]))),
+                     std::max(1, int(std::round(opts_.band_width / d_.sp[2])))};
+  {
+    std::vector<unsigned char> outer = lumen0_, inner = lumen0_;
+    dilate_box(outer, d_, rb);
+    erode_box(inner, d_, rb);
+    for (std::size_t q = 0; q < d_.total; ++q) state_[q] = inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0);
+  }
+  std::vector<unsigned char> near_fluid(d_.total);
+  for (std::size_t q = 0; q < d_.total; ++q) near_fluid[q] = lab_[q] == 2;
+  const int rf[3] = {rb[0] + 1, rb[1] + 1, rb[2] + 1};
+  dilate_box(near_fluid, d_, rf);
+  st_.band_voxels = std::size_t(std::count(state_.begin(), state_.end(), 2));
+  GraphCutInput in;
+  in.d = &d_;
+  in.hu = hu_.data();
+  in.near_fluid = &near_fluid;
+  in.air = st_.air_hu;
+  in.tissue = st_.tissue_hu;
+  in.fluid = st_.fluid_hu;
+  in.smoothness = opts_.smoothness;
+  in.edge_sigma = opts_.edge_sigma;
+  const GraphCutOutput out = graph_cut_band(in, state_);
+  st_.flow = out.flow;
+  st_.graph_edges = out.edges;
+  timings_["graph_build_cpu"] = out.build_cpu_s;
+  timings_["maxflow_cpu"] = out.flow_cpu_s;
+  st_.graph_cut_time_s = clock.seconds();
+}
+
+// Components of the refined lumen that hold initial lumen and at least min(1 mL, half the
+// smallest body the options allow) stay; they are the final segments.
+void ColonSegmenter::final_segments() {
+  MaskImage::Pointer work = mask_of_size(d_.n);
+  unsigned char* w = work->GetBufferPointer();
+  std::copy(state_.begin(), state_.end(), w);
+  std::uint32_t n = 0;
+  LabelImage::Pointer cl = components(work, n);
+  const std::uint32_t* clb = cl->GetBufferPointer();
+  std::vector<std::size_t> count(n + 1, 0), core(n + 1, 0);
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    ++count[clb[q]];
+    core[clb[q]] += lumen0_[q];
+  }
+  const double min_ml = std::min(1.0, 0.5 * std::min(opts_.min_segment_volume, opts_.min_tagged_volume));
+  std::vector<unsigned char> keep(n + 1, 0);
+  std::vector<double> vols;
+  for (std::uint32_t l = 1; l <= n; ++l)
+    if (core[l] > 0 && double(count[l]) * voxel_ml_ >= min_ml) keep[l] = 1, vols.push_back(double(count[l]) * voxel_ml_);
+  std::size_t fluid = 0;
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    state_[q] = state_[q] && keep[clb[q]];
+    fluid += state_[q] && hu_[q] >= opts_.fluid_threshold;
+  }
+  if (vols.empty()) throw PreconditionError("no colon found after graph-cut refinement");
+  std::sort(vols.rbegin(), vols.rend());
+  st_.segments = int(vols.size());
+  st_.segment_volumes_ml = vols;
+  st_.lumen_volume_ml = std::accumulate(vols.begin(), vols.end(), 0.0);
+  st_.fluid_volume_ml = double(fluid) * voxel_ml_;
+  std::vector<unsigned char>().swap(lumen0_);
+}
+
+MaskImage::Pointer ColonSegmenter::paste() const {
+  auto out = MaskImage::New();
+  out->CopyInformation(ct_);
+  out->SetRegions(ct_->GetLargestPossibleRegion());
+  out->Allocate();
+  out->FillBuffer(0);
+  unsigned char* om = out->GetBufferPointer();
+  for (std::size_t k = 0; k < d_.n[2]; ++k)
+    for (std::size_t j = 0; j < d_.n[1]; ++j)
+      std::copy_n(state_.data() + (k * d_.n[1] + j) * d_.n[0], d_.n[0], om + full_.idx(blo_[0], blo_[1] + j, blo_[2] + k));
+  return out;
+}
+
+}  // namespace cf::segment_detail

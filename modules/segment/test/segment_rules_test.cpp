@@ -1,0 +1,145 @@
+// One tiny synthetic volume per segmentation rule of issue 13: a fully tagged tube between two gas
+// tubes is kept; a contrast-filled loop beside the colon (with a gas bubble) is rejected; prone
+// fluid levels are recognised without and with the DICOM PatientPosition; a rectal tube's gas
+// channel is trimmed while the rectum stays; every decision is reported.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "colonflat/segment/segment.h"
+#include "segment_volumes.h"
+
+namespace cf {
+namespace {
+
+double tube_dist(double y, double z, double cy, double cz) { return std::sqrt((y - cy) * (y - cy) + (z - cz) * (z - cz)); }
+
+bool has_decision(const SegmentStats& st, const std::string& decision, const std::string& reason_part,
+                  const std::string& what_part = "") {
+  for (const auto& d : st.decisions)
+    if (d["decision"] == decision && d["reason"].get<std::string>().find(reason_part) != std::string::npos &&
+        d["what"].get<std::string>().find(what_part) != std::string::npos)
+      return true;
+  return false;
+}
+
+// Gas tube, collapsed neck, tube completely filled with tagged fluid, neck, gas tube: the fluid
+// tube continues the colon from a gas segment's end and is kept as a fully tagged stretch.
+TEST(SegmentRules, FullyTaggedTubeBetweenGasTubesKept) {
+  auto ct = make_volume(100, [&](double x, double y, double z) {
+    if (tube_dist(y, z, 50, 50) >= 8) return kKeep;
+    if (x >= 8 && x <= 38) return -1000.0;
+    if (x >= 45 && x <= 70) return 500.0;
+    if (x >= 77 && x <= 92) return -1000.0;
+    return kKeep;
+  }, 0.6, 10);
+  SegmentOptions o = small_volume_options();
+  o.min_tagged_volume = 2;
+  SegmentStats st;
+  auto m = segment_colon(ct, o, &st);
+  EXPECT_EQ(st.tagged_stretches, 1) << st.to_json().dump(1);
+  std::size_t inside = 0, kept = 0;
+  for (int x = 48; x <= 67; ++x)
+    for (int y = 44; y <= 56; ++y)
+      for (int z = 44; z <= 56; ++z)
+        if (tube_dist(y, z, 50, 50) < 6) ++inside, kept += at(m, x, y, z);
+  EXPECT_EQ(kept, inside);
+  EXPECT_TRUE(at(m, 20, 50, 50));
+  EXPECT_TRUE(at(m, 85, 50, 50));
+  EXPECT_EQ(st.segments, 3);  // the necks keep the segments apart
+  EXPECT_TRUE(has_decision(st, "kept", "fully tagged colon stretch"));
+}
+
+// A contrast-filled small-bowel loop with a gas bubble on top runs beside the colon (10 mm gap):
+// it does not continue the colon and is rejected; so is the same loop without gas.
+TEST(SegmentRules, ContrastLoopBesideColonRejected) {
+  for (bool bubble : {true, false}) {
+    SCOPED_TRACE(bubble);
+    auto ct = make_volume(100, [&](double x, double y, double z) {
+      if (x >= 10 && x <= 85 && tube_dist(y, z, 35, 50) < 8) return -1000.0;  // colon
+      if (x >= 20 && x <= 70 && tube_dist(y, z, 60, 50) < 7) return bubble && y < 56 ? -1000.0 : 450.0;
+      return kKeep;
+    }, 0.6, 10);
+    SegmentOptions o = small_volume_options();
+    o.min_tagged_volume = 2;
+    SegmentStats st;
+    auto m = segment_colon(ct, o, &st);
+    EXPECT_EQ(st.tagged_stretches, 0);
+    std::size_t loop_kept = 0;
+    for (int x = 20; x <= 70; ++x)
+      for (int y = 52; y <= 68; ++y)
+        for (int z = 42; z <= 58; ++z) loop_kept += tube_dist(y, z, 60, 50) < 7 && at(m, x, y, z);
+    EXPECT_EQ(loop_kept, 0u);
+    EXPECT_TRUE(at(m, 50, 35, 50));
+    EXPECT_TRUE(has_decision(st, "rejected", "", "fluid body")) << st.to_json().dump(1);  // reported with its reason
+  }
+}
+
+// Prone: fluid lies on the anterior side (lower y) under the gas. Without a PatientPosition the
+// levels give gravity -y; with PatientPosition HFP the header does. The layer stays lumen.
+TEST(SegmentRules, ProneFluidLevelsRecognised) {
+  const double level_y = 28;
+  auto ct = make_volume(64, [&](double x, double y, double z) {
+    if (std::sqrt((x - 32) * (x - 32) + (y - 32) * (y - 32)) >= 14 || z < 8 || z > 56) return kKeep;
+    return y < level_y ? 450.0 : -1000.0;
+  }, 1.0, 10);
+  for (const char* header : {"", "HFP"}) {
+    SCOPED_TRACE(header);
+    set_patient_position(ct.GetPointer(), header);
+    SegmentStats st;
+    auto m = segment_colon(ct, small_volume_options(), &st);
+    EXPECT_EQ(st.gravity, "-y (anterior)");
+    EXPECT_NE(st.gravity_source.find(*header ? "PatientPosition HFP" : "fluid levels"), std::string::npos) << st.gravity_source;
+    EXPECT_EQ(components(m), 1u);
+    EXPECT_GT(st.fluid_volume_ml, 1.0);
+    for (int z = 12; z <= 52; z += 4)
+      for (int y = int(level_y) - 3; y <= int(level_y) + 3; ++y) EXPECT_TRUE(at(m, 32, y, z)) << y << " " << z;
+  }
+  // The same volume declared supine: the fluid lies above the gas, which no pool does.
+  set_patient_position(ct.GetPointer(), "HFS");
+  SegmentStats st;
+  auto m = segment_colon(ct, small_volume_options(), &st);
+  EXPECT_EQ(st.gravity, "+y (posterior)");
+  EXPECT_FALSE(at(m, 32, 22, 32));
+}
+
+// A rectal tube's air lumen (2 mm radius) enters the rectum from the inferior face: the channel is
+// trimmed, the rectum around it is kept; with --tube-area 0 the channel stays.
+TEST(SegmentRules, RectalTubeTrimmedRectumKept) {
+  auto ct = make_volume(80, [&](double x, double y, double z) {
+    const double d = tube_dist(x, y, 40, 40);
+    if (z >= 20 && z <= 60 && d < 14) return -1000.0;  // rectum
+    if (z < 20 && d < 2) return -1000.0;               // tube lumen down to the inferior face
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_colon(ct, small_volume_options(), &st);
+  EXPECT_TRUE(at(m, 40, 40, 40));
+  EXPECT_TRUE(at(m, 30, 40, 22));
+  for (int z = 0; z < 16; ++z) EXPECT_FALSE(at(m, 40, 40, z)) << z;
+  EXPECT_GT(st.rectal_tube_trimmed_ml, 0.0);
+  EXPECT_TRUE(has_decision(st, "rejected", "rectal tube") || st.rectal_tube_trimmed_ml < 1.0);
+  SegmentOptions o = small_volume_options();
+  o.tube_area = 0;
+  auto kept = segment_colon(ct, o, &st);
+  EXPECT_TRUE(at(kept, 40, 40, 5));
+}
+
+// New options are checked.
+TEST(SegmentRules, InvalidNewOptionsRejected) {
+  SegmentOptions o;
+  o.position = "upside-down";
+  EXPECT_THROW(validate(o), UsageError);
+  o = {};
+  o.link_gap = -1;
+  EXPECT_THROW(validate(o), UsageError);
+  o = {};
+  o.min_tagged_volume = 0;
+  EXPECT_THROW(validate(o), UsageError);
+  o = {};
+  o.tube_area = 5000;
+  EXPECT_THROW(validate(o), UsageError);
+}
+
+}  // namespace
+}  // namespace cf
