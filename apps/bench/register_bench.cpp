@@ -6,6 +6,8 @@
 //                               `colonflat run` on both CTs, `colonflat register`-equivalent, scored
 //                               against the phantom truth (polyp ids, centre lines). Needs
 //                               `colonflat phantom --position prone` (reported when missing).
+//   register_bench --write-synthetic DIR [TWIST_DEG]
+//                               writes a small synthetic pair as run folders DIR/supine, DIR/prone.
 //   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]
 //                               one existing pair of run folders (scored when truth is given).
 // Columns: polyps >= 6 mm; matched = truth polyps paired with themselves when the two truth lists
@@ -258,6 +260,12 @@ int main(int argc, char** argv) {
         if (a[i] == "--work") work = a[i + 1];
       }
       phantom_table(first, last, size, work);
+    } else if (!a.empty() && a[0] == "--write-synthetic" && a.size() >= 2) {
+      cf::SyntheticPairOptions o;
+      if (a.size() >= 3) o.twist_deg = std::stod(a[2]);
+      const cf::SyntheticPair pair = cf::make_synthetic_pair(o);
+      cf::write_run_dir(pair.supine, fs::path(a[1]) / "supine");
+      cf::write_run_dir(pair.prone, fs::path(a[1]) / "prone");
     } else if (!a.empty() && a[0] == "--pair" && a.size() >= 3) {
       print_header();
       const bool truth = a.size() >= 6 && a[3] == "--truth";

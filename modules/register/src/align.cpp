@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 
 namespace cf {
@@ -115,22 +116,28 @@ LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, con
 
 namespace {
 
-// Mean radial relief per angle bin of the samples with s in [lo, hi), minus its mean.
-std::vector<double> relief(const ScanCoordinates& c, const std::vector<int>& order, double lo, double hi, int bins,
-                           double shift) {
-  std::vector<double> sum(size_t(bins), 0.0), n(size_t(bins), 0.0);
+constexpr double kRowMm = 4.0;  // along-colon row height of the relief patches
+
+// Relief patch of the samples with s in [lo, hi): rows of kRowMm (row of a sample = `row_of(s)`),
+// `bins` angle columns; each row minus its mean; NaN where a cell has no sample.
+std::vector<double> relief(const ScanCoordinates& c, const std::vector<int>& order, double lo, double hi, int rows,
+                           int bins, const std::function<double(double)>& row_of) {
+  std::vector<double> sum(size_t(rows * bins), 0.0), n(sum.size(), 0.0);
   auto first = std::lower_bound(order.begin(), order.end(), lo, [&](int v, double x) { return c.s[size_t(v)] < x; });
   for (auto it = first; it != order.end() && c.s[size_t(*it)] < hi; ++it) {
-    double t = std::fmod(c.theta[size_t(*it)] + shift, kTwoPi);
-    if (t < 0) t += kTwoPi;
-    const int k = std::min(bins - 1, int(t / kTwoPi * bins));
-    sum[size_t(k)] += c.radial[size_t(*it)], n[size_t(k)] += 1;
+    const int r = std::clamp(int(row_of(c.s[size_t(*it)])), 0, rows - 1);
+    const int k = std::min(bins - 1, int(c.theta[size_t(*it)] / kTwoPi * bins));
+    sum[size_t(r * bins + k)] += c.radial[size_t(*it)], n[size_t(r * bins + k)] += 1;
   }
-  double mean = 0, used = 0;
-  for (int k = 0; k < bins; ++k)
-    if (n[size_t(k)] > 0) sum[size_t(k)] /= n[size_t(k)], mean += sum[size_t(k)], used += 1;
-  if (used < bins) return {};  // an angle without wall (fluid gap, cut out region): no estimate
-  for (double& x : sum) x -= mean / used;
+  for (int r = 0; r < rows; ++r) {
+    double mean = 0, used = 0;
+    for (int k = 0; k < bins; ++k) {
+      const size_t i = size_t(r * bins + k);
+      sum[i] = n[i] > 0 ? sum[i] / n[i] : std::numeric_limits<double>::quiet_NaN();
+      if (n[i] > 0) mean += sum[i], used += 1;
+    }
+    for (int k = 0; k < bins; ++k) sum[size_t(r * bins + k)] -= used > 0 ? mean / used : 0.0;
+  }
   return sum;
 }
 
@@ -142,19 +149,23 @@ std::vector<int> sorted_by_s(const ScanCoordinates& c) {
   return order;
 }
 
-// Best circular shift (rad) of hb against ha within +-max bins, and its Pearson correlation.
-std::pair<double, double> best_shift(const std::vector<double>& ha, const std::vector<double>& hb, int max_shift) {
-  const int n = int(ha.size());
-  double best = -2, best_m = 0, na = 0, nb = 0;
-  for (int k = 0; k < n; ++k) na += ha[size_t(k)] * ha[size_t(k)], nb += hb[size_t(k)] * hb[size_t(k)];
-  if (na < 1e-9 || nb < 1e-9) return {0.0, 0.0};
+// Best circular column shift (rad) of patch hb against ha within +-max bins, and its Pearson
+// correlation over the cells present in both.
+std::pair<double, double> best_shift(const std::vector<double>& ha, const std::vector<double>& hb, int rows, int bins,
+                                     int max_shift) {
+  double best = -2, best_m = 0;
   for (int m = -max_shift; m <= max_shift; ++m) {
-    double dot = 0;
-    for (int k = 0; k < n; ++k) dot += ha[size_t(k)] * hb[size_t(((k + m) % n + n) % n)];
-    const double r = dot / std::sqrt(na * nb);
-    if (r > best) best = r, best_m = m;
+    double dot = 0, na = 0, nb = 0;
+    for (int r = 0; r < rows; ++r)
+      for (int k = 0; k < bins; ++k) {
+        const double a = ha[size_t(r * bins + k)], b = hb[size_t(r * bins + ((k + m) % bins + bins) % bins)];
+        if (std::isnan(a) || std::isnan(b)) continue;
+        dot += a * b, na += a * a, nb += b * b;
+      }
+    const double corr = na > 1e-9 && nb > 1e-9 ? dot / std::sqrt(na * nb) : 0.0;
+    if (corr > best) best = corr, best_m = m;
   }
-  return {best_m * kTwoPi / n, best};
+  return {best_m * kTwoPi / bins, best};
 }
 
 }  // namespace
@@ -170,10 +181,11 @@ std::vector<double> estimate_twist(const ScanCoordinates& a, const ScanCoordinat
   std::vector<double> at_s, value;
   for (double lo = 0; lo + 0.5 * o.window_mm < pa.length_mm(); lo += 0.5 * o.window_mm) {
     const double hi = lo + o.window_mm;
-    const auto ha = relief(a, order_a, lo, hi, o.angle_bins, 0.0);
-    const auto hb = relief(b, order_b, length.a_to_b(lo), length.a_to_b(hi), o.angle_bins, 0.0);
-    if (ha.empty() || hb.empty()) continue;
-    const auto [shift, r] = best_shift(ha, hb, max_shift);
+    const int rows = std::max(1, int(std::ceil(o.window_mm / kRowMm)));
+    const auto ha = relief(a, order_a, lo, hi, rows, o.angle_bins, [&](double s) { return (s - lo) / kRowMm; });
+    const auto hb = relief(b, order_b, length.a_to_b(lo), length.a_to_b(hi), rows, o.angle_bins,
+                           [&](double s) { return (length.b_to_a(s) - lo) / kRowMm; });
+    const auto [shift, r] = best_shift(ha, hb, rows, o.angle_bins, max_shift);
     if (r < o.min_correlation) continue;
     at_s.push_back(0.5 * (lo + hi));
     value.push_back(shift);

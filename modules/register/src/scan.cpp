@@ -2,6 +2,7 @@
 
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
+#include <vtkLogger.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
@@ -25,9 +26,14 @@ vtkSmartPointer<vtkPolyData> read_vtp(const fs::path& path) {
   const std::string name = path.string();
   if (!fs::is_regular_file(path)) throw InputError(name, "no such file (a run directory needs flat.vtp)");
   VtkMessageCapture msgs;
+  // VTK 9.1 also logs reader failures through vtkLogger (not the output window): silence it so
+  // that a bad file gives only our one error line.
+  const vtkLogger::Verbosity saved = vtkLogger::GetCurrentVerbosityCutoff();
+  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
   vtkNew<vtkXMLPolyDataReader> reader;
   reader->SetFileName(path.c_str());
   reader->Update();
+  vtkLogger::SetStderrVerbosity(saved);
   if (!msgs.first_problem().empty() || reader->GetErrorCode() != 0)
     throw InputError(name, "cannot read VTK XML PolyData: " +
                                (msgs.first_problem().empty() ? std::string("parse error") : msgs.first_problem()));

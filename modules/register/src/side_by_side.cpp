@@ -136,13 +136,14 @@ vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, 
   auto out = vtkSmartPointer<vtkImageData>::New();
   out->DeepCopy(canvas->GetOutput());
   const double white[3] = {1, 1, 1}, orange[3] = {1, 0.6, 0};
-  draw_text(out, "Supine (top) and prone (bottom, registered onto the supine length axis); rows: angle around the "
-                 "colon from anterior", kLeft, 10, 15, white);
+  draw_text(out, "Supine / prone on one length axis", kLeft, 10, 15, white);
+
   draw_text(out, "supine", 8, l.supine_top + l.band / 2 - 8, 15, white);
   draw_text(out, "prone", 8, l.prone_top + l.band / 2 - 8, 15, white);
   for (int s = 0; s <= int(l.band_cols * l.pixel); s += 100)
     draw_text(out, std::to_string(s), l.column(s) - 8, l.height - kAxis + 14, 12, white);
-  draw_text(out, "mm along the colon (supine)", kLeft, l.height - 22, 13, white);
+  draw_text(out, "mm along the colon (supine axis); rows: angle around it, anterior at the top of each band", kLeft,
+            l.height - 24, 12, white);
   for (const auto& m : marks) draw_text(out, m.label, m.x + m.radius + 2, m.row - m.radius - 10, 12, white);
   std::ostringstream legend;
   legend << reg.matching().pairs.size() << " matched pairs (green), " << reg.matching().supine_only.size()

@@ -32,7 +32,7 @@ LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, con
 LengthProfile reversed_profile(const LengthProfile& p);
 
 struct TwistOptions {
-  double max_twist_deg = 30;  // degrees; search range of the residual rotation (0 = none)
+  double max_twist_deg = 45;  // degrees; search range of the residual rotation (0 = none)
   double window_mm = 60;      // mm; length of each correlation window
   int angle_bins = 72;        // angular bins of the relief profile
   double min_correlation = 0.5;  // windows with a weaker peak are ignored
