@@ -14,7 +14,9 @@
 // are matched through the registration; false = pairs joining different polyps; along / around =
 // median error of the registered position of each polyp (mm along the true prone centre line,
 // degrees around it); det_pairs / det_false = the same for the runs' detected candidates
-// (a candidate is a polyp's when within diameter/2 + 5 mm); time = registration wall time.
+// (a candidate is a polyp's when within diameter/2 + 5 mm); time = registration wall time;
+// lps_along / lps_around = baseline without registration: the prone wall point nearest to the
+// supine polyp's LPS position (small when the prone colon barely moves in patient coordinates).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -54,17 +56,19 @@ struct Row {
   size_t vertices = 0;
   int polyps = 0, matched = 0, false_matches = 0, det_pairs = -1, det_false = -1;
   double along = NAN, around = NAN, seconds = 0;
+  double lps_along = NAN, lps_around = NAN;  // baseline: the same LPS point taken in the other scan
 };
 
 void print_header() {
   std::printf("load average %.2f\n", load_average());
-  std::printf("%-24s %9s %6s %7s %5s %9s %10s %9s %9s %7s\n", "pair", "vertices", "polyps", "matched", "false",
-              "along_mm", "around_deg", "det_pairs", "det_false", "time_s");
+  std::printf("%-24s %9s %6s %7s %5s %9s %10s %9s %9s %7s %11s %12s\n", "pair", "vertices", "polyps", "matched",
+              "false", "along_mm", "around_deg", "det_pairs", "det_false", "time_s", "lps_along", "lps_around");
 }
 
 void print_row(const Row& r) {
-  std::printf("%-24s %9zu %6d %7d %5d %9.1f %10.1f %9d %9d %7.2f\n", r.name.c_str(), r.vertices, r.polyps, r.matched,
-              r.false_matches, r.along, r.around, r.det_pairs, r.det_false, r.seconds);
+  std::printf("%-24s %9zu %6d %7d %5d %9.1f %10.1f %9d %9d %7.2f %11.1f %12.1f\n", r.name.c_str(), r.vertices,
+              r.polyps, r.matched, r.false_matches, r.along, r.around, r.det_pairs, r.det_false, r.seconds, r.lps_along,
+              r.lps_around);
   std::fflush(stdout);
 }
 
@@ -190,7 +194,7 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
   const auto cs = as_candidates(ts), cp = as_candidates(tp);
   r.polyps = int(cs.size());
   count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
-  std::vector<double> along, around;
+  std::vector<double> along, around, lps_along, lps_around;
   for (const auto& q : cs)
     for (const auto& p : cp)
       if (p.id == q.id) {
@@ -198,8 +202,14 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
         if (!std::isfinite(mapped.sum())) continue;
         const auto [a, b] = truth_error(tp, mapped, p.lps);
         along.push_back(a), around.push_back(b);
+        const auto [s, t] = reg.locate(q.lps, cf::Direction::kProneToSupine);  // nearest prone wall vertex
+        const int w = reg.vertex_at(false, s, t);
+        if (w < 0) continue;
+        const auto [la, lb] = truth_error(tp, pro.lps[size_t(w)], p.lps);
+        lps_along.push_back(la), lps_around.push_back(lb);
       }
   r.along = median(along), r.around = median(around);
+  r.lps_along = median(lps_along), r.lps_around = median(lps_around);
   r.det_pairs = r.det_false = 0;
   for (const auto& m : reg.matching().pairs) {
     int hs = -2, hp = -3;
