@@ -15,6 +15,7 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/vtk_messages.h"
 #include "colonflat/render/artifacts.h"
 
@@ -37,7 +38,8 @@ void write_vtp(vtkPolyData* pd, const fs::path& tmp, const fs::path& target) {
   w->SetFileName(tmp.c_str());
   w->SetInputData(pd);
   w->SetDataModeToAppended();
-  w->SetCompressorTypeToZLib();
+  w->SetCompressorTypeToNone();  // raw binary: compressing doubles costs seconds per file for a few % of size
+  w->EncodeAppendedDataOff();
   if (!w->Write() || !msgs.first_problem().empty())
     throw Error(target.string() + ": cannot write: " + msgs.first_problem());
 }
@@ -90,7 +92,9 @@ void write_registration(const ColonRegistration& reg, const fs::path& dir, const
   j["parameters"] = params;
   j["files"] = {{"supine_to_prone", "supine_to_prone.vtp"}, {"prone_to_supine", "prone_to_supine.vtp"},
                 {"image", "supine_prone.png"}};
+  Stopwatch clock;
   auto png = render_side_by_side(reg, image);
+  j["timing_s"]["image_s"] = clock.seconds();
   auto forward = correspondence_polydata(reg, Direction::kSupineToProne);
   auto backward = correspondence_polydata(reg, Direction::kProneToSupine);
   std::error_code ec;
@@ -102,6 +106,7 @@ void write_registration(const ColonRegistration& reg, const fs::path& dir, const
     write_vtp(forward, tx.stage(dir / "supine_to_prone.vtp"), dir / "supine_to_prone.vtp");
     write_vtp(backward, tx.stage(dir / "prone_to_supine.vtp"), dir / "prone_to_supine.vtp");
     png_image_artifact().write(std::any(ImagePtr(png)), tx.stage(dir / "supine_prone.png"), dir / "supine_prone.png");
+    j["timing_s"]["image_and_files_s"] = clock.seconds();
     const fs::path json_tmp = tx.stage(dir / "registration.json");
     std::ofstream(json_tmp) << j.dump(1) << "\n";
     tx.commit();

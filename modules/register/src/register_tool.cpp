@@ -1,5 +1,6 @@
 #include "colonflat/register/register_tool.h"
 
+#include <array>
 #include <iomanip>
 #include <ostream>
 
@@ -76,22 +77,27 @@ class RegisterTool : public Tool {
       register_param_table().validate(params);
       Stopwatch clock;
       const ColonScan sup = read_run_dir(supine), pro = read_run_dir(prone);
+      const double read_s = clock.seconds();
       ColonRegistration reg(sup, pro, register_options(params));
       reg.run();
+      const double register_s = clock.seconds() - read_s;
       write_registration(reg, dir, SideBySideOptions{params.pixel_mm}, register_param_table().to_json(params));
-      if (!quiet) report(reg, clock.seconds(), dir, err);
+      if (!quiet) report(reg, {read_s, register_s, clock.seconds() - read_s - register_s}, dir, err);
       return kExitOk;
     });
   }
 
  private:
-  static void report(const ColonRegistration& reg, double seconds, const std::string& dir, std::ostream& err) {
+  // `seconds`: reading, registration, image and writing.
+  static void report(const ColonRegistration& reg, const std::array<double, 3>& seconds, const std::string& dir,
+                     std::ostream& err) {
     const auto& m = reg.matching();
     err << std::fixed << std::setprecision(0) << "register: supine " << reg.supine_coordinates().profile.length_mm()
         << " mm, prone " << reg.prone_coordinates().profile.length_mm() << " mm"
         << (reg.prone_reversed() ? " (reversed)" : "") << "; " << m.pairs.size() << " candidate pairs, "
         << m.supine_only.size() << " supine-only, " << m.prone_only.size() << " prone-only; " << std::setprecision(1)
-        << seconds << " s -> " << dir << "\n";
+        << seconds[0] + seconds[1] + seconds[2] << " s (read " << seconds[0] << ", register " << seconds[1]
+        << ", image and write " << seconds[2] << ") -> " << dir << "\n";
   }
 };
 
