@@ -14,7 +14,9 @@
 // are matched through the registration; false = pairs joining different polyps; along / around =
 // median error of the registered position of each polyp (mm along the true prone centre line,
 // degrees around it); det_pairs / det_false = the same for the runs' detected candidates
-// (a candidate is a polyp's when within diameter/2 + 5 mm); time = registration wall time;
+// (a candidate is a polyp's when within diameter/2 + 5 mm; det_false = a pair of a polyp's
+// candidate with another polyp's or a non-polyp one; det_np = pairs of two non-polyp candidates,
+// e.g. the same fold tip or noise site seen in both scans); time = registration wall time;
 // lps_along / lps_around = baseline without registration: the prone wall point nearest to the
 // supine polyp's LPS position (small when the prone colon barely moves in patient coordinates).
 #include <algorithm>
@@ -54,21 +56,21 @@ double median(std::vector<double> v) {
 struct Row {
   std::string name;
   size_t vertices = 0;
-  int polyps = 0, matched = 0, false_matches = 0, det_pairs = -1, det_false = -1;
+  int polyps = 0, matched = 0, false_matches = 0, det_pairs = -1, det_false = -1, det_nonpolyp = 0;
   double along = NAN, around = NAN, seconds = 0;
   double lps_along = NAN, lps_around = NAN;  // baseline: the same LPS point taken in the other scan
 };
 
 void print_header() {
   std::printf("load average %.2f\n", load_average());
-  std::printf("%-24s %9s %6s %7s %5s %9s %10s %9s %9s %7s %11s %12s\n", "pair", "vertices", "polyps", "matched",
-              "false", "along_mm", "around_deg", "det_pairs", "det_false", "time_s", "lps_along", "lps_around");
+  std::printf("%-24s %9s %6s %7s %5s %9s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "polyps", "matched",
+              "false", "along_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s", "lps_along", "lps_around");
 }
 
 void print_row(const Row& r) {
-  std::printf("%-24s %9zu %6d %7d %5d %9.1f %10.1f %9d %9d %7.2f %11.1f %12.1f\n", r.name.c_str(), r.vertices,
-              r.polyps, r.matched, r.false_matches, r.along, r.around, r.det_pairs, r.det_false, r.seconds, r.lps_along,
-              r.lps_around);
+  std::printf("%-24s %9zu %6d %7d %5d %9.1f %10.1f %9d %9d %6d %7.2f %11.1f %12.1f\n", r.name.c_str(), r.vertices,
+              r.polyps, r.matched, r.false_matches, r.along, r.around, r.det_pairs, r.det_false, r.det_nonpolyp, r.seconds,
+              r.lps_along, r.lps_around);
   std::fflush(stdout);
 }
 
@@ -215,7 +217,8 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
     int hs = -2, hp = -3;
     for (const auto& c : sup.candidates) if (c.id == m.supine_id) hs = hit(ts, c);
     for (const auto& c : pro.candidates) if (c.id == m.prone_id) hp = hit(tp, c);
-    (hs == hp && hs >= 0 ? r.det_pairs : r.det_false) += 1;
+    if (hs == hp) (hs >= 0 ? r.det_pairs : r.det_nonpolyp) += 1;
+    else r.det_false += 1;
   }
   return r;
 }
