@@ -1,0 +1,105 @@
+#pragma once
+// Supine-prone registration of two flattened colons (docs/register.md).
+//
+//   cf::ColonScan sup = cf::read_run_dir("supine"), pro = cf::read_run_dir("prone");
+//   cf::ColonRegistration reg(sup, pro, cf::RegisterOptions{});
+//   reg.run();                                         // coordinates, length, twist, vertices, candidates
+//   Eigen::Vector3d q = reg.map_lps(p, cf::Direction::kSupineToProne);
+//
+// Steps: (1) per scan, colon coordinates (s along, theta around; profile.h); (2) orientation and
+// length alignment by dynamic time warping of fold / calibre / curvature profiles; (3) residual
+// rotation around the colon from the wall relief; (4) per-vertex correspondence in both
+// directions (nearest vertex in (s, r theta) of the other scan); (5) candidate matching.
+// The two scans are borrowed: they must outlive the registration.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "colonflat/register/align.h"
+#include "colonflat/register/profile.h"
+#include "colonflat/register/scan.h"
+
+namespace cf {
+
+struct RegisterOptions {
+  ProfileOptions profile;
+  AlignOptions align;
+  TwistOptions twist;
+  std::string orientation = "auto";  // "auto" (try both when the rectal end is not labelled), "same", "reverse"
+  double match_along_mm = 30;        // mm; largest distance along the colon of a candidate pair
+  double match_around_deg = 45;      // degrees; largest angle around the colon of a pair
+  double match_size_ratio = 2.0;     // largest size ratio of a pair (larger / smaller)
+};
+
+enum class Direction { kSupineToProne, kProneToSupine };
+
+struct CandidateMatch {
+  int supine_id = 0, prone_id = 0;
+  double along_mm = 0;      // |s_prone - map(s_supine)|
+  double around_deg = 0;    // |theta difference| after registration
+  double size_ratio = 1;    // larger / smaller (1 when a size is unknown)
+  double score = 0;         // raised: 1 - (1 - score_supine)(1 - score_prone)
+};
+
+struct CandidateMatching {
+  std::vector<CandidateMatch> pairs;
+  std::vector<int> supine_only, prone_only;  // candidate ids
+};
+
+class ColonRegistration {
+ public:
+  ColonRegistration(const ColonScan& supine, const ColonScan& prone, RegisterOptions opts = {});
+  ~ColonRegistration();
+  void run();  // all steps below, in order
+
+  void compute_coordinates();   // (1) + orientation choice (2)
+  void align_along();           // (2)
+  void align_around();          // (3)
+  void correspond_vertices();   // (4)
+  void match_candidates();      // (5) the scans' own candidates
+  // Matches any two candidate lists (e.g. ground-truth polyps) with the registration's map.
+  CandidateMatching match(const std::vector<ScanCandidate>& supine, const std::vector<ScanCandidate>& prone) const;
+
+  // Position of a scan's point (s, theta) in the other scan.
+  void map_coordinates(Direction d, double s, double theta, double& s_out, double& theta_out) const;
+  // Nearest wall vertex of the target scan to the image of a point (-1 when not registered).
+  int map_vertex(Direction d, double s, double theta) const;
+  // Nearest registered wall vertex of the supine (or prone) scan to its own (s, theta); -1 if none.
+  int vertex_at(bool supine_scan, double s, double theta) const;
+  // An LPS point of one scan to the other: nearest wall vertex, its (s, theta), mapped, the
+  // target's wall vertex there; returns its LPS position (NaN when the point is not registered).
+  Eigen::Vector3d map_lps(const Eigen::Vector3d& p, Direction d) const;
+  // (s, theta) of the wall vertex nearest to an LPS point of a scan (NaN when not registered).
+  std::pair<double, double> locate(const Eigen::Vector3d& p, Direction from) const;
+
+  const ScanCoordinates& supine_coordinates() const { return sup_; }
+  const ScanCoordinates& prone_coordinates() const { return pro_; }
+  const LengthAlignment& length() const { return length_; }
+  const std::vector<double>& twist_rad() const { return twist_; }  // per supine profile bin
+  const std::vector<int>& supine_to_prone() const { return sup_to_pro_; }
+  const std::vector<int>& prone_to_supine() const { return pro_to_sup_; }
+  const CandidateMatching& matching() const { return matching_; }
+  const ColonScan& supine() const { return supine_; }
+  const ColonScan& prone() const { return prone_; }
+  bool prone_reversed() const { return pro_.reversed; }
+  nlohmann::json summary() const;  // the JSON written to registration.json (without inputs)
+
+ private:
+  struct Index;
+  const ColonScan& supine_;
+  const ColonScan& prone_;
+  RegisterOptions opts_;
+  ScanCoordinates sup_, pro_;
+  LengthAlignment length_;
+  std::vector<double> twist_;
+  int twist_windows_ = 0;
+  std::vector<int> sup_to_pro_, pro_to_sup_;
+  CandidateMatching matching_;
+  std::unique_ptr<Index> sup_index_, pro_index_;
+  nlohmann::json timing_ = nlohmann::json::object();
+};
+
+}  // namespace cf

@@ -1,0 +1,152 @@
+#include "colonflat/register/register.h"
+
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStaticPointLocator.h>
+
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/run_stats.h"
+
+namespace cf {
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kTwoPi = 6.283185307179586;
+
+vtkSmartPointer<vtkStaticPointLocator> make_locator(const std::vector<Eigen::Vector3d>& pts) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(vtkIdType(pts.size()));
+  for (size_t i = 0; i < pts.size(); ++i) points->SetPoint(vtkIdType(i), pts[i].data());
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  auto loc = vtkSmartPointer<vtkStaticPointLocator>::New();
+  loc->SetDataSet(pd);
+  loc->SetNumberOfPointsPerBucket(4);
+  loc->BuildLocator();
+  return loc;
+}
+}  // namespace
+
+// Point locators of one scan: its wall in LPS, and its registered vertices in the cylinder
+// embedding (s, R cos theta, R sin theta), R = the scan's mean radius.
+struct ColonRegistration::Index {
+  vtkSmartPointer<vtkStaticPointLocator> lps, cylinder;
+  std::vector<int> cylinder_vertex;  // locator point -> scan vertex
+  double radius = 1;
+  Index(const ColonScan& scan, const ScanCoordinates& c) : radius(std::max(1.0, c.mean_radius_mm)) {
+    lps = make_locator(scan.lps);
+    std::vector<Eigen::Vector3d> emb;
+    for (size_t v = 0; v < c.s.size(); ++v) {
+      if (std::isnan(c.s[v])) continue;
+      emb.push_back(embed(c.s[v], c.theta[v]));
+      cylinder_vertex.push_back(int(v));
+    }
+    cylinder = make_locator(emb);
+  }
+  Eigen::Vector3d embed(double s, double theta) const {
+    return {s, radius * std::cos(theta), radius * std::sin(theta)};
+  }
+  int nearest(double s, double theta) const {
+    const Eigen::Vector3d q = embed(s, theta);
+    const vtkIdType id = cylinder->FindClosestPoint(q.data());
+    return id < 0 ? -1 : cylinder_vertex[size_t(id)];
+  }
+};
+
+ColonRegistration::ColonRegistration(const ColonScan& supine, const ColonScan& prone, RegisterOptions opts)
+    : supine_(supine), prone_(prone), opts_(std::move(opts)) {
+  if (opts_.orientation != "auto" && opts_.orientation != "same" && opts_.orientation != "reverse")
+    throw UsageError("--orientation must be one of auto, same, reverse (got '" + opts_.orientation + "')");
+}
+
+ColonRegistration::~ColonRegistration() = default;
+
+void ColonRegistration::run() {
+  Stopwatch t;
+  compute_coordinates();
+  timing_["coordinates_s"] = t.seconds();
+  align_along();
+  timing_["length_alignment_s"] = t.seconds() - timing_["coordinates_s"].get<double>();
+  align_around();
+  const double before = t.seconds();
+  correspond_vertices();
+  timing_["vertex_correspondence_s"] = t.seconds() - before;
+  match_candidates();
+  timing_["total_s"] = t.seconds();
+}
+
+void ColonRegistration::compute_coordinates() {
+  sup_ = colon_coordinates(supine_, opts_.profile);
+  pro_ = colon_coordinates(prone_, opts_.profile, opts_.orientation == "reverse");
+  const bool labelled = sup_.from_rectum && pro_.from_rectum;
+  if (opts_.orientation == "auto" && !labelled) {
+    const double same = align_length(sup_.profile, pro_.profile, opts_.align).cost;
+    const double reverse = align_length(sup_.profile, reversed_profile(pro_.profile), opts_.align).cost;
+    if (reverse < same) pro_ = colon_coordinates(prone_, opts_.profile, true);
+  }
+  sup_index_ = std::make_unique<Index>(supine_, sup_);
+  pro_index_ = std::make_unique<Index>(prone_, pro_);
+}
+
+void ColonRegistration::align_along() { length_ = align_length(sup_.profile, pro_.profile, opts_.align); }
+
+void ColonRegistration::align_around() {
+  twist_ = estimate_twist(sup_, pro_, length_, opts_.twist, &twist_windows_);
+}
+
+void ColonRegistration::map_coordinates(Direction d, double s, double theta, double& s_out, double& theta_out) const {
+  const bool forward = d == Direction::kSupineToProne;
+  s_out = forward ? length_.a_to_b(s) : length_.b_to_a(s);
+  const double s_supine = forward ? s : s_out;
+  const double tw = twist_.empty() ? 0.0 : twist_[size_t(sup_.profile.bin_of(s_supine))];
+  theta_out = std::fmod(theta + (forward ? tw : -tw) + 2 * kTwoPi, kTwoPi);
+}
+
+int ColonRegistration::map_vertex(Direction d, double s, double theta) const {
+  if (std::isnan(s) || std::isnan(theta)) return -1;
+  double s2, t2;
+  map_coordinates(d, s, theta, s2, t2);
+  return (d == Direction::kSupineToProne ? pro_index_ : sup_index_)->nearest(s2, t2);
+}
+
+void ColonRegistration::correspond_vertices() {
+  auto fill = [this](Direction d, const ScanCoordinates& c, std::vector<int>& out) {
+    out.assign(c.s.size(), -1);
+    const size_t n = c.s.size(), half = n / 2;
+    auto part = [&](size_t lo, size_t hi) {
+      for (size_t v = lo; v < hi; ++v) out[v] = map_vertex(d, c.s[v], c.theta[v]);
+    };
+    std::thread other(part, half, n);  // static locators answer queries concurrently
+    part(0, half);
+    other.join();
+  };
+  fill(Direction::kSupineToProne, sup_, sup_to_pro_);
+  fill(Direction::kProneToSupine, pro_, pro_to_sup_);
+}
+
+int ColonRegistration::vertex_at(bool supine_scan, double s, double theta) const {
+  return (supine_scan ? sup_index_ : pro_index_)->nearest(s, theta);
+}
+
+std::pair<double, double> ColonRegistration::locate(const Eigen::Vector3d& p, Direction from) const {
+  const bool sup = from == Direction::kSupineToProne;
+  const Index& idx = sup ? *sup_index_ : *pro_index_;
+  const ScanCoordinates& c = sup ? sup_ : pro_;
+  const vtkIdType v = idx.lps->FindClosestPoint(p.data());
+  if (v < 0) return {kNaN, kNaN};
+  return {c.s[size_t(v)], c.theta[size_t(v)]};
+}
+
+Eigen::Vector3d ColonRegistration::map_lps(const Eigen::Vector3d& p, Direction d) const {
+  const auto [s, theta] = locate(p, d);
+  const int v = map_vertex(d, s, theta);
+  if (v < 0) return Eigen::Vector3d::Constant(kNaN);
+  return (d == Direction::kSupineToProne ? prone_ : supine_).lps[size_t(v)];
+}
+
+}  // namespace cf

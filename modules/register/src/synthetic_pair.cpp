@@ -1,0 +1,218 @@
+#include "colonflat/register/synthetic_pair.h"
+
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include <Eigen/Geometry>
+
+namespace cf {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+// A centre line sampled every 0.25 mm of its parameter, with arc length and a parallel-transport frame.
+struct Curve {
+  std::vector<Eigen::Vector3d> p, e1, e2;
+  std::vector<double> arc;
+  // Index of the sample at arc length s.
+  size_t at_arc(double s) const {
+    return std::min(arc.size() - 1, size_t(std::lower_bound(arc.begin(), arc.end(), s) - arc.begin()));
+  }
+};
+
+Curve sample_curve(const std::function<Eigen::Vector3d(double)>& f, double t_max) {
+  Curve c;
+  for (double t = 0; t <= t_max; t += 0.25) c.p.push_back(f(t));
+  const size_t n = c.p.size();
+  c.arc.assign(n, 0.0);
+  for (size_t i = 1; i < n; ++i) c.arc[i] = c.arc[i - 1] + (c.p[i] - c.p[i - 1]).norm();
+  Eigen::Vector3d r(1, 0, 0);  // transported from a fixed start vector: same start in both scans
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d t = (c.p[std::min(n - 1, i + 1)] - c.p[i == 0 ? 0 : i - 1]).normalized();
+    r = (r - r.dot(t) * t).normalized();
+    c.e1.push_back(r);
+    c.e2.push_back(t.cross(r));
+  }
+  return c;
+}
+
+struct Fold { double sigma, phi, depth; };
+
+// The tube in material coordinates: lumen radius at (sigma, phi).
+struct Tube {
+  SyntheticPairOptions o;
+  std::vector<Fold> folds;
+  std::vector<SyntheticPolyp> polyps;
+  double radius(double sigma, double phi) const {
+    double r = o.radius_mm * (1 + 0.15 * std::sin(kTwoPi * sigma / 230 + 1) + 0.08 * std::sin(kTwoPi * sigma / 97));
+    for (const auto& f : folds) {
+      const double ds = (sigma - f.sigma) / 2.5;
+      if (std::abs(ds) > 4) continue;
+      const double da = std::remainder(phi - f.phi, kTwoPi);  // crescent: 2/3 of the circumference
+      const double w = std::abs(da) < 2.1 ? 0.5 * (1 + std::cos(da / 2.1 * 3.14159265)) : 0.0;
+      r -= f.depth * std::exp(-ds * ds) * std::sqrt(w);
+    }
+    for (const auto& q : polyps) {
+      const double d2 = std::pow(sigma - q.sigma_mm, 2) + std::pow(o.radius_mm * std::remainder(phi - q.phi_rad, kTwoPi), 2);
+      r -= 0.5 * q.size_mm * std::exp(-d2 / (2 * std::pow(q.size_mm / 3, 2)));
+    }
+    return r;
+  }
+};
+
+Tube make_tube(const SyntheticPairOptions& o) {
+  Tube tube{o, {}, {}};
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (double s = 15 + 20 * u(rng); s < o.length_mm - 15; s += 18 + 22 * u(rng))
+    tube.folds.push_back({s, kTwoPi * u(rng), o.radius_mm * (0.15 + 0.15 * u(rng))});
+  for (int i = 0; i < o.polyps; ++i) {
+    SyntheticPolyp q;
+    q.id = i + 1;
+    q.sigma_mm = 40 + (o.length_mm - 80) * (i + 0.2 + 0.6 * u(rng)) / std::max(1, o.polyps);
+    q.phi_rad = kTwoPi * u(rng);
+    q.size_mm = 6 + 6 * u(rng);
+    tube.polyps.push_back(q);
+  }
+  return tube;
+}
+
+// One scan's wall: rings at material sigma, placed on `curve` at arc `place(sigma)`.
+struct Placement {
+  const Curve* curve;
+  std::function<double(double)> arc_of_sigma;  // material sigma -> arc length on the curve
+  double twist = 0;                            // rad
+};
+
+Eigen::Vector3d wall_point(const Tube& tube, const Placement& pl, double sigma, double phi) {
+  const size_t i = pl.curve->at_arc(pl.arc_of_sigma(sigma));
+  const double a = phi + pl.twist;
+  return pl.curve->p[i] + tube.radius(sigma, phi) * (std::cos(a) * pl.curve->e1[i] + std::sin(a) * pl.curve->e2[i]);
+}
+
+struct Grid {
+  std::vector<double> sigma, phi;  // per vertex
+  int rings = 0, around = 0;
+};
+
+vtkSmartPointer<vtkPolyData> grid_polydata(const Tube& tube, const Placement& pl, const Grid& g,
+                                           const std::function<double(double)>& flat_x, double cut, bool with_arc) {
+  const vtkIdType n = vtkIdType(g.sigma.size());
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> pos, nrm, arc;
+  pos->SetName("position_lps_mm"), pos->SetNumberOfComponents(3);
+  nrm->SetName("Normals"), nrm->SetNumberOfComponents(3);
+  arc->SetName("centreline_mm");
+  vtkNew<vtkIntArray> seg, src;
+  seg->SetName("segment_id"), src->SetName("source_vertex");
+  const double ds = 0.5, dp = 0.01;
+  for (vtkIdType v = 0; v < n; ++v) {
+    const double s = g.sigma[size_t(v)], f = g.phi[size_t(v)];
+    const Eigen::Vector3d p = wall_point(tube, pl, s, f);
+    Eigen::Vector3d normal = (wall_point(tube, pl, s + ds, f) - wall_point(tube, pl, s - ds, f))
+                                 .cross(wall_point(tube, pl, s, f + dp) - wall_point(tube, pl, s, f - dp));
+    const Eigen::Vector3d centre = pl.curve->p[pl.curve->at_arc(pl.arc_of_sigma(s))];
+    if (normal.dot(p - centre) < 0) normal = -normal;  // out of the lumen
+    pts->InsertNextPoint(flat_x(s), tube.o.radius_mm * std::fmod(f - cut + 2 * kTwoPi, kTwoPi), 0.0);
+    pos->InsertNextTuple(p.data());
+    nrm->InsertNextTuple(normal.normalized().data());
+    arc->InsertNextValue(pl.arc_of_sigma(s));
+    seg->InsertNextValue(0), src->InsertNextValue(int(v));
+  }
+  vtkNew<vtkCellArray> polys;
+  for (int r = 0; r + 1 < g.rings; ++r)
+    for (int a = 0; a + 1 < g.around; ++a) {
+      const vtkIdType v = vtkIdType(r * g.around + a);
+      const vtkIdType t1[3] = {v, v + g.around, v + 1}, t2[3] = {v + 1, v + g.around, v + g.around + 1};
+      polys->InsertNextCell(3, t1), polys->InsertNextCell(3, t2);
+    }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  pd->GetPointData()->AddArray(pos);
+  pd->GetPointData()->SetNormals(nrm);
+  pd->GetPointData()->AddArray(seg);
+  pd->GetPointData()->AddArray(src);
+  if (with_arc) pd->GetPointData()->AddArray(arc);
+  return pd;
+}
+
+Grid make_grid(double length, double spacing, double radius, double phase) {
+  Grid g;
+  g.rings = int(length / spacing) + 1;
+  g.around = int(std::round(kTwoPi * radius / spacing));
+  for (int r = 0; r < g.rings; ++r)
+    for (int a = 0; a < g.around; ++a) {
+      g.sigma.push_back(std::min(length, r * spacing));
+      g.phi.push_back(std::fmod(kTwoPi * (a + phase) / g.around, kTwoPi));
+    }
+  return g;
+}
+
+void add_segments_json(vtkPolyData* pd, double length, bool labels, bool reversed) {
+  nlohmann::json seg = {{"id", 0}, {"rectangle_mm", {{"x0", 0}, {"y0", 0}, {"length", length}}}};
+  if (labels) seg["x0_end"] = reversed ? "cecum" : "rectum", seg["x1_end"] = reversed ? "rectum" : "cecum";
+  vtkNew<vtkStringArray> js;
+  js->SetName("FlatSegments");
+  js->InsertNextValue(nlohmann::json{{"segments", {seg}}}.dump());
+  pd->GetFieldData()->AddArray(js);
+}
+
+}  // namespace
+
+SyntheticPair make_synthetic_pair(const SyntheticPairOptions& o) {
+  Tube tube = make_tube(o);
+  auto base = [](double t) { return Eigen::Vector3d(90 * std::sin(t / 110), 35 * std::sin(t / 170 + 0.5), 0.8 * t); };
+  const Curve sup_curve = sample_curve(base, o.length_mm * 1.3);
+  const double t_mid = 0.5 * o.length_mm;
+  auto shifted = [&](double t) -> Eigen::Vector3d {
+    return base(t) + o.shift_mm * std::exp(-std::pow((t - t_mid) / (o.length_mm / 6), 2)) * Eigen::Vector3d(0.8, 0.6, 0);
+  };
+  const Curve pro_curve = sample_curve(shifted, o.length_mm * 1.3);
+  const double L = o.length_mm;
+  Placement sup{&sup_curve, [](double s) { return s; }, 0.0};
+  Placement pro{&pro_curve, [&](double s) {
+                  const double slid = s + o.slide_mm * std::sin(kTwoPi * s / L);
+                  return pro_curve.arc[sup_curve.at_arc(slid)] - pro_curve.arc[sup_curve.at_arc(0)];
+                }, o.twist_deg * kTwoPi / 360};
+  SyntheticPair out;
+  const Grid gs = make_grid(L, o.spacing_mm, o.radius_mm, 0.0), gp = make_grid(L, 1.1 * o.spacing_mm, o.radius_mm, 0.37);
+  const double pro_len = pro.arc_of_sigma(L);
+  auto pro_x = [&](double s) { return o.reverse_prone ? pro_len - 0.95 * pro.arc_of_sigma(s) : 0.95 * pro.arc_of_sigma(s); };
+  auto sup_pd = grid_polydata(tube, sup, gs, [](double s) { return s; }, 0.3, o.centreline);
+  auto pro_pd = grid_polydata(tube, pro, gp, pro_x, 2.0, o.centreline && !o.reverse_prone);
+  add_segments_json(sup_pd, L, o.centreline, false);
+  add_segments_json(pro_pd, 0.95 * pro_len, o.centreline && !o.reverse_prone, false);
+  out.supine = scan_from_polydata(sup_pd, "synthetic supine");
+  out.prone = scan_from_polydata(pro_pd, "synthetic prone");
+  out.supine_sigma = gs.sigma, out.supine_phi = gs.phi, out.prone_sigma = gp.sigma, out.prone_phi = gp.phi;
+  std::mt19937_64 rng(o.seed + 17);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (auto& q : tube.polyps) {
+    q.supine_lps = wall_point(tube, sup, q.sigma_mm, q.phi_rad);
+    q.prone_lps = wall_point(tube, pro, q.sigma_mm, q.phi_rad);
+    out.supine.candidates.push_back({q.id, q.supine_lps, q.size_mm * (0.9 + 0.2 * u(rng)), 0.7});
+    out.prone.candidates.push_back({q.id, q.prone_lps, q.size_mm * (0.9 + 0.2 * u(rng)), 0.7});
+  }
+  for (int k = 0; k < o.extra_candidates; ++k) {  // stool or noise: seen in one scan only
+    out.supine.candidates.push_back({100 + k, wall_point(tube, sup, L * (0.2 + 0.6 * u(rng)), kTwoPi * u(rng)), 7, 0.6});
+    out.prone.candidates.push_back({200 + k, wall_point(tube, pro, L * (0.2 + 0.6 * u(rng)), kTwoPi * u(rng)), 7, 0.6});
+  }
+  out.polyps = tube.polyps;
+  return out;
+}
+
+}  // namespace cf
