@@ -74,7 +74,7 @@ void read_vector_array(vtkDataArray* a, std::vector<Eigen::Vector3d>& out) {
 
 }  // namespace
 
-std::vector<ScanCandidate> candidates_from_json(const nlohmann::json& j, const std::string& name) {
+std::vector<ScanCandidate> scan_candidates_from_json(const nlohmann::json& j, const std::string& name) {
   const nlohmann::json* list = &j;
   if (j.is_object()) {
     if (!j.contains("candidates") || !j["candidates"].is_array())
@@ -142,7 +142,7 @@ ColonScan read_run_dir(const fs::path& dir) {
   s.name = dir.string();
   for (const char* file : {"candidates.json", "polyps.json"}) {
     if (!fs::exists(dir / file)) continue;
-    s.candidates = candidates_from_json(read_json(dir / file), (dir / file).string());
+    s.candidates = scan_candidates_from_json(read_json(dir / file), (dir / file).string());
     s.candidates_file = file;
     break;
   }

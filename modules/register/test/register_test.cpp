@@ -174,18 +174,18 @@ TEST(RegisterProfile, UnknownOrientationIsRejected) {
 // Candidate files: the render stage's object form and the phantom's plain list are read; an
 // entry without a position is an InputError.
 TEST(RegisterScan, CandidateJsonForms) {
-  const auto a = candidates_from_json(
+  const auto a = scan_candidates_from_json(
       nlohmann::json::parse(R"({"candidates":[{"id":3,"position_lps_mm":[1,2,3],"size_mm":7,"score":0.8}]})"), "c.json");
   ASSERT_EQ(a.size(), 1u);
   EXPECT_EQ(a[0].id, 3);
   EXPECT_DOUBLE_EQ(a[0].lps.z(), 3);
   EXPECT_DOUBLE_EQ(a[0].size_mm, 7);
-  const auto b = candidates_from_json(nlohmann::json::parse(R"([{"id":1,"center_lps_mm":[4,5,6],"diameter_mm":9}])"), "p");
+  const auto b = scan_candidates_from_json(nlohmann::json::parse(R"([{"id":1,"center_lps_mm":[4,5,6],"diameter_mm":9}])"), "p");
   ASSERT_EQ(b.size(), 1u);
   EXPECT_DOUBLE_EQ(b[0].size_mm, 9);
   EXPECT_DOUBLE_EQ(b[0].score, 1.0);
-  EXPECT_THROW(candidates_from_json(nlohmann::json::parse(R"([{"id":1,"size_mm":3}])"), "p"), InputError);
-  EXPECT_THROW(candidates_from_json(nlohmann::json::parse(R"({"items":[]})"), "p"), InputError);
+  EXPECT_THROW(scan_candidates_from_json(nlohmann::json::parse(R"([{"id":1,"size_mm":3}])"), "p"), InputError);
+  EXPECT_THROW(scan_candidates_from_json(nlohmann::json::parse(R"({"items":[]})"), "p"), InputError);
 }
 
 }  // namespace

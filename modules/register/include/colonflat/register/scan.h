@@ -48,7 +48,7 @@ ColonScan scan_from_polydata(vtkSmartPointer<vtkPolyData> flat, const std::strin
 
 // Candidates from the render stage's JSON ({"candidates": [...]}) or a plain list (phantom truth).
 // Throws InputError(name, ...) on a malformed entry.
-std::vector<ScanCandidate> candidates_from_json(const nlohmann::json& j, const std::string& name);
+std::vector<ScanCandidate> scan_candidates_from_json(const nlohmann::json& j, const std::string& name);
 
 // Writes a scan as a run directory (flat.vtp, candidates.json, run_report.json); for tests and
 // benchmarks building synthetic pairs.
