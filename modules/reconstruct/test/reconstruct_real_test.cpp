@@ -28,7 +28,7 @@ TEST(ReconstructReal, SubvoxelSurfaceOfARealMask) {
   EXPECT_EQ(t.unreferenced_vertices, 0u);
   ASSERT_TRUE(t.genus);
   EXPECT_EQ(*t.genus, st.genus);
-  EXPECT_EQ(st.field_source, "mask (antialias)");
+  EXPECT_EQ(st.field_source, "mask (sinc)");  // the mask-only default
   const BoundaryDistance d = distance_to_mask_boundary(surface, mask.GetPointer());
   EXPECT_EQ(d.far, 0u);
   EXPECT_LE(d.max_voxels, 0.5);

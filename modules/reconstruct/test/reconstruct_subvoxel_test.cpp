@@ -280,7 +280,7 @@ TEST(ReconstructSubvoxel, CtMustMatchTheMask) {
   EXPECT_THROW(reconstruct_surface(data.mask, shifted, with_subvoxel("auto")), PreconditionError);
   ReconstructStats st;
   reconstruct_surface(data.mask, shifted, with_subvoxel("mask"), &st);
-  EXPECT_EQ(st.field_source, "mask (antialias)");
+  EXPECT_EQ(st.field_source, "mask (sinc)");  // the mask-only default
 }
 
 // Invalid sub-voxel parameters are rejected with a UsageError naming the parameter.
