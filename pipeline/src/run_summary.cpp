@@ -49,8 +49,16 @@ std::string key_results(const nlohmann::json& result) {
   return s;
 }
 
-// Mean coverage over flatten's segments, when they report one ("coverage": number or {"fraction"}).
+// The share of the wall the image shows: flatten's "coverage": {"fraction_shown"} over the whole
+// colon, else the mean of its segments' coverage (a number or {"fraction"}).
 std::string coverage_text(const nlohmann::json& flat) {
+  const auto whole = flat.find("coverage");
+  if (whole != flat.end() && whole->is_object() && whole->contains("fraction_shown") &&
+      (*whole)["fraction_shown"].is_number()) {
+    std::ostringstream t;
+    t << std::fixed << std::setprecision(1) << 100.0 * (*whole)["fraction_shown"].get<double>() << " % of the wall shown";
+    return t.str();
+  }
   if (!flat.contains("segments") || !flat["segments"].is_array()) return "";
   double sum = 0;
   int n = 0;
