@@ -96,7 +96,7 @@ d = sys.argv[1]
 def check(cond, msg):
     if not cond:
         sys.exit("FAIL: " + msg)
-for f in ("lumen_mask.nrrd", "surface.vtp", "denoised.vtp", "loops.vtp", "flat.vtp", "colon.png", "polyps.json",
+for f in ("lumen_mask.nrrd", "surface.vtp", "denoised.vtp", "loops.vtp", "flat.vtp", "colon.png", "candidates.json", "report.html", "polyps.mrk.json",
           "run_report.json", "run_report.txt"):
     p = os.path.join(d, f)
     check(os.path.isfile(p) and os.path.getsize(p) > 0, f"{p} missing or empty")
@@ -106,7 +106,7 @@ st = {s["stage"]: s["result"] for s in rep["stages"]}
 check(list(st) == ["segment", "reconstruct", "denoise", "flatten", "render"], f"stages {list(st)}")
 check(st["denoise"]["genus_after"] == 0, f"genus after denoise {st['denoise']['genus_after']}")
 check(st["segment"]["segments"] >= 1, "no segment")
-json.load(open(os.path.join(d, "polyps.json")))
+json.load(open(os.path.join(d, "candidates.json")))
 print(f"container-test: outputs OK in {d}: segments {st['segment']['segments']}, genus "
       f"{st['denoise']['genus_before']} -> {st['denoise']['genus_after']}, "
       f"{st['render']['candidates']} polyp candidates, pipeline {rep['total_time_s']:.1f} s, "
