@@ -21,6 +21,7 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -185,6 +186,36 @@ double x_of_centreline(const FlatSegment& s, double d) {
   while (t[i][0] < d) ++i;
   const double a = (d - t[i - 1][0]) / std::max(1e-12, t[i][0] - t[i - 1][0]);
   return t[i - 1][1] + a * (t[i][1] - t[i - 1][1]);
+}
+
+// Where the wall the map does not show (flatten's coverage clusters, >= kNotShownMinArea) lies on
+// the image: at the mapped vertex nearest to each cluster's LPS centroid (on its rim when the
+// cluster is missing from the map, inside it when it is only compressed). The cluster's own pixels
+// are too few to see, so the image rings them instead.
+constexpr double kNotShownMinArea = 25.0;  // mm^2 of 3D wall
+struct NotShownMark {
+  int segment = 0;
+  double x = 0, y = 0;  // flat layout position (mm)
+  double area_mm2 = 0;
+};
+std::vector<NotShownMark> not_shown_marks(const FlatMap& f) {
+  std::vector<NotShownMark> marks;
+  for (const FlatSegment& s : f.segments)
+    for (const auto& cl : s.coverage.not_shown) {
+      if (cl.area_mm2 < kNotShownMinArea) continue;
+      double best = std::numeric_limits<double>::infinity();
+      NotShownMark m;
+      m.segment = s.id;
+      m.area_mm2 = cl.area_mm2;
+      for (std::size_t v = 0; v < f.position.size(); ++v) {
+        if (f.segment[v] != s.id) continue;
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += (f.position[v][k] - cl.centroid_lps_mm[k]) * (f.position[v][k] - cl.centroid_lps_mm[k]);
+        if (d < best) best = d, m.x = f.uv[v][0], m.y = f.uv[v][1];
+      }
+      if (best < std::numeric_limits<double>::infinity()) marks.push_back(m);
+    }
+  return marks;
 }
 
 struct Tick {
@@ -427,6 +458,21 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
     if (mk.known) l.col[0] = 0.25, l.col[1] = 0.95, l.col[2] = 0.4, l.y = int(height - 1 - (cy - r * 0.75)) + 2;
     labels.push_back(l);
   }
+  canvas->SetDrawColor(255, 60, 60);  // wall not shown: a red square ring, labelled with its area
+  for (const NotShownMark& m : not_shown_marks(f)) {
+    const Band* bb = nullptr;
+    for (const auto& b : bands)
+      if (b.seg == m.segment) bb = &b;
+    if (!bb) continue;
+    const FlatSegment& s = f.segments[m.segment];
+    const double y = std::fmod(std::fmod(m.y - bb->c0, s.period) + s.period, s.period);
+    const int cx = int(bb->col0 + (m.x - s.x0) / px), cy = int(bb->row0 + y / px), r = 9;
+    canvas->FillBox(cx - r, cx + r, cy - r, cy - r + 1);
+    canvas->FillBox(cx - r, cx + r, cy + r - 1, cy + r);
+    canvas->FillBox(cx - r, cx - r + 1, cy - r, cy + r);
+    canvas->FillBox(cx + r - 1, cx + r, cy - r, cy + r);
+    labels.push_back({(m.area_mm2 < 1000 ? fmt0(m.area_mm2) + " mm2" : fmt0(m.area_mm2 / 100.0) + " cm2") + " not shown", cx + r + 2, height - 1 - cy - 6, {1, 0.45, 0.45}, 12, 0.55});
+  }
   // scale bar (bottom left), in mm at the mean (area-preserving) scale
   const double bar_mm = nice_length(0.12 * (width - 2 * margin) * px);
   const int bar_px = int(std::lround(bar_mm / px));
@@ -466,7 +512,7 @@ ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, s
     draw_text(final_img, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
   }
   draw_text(final_img, "hatched blue: wall compressed below " + fmt2(o.compressed_ratio) +
-                           " x its area; hatched red: wall not in the map", margin, height - 22, 12, grey);
+                           " x its area; hatched red: wall not in the map; red squares: wall the image cannot show (its 3D area)", margin, height - 22, 12, grey);
   std::string title = o.title;
   if (title.empty()) {
     int nc = 0, nk = 0;

@@ -113,6 +113,41 @@ TEST(RenderImage, MissingWallIsHatched) {
   EXPECT_NEAR(double(holed.missing_pixels) * px_area, removed, 0.15 * removed);
 }
 
+// Wall the image cannot show (a coverage cluster of flatten) is ringed in red at the mapped point
+// nearest to the cluster's LPS centroid; without the cluster the same pixels are not red.
+TEST(RenderImage, NotShownWallIsRingedAtItsPlace) {
+  auto c = test_colon();
+  FlatMap f = flatten_colon(c.mesh);
+  f.segments[0].coverage.not_shown.clear();
+  std::vector<ImageMarker> none;
+  ColonImageOptions o;
+  std::size_t v = 0;  // a vertex in the middle of the band
+  for (std::size_t i = 0; i < f.uv.size(); ++i)
+    if (std::abs(f.uv[i][0] - 110) + std::abs(f.uv[i][1] - f.segments[0].y0 - 0.5 * f.segments[0].period) <
+        std::abs(f.uv[v][0] - 110) + std::abs(f.uv[v][1] - f.segments[0].y0 - 0.5 * f.segments[0].period))
+      v = i;
+  const ColonImage plain = render_colon_image(f, {}, none, o);
+  Coverage::Cluster cl;
+  cl.centroid_lps_mm = f.position[v];
+  cl.area_mm2 = 500;
+  f.segments[0].coverage.not_shown.push_back(cl);
+  const ColonImage ringed = render_colon_image(f, {}, none, o);
+  const ColonImageGeometry g = colon_image_geometry(f, o.pixel_size, o.max_width);
+  const FlatSegment& s = f.segments[0];
+  const int cx = int(g.bands[0].col0 + (f.uv[v][0] - s.x0) / g.pixel_size);
+  const int cy = int(g.bands[0].row_bottom + (f.uv[v][1] - s.y0) / g.pixel_size);
+  auto red = [](const ColonImage& im, int x, int y) {
+    const auto* p = static_cast<const unsigned char*>(im.image->GetScalarPointer(x, y, 0));
+    return p[0] == 255 && p[1] == 60 && p[2] == 60;
+  };
+  int ring = 0, before = 0;
+  for (int d : {-9, 9})
+    for (int k = -5; k <= 5; ++k) ring += red(ringed, cx + d, cy + k) + red(ringed, cx + k, cy + d),
+                                  before += red(plain, cx + d, cy + k) + red(plain, cx + k, cy + d);
+  EXPECT_GE(ring, 40);  // 44 ring pixels probed, 4 sides x 11
+  EXPECT_EQ(before, 0);
+}
+
 // Known polyps are placed on the nearest wall point and scored against the candidates.
 TEST(RenderImage, KnownPolypsAreOverlaidAndScored) {
   testing::TempDir tmp;
