@@ -5,8 +5,6 @@
 #include <limits>
 #include <sstream>
 
-#include "colonflat/render/colon_image.h"
-
 namespace cf {
 namespace {
 
@@ -19,16 +17,8 @@ ColonImageLayout::ColonImageLayout(const FlatMap& flat, double pixel_size, int m
   pixel_size_ = geometry.pixel_size;
   width_ = geometry.width;
   height_ = geometry.height;
-  for (const ColonImageBand& g : geometry.bands) {
-    ImageBand b;
-    b.segment = g.segment;
-    b.col0 = g.col0;
-    b.row_bottom = g.row_bottom;
-    b.w = g.w;
-    b.h = g.h;
-    b.roll = flat.segments[g.segment].y0;  // render's roll when a band has no marker
-    bands_.push_back(b);
-  }
+  for (const ColonImageBand& g : geometry.bands)
+    bands_.push_back({g, flat.segments[g.segment].y0});  // render's roll when a band has no marker
 }
 
 const ImageBand* ColonImageLayout::band_of(int segment) const {

@@ -14,15 +14,13 @@
 #include <nlohmann/json.hpp>
 
 #include "colonflat/flatten/flatten.h"
+#include "colonflat/render/colon_image.h"
 
 namespace cf {
 
-struct ImageBand {
-  int segment = 0;
-  int col0 = 0;        // left column of the band
-  int row_bottom = 0;  // bottom row of the band, counted from the image bottom (VTK rows)
-  int w = 0, h = 0;    // pixels
-  double roll = 0;     // mm: flat y shown at the band's bottom edge
+// A band of colon.png (render's geometry: segment, col0, row_bottom, w, h) and its roll.
+struct ImageBand : ColonImageBand {
+  double roll = 0;  // mm: flat y shown at the band's bottom edge
 };
 
 class ColonImageLayout {
