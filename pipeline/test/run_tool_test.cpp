@@ -11,17 +11,13 @@
 #include "colonflat/core/synthetic.h"
 #include "colonflat/pipeline/registry.h"
 #include "colonflat/testing/command.h"
+#include "colonflat/core/stage.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
 
 class RunTool : public ::testing::Test {
  protected:
@@ -40,7 +36,7 @@ TEST_F(RunTool, FromToWithDebugDirAndReport) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(load_mesh(dir_ / "out" / "denoised.vtp").topology.genus, 0);
   EXPECT_TRUE(fs::exists(dir_ / "out" / "loops.vtp"));
-  auto rep = read_json(dir_ / "out" / "run_report.json");
+  auto rep = read_json_file(dir_ / "out" / "run_report.json");
   EXPECT_EQ(rep["units"], "mm");
   EXPECT_EQ(rep["coordinate_system"], "LPS");
   ASSERT_EQ(rep["stages"].size(), 1u);
@@ -58,7 +54,7 @@ TEST_F(RunTool, FromToWithDebugDirAndReport) {
     }
   EXPECT_TRUE(found);
   // --params-out lists the stage's parameters with their values.
-  auto params = read_json(dir_ / "params.json");
+  auto params = read_json_file(dir_ / "params.json");
   EXPECT_EQ(params["denoise"]["method"], "exact");
   EXPECT_NE(r.err.find("[1/1] denoise"), std::string::npos) << r.err;
 }

@@ -16,6 +16,7 @@
 #include "colonflat/report/image_layout.h"
 #include "colonflat/report/report_tool.h"
 #include "colonflat/report/slicer_markups.h"
+#include "colonflat/core/stage.h"
 #include "colonflat/testing/temp_dir.h"
 #include "synthetic_run.h"
 
@@ -25,11 +26,6 @@ namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
 
 struct ToolResult {
   int code;
@@ -156,10 +152,10 @@ TEST(ReportTool, WritesPageMarkupsAndImages) {
   for (const char* net : {"src=\"http", "href=\"http", "<link", "url(http", "@import", "fetch("})
     EXPECT_EQ(html.find(net), std::string::npos) << net;
   EXPECT_NE(html.find("window.REPORT = "), std::string::npos);
-  const auto mrk = read_json(tmp / "run" / "polyps.mrk.json");
+  const auto mrk = read_json_file(tmp / "run" / "polyps.mrk.json");
   const auto& cps = mrk["markups"][0]["controlPoints"];
   ASSERT_EQ(cps.size(), run.candidates["candidates"].size());
-  EXPECT_EQ(read_json(tmp / "run" / "known_polyps.mrk.json")["markups"][0]["controlPoints"].size(),
+  EXPECT_EQ(read_json_file(tmp / "run" / "known_polyps.mrk.json")["markups"][0]["controlPoints"].size(),
             std::size_t(run.known_polyps));
   // the first point is the top-scoring candidate, at its LPS position
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(cps[0]["position"][k].get<double>(), run.top_candidate[k], 0.051);
@@ -182,7 +178,7 @@ TEST(ReportTool, FallsBackToPolypsJson) {
   fs::rename(tmp / "run" / "candidates.json", tmp / "run" / "polyps.json");
   const auto r = run_report_tool({(tmp / "run").string(), "--quiet", "--no-endoluminal"});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(read_json(tmp / "run" / "polyps.mrk.json")["markups"][0]["controlPoints"].size(),
+  EXPECT_EQ(read_json_file(tmp / "run" / "polyps.mrk.json")["markups"][0]["controlPoints"].size(),
             run.candidates["candidates"].size());
 }
 
