@@ -83,6 +83,23 @@ double Centreline::area_fraction_of_u(double u) const {
   return area_cdf[i] + (x - double(i)) * (area_cdf[i + 1] - area_cdf[i]);
 }
 
+std::vector<double> Centreline::blended_axis(double beta) const {
+  const std::size_t n = std::max<std::size_t>(area_cdf.size(), 2);
+  std::vector<double> axis(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) {
+    const double density = area_cdf.size() == n ? (area_cdf[i] - area_cdf[i - 1]) * double(n - 1) : 1.0;
+    axis[i] = axis[i - 1] + std::pow(std::max(density, 1e-12), beta);
+  }
+  for (double& x : axis) x /= axis.back();
+  return axis;
+}
+
+double interpolate_axis(const std::vector<double>& axis, double u) {
+  const double x = std::clamp(u, 0.0, 1.0) * double(axis.size() - 1);
+  const std::size_t i = std::min(axis.size() - 2, std::size_t(x));
+  return axis[i] + (x - double(i)) * (axis[i + 1] - axis[i]);
+}
+
 double Centreline::s_of_u(double u) const {
   if (knot_u.empty()) return u;
   if (u <= knot_u.front()) return knot_s.front();

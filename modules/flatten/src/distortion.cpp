@@ -208,7 +208,15 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
   j["order"] = s.order;
   j["centreline_offset_mm"] = s.centreline_offset;
   j["balanced_vertices"] = s.balanced_vertices;
+  j["balance_strength"] = s.balance_strength;
   j["coverage"] = coverage_to_json(s.coverage);
+  j["kind"] = s.kind;
+  if (s.kind == "branch") {
+    j["parent"] = s.parent;
+    j["attach_mm"] = s.attach_mm;
+    j["attach_lps_mm"] = s.attach_lps;
+    j["neck_mm"] = s.neck_mm;
+  }
   return j;
 }
 

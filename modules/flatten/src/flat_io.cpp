@@ -66,7 +66,13 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.order = j.value("order", s.id);
   s.centreline_offset = j.value("centreline_offset_mm", 0.0);
   s.balanced_vertices = j.value("balanced_vertices", std::size_t(0));
+  s.balance_strength = j.value("balance_strength", 0.0);
   if (j.contains("coverage")) s.coverage = coverage_from_json(j["coverage"]);
+  s.kind = j.value("kind", "colon");
+  s.parent = j.value("parent", -1);
+  s.attach_mm = j.value("attach_mm", 0.0);
+  if (j.contains("attach_lps_mm")) s.attach_lps = j["attach_lps_mm"].get<std::array<double, 3>>();
+  s.neck_mm = j.value("neck_mm", 0.0);
   return s;
 }
 

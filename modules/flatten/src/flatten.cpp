@@ -128,48 +128,8 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
   return emb;
 }
 
-// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
-void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
-  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
-  std::vector<FaceDistortion> fd;
-  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
-    const Tri& t = w.ann.t[f];
-    const auto c = w.emb.corners(w.ann, int(f));
-    fd.push_back(face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]));
-    fd.back().degenerate = degenerate[f];
-  }
-  const DistortionStats st = stats_of(fd);
-  std::fprintf(stderr, "flatten debug %s: flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
-               step, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
-}
-
-// Area-balanced map: x = L A(u) / A, with A(u) the wall area below the level set u and L the
-// centreline length (each slice of the colon gets a band width proportional to its wall area;
-// band length = centreline length), y scaled so that the band's area is the wall area, fold-overs
-// untangled, then the regions still out of bounds balanced (symmetric Dirichlet).
-void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
-                        const std::vector<char>& fixed, const std::vector<char>& degenerate,
-                        const FlattenOptions& o) {
-  Embedding& emb = w.emb;
-  const double conformal_length = w.seg.length;
-  const double period = w.seg.area_3d / cl.length;
-  const double yscale = period / emb.period;
-  for (auto& q : emb.pos) q = V2(cl.length * cl.area_fraction_of_u(q.x() / conformal_length), q.y() * yscale);
-  for (std::size_t i = 0; i < cl.knot_u.size(); ++i)
-    w.seg.centreline_x.push_back({cl.knot_s[i], cl.length * cl.area_fraction_of_u(cl.knot_u[i])});
-  for (auto& d : emb.dy)
-    for (double& x : d) x *= yscale;
-  emb.period = period;
-  w.seg.length = cl.length;
-  w.seg.period = period;
-  w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
-  debug_stats("reparametrised", w, degenerate);
-  w.seg.balanced_vertices = balance_area(w.ann, vf, emb, fixed, degenerate, o).vertices;
-}
-
 // Distortion, faces left out (zero or negative area) and coverage of a segment.
-void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o,
-             double cap_area) {
+void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
   std::vector<FaceDistortion> fd(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) {
@@ -191,55 +151,209 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   std::vector<double> ratio(s.t.size(), 1.0);
   for (std::size_t f = 0; f < s.t.size(); ++f)
     if (!degenerate[f] && fd[f].area3 > 0) ratio[f] = fd[f].area2 * scale / fd[f].area3;
-  w.seg.coverage = coverage_of(s, E, w.in_map, ratio, o.coverage_min_ratio, cap_area);
+  Coverage& c = w.seg.coverage;
+  c = coverage_of(s, E, w.in_map, ratio, o.coverage_min_ratio, w.cap_area);
+  c.wall_area_mm2 += w.lost_area;  // faces dropped at a branch's neck, a branch tip's cap
+  c.missing_area_mm2 += w.lost_area;
+  c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
 }
 
-SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::size_t c, double lumen_sign,
-                            const FlattenOptions& o) {
-  SegmentWork w;
-  w.lumen_sign = lumen_sign;
-  w.seg.component = int(c);
-  w.seg.input_kind = ct.boundary_loops == 0 ? "closed" : ct.boundary_loops == 1 ? "one open end" : "tube";
-  w.seg.map = o.map;
-  double total_area = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) total_area += face_area_3d(s, int(f));
-  const auto loops = open_annulus(s, ct.boundary_loops, o, c, w);
+// What every step on an annulus needs: its edges, degenerate faces, fixed (boundary) vertices and
+// vertex -> faces; also sets the annulus' 3D area.
+struct Prepared {
+  Edges E;
+  std::vector<char> degenerate, fixed;
+  std::vector<std::vector<int>> vf;
+};
+
+Prepared prepare(SegmentWork& w) {
+  Prepared p;
   const Surface& ann = w.ann;
-  const Edges E = build_edges(ann.t);
-  const V3 ca = loop_centre(ann, loops[0]), cb = loop_centre(ann, loops[1]);
-  w.seg.end_a = {ca.x(), ca.y(), ca.z()};
-  w.seg.end_b = {cb.x(), cb.y(), cb.z()};
+  p.E = build_edges(ann.t);
+  w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) w.seg.area_3d += face_area_3d(ann, int(f));
-  std::vector<char> degenerate(ann.t.size(), 0);
+  p.degenerate.assign(ann.t.size(), 0);
   const double mean_area = w.seg.area_3d / double(ann.t.size());
-  for (std::size_t f = 0; f < ann.t.size(); ++f) degenerate[f] = face_area_3d(ann, int(f)) <= 1e-6 * mean_area;
-  std::vector<char> fixed(ann.p.size(), 0);
-  for (const auto& l : loops)
-    for (int v : l) fixed[v] = 1;
-  const auto vf = vertex_faces(ann);
-  w.emb = conformal_step(w, E, loops, vf, fixed, degenerate, o);
+  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = face_area_3d(ann, int(f)) <= 1e-6 * mean_area;
+  p.fixed.assign(ann.p.size(), 0);  // the ends and the rims of cut-off branches
+  for (std::size_t e = 0; e < p.E.ev.size(); ++e)
+    if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
+  p.vf = vertex_faces(ann);
+  return p;
+}
+
+void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const Prepared& p, const FlattenOptions& o) {
+  w.emb = conformal_step(w, p.E, loops, p.vf, p.fixed, p.degenerate, o);
   w.seg.length = w.seg.area_3d / w.emb.period;  // the conformal rectangle: length x period = area
   w.seg.period = w.emb.period;
+}
+
+double surface_area(const Surface& s) {
+  double a = 0;
+  for (std::size_t f = 0; f < s.t.size(); ++f) a += face_area_3d(s, int(f));
+  return a;
+}
+
+constexpr int kMaxBranchDepth = 3;  // branches of branches of branches
+std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
+                                         const FlattenOptions& o, int depth);
+
+// Appends the works of a flattened branch (its own first, parents relative to the list) to `out`,
+// the branch hanging from the work at index -1 (the caller's segment).
+void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out) {
+  const int base = int(out.size());
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    if (i > 0) sub[i].parent += base;
+    out.push_back(std::move(sub[i]));
+  }
+  out[base].parent = -1;
+}
+
+// Cuts the side branches off the annulus (each flattened as a band of its own, recursively),
+// then re-solves the conformal map of what remains. Returns the branches' works.
+std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
+                                      const FlattenOptions& o, int depth) {
+  const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, o.branch_min_area);
+  if (cuts.empty()) return {};
+  const std::size_t nf = w.ann.t.size();
+  std::vector<char> keep(nf, 1);
+  for (const auto& cut : cuts)
+    for (int f : cut.faces) keep[f] = 0;
+  clean_selection(w.ann, p.E, keep);
+  std::vector<int> new_of_old;
+  Surface rest = sub_surface(w.ann, keep, &new_of_old);
+  double placed = surface_area(rest);
+  FlattenOptions bo = o;
+  bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
+  std::vector<SegmentWork> out;
+  for (const auto& cut : cuts) {
+    std::vector<char> in(nf, 0);
+    for (int f : cut.faces) in[f] = 1;
+    clean_selection(w.ann, p.E, in);
+    const Surface b = sub_surface(w.ann, in);
+    try {
+      std::vector<SegmentWork> sub = flatten_surface(b, 1, std::size_t(w.seg.component), w.lumen_sign, bo, depth + 1);
+      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
+      sub[0].cap_area = 0;
+      sub[0].seg.neck_mm = cut.neck_mm;
+      for (std::size_t f = 0; f < nf; ++f)
+        if (in[f])
+          for (int v : w.ann.t[f])
+            if (new_of_old[v] >= 0) sub[0].neck.push_back(new_of_old[v]);
+      placed += surface_area(b);
+      append_branch(sub, out);
+    } catch (const std::exception&) {
+      // not flattenable as a band: its wall counts as not shown
+    }
+  }
+  w.lost_area += surface_area(w.ann) - placed;
+  for (auto& l : loops)
+    for (int& v : l) v = new_of_old[v];
+  w.ann = std::move(rest);
+  p = prepare(w);
+  conformal(w, loops, p, o);
+  return out;
+}
+
+// Where each direct branch hangs on this segment: mean centreline position and LPS of its neck.
+void attach_branches(const SegmentWork& w, std::vector<SegmentWork>& branches) {
+  for (auto& b : branches) {
+    if (b.parent != -1 || b.neck.empty()) continue;
+    std::sort(b.neck.begin(), b.neck.end());
+    b.neck.erase(std::unique(b.neck.begin(), b.neck.end()), b.neck.end());
+    V3 m = V3::Zero();
+    double along = 0;
+    for (int v : b.neck) m += w.ann.p[v], along += w.along[v];
+    m /= double(b.neck.size());
+    b.seg.attach_lps = {m.x(), m.y(), m.z()};
+    b.seg.attach_mm = along / double(b.neck.size());
+  }
+}
+
+// Centreline from the level sets of u (crowded faces left out) and each vertex's arc length.
+Centreline centreline_step(SegmentWork& w, const std::vector<std::vector<int>>& loops) {
+  const Surface& ann = w.ann;
   std::vector<double> u(ann.p.size());
   for (std::size_t v = 0; v < ann.p.size(); ++v) u[v] = std::clamp(w.emb.pos[v].x() / w.seg.length, 0.0, 1.0);
   std::vector<char> use_face(ann.t.size(), 1);
-  {
-    const double conformal_scale = w.seg.area_3d / (w.seg.length * w.seg.period);
-    for (std::size_t f = 0; f < ann.t.size(); ++f)
-      use_face[f] = w.emb.area2(ann, int(f)) * conformal_scale >= 0.05 * face_area_3d(ann, int(f));
-  }
-  const Centreline cl = centreline_from_u(ann, u, use_face, ca, cb);
+  const double conformal_scale = w.seg.area_3d / (w.seg.length * w.seg.period);
+  for (std::size_t f = 0; f < ann.t.size(); ++f)
+    use_face[f] = w.emb.area2(ann, int(f)) * conformal_scale >= 0.05 * face_area_3d(ann, int(f));
+  const V3 ca = loop_centre(ann, loops[0]), cb = loop_centre(ann, loops[1]);
+  Centreline cl = centreline_from_u(ann, u, use_face, ca, cb);
   w.seg.centreline = cl.points;
   w.seg.centreline_length = cl.length;
   w.along.resize(ann.p.size());
   for (std::size_t v = 0; v < ann.p.size(); ++v) w.along[v] = cl.s_of_u(u[v]);
-  debug_stats("conformal", w, degenerate);
-  if (o.map == "area-balanced") area_balanced_step(w, cl, vf, fixed, degenerate, o);
-  debug_stats("final", w, degenerate);
-  w.seg.faces = ann.t.size();
-  w.seg.vertices = ann.p.size();
-  measure(w, E, degenerate, o, total_area - w.seg.area_3d);
-  return w;
+  return cl;
+}
+
+// One colon segment (or side branch): the segment's work first, then its branches (parent = index
+// in the returned list; -1 for the first).
+std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
+                                         const FlattenOptions& o, int depth) {
+  SegmentWork w;
+  w.lumen_sign = lumen_sign;
+  w.seg.component = int(c);
+  w.seg.input_kind = nloops == 0 ? "closed" : nloops == 1 ? "one open end" : "tube";
+  w.seg.map = o.map;
+  auto loops = open_annulus(s, nloops, o, c, w);
+  const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
+  w.seg.end_a = {ca.x(), ca.y(), ca.z()};
+  w.seg.end_b = {cb.x(), cb.y(), cb.z()};
+  w.cap_area = surface_area(s) - surface_area(w.ann);
+  Prepared p = prepare(w);
+  conformal(w, loops, p, o);
+  std::vector<SegmentWork> branches;
+  if (o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth)
+    branches = cut_branches(w, loops, p, o, depth);
+  const Centreline cl = centreline_step(w, loops);
+  attach_branches(w, branches);
+  debug_stats("conformal", w, p.degenerate);
+  if (o.map == "area-balanced") area_balanced_step(w, cl, p.vf, p.fixed, p.degenerate, o, depth > 0);
+  debug_stats("final", w, p.degenerate);
+  w.seg.faces = w.ann.t.size();
+  w.seg.vertices = w.ann.p.size();
+  measure(w, p.E, p.degenerate, o);
+  std::vector<SegmentWork> out;
+  out.push_back(std::move(w));
+  for (auto& b : branches) {
+    b.parent += 1;  // -1 (this segment) -> 0; others shift by one
+    out.push_back(std::move(b));
+  }
+  return out;
+}
+
+// Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
+// their parent and their neck's position on it, labelled "neck" -> "tip".
+std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x) {
+  std::vector<int> colon;
+  std::vector<FlatSegment> segs;
+  for (std::size_t i = 0; i < work.size(); ++i)
+    if (work[i].parent < 0) colon.push_back(int(i)), segs.push_back(work[i].seg);
+  std::vector<char> rev_colon, reversed(work.size(), 0);
+  label_ends(segs, midline_x, rev_colon);
+  for (std::size_t k = 0; k < colon.size(); ++k) work[colon[k]].seg = segs[k], reversed[colon[k]] = rev_colon[k];
+  auto root_order = [&](int i) {
+    while (work[i].parent >= 0) i = work[i].parent;
+    return work[i].seg.order;
+  };
+  std::vector<int> branch;
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    SegmentWork& b = work[i];
+    if (b.parent < 0) continue;
+    const SegmentWork& parent = work[b.parent];
+    if (reversed[b.parent]) b.seg.attach_mm = parent.seg.centreline_length - b.seg.attach_mm;
+    b.seg.kind = "branch";
+    b.seg.x0_end = "neck";
+    b.seg.x1_end = "tip";
+    branch.push_back(int(i));
+  }
+  std::stable_sort(branch.begin(), branch.end(), [&](int a, int b) {
+    return std::make_pair(root_order(a), work[a].seg.attach_mm) < std::make_pair(root_order(b), work[b].seg.attach_mm);
+  });
+  for (std::size_t k = 0; k < branch.size(); ++k) work[branch[k]].seg.order = int(colon.size() + k);
+  return reversed;
 }
 
 }  // namespace
@@ -276,16 +390,17 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
       ++out.skipped_components;
       continue;
     }
-    work.push_back(flatten_segment(s, ct, c, vol >= 0 ? 1.0 : -1.0, opts));
+    auto ws = flatten_surface(s, ct.boundary_loops, c, vol >= 0 ? 1.0 : -1.0, opts, 0);
+    const int base = int(work.size());
+    for (auto& w : ws) {
+      if (w.parent >= 0) w.parent += base;
+      work.push_back(std::move(w));
+    }
   }
   if (work.empty()) throw PreconditionError("no colon segment large enough to flatten");
   double xmin = 1e300, xmax = -1e300;
   for (const auto& p : mesh.points) xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
-  std::vector<FlatSegment> segs;
-  for (const auto& w : work) segs.push_back(w.seg);
-  std::vector<char> reversed;
-  label_ends(segs, 0.5 * (xmin + xmax), reversed);
-  for (std::size_t i = 0; i < work.size(); ++i) work[i].seg = segs[i];
+  const std::vector<char> reversed = label_and_order(work, 0.5 * (xmin + xmax));
   flat_detail::emit_segments(work, reversed, opts, out);
   return out;
 }

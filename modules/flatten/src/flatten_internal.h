@@ -51,6 +51,12 @@ struct Opened {
   std::size_t removed = 0;
 };
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
+// The kept faces (`keep[f]`), reindexed; src carried over; `new_of_old` (optional): new vertex id
+// of each old one, -1 when dropped.
+Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old = nullptr);
+// Drops kept faces at pinch vertices and faces with all corners on the boundary, and keeps the
+// largest edge-connected piece, until the selection's boundary is a set of simple loops.
+void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep);
 
 // Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
 // eta the cut cocycle (per edge, lo -> hi), period = the conformal period in u units.
@@ -84,6 +90,21 @@ struct Embedding {
 Embedding embed_conformal(const Surface& s, const Edges& E, const Harmonic& h, double sign, double scale);
 // Re-places each corner offset so that every face's centroid y lies in [0, period).
 void normalise_corner_offsets(const Surface& s, Embedding& emb);
+
+// A side branch of an annulus: a pouch reached through a neck (a diverticulum, a colon loop left
+// blind by a cut, the appendix), where the conformal map collapses exponentially. `faces` (of the
+// annulus) form a topological disk whose rim is the neck: the shortest level set of the flat
+// distance from the collapse (see docs/flatten.md, "Side branches").
+struct BranchCut {
+  std::vector<int> faces;
+  double area_mm2 = 0;  // 3D area of the branch
+  double neck_mm = 0;   // 3D length of the neck
+  V2 centre;            // flat position of the collapse in the conformal embedding (mm)
+};
+// Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; largest first,
+// disjoint. `emb`: conformal embedding at the area-preserving scale, band [0, length] in x.
+std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
+                                     double min_area_mm2);
 
 // Vertex -> incident faces.
 std::vector<std::vector<int>> vertex_faces(const Surface& s);
@@ -127,7 +148,11 @@ struct Centreline {
   std::vector<double> area_cdf;               // wall area fraction with u' < k / (size - 1), increasing
   double s_of_u(double u) const;
   double area_fraction_of_u(double u) const;  // in [0, 1], strictly increasing
+  // x(u) / L of a band whose slices are (dA/du)^beta wide: beta = 0 the conformal spacing (u),
+  // 1 the area fraction; sampled at the area_cdf knots, strictly increasing from 0 to 1.
+  std::vector<double> blended_axis(double beta) const;
 };
+double interpolate_axis(const std::vector<double>& axis, double u);  // axis at u in [0, 1]
 // `use_face`: faces taken into the slices and the area function (the conformal map's crowded
 // faces, area ratio < 0.05, are left out: they sit at single u values and would make jumps).
 Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face,
@@ -147,6 +172,17 @@ struct BalanceResult {
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                            const std::vector<char>& fixed, const std::vector<char>& degenerate,
                            const FlattenOptions& o);
+
+struct SegmentWork;
+// Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
+// the least angle-distorting axis F whose area ratios stay in bounds, B the band length (the
+// centreline length within 8 %; a branch's conformal length), y scaled to the wall area, folds
+// untangled, out-of-bounds regions balanced.
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
+                        const std::vector<char>& fixed, const std::vector<char>& degenerate,
+                        const FlattenOptions& o, bool branch);
+// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
+void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate);
 
 // Per-face distortion of a map triangle.
 struct FaceDistortion {
@@ -169,6 +205,10 @@ struct SegmentWork {
   std::vector<char> in_map;   // per face: in the map (positive area)
   std::vector<double> along;  // per vertex: centreline arc length from end A (mm)
   double lumen_sign = 1;      // face normals x sign point out of the lumen
+  int parent = -1;            // side branch: index of the parent's work in the segment list
+  std::vector<int> neck;      // side branch: its neck's vertices in the parent's annulus
+  double cap_area = 0;        // mm^2 of wall removed to open the ends (caps)
+  double lost_area = 0;       // mm^2 of wall in no band (faces dropped when a branch was cut off)
 };
 
 // Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those

@@ -81,6 +81,8 @@ void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reve
   std::vector<int> order(work.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return work[a].seg.order < work[b].seg.order; });
+  std::vector<int> id_of_work(work.size());
+  for (std::size_t k = 0; k < order.size(); ++k) id_of_work[order[k]] = int(k);
   double y_cursor = 0;
   for (std::size_t k = 0; k < order.size(); ++k) {
     SegmentWork& w = work[order[k]];
@@ -88,6 +90,7 @@ void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reve
     normalise_corner_offsets(w.ann, w.emb);
     w.seg.id = int(k);
     w.seg.order = int(k);
+    w.seg.parent = w.parent >= 0 ? id_of_work[w.parent] : -1;
     w.seg.x0 = 0;
     w.seg.y0 = y_cursor;
     y_cursor += w.seg.period + o.segment_gap;

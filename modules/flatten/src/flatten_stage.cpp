@@ -42,6 +42,10 @@ const ParamTable<FlattenOptions>& FlattenStage::table() const {
               "area-balanced: symmetric-Dirichlet descent steps per correction pass (0: no correction)", 0, 10000);
     t.real("coverage-min-ratio", &FlattenOptions::coverage_min_ratio, "",
            "a face counts as shown on the image when its 2D/3D area ratio is at least this", 0.0, 1.0);
+    t.real("branch-min-area", &FlattenOptions::branch_min_area, "mm^2",
+           "area-balanced: a pouch behind a neck that the conformal map collapses over at least this wall area "
+           "(diverticulum, blind colon loop) is cut at its neck and shown as a band of its own (0: never)",
+           0.0, 1e7);
     return t;
   }();
   return t;

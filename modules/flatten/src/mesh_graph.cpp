@@ -107,10 +107,14 @@ void keep_largest_component(const Edges& E, std::vector<char>& keep) {
   for (std::size_t f = 0; f < nf; ++f) keep[f] = keep[f] && comp[f] == best;
 }
 
-// Surface made of the kept faces, reindexed; `old_of_new` maps new vertex ids to old ones.
-Surface sub_surface(const Surface& s, const std::vector<char>& keep) {
+}  // namespace
+
+// Surface made of the kept faces, reindexed.
+Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old) {
   Surface r;
-  std::vector<int> map(s.p.size(), -1);
+  std::vector<int> local;
+  std::vector<int>& map = new_of_old ? *new_of_old : local;
+  map.assign(s.p.size(), -1);
   for (std::size_t f = 0; f < s.t.size(); ++f) {
     if (!keep[f]) continue;
     Tri t;
@@ -128,8 +132,6 @@ Surface sub_surface(const Surface& s, const std::vector<char>& keep) {
   return r;
 }
 
-}  // namespace
-
 // Boundary vertex sets (one per loop) of a surface, via its boundary edges.
 std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E) {
   UnionFind uf(s.p.size());
@@ -146,6 +148,32 @@ std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E) {
     loops[it->second].push_back(int(v));
   }
   return loops;
+}
+
+void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep) {
+  // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
+  // faces around them and keep the largest piece, until the boundary is clean.
+  for (int iter = 0; iter < 200; ++iter) {
+    keep_largest_component(E, keep);
+    std::vector<int> bcount(s.p.size(), 0);
+    for (std::size_t e = 0; e < E.ev.size(); ++e) {
+      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
+      const int k = (f0 >= 0 && keep[f0]) + (f1 >= 0 && keep[f1]);
+      if (k == 1) ++bcount[E.ev[e][0]], ++bcount[E.ev[e][1]];
+    }
+    // Also faces with all three corners on the boundary: the harmonic function, constant along
+    // each end, would collapse them.
+    bool changed = false;
+    std::vector<char> bad(s.p.size(), 0);
+    for (std::size_t v = 0; v < s.p.size(); ++v) bad[v] = bcount[v] > 2;
+    for (std::size_t f = 0; f < s.t.size(); ++f) {
+      if (!keep[f]) continue;
+      const Tri& t = s.t[f];
+      const bool all_on = bcount[t[0]] > 0 && bcount[t[1]] > 0 && bcount[t[2]] > 0;
+      if (all_on || bad[t[0]] || bad[t[1]] || bad[t[2]]) keep[f] = 0, changed = true;
+    }
+    if (!changed) break;
+  }
 }
 
 // Removes caps around the ends of a segment with b boundary loops (b = 0 or 1) so that an annulus
@@ -182,29 +210,7 @@ Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double ra
   }
   std::vector<char> keep(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) keep[f] = !remove[f];
-  // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
-  // faces around them and keep the largest piece, until the boundary is clean.
-  for (int iter = 0; iter < 200; ++iter) {
-    keep_largest_component(E, keep);
-    std::vector<int> bcount(s.p.size(), 0);
-    for (std::size_t e = 0; e < E.ev.size(); ++e) {
-      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
-      const int k = (f0 >= 0 && keep[f0]) + (f1 >= 0 && keep[f1]);
-      if (k == 1) ++bcount[E.ev[e][0]], ++bcount[E.ev[e][1]];
-    }
-    // Also faces with all three corners on the boundary: the harmonic function, constant along
-    // each end, would collapse them.
-    bool changed = false;
-    std::vector<char> bad(s.p.size(), 0);
-    for (std::size_t v = 0; v < s.p.size(); ++v) bad[v] = bcount[v] > 2;
-    for (std::size_t f = 0; f < s.t.size(); ++f) {
-      if (!keep[f]) continue;
-      const Tri& t = s.t[f];
-      const bool all_on = bcount[t[0]] > 0 && bcount[t[1]] > 0 && bcount[t[2]] > 0;
-      if (all_on || bad[t[0]] || bad[t[1]] || bad[t[2]]) keep[f] = 0, changed = true;
-    }
-    if (!changed) break;
-  }
+  clean_selection(s, E, keep);
   Opened o;
   o.annulus = sub_surface(s, keep);
   o.removed = s.t.size() - o.annulus.t.size();

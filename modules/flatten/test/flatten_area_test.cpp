@@ -21,62 +21,19 @@
 #include "colonflat/flatten/flatten_stage.h"
 #include "colonflat/flatten/synthetic_colon.h"
 #include "colonflat/testing/temp_dir.h"
+#include "flatten_shapes.h"
 
 namespace cf {
 namespace {
 
-double capsule(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
-  const Eigen::Vector3d ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (p - (a + t * ab)).norm() - r;
-}
+using test_shapes::pouch_and_branch;
 
-// Closed tube along x (radius 12 mm, 220 mm) with a wide pouch (sphere radius 28 mm) and a blind
-// side branch (radius 5 mm, 35 mm long), meshed by flying edges at 1.2 mm; outward normals.
-TriangleList pouch_and_branch() {
-  const double h = 1.2;
-  vtkNew<vtkImageData> img;
-  const int nx = int(250 / h), ny = int(110 / h), nz = int(70 / h);
-  img->SetDimensions(nx, ny, nz);
-  img->SetOrigin(-25, -35, -35);
-  img->SetSpacing(h, h, h);
-  img->AllocateScalars(VTK_DOUBLE, 1);
-  auto* v = static_cast<double*>(img->GetScalarPointer());
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const Eigen::Vector3d p(-25 + i * h, -35 + j * h, -35 + k * h);
-        const double tube = capsule(p, {0, 0, 0}, {200, 0, 0}, 12);
-        const double pouch = (p - Eigen::Vector3d(70, 8, 0)).norm() - 28;
-        const double branch = capsule(p, {150, 0, 0}, {150, 55, 0}, 5);
-        v[(std::size_t(k) * ny + j) * nx + i] = std::min({tube, pouch, branch});
-      }
-  vtkNew<vtkFlyingEdges3D> fe;
-  fe->SetInputData(img);
-  fe->SetValue(0, 0.0);
-  fe->ComputeNormalsOff();
-  fe->Update();
-  const PolygonSoup soup = polydata_to_soup(fe->GetOutput());
-  TriangleList t;
-  t.points = soup.points;
-  for (std::size_t f = 0; f + 1 < soup.face_start.size(); ++f) {
-    const auto* c = &soup.corners[soup.face_start[f]];
-    t.triangles.push_back({int(c[0]), int(c[1]), int(c[2])});
-  }
-  double vol = 0;
-  for (const auto& tr : t.triangles) {
-    const auto &a = t.points[tr[0]], &b = t.points[tr[1]], &c = t.points[tr[2]];
-    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-  }
-  if (vol < 0)
-    for (auto& tr : t.triangles) std::swap(tr[1], tr[2]);
-  return t;
-}
-
-// A wide pouch and a blind side branch: the map has no flipped triangle, the coverage areas add
-// up to the wall area, and the wall not shown is reported where it is: in the side branch.
+// With side branches off: the map has no flipped triangle, the coverage areas add up to the wall
+// area, and the wall not shown is reported where it is: in the blind side branch.
 TEST(FlattenAreaBalanced, PouchAndSideBranchCoverageIsMeasuredAndLocated) {
-  FlatMap f = flatten_colon(pouch_and_branch());
+  FlattenOptions o;
+  o.branch_min_area = 0;
+  FlatMap f = flatten_colon(pouch_and_branch(), o);
   ASSERT_EQ(f.segments.size(), 1u);
   EXPECT_EQ(f.segments[0].map, "area-balanced");
   EXPECT_EQ(f.stats.flipped, 0u);
@@ -90,14 +47,23 @@ TEST(FlattenAreaBalanced, PouchAndSideBranchCoverageIsMeasuredAndLocated) {
   EXPECT_LE(f.stats.area_p95, 5.0);
 }
 
-// Issue 11 target, NOT met yet (measured: coverage 94.2 %, area p05 0.043, qc mean 2.4): the
-// whole wall of a tube with a wide pouch and a blind side branch readable on the map.
-TEST(FlattenAreaBalanced, DISABLED_PouchAndSideBranchLoseNothing) {
+// Issue 11 targets on a tube with a wide pouch and a blind side branch (the branch shown as a band
+// of its own): the whole wall readable, area and angle distortion within bounds.
+TEST(FlattenAreaBalanced, PouchAndSideBranchLoseNothing) {
   FlatMap f = flatten_colon(pouch_and_branch());
-  EXPECT_EQ(f.segments[0].crowded_faces, 0u);
+  EXPECT_EQ(f.segments.size(), 2u);
   EXPECT_GE(f.coverage.fraction, 0.995);
   EXPECT_GE(f.stats.area_p05, 0.2);
+  EXPECT_LE(f.stats.area_p95, 5.0);
   EXPECT_LE(f.stats.qc_mean, 1.5);
+  EXPECT_EQ(f.stats.flipped, 0u);
+}
+
+// Issue 11 target NOT met yet (measured: 1 face of 36 k left out, a sliver on an end loop whose two
+// boundary corners the conformal map puts in the wrong order): every face in the map.
+TEST(FlattenAreaBalanced, DISABLED_PouchAndSideBranchEveryFaceInTheMap) {
+  FlatMap f = flatten_colon(pouch_and_branch());
+  for (const auto& s : f.segments) EXPECT_EQ(s.crowded_faces, 0u);
 }
 
 // An open bent tube of known centreline length (300 mm): band length = centreline length within
@@ -114,7 +80,7 @@ TEST(FlattenAreaBalanced, BandLengthIsCentrelineLength) {
   ASSERT_EQ(f.segments.size(), 1u);
   const FlatSegment& s = f.segments[0];
   EXPECT_NEAR(s.centreline_length, 300.0, 30.0);
-  EXPECT_DOUBLE_EQ(s.length, s.centreline_length);
+  EXPECT_NEAR(s.length, s.centreline_length, 0.1 * s.centreline_length);
   ASSERT_EQ(f.centreline_mm.size(), f.uv.size());
   double worst = 0;
   for (std::size_t i = 0; i < f.uv.size(); ++i) worst = std::max(worst, std::abs(f.uv[i][0] - f.centreline_mm[i]));

@@ -37,6 +37,8 @@ struct FlattenOptions {
   double area_ratio_high = 3.0;        // area-balanced: faces above this ratio seed a correction region
   int balance_iterations = 30;         // area-balanced: descent steps per correction pass
   double coverage_min_ratio = 0.1;     // a face counts as shown when its 2D/3D area ratio is at least this
+  double branch_min_area = 300.0;      // mm^2; area-balanced: a pouch the conformal map collapses over at
+                                       // least this area is cut at its neck and shown as a band of its own (0: never)
 };
 
 // How much of the 3D wall the map shows.
@@ -90,7 +92,14 @@ struct FlatSegment {
   int order = 0;                                     // position rectum -> cecum among segments
   double centreline_offset = 0;                      // mm of centreline of the segments before it
   std::size_t balanced_vertices = 0;                 // vertices moved by the area correction
+  double balance_strength = 0;                       // beta of the x axis: 0 conformal spacing, 1 area fraction
   Coverage coverage;
+  // side branches (a pouch cut off at its neck and shown as a band of its own: x0 = neck, x1 = tip)
+  std::string kind = "colon";                        // "colon" or "branch"
+  int parent = -1;                                   // branch: id of the band it hangs from
+  double attach_mm = 0;                              // branch: centreline mm of its neck on the parent band
+  std::array<double, 3> attach_lps{0, 0, 0};         // branch: centre of the neck, LPS mm
+  double neck_mm = 0;                                // branch: 3D length of the neck (mm)
 };
 
 // The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices

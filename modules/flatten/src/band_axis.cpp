@@ -1,0 +1,107 @@
+// The x axis of a segment's band and the area-balanced map built on it (see flatten.h).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+
+// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
+void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
+  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  std::vector<FaceDistortion> fd;
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
+    const Tri& t = w.ann.t[f];
+    const auto c = w.emb.corners(w.ann, int(f));
+    fd.push_back(face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]));
+    fd.back().degenerate = degenerate[f];
+  }
+  const DistortionStats st = stats_of(fd);
+  std::fprintf(stderr, "flatten debug %s: flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
+               step, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
+}
+
+
+namespace {
+
+constexpr double kAxisAreaLow = 0.3, kAxisAreaHigh = 3.5;  // bounds of the axis choice (targets: 0.2, 5)
+
+// Distortion of the band for one axis (x = L axis(u), y scaled by yscale), on a sample of faces.
+DistortionStats axis_distortion(const SegmentWork& w, const std::vector<double>& axis, double length, double yscale,
+                                const std::vector<char>& degenerate) {
+  const Surface& s = w.ann;
+  const std::size_t stride = std::max<std::size_t>(1, s.t.size() / 200000);
+  std::vector<FaceDistortion> fd;
+  for (std::size_t f = 0; f < s.t.size(); f += stride) {
+    if (degenerate[f]) continue;
+    const Tri& t = s.t[f];
+    auto c = w.emb.corners(s, int(f));
+    for (auto& q : c) q = V2(length * interpolate_axis(axis, q.x() / w.seg.length), q.y() * yscale);
+    fd.push_back(face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]));
+  }
+  return stats_of(fd);
+}
+
+// The band's x axis: among x(u) = B F_beta(u) (B the band length) (beta = 0: conformal spacing; 1: each slice as wide
+// as its wall area), the one with the smallest angle distortion whose area ratios stay in bounds
+// (5th percentile >= 0.3, 95th <= 3.5); else the one with the largest 5th percentile.
+std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double band, double yscale,
+                                const std::vector<char>& degenerate) {
+  double best_qc = 1e300;
+  std::vector<double> best = cl.blended_axis(1.0);
+  w.seg.balance_strength = 1.0;
+  double best_p05 = -1;  // when no axis is within bounds: the one with the best 5th percentile
+  for (int step = 0; step <= 10; ++step) {
+    const double beta = 0.1 * step;
+    std::vector<double> axis = cl.blended_axis(beta);
+    const DistortionStats st = axis_distortion(w, axis, band, yscale, degenerate);
+    const bool within = st.area_p05 >= kAxisAreaLow && st.area_p95 <= kAxisAreaHigh;
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug axis beta %.1f (conformal length %.0f, band %.0f mm): qc mean %.3f area p05 %.3f p95 %.3f\n",
+                   beta, w.seg.length, band, st.qc_mean, st.area_p05, st.area_p95);
+    if (within ? st.qc_mean < best_qc : best_qc == 1e300 && st.area_p05 > best_p05) {
+      if (within) best_qc = st.qc_mean;
+      best_p05 = st.area_p05, best = std::move(axis), w.seg.balance_strength = beta;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+// Band length: the centreline length L, moved towards the conformal length by at most 8 % (the
+// wall of a folded colon is longer than its centreline; within the 10 % the band may differ from
+// L this removes part of the angle distortion a rectangle of length L would impose everywhere).
+// A side branch's band takes its conformal length (a pouch's centreline is short and ill-defined;
+// its ticks still give centreline mm from the neck).
+constexpr double kBandLengthSlack = 0.08;
+
+// Area-balanced map: x = B F(u) (the axis chosen above; B the band length), y scaled so that the
+// band's area is the wall area, fold-overs untangled, then the regions still out of bounds
+// balanced (symmetric Dirichlet). centreline_x keeps the true centreline mm of each band x.
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
+                        const std::vector<char>& fixed, const std::vector<char>& degenerate,
+                        const FlattenOptions& o, bool branch) {
+  Embedding& emb = w.emb;
+  const double conformal_length = w.seg.length;
+  const double slack = branch ? 1e9 : kBandLengthSlack;
+  const double band = std::clamp(conformal_length, (1 - std::min(slack, 0.5)) * cl.length, (1 + slack) * cl.length);
+  const double period = w.seg.area_3d / band;
+  const double yscale = period / emb.period;
+  const std::vector<double> axis = choose_axis(w, cl, band, yscale, degenerate);
+  for (auto& q : emb.pos) q = V2(band * interpolate_axis(axis, q.x() / conformal_length), q.y() * yscale);
+  for (std::size_t i = 0; i < cl.knot_u.size(); ++i)
+    w.seg.centreline_x.push_back({cl.knot_s[i], band * interpolate_axis(axis, cl.knot_u[i])});
+  for (auto& d : emb.dy)
+    for (double& x : d) x *= yscale;
+  emb.period = period;
+  w.seg.length = band;
+  w.seg.period = period;
+  w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
+  debug_stats("reparametrised", w, degenerate);
+  w.seg.balanced_vertices = balance_area(w.ann, vf, emb, fixed, degenerate, o).vertices;
+}
+
+}  // namespace cf::flat_detail

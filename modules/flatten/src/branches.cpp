@@ -1,0 +1,235 @@
+// Side branches of a colon segment: regions the conformal map collapses (a pouch behind a neck).
+//
+// A blind pouch hanging off the tube through a neck of length l is shrunk by the conformal map by
+// a factor that falls exponentially with its depth (about exp(-2 pi depth / l)), so no single map
+// onto a rectangle can show it. Each such pouch is found and cut off at its neck, to be flattened as
+// a band of its own:
+//  1. collapsed clusters: edge-connected faces whose 2D/3D area ratio is below 0.01, by area;
+//  2. the flat distance d(v) = |f(v) - c| from the cluster's centre c (periodic in y). Because the
+//     conformal map f is a bijection, each sub-level set {d < r} is a topological disk around the
+//     pouch, and its rim a closed curve on the surface;
+//  3. the neck: the radius r >= the cluster's extent whose rim is shortest in 3D (inside the pouch
+//     the rim runs around its body, beyond the neck it grows with the tube wall);
+//  4. the branch: faces with d < r connected to the cluster, with any enclosed island added.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace {
+
+constexpr double kCollapsedRatio = 0.01;  // 2D/3D area ratio below which a face is collapsed
+constexpr int kRadii = 64;                 // radii sampled between the cluster's extent and the limit
+
+struct Cluster {
+  std::vector<int> faces;
+  double area = 0;
+};
+
+class BranchFinder {
+ public:
+  BranchFinder(const Surface& s, const Edges& E, const Embedding& emb, double length)
+      : s_(s), E_(E), emb_(emb), length_(length), area3_(s.t.size()), taken_(s.t.size(), 0) {
+    for (std::size_t f = 0; f < s.t.size(); ++f) area3_[f] = face_area_3d(s, int(f));
+  }
+
+  std::vector<BranchCut> run(double min_area) {
+    std::vector<BranchCut> cuts;
+    for (const Cluster& c : collapsed_clusters(min_area)) {
+      if (std::any_of(c.faces.begin(), c.faces.end(), [&](int f) { return taken_[f] != 0; })) continue;
+      BranchCut b;
+      if (!cut_branch(c, b)) continue;
+      for (int f : b.faces) taken_[f] = 1;
+      cuts.push_back(std::move(b));
+    }
+    return cuts;
+  }
+
+ private:
+  // Step 1: edge-connected clusters of collapsed faces with at least `min_area` mm^2, largest first.
+  std::vector<Cluster> collapsed_clusters(double min_area) const {
+    std::vector<char> collapsed(s_.t.size(), 0);
+    for (std::size_t f = 0; f < s_.t.size(); ++f)
+      collapsed[f] = area3_[f] > 0 && emb_.area2(s_, int(f)) < kCollapsedRatio * area3_[f];
+    std::vector<int> label(s_.t.size(), -1);
+    std::vector<Cluster> out;
+    for (std::size_t f0 = 0; f0 < s_.t.size(); ++f0) {
+      if (!collapsed[f0] || label[f0] >= 0) continue;
+      Cluster c;
+      std::vector<int> stack{int(f0)};
+      label[f0] = 1;
+      while (!stack.empty()) {
+        const int f = stack.back();
+        stack.pop_back();
+        c.faces.push_back(f);
+        c.area += area3_[f];
+        for (int e : E_.fe[f])
+          for (int g : E_.ef[e])
+            if (g >= 0 && collapsed[g] && label[g] < 0) label[g] = 1, stack.push_back(g);
+      }
+      if (c.area >= min_area) out.push_back(std::move(c));
+    }
+    std::sort(out.begin(), out.end(), [](const Cluster& a, const Cluster& b) { return a.area > b.area; });
+    return out;
+  }
+
+  // Step 2: flat distance of every vertex from `centre`, y taken modulo the period.
+  std::vector<double> flat_distance(const V2& centre) const {
+    const double P = emb_.period;
+    std::vector<double> d(s_.p.size());
+    for (std::size_t v = 0; v < s_.p.size(); ++v) {
+      const V2 q = emb_.pos[v] - centre;
+      const double dy = q.y() - P * std::round(q.y() / P);
+      d[v] = std::hypot(q.x(), dy);
+    }
+    return d;
+  }
+
+  // The cluster's centre: the corner mean of its most collapsed face.
+  V2 centre_of(const Cluster& c) const {
+    int best = c.faces.front();
+    double best_ratio = 1e300;
+    for (int f : c.faces) {
+      const double r = emb_.area2(s_, f) / area3_[f];
+      if (r < best_ratio) best_ratio = r, best = f;
+    }
+    const auto k = emb_.corners(s_, best);
+    return (k[0] + k[1] + k[2]) / 3;
+  }
+
+  // 3D length of the level set {d = r} inside face f (0 when it does not cross).
+  double crossing_length(int f, const std::vector<double>& d, double r) const {
+    const Tri& t = s_.t[f];
+    V3 pts[3];
+    int n = 0;
+    for (int k = 0; k < 3 && n < 2; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if ((d[a] < r) == (d[b] < r)) continue;
+      const double w = (r - d[a]) / (d[b] - d[a]);
+      pts[n++] = s_.p[a] + w * (s_.p[b] - s_.p[a]);
+    }
+    return n == 2 ? (pts[1] - pts[0]).norm() : 0.0;
+  }
+
+  // Step 3: the radius in [extent, limit] whose rim is shortest in 3D; 0 when there is no room.
+  double neck_radius(const Cluster& c, const std::vector<double>& d, double& neck_mm) const {
+    double extent = 0;
+    for (int f : c.faces)
+      for (int v : s_.t[f]) extent = std::max(extent, d[v]);
+    const V2 centre = centre_of(c);
+    const double limit = 0.95 * std::min({0.4 * emb_.period, centre.x(), length_ - centre.x()});
+    if (!(extent > 0) || extent >= limit) return 0;
+    std::vector<int> near;
+    for (std::size_t f = 0; f < s_.t.size(); ++f) {
+      const Tri& t = s_.t[f];
+      if (std::min({d[t[0]], d[t[1]], d[t[2]]}) < limit) near.push_back(int(f));
+    }
+    double best_r = 0;
+    neck_mm = 1e300;
+    for (int k = 0; k < kRadii; ++k) {
+      const double r = extent * std::pow(limit / extent, double(k) / (kRadii - 1));
+      double len = 0;
+      for (int f : near) len += crossing_length(f, d, r);
+      if (len > 0 && len < neck_mm) neck_mm = len, best_r = r;
+    }
+    return best_r;
+  }
+
+  // Step 4: faces inside radius r connected to the cluster, plus enclosed islands.
+  std::vector<char> inside(const Cluster& c, const std::vector<double>& d, double r) const {
+    std::vector<char> in(s_.t.size(), 0);
+    auto within = [&](int f) {
+      const Tri& t = s_.t[f];
+      return std::max({d[t[0]], d[t[1]], d[t[2]]}) < r;
+    };
+    std::vector<int> stack;
+    for (int f : c.faces)
+      if (within(f)) in[f] = 1, stack.push_back(f);
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      for (int e : E_.fe[f])
+        for (int g : E_.ef[e])
+          if (g >= 0 && !in[g] && !taken_[g] && within(g)) in[g] = 1, stack.push_back(g);
+    }
+    // The outside must be one piece holding the annulus' own boundary: other pieces are islands.
+    std::vector<char> out(s_.t.size());
+    for (std::size_t f = 0; f < s_.t.size(); ++f) out[f] = !in[f];
+    keep_largest_component(out);
+    for (std::size_t f = 0; f < s_.t.size(); ++f) in[f] = !out[f];
+    return in;
+  }
+
+  void keep_largest_component(std::vector<char>& keep) const {
+    std::vector<int> comp(s_.t.size(), -1), stack;
+    int best = -1;
+    std::size_t best_size = 0;
+    for (std::size_t f0 = 0, n = 0; f0 < s_.t.size(); ++f0) {
+      if (!keep[f0] || comp[f0] >= 0) continue;
+      std::size_t size = 0;
+      comp[f0] = int(n);
+      stack.push_back(int(f0));
+      while (!stack.empty()) {
+        const int f = stack.back();
+        stack.pop_back();
+        ++size;
+        for (int e : E_.fe[f])
+          for (int g : E_.ef[e])
+            if (g >= 0 && keep[g] && comp[g] < 0) comp[g] = int(n), stack.push_back(g);
+      }
+      if (size > best_size) best_size = size, best = int(n);
+      ++n;
+    }
+    for (std::size_t f = 0; f < s_.t.size(); ++f) keep[f] = keep[f] && comp[f] == best;
+  }
+
+  // A disk: one boundary loop and Euler characteristic 1.
+  bool is_disk(const std::vector<char>& in) const {
+    long long V = 0, Ed = 0, F = 0;
+    std::vector<char> vin(s_.p.size(), 0);
+    for (std::size_t f = 0; f < s_.t.size(); ++f)
+      if (in[f]) {
+        ++F;
+        for (int v : s_.t[f]) vin[v] = 1;
+      }
+    for (char c : vin) V += c;
+    std::size_t boundary = 0;
+    for (std::size_t e = 0; e < E_.ev.size(); ++e) {
+      const int f0 = E_.ef[e][0], f1 = E_.ef[e][1];
+      const int k = (f0 >= 0 && in[f0]) + (f1 >= 0 && in[f1]);
+      Ed += k > 0;
+      boundary += k == 1;
+    }
+    return V - Ed + F == 1 && boundary >= 3;
+  }
+
+  bool cut_branch(const Cluster& c, BranchCut& b) const {
+    b.centre = centre_of(c);
+    const std::vector<double> d = flat_distance(b.centre);
+    const double r = neck_radius(c, d, b.neck_mm);
+    if (!(r > 0)) return false;
+    const std::vector<char> in = inside(c, d, r);
+    if (!is_disk(in)) return false;
+    for (std::size_t f = 0; f < s_.t.size(); ++f)
+      if (in[f]) b.faces.push_back(int(f)), b.area_mm2 += area3_[f];
+    return !b.faces.empty();
+  }
+
+  const Surface& s_;
+  const Edges& E_;
+  const Embedding& emb_;
+  double length_;
+  std::vector<double> area3_;
+  std::vector<char> taken_;
+};
+
+}  // namespace
+
+std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
+                                     double min_area_mm2) {
+  return BranchFinder(s, E, emb, length).run(min_area_mm2);
+}
+
+}  // namespace cf::flat_detail

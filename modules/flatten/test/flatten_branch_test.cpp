@@ -1,0 +1,111 @@
+// Side branches (branches.cpp): a pouch the conformal map collapses is cut at its neck and shown
+// as a band of its own; nothing of the kind on a plain tube; the fields survive the flat file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/mesh_io.h"
+#include "colonflat/core/synthetic.h"
+#include "colonflat/flatten/flat_artifact.h"
+#include "colonflat/flatten/flatten.h"
+#include "colonflat/flatten/flatten_stage.h"
+#include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/testing/temp_dir.h"
+#include "flatten_shapes.h"
+
+namespace cf {
+namespace {
+
+double wall_area(const TriangleList& t) {
+  double a = 0;
+  for (const auto& tr : t.triangles) {
+    const Eigen::Vector3d p0(t.points[tr[0]].data()), p1(t.points[tr[1]].data()), p2(t.points[tr[2]].data());
+    a += 0.5 * (p1 - p0).cross(p2 - p0).norm();
+  }
+  return a;
+}
+
+// A pouch (22 mm sphere) behind a 3 mm neck: a second band, hanging from the colon band at the
+// neck (LPS ~ (120, 12..32, 0), neck length ~ 2 pi 3 mm), and the whole wall shown.
+TEST(FlattenBranches, PouchBehindNarrowNeckIsABandOfItsOwn) {
+  const TriangleList mesh = test_shapes::pouch_behind_neck(3.0);
+  const FlatMap f = flatten_colon(mesh);
+  ASSERT_EQ(f.segments.size(), 2u);
+  const FlatSegment& colon = f.segments[0];
+  const FlatSegment& b = f.segments[1];
+  EXPECT_EQ(colon.kind, "colon");
+  EXPECT_EQ(b.kind, "branch");
+  EXPECT_EQ(b.parent, colon.id);
+  EXPECT_EQ(b.x0_end, "neck");
+  EXPECT_NEAR(b.attach_lps[0], 120.0, 6.0);
+  EXPECT_GT(b.attach_lps[1], 8.0);
+  EXPECT_LT(b.attach_lps[1], 40.0);
+  EXPECT_GT(b.neck_mm, 0.5 * 2 * M_PI * 3.0);
+  EXPECT_LT(b.neck_mm, 3.0 * 2 * M_PI * 3.0);
+  EXPECT_GT(b.area_3d, 0.8 * 4 * M_PI * 22 * 22);  // the sphere's wall is in the branch band
+  EXPECT_NEAR(b.attach_mm, std::abs(120.0 - colon.end_a[0]), 10.0);  // centreline mm from the band's x0 end
+  EXPECT_GE(f.coverage.fraction, 0.995);
+  EXPECT_EQ(f.stats.flipped, 0u);
+  // Every bit of wall is accounted for once: the bands' walls plus the end caps = the surface.
+  EXPECT_NEAR(f.coverage.wall_area_mm2 + f.coverage.end_cap_area_mm2, wall_area(mesh), 1e-6 * wall_area(mesh));
+}
+
+// With branches off (--branch-min-area 0) the same pouch stays in the colon band, collapsed:
+// it is reported as wall not shown, at its place.
+TEST(FlattenBranches, WithoutBranchesThePouchIsNotShownAndLocated) {
+  FlattenOptions o;
+  o.branch_min_area = 0;
+  const FlatMap f = flatten_colon(test_shapes::pouch_behind_neck(3.0), o);
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_LT(f.coverage.fraction, 0.9);
+  ASSERT_FALSE(f.coverage.not_shown.empty());
+  EXPECT_NEAR(f.coverage.not_shown[0].centroid_lps_mm[0], 120.0, 10.0);
+  EXPECT_GT(f.coverage.not_shown[0].centroid_lps_mm[1], 30.0);
+}
+
+// A plain folded colon tube has no side branch (no false cut) and keeps its whole wall.
+TEST(FlattenBranches, PlainFoldedTubeHasNoBranch) {
+  synthetic::ColonOptions o;
+  o.length = 300;
+  o.radius = 15;
+  o.spacing = 1.5;
+  o.fold_height = 4;
+  const FlatMap f = flatten_colon(synthetic::colon(o).mesh);
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_EQ(f.segments[0].kind, "colon");
+  EXPECT_GE(f.coverage.fraction, 0.995);
+}
+
+// The branch fields (kind, parent, attachment, neck) survive the flat .vtp round trip.
+TEST(FlattenBranches, BranchFieldsSurviveTheFlatFile) {
+  testing::TempDir tmp;
+  const FlatMap f = flatten_colon(test_shapes::pouch_behind_neck(3.0));
+  ASSERT_EQ(f.segments.size(), 2u);
+  write_flat(f, tmp / "flat.vtp");
+  const FlatMap g = read_flat(tmp / "flat.vtp");
+  ASSERT_EQ(g.segments.size(), 2u);
+  EXPECT_EQ(g.segments[1].kind, "branch");
+  EXPECT_EQ(g.segments[1].parent, f.segments[1].parent);
+  EXPECT_DOUBLE_EQ(g.segments[1].attach_mm, f.segments[1].attach_mm);
+  EXPECT_EQ(g.segments[1].attach_lps, f.segments[1].attach_lps);
+  EXPECT_DOUBLE_EQ(g.segments[1].neck_mm, f.segments[1].neck_mm);
+  EXPECT_EQ(g.segments[0].kind, "colon");
+}
+
+// A negative --branch-min-area is refused by `colonflat flatten` (usage error, one line, no output).
+TEST(FlattenBranches, NegativeMinAreaIsRefused) {
+  testing::TempDir tmp;
+  write_mesh(synthetic::to_mesh(synthetic::open_cylinder(10, 50, 32, 40)), tmp / "in.vtp");
+  auto tool = make_stage_tool(make_flatten_stage);
+  std::ostringstream out, err;
+  const int code = tool->run({tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "-5"}, out, err);
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(err.str().rfind("colonflat flatten: error: ", 0), 0u) << err.str();
+  EXPECT_NE(err.str().find("branch-min-area"), std::string::npos) << err.str();
+  EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
+}
+
+}  // namespace
+}  // namespace cf

@@ -1,0 +1,89 @@
+#pragma once
+// Synthetic colon-like surfaces for the flatten tests, meshed by VTK flying edges from a signed
+// distance on a grid (LPS mm, normals out of the lumen).
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <functional>
+
+#include "colonflat/core/soup.h"
+#include "colonflat/core/vtk_convert.h"
+
+namespace cf::test_shapes {
+
+inline double capsule(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm() - r;
+}
+
+// The zero level set of `sdf` on the box [lo, hi] sampled every h mm, outward normals.
+inline TriangleList surface_of(const std::function<double(const Eigen::Vector3d&)>& sdf, const Eigen::Vector3d& lo,
+                               const Eigen::Vector3d& hi, double h) {
+  vtkNew<vtkImageData> img;
+  const Eigen::Vector3d n = (hi - lo) / h;
+  const int nx = int(n.x()), ny = int(n.y()), nz = int(n.z());
+  img->SetDimensions(nx, ny, nz);
+  img->SetOrigin(lo.x(), lo.y(), lo.z());
+  img->SetSpacing(h, h, h);
+  img->AllocateScalars(VTK_DOUBLE, 1);
+  auto* v = static_cast<double*>(img->GetScalarPointer());
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) v[(std::size_t(k) * ny + j) * nx + i] = sdf(lo + h * Eigen::Vector3d(i, j, k));
+  vtkNew<vtkFlyingEdges3D> fe;
+  fe->SetInputData(img);
+  fe->SetValue(0, 0.0);
+  fe->ComputeNormalsOff();
+  fe->Update();
+  const PolygonSoup soup = polydata_to_soup(fe->GetOutput());
+  TriangleList t;
+  t.points = soup.points;
+  for (std::size_t f = 0; f + 1 < soup.face_start.size(); ++f) {
+    const auto* c = &soup.corners[soup.face_start[f]];
+    t.triangles.push_back({int(c[0]), int(c[1]), int(c[2])});
+  }
+  double vol = 0;
+  for (const auto& tr : t.triangles) {
+    const auto &a = t.points[tr[0]], &b = t.points[tr[1]], &c = t.points[tr[2]];
+    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (vol < 0)
+    for (auto& tr : t.triangles) std::swap(tr[1], tr[2]);
+  return t;
+}
+
+// Closed tube along x (radius 12 mm, 220 mm) with a wide pouch (sphere radius 28 mm) and a blind
+// side branch (radius 5 mm, 35 mm long, leaving the tube at x = 150 along +y), at 1.2 mm.
+inline TriangleList pouch_and_branch() {
+  return surface_of(
+      [](const Eigen::Vector3d& p) {
+        const double tube = capsule(p, {0, 0, 0}, {200, 0, 0}, 12);
+        const double pouch = (p - Eigen::Vector3d(70, 8, 0)).norm() - 28;
+        const double branch = capsule(p, {150, 0, 0}, {150, 55, 0}, 5);
+        return std::min({tube, pouch, branch});
+      },
+      {-25, -35, -35}, {225, 75, 35}, 1.2);
+}
+
+// Closed tube along x (radius 12 mm, 0..200 mm) and, behind a neck of radius `neck` mm (a channel
+// from the tube at x = 120 along +y to y = 30), a blind pouch: a sphere of radius 22 mm at y = 50.
+inline TriangleList pouch_behind_neck(double neck) {
+  return surface_of(
+      [neck](const Eigen::Vector3d& p) {
+        const double tube = capsule(p, {0, 0, 0}, {200, 0, 0}, 12);
+        const double channel = capsule(p, {120, 0, 0}, {120, 32, 0}, neck);
+        const double pouch = (p - Eigen::Vector3d(120, 50, 0)).norm() - 22;
+        return std::min({tube, channel, pouch});
+      },
+      {-15, -15, -25}, {215, 75, 25}, 1.0);
+}
+
+}  // namespace cf::test_shapes
