@@ -136,7 +136,11 @@ FlatMap grid_flat_map(const Tube& tube, const Placement& pl, const Grid& g, cons
   FlatSegment seg;
   seg.length = length;
   seg.period = kTwoPi * tube.o.radius_mm;
-  if (with_arc) seg.x0_end = "rectum", seg.x1_end = "cecum";
+  if (with_arc) {  // contract 1: a map along the centreline, ends named
+    seg.map = "area-balanced";
+    seg.centreline_length = pl.arc_of_sigma(g.sigma.back());
+    seg.x0_end = "rectum", seg.x1_end = "cecum";
+  }
   flat.segments.push_back(seg);
   return flat;
 }
