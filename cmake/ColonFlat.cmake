@@ -4,7 +4,8 @@
 #     builds static library colonflat_<name> from modules/<name>/src, public include dir
 #     modules/<name>/include.
 #   colonflat_tests(NAME <name> SOURCES ... DEPS ... [LABELS ...])
-#     builds <name>_tests from the given test sources and registers every GoogleTest case with ctest.
+#     builds <name>_tests from the given test sources and registers every GoogleTest case with ctest;
+#     every test links the test-support library colonflat_testdata (modules/testdata).
 #   colonflat_register_tool(FACTORY <fn> HEADER <header>)
 #     adds a `colonflat <tool>` command (a function returning std::unique_ptr<cf::Tool>).
 #   colonflat_register_stage(FACTORY <fn> HEADER <header>)
@@ -27,7 +28,7 @@ function(colonflat_tests)
     return()
   endif()
   add_executable(${T_NAME}_tests ${T_SOURCES})
-  target_link_libraries(${T_NAME}_tests PRIVATE ${T_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
+  target_link_libraries(${T_NAME}_tests PRIVATE ${T_DEPS} colonflat_testdata GTest::gtest GTest::gtest_main GTest::gmock)
   target_include_directories(${T_NAME}_tests PRIVATE ${PROJECT_SOURCE_DIR}/modules/core/test/support)
   target_compile_definitions(${T_NAME}_tests PRIVATE
     COLONFLAT_SHARED_DIR="${COLONFLAT_SHARED_DIR}"

@@ -15,6 +15,8 @@
 //                            DIR3 gets colon.png per case.
 #include <benchmark/benchmark.h>
 
+#include "bench_cli.h"
+
 #include <cstdio>
 #include <ctime>
 #include <cstring>
@@ -42,14 +44,7 @@
 
 namespace {
 
-double load_average() {
-  double l = 0;
-  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf", &l) != 1) l = 0;
-    std::fclose(f);
-  }
-  return l;
-}
+using cf::bench::load_average;
 
 cf::synthetic::ColonOptions million_face_colon() {
   cf::synthetic::ColonOptions o;
@@ -209,34 +204,28 @@ BENCHMARK(BM_FlattenColon)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
+  cf::bench::BenchCli cli("flatten_bench", "Flattening benchmark and acceptance table (see the file's header)");
   bool table_only = false;
-  int first = 0, last = -1;
-  std::string size = "full", out, real, cache = "/tmp/flatten_bench_cache", map = "area-balanced";
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--table-only")) table_only = true;
-    if (!std::strcmp(argv[i], "--phantom") && i + 1 < argc) {
-      const std::string r = argv[++i];
-      const auto dash = r.find('-');
-      first = std::stoi(r.substr(0, dash));
-      last = dash == std::string::npos ? first : std::stoi(r.substr(dash + 1));
+  std::string phantoms, size = "full", out, real, cache = "/tmp/flatten_bench_cache", map = "area-balanced";
+  CLI::App& app = cli.app();
+  app.add_flag("--table-only", table_only, "the table without Google Benchmark");
+  app.add_option("--phantom", phantoms, "acceptance on phantom seeds N or N-M");
+  app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
+  app.add_option("--out", out, "folder for the colon images and candidate JSON");
+  app.add_option("--real", real, "folder of real cases (*.nii.gz masks, *.vtk / *.vtp surfaces)");
+  app.add_option("--cache", cache, "cache of denoised real surfaces");
+  app.add_option("--map", map, "flatten map")->check(CLI::IsMember({"area-balanced", "conformal"}));
+  return cli.run(argc, argv, [&] {
+    if (!real.empty()) {
+      real_table(real, cache, map, out);
+      return 0;
     }
-    if (!std::strcmp(argv[i], "--size") && i + 1 < argc) size = argv[++i];
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    if (!std::strcmp(argv[i], "--real") && i + 1 < argc) real = argv[++i];
-    if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
-    if (!std::strcmp(argv[i], "--map") && i + 1 < argc) map = argv[++i];
-  }
-  if (!real.empty()) {
-    real_table(real, cache, map, out);
-    return 0;
-  }
-  if (last >= first) {
-    phantom_table(first, last, size, out);
-    return 0;
-  }
-  table();
-  if (table_only) return 0;
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
+    if (!phantoms.empty()) {
+      const auto [first, last] = cf::bench::parse_range(phantoms);
+      phantom_table(first, last, size, out);
+      return 0;
+    }
+    table();
+    return table_only ? 0 : cli.run_google_benchmarks();
+  });
 }

@@ -13,20 +13,20 @@
 // Peak memory: the process's peak resident set is reset (/proc/self/clear_refs) after generating
 // the phantom, so "peak" is the high-water mark while reconstructing, the mask included.
 #include <benchmark/benchmark.h>
+
+#include "bench_cli.h"
+#include "colonflat/render/artifacts.h"
+#include "colonflat/render/snapshot.h"
 #include <vtkAutoInit.h>
 VTK_MODULE_INIT(vtkRenderingOpenGL2);
 
 #include <Eigen/Dense>
 #include <vtkActor.h>
 #include <vtkCamera.h>
-#include <vtkCellArray.h>
 #include <vtkLight.h>
 #include <vtkNew.h>
-#include <vtkPNGWriter.h>
-#include <vtkPoints.h>
+#include <vtkImageData.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataMapper.h>
-#include <vtkPolyDataNormals.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -224,30 +224,19 @@ cf::Mesh::VertexHandle flattest_visible(const cf::Mesh& m, const cf::MaskImage* 
 }
 
 void render_closeup(const cf::Mesh& m, const cf::Vec3& centre, const cf::Vec3& normal, const std::string& png) {
-  vtkNew<vtkPoints> pts;
-  for (auto v : m.vertices()) pts->InsertNextPoint(m.point(v).data());
-  vtkNew<vtkCellArray> polys;
+  cf::TriangleList near;  // every vertex, the faces within 45 mm of the centre
+  for (auto v : m.vertices()) near.points.push_back({m.point(v)[0], m.point(v)[1], m.point(v)[2]});
   for (auto f : m.faces()) {
     if ((m.point(*m.cfv_begin(f)) - centre).norm() > 45) continue;
-    vtkIdType ids[3];
+    std::array<int, 3> ids;
     int k = 0;
     for (auto v : m.fv_range(f)) ids[k++] = v.idx();
-    polys->InsertNextCell(3, ids);
+    near.triangles.push_back(ids);
   }
-  vtkNew<vtkPolyData> pd;
-  pd->SetPoints(pts);
-  pd->SetPolys(polys);
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(pd);
-  normals->SplittingOff();
-  normals->ConsistencyOff();
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputConnection(normals->GetOutputPort());
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
-  actor->GetProperty()->SetColor(0.93, 0.72, 0.62);
-  actor->GetProperty()->SetSpecular(0.25);
-  actor->GetProperty()->SetSpecularPower(20);
+  cf::SurfaceLook look;
+  look.color[0] = 0.93, look.color[1] = 0.72, look.color[2] = 0.62;
+  look.specular = 0.25;
+  const vtkSmartPointer<vtkActor> actor = cf::surface_actor(cf::surface_polydata(near), look);
   vtkNew<vtkRenderer> ren;
   ren->AddActor(actor);
   ren->SetBackground(0, 0, 0);
@@ -272,10 +261,8 @@ void render_closeup(const cf::Mesh& m, const cf::Vec3& centre, const cf::Vec3& n
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(win);
   grab->ReadFrontBufferOff();
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetInputConnection(grab->GetOutputPort());
-  writer->SetFileName(png.c_str());
-  writer->Write();
+  grab->Update();
+  cf::write_png(grab->GetOutput(), png);
 }
 
 int closeup(const std::string& dir) {
@@ -339,16 +326,16 @@ BENCHMARK_CAPTURE(BM_ReconstructPhantom, full_decimated_200k, std::string("full"
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
+  cf::bench::BenchCli cli("reconstruct_bench", "Reconstruction benchmark and acceptance table (see the file's header)");
   bool table_only = false, real_only = false;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--table-only") == 0) table_only = true;
-    if (std::strcmp(argv[i], "--real-only") == 0) table_only = real_only = true;
-    if (std::strcmp(argv[i], "--closeup") == 0 && i + 1 < argc) return closeup(argv[i + 1]);
-  }
-  table(real_only);
-  if (table_only) return 0;
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  std::string closeup_dir;
+  CLI::App& app = cli.app();
+  app.add_flag("--table-only", table_only, "the table without Google Benchmark");
+  app.add_flag("--real-only", real_only, "only the real mask's rows of the table");
+  app.add_option("--closeup", closeup_dir, "write close-ups of the real mask's flattest wall patch here");
+  return cli.run(argc, argv, [&] {
+    if (!closeup_dir.empty()) return closeup(closeup_dir);
+    table(real_only);
+    return table_only || real_only ? 0 : cli.run_google_benchmarks();
+  });
 }

@@ -6,7 +6,7 @@
 //                               `colonflat run` on both CTs, `colonflat register`-equivalent, scored
 //                               against the phantom truth (polyp ids, centre lines). Needs
 //                               `colonflat phantom --position prone` (reported when missing).
-//   register_bench --write-synthetic DIR [TWIST_DEG]
+//   register_bench --write-synthetic DIR [--twist DEG]
 //                               writes a small synthetic pair as run folders DIR/supine, DIR/prone.
 //   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]
 //                               one existing pair of run folders (scored when truth is given).
@@ -29,23 +29,17 @@
 #include <string>
 #include <vector>
 
+#include "bench_cli.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/register/register.h"
-#include "colonflat/register/synthetic_pair.h"
+#include "colonflat/testdata/synthetic_pair.h"
 
 namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = 3.141592653589793;
 
-double load_average() {
-  double l = 0;
-  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf", &l) != 1) l = 0;
-    std::fclose(f);
-  }
-  return l;
-}
+using cf::bench::load_average;
 
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
@@ -262,33 +256,34 @@ void phantom_table(int first, int last, const std::string& size, const fs::path&
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> a(argv + 1, argv + argc);
-  try {
-    if (!a.empty() && a[0] == "--phantom" && a.size() >= 2) {
-      int first = 1, last = 1;
-      if (std::sscanf(a[1].c_str(), "%d-%d", &first, &last) == 1) last = first;
-      std::string size = "full", work = "register_bench_work";
-      for (size_t i = 2; i + 1 < a.size(); ++i) {
-        if (a[i] == "--size") size = a[i + 1];
-        if (a[i] == "--work") work = a[i + 1];
-      }
+  cf::bench::BenchCli cli("register_bench", "Supine-prone registration benchmark (see the file's header)");
+  std::string phantoms, size = "full", work = "register_bench_work", synthetic_dir;
+  std::vector<std::string> pair, truth;
+  double twist_deg = 0;
+  CLI::App& app = cli.app();
+  app.add_option("--phantom", phantoms, "phantom pairs of seeds N or N-M");
+  app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
+  app.add_option("--work", work, "work folder of the phantom pairs");
+  app.add_option("--write-synthetic", synthetic_dir, "write a small synthetic pair as DIR/supine and DIR/prone");
+  app.add_option("--twist", twist_deg, "with --write-synthetic: prone twist around the centre line (degrees)");
+  app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
+  app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
+  return cli.run(argc, argv, [&] {
+    if (!phantoms.empty()) {
+      const auto [first, last] = cf::bench::parse_range(phantoms);
       phantom_table(first, last, size, work);
-    } else if (!a.empty() && a[0] == "--write-synthetic" && a.size() >= 2) {
+    } else if (!synthetic_dir.empty()) {
       cf::SyntheticPairOptions o;
-      if (a.size() >= 3) o.twist_deg = std::stod(a[2]);
-      const cf::SyntheticPair pair = cf::make_synthetic_pair(o);
-      cf::write_run_dir(pair.supine, fs::path(a[1]) / "supine");
-      cf::write_run_dir(pair.prone, fs::path(a[1]) / "prone");
-    } else if (!a.empty() && a[0] == "--pair" && a.size() >= 3) {
+      o.twist_deg = twist_deg;
+      const cf::SyntheticPair pair_data = cf::make_synthetic_pair(o);
+      cf::write_run_dir(pair_data.supine, fs::path(synthetic_dir) / "supine");
+      cf::write_run_dir(pair_data.prone, fs::path(synthetic_dir) / "prone");
+    } else if (!pair.empty()) {
       print_header();
-      const bool truth = a.size() >= 6 && a[3] == "--truth";
-      print_row(pair_row("pair", a[1], a[2], truth ? a[4] : "", truth ? a[5] : ""));
+      print_row(pair_row("pair", pair[0], pair[1], truth.empty() ? "" : truth[0], truth.empty() ? "" : truth[1]));
     } else {
       synthetic_table();
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "register_bench: error: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

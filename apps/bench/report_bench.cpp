@@ -5,14 +5,14 @@
 // <= 10 % to a full-phantom run.
 // Run in Release: ./build/apps/bench/report_bench RUN_DIR [repeats]
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "bench_cli.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/stage.h"
 #include "colonflat/report/report.h"
 
 namespace fs = std::filesystem;
@@ -41,26 +41,28 @@ void row(const char* what, const fs::path& dir, const cf::ReportOptions& opts, d
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: report_bench RUN_DIR [repeats]  (RUN_DIR from `colonflat run -o RUN_DIR`)\n");
-    return 2;
-  }
-  const fs::path dir = argv[1];
-  const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
-  std::ifstream in(dir / "run_report.json");
-  const nlohmann::json rr = nlohmann::json::parse(in, nullptr, false);
-  const double run_s = rr.is_discarded() ? 0.0 : rr.value("total_time_s", 0.0);
-  std::printf("run %s: %.1f s (run_report.json total_time_s)\n", dir.c_str(), run_s);
-  std::printf("%-26s %6s %6s %7s %6s %9s %9s %8s %9s\n", "case", "cands", "known", "images", "endo", "time_s",
-              "%_of_run", "MiB", "peak_MiB");
-  cf::ReportOptions defaults;
-  for (int i = 0; i < repeats; ++i) row("default", dir, defaults, run_s);
-  cf::ReportOptions no_endo = defaults;
-  no_endo.endoluminal = false;
-  row("no endoluminal views", dir, no_endo, run_s);
-  cf::ReportOptions coarse = defaults;
-  coarse.stack_step_mm = 8;
-  row("CT planes every 8 mm", dir, coarse, run_s);
-  row("default (report last)", dir, defaults, run_s);
-  return 0;
+  cf::bench::BenchCli cli("report_bench", "Review-report benchmark on a finished run folder (see the file's header)");
+  std::string run_dir;
+  int repeats = 1;
+  cli.app().add_option("run_dir", run_dir, "run folder from `colonflat run -o RUN_DIR`")->required()->check(CLI::ExistingDirectory);
+  cli.app().add_option("repeats", repeats, "repeats of the default row")->check(CLI::Range(1, 100));
+  return cli.run(argc, argv, [&] {
+    const fs::path dir = run_dir;
+    const nlohmann::json rr = cf::read_json_file(dir / "run_report.json");
+    const double run_s = rr.value("total_time_s", 0.0);
+    std::printf("run %s: %.1f s (run_report.json total_time_s); load average %.2f\n", dir.c_str(), run_s,
+                cf::bench::load_average());
+    std::printf("%-26s %6s %6s %7s %6s %9s %9s %8s %9s\n", "case", "cands", "known", "images", "endo", "time_s",
+                "%_of_run", "MiB", "peak_MiB");
+    cf::ReportOptions defaults;
+    for (int i = 0; i < repeats; ++i) row("default", dir, defaults, run_s);
+    cf::ReportOptions no_endo = defaults;
+    no_endo.endoluminal = false;
+    row("no endoluminal views", dir, no_endo, run_s);
+    cf::ReportOptions coarse = defaults;
+    coarse.stack_step_mm = 8;
+    row("CT planes every 8 mm", dir, coarse, run_s);
+    row("default (report last)", dir, defaults, run_s);
+    return 0;
+  });
 }

@@ -54,140 +54,172 @@ std::string MeshDiagnosis::summary(Severity s) const {
   return out;
 }
 
+namespace {
+
+// diagnose_soup's checks, one per function, each adding at most one finding per defect kind.
+
+void check_nonfinite_coordinates(const PolygonSoup& soup, MeshDiagnosis& d) {
+  std::vector<std::size_t> bad;
+  std::size_t n = 0;
+  for (std::size_t v = 0; v < soup.points.size(); ++v) {
+    const auto& p = soup.points[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      ++n;
+      if (bad.size() < 5) bad.push_back(v);
+    }
+  }
+  if (n)
+    d.findings.push_back({"nonfinite_coordinates", Severity::kFatal, n,
+                          plural(n, "vertex", "vertices") + " with NaN or infinite coordinates" +
+                              examples(bad, [](std::size_t v) { return "v" + std::to_string(v); })});
+}
+
+std::string listed(const std::vector<std::string>& v) {
+  return examples(v, [](const std::string& s) { return s; });
+}
+
+// Per-face defects: counts and up to 5 examples of each kind.
+struct FaceDefects {
+  std::size_t out_of_range = 0, too_small = 0, polygons = 0, repeated = 0;
+  std::vector<std::string> ex_range, ex_small, ex_poly, ex_rep;
+};
+
+// One face: ids in range (marking the vertices it uses), size, a repeated id.
+void inspect_face(const PolygonSoup& soup, std::size_t f, std::vector<std::uint8_t>& used, FaceDefects& fd) {
+  const std::size_t P = soup.points.size();
+  const std::size_t n = soup.face_size(f);
+  const std::int64_t* ids = soup.face(f);
+  bool in_range = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (ids[k] < 0 || static_cast<std::size_t>(ids[k]) >= P) {
+      in_range = false;
+      if (fd.ex_range.size() < 5) fd.ex_range.push_back("face " + std::to_string(f) + " -> " + std::to_string(ids[k]));
+    } else {
+      used[ids[k]] = 1;
+    }
+  }
+  if (!in_range) ++fd.out_of_range;
+  if (n < 3) {
+    ++fd.too_small;
+    if (fd.ex_small.size() < 5) fd.ex_small.push_back("face " + std::to_string(f));
+    return;
+  }
+  if (n > 3) {
+    ++fd.polygons;
+    if (fd.ex_poly.size() < 5) fd.ex_poly.push_back("face " + std::to_string(f) + " has " + std::to_string(n));
+  }
+  bool rep = false;
+  for (std::size_t a = 0; a < n && !rep; ++a)
+    for (std::size_t b = a + 1; b < n && !rep; ++b) rep = ids[a] == ids[b];
+  if (rep) {
+    ++fd.repeated;
+    if (fd.ex_rep.size() < 5) fd.ex_rep.push_back("face " + std::to_string(f));
+  }
+}
+
+// Every face inspected; findings for ids out of range, small faces, polygons and repeated ids.
+// `used` marks the vertices some face references. Returns false when an id is out of range.
+bool check_faces(const PolygonSoup& soup, std::vector<std::uint8_t>& used, MeshDiagnosis& d) {
+  const std::size_t P = soup.points.size();
+  FaceDefects fd;
+  for (std::size_t f = 0; f < soup.num_faces(); ++f) inspect_face(soup, f, used, fd);
+  if (fd.out_of_range)
+    d.findings.push_back({"index_out_of_range", Severity::kFatal, fd.out_of_range,
+                          plural(fd.out_of_range, "face references", "faces reference") +
+                              " vertex ids outside 0.." + std::to_string(P == 0 ? 0 : P - 1) + listed(fd.ex_range)});
+  if (fd.too_small)
+    d.findings.push_back({"faces_too_small", Severity::kDefect, fd.too_small,
+                          plural(fd.too_small, "face has", "faces have") + " fewer than 3 vertices" + listed(fd.ex_small)});
+  if (fd.polygons)
+    d.findings.push_back({"non_triangle_faces", Severity::kRepaired, fd.polygons,
+                          plural(fd.polygons, "face is a polygon", "faces are polygons") +
+                              " with more than 3 vertices, fan-triangulated" + listed(fd.ex_poly)});
+  if (fd.repeated)
+    d.findings.push_back({"degenerate_faces", Severity::kDefect, fd.repeated,
+                          plural(fd.repeated, "degenerate face repeats", "degenerate faces repeat") +
+                              " a vertex id" + listed(fd.ex_rep)});
+  return fd.out_of_range == 0;
+}
+
+// Duplicate faces: same vertex set (either orientation).
+void check_duplicate_faces(const PolygonSoup& soup, MeshDiagnosis& d) {
+  const std::size_t F = soup.num_faces();
+  std::vector<std::pair<std::vector<std::int64_t>, std::size_t>> keys;
+  keys.reserve(F);
+  for (std::size_t f = 0; f < F; ++f) {
+    std::vector<std::int64_t> k(soup.face(f), soup.face(f) + soup.face_size(f));
+    std::sort(k.begin(), k.end());
+    keys.emplace_back(std::move(k), f);
+  }
+  std::sort(keys.begin(), keys.end());
+  std::size_t dup = 0;
+  std::vector<std::string> ex_dup;
+  for (std::size_t i = 1; i < keys.size(); ++i) {
+    if (keys[i].first == keys[i - 1].first) {
+      ++dup;
+      if (ex_dup.size() < 5)
+        ex_dup.push_back("face " + std::to_string(keys[i].second) + " = face " + std::to_string(keys[i - 1].second));
+    }
+  }
+  if (dup)
+    d.findings.push_back({"duplicate_faces", Severity::kDefect, dup,
+                          plural(dup, "duplicate face uses", "duplicate faces use") +
+                              " the same vertices as another face" + listed(ex_dup)});
+}
+
+void check_unreferenced_vertices(const std::vector<std::uint8_t>& used, MeshDiagnosis& d) {
+  std::size_t n = 0;
+  std::vector<std::string> exv;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (!used[v]) {
+      ++n;
+      if (exv.size() < 5) exv.push_back("v" + std::to_string(v));
+    }
+  if (n)
+    d.findings.push_back({"unreferenced_vertices", Severity::kRepaired, n,
+                          plural(n, "vertex is", "vertices are") + " not used by any face (ignored)" + listed(exv)});
+}
+
+// Coincident points: distinct referenced vertices at exactly the same position.
+void check_coincident_vertices(const PolygonSoup& soup, const std::vector<std::uint8_t>& used, MeshDiagnosis& d) {
+  std::vector<std::uint32_t> order;
+  order.reserve(soup.points.size());
+  for (std::size_t v = 0; v < soup.points.size(); ++v)
+    if (used[v]) order.push_back(static_cast<std::uint32_t>(v));
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return soup.points[a] < soup.points[b] || (soup.points[a] == soup.points[b] && a < b);
+  });
+  std::size_t extra = 0;
+  std::vector<std::string> exc;
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    if (soup.points[order[i]] == soup.points[order[i - 1]]) {
+      ++extra;
+      if (exc.size() < 5) exc.push_back("v" + std::to_string(order[i]) + " = v" + std::to_string(order[i - 1]));
+    }
+  }
+  if (extra)
+    d.findings.push_back({"coincident_vertices", Severity::kNote, extra,
+                          plural(extra, "vertex duplicates", "vertices duplicate") +
+                              " the position of another (an unwelded seam? weld them before use)" + listed(exc)});
+}
+
+}  // namespace
+
 MeshDiagnosis diagnose_soup(const PolygonSoup& soup) {
   MeshDiagnosis d;
   const std::size_t P = soup.points.size();
-  const std::size_t F = soup.num_faces();
-  if (F == 0) {
+  if (soup.num_faces() == 0) {
     d.findings.push_back({"empty", Severity::kFatal, 0,
                           P == 0 ? "empty mesh: no vertices and no faces"
                                  : "empty mesh: " + plural(P, "vertex", "vertices") + " but no faces"});
     return d;
   }
-  {  // Non-finite coordinates.
-    std::vector<std::size_t> bad;
-    std::size_t n = 0;
-    for (std::size_t v = 0; v < P; ++v) {
-      const auto& p = soup.points[v];
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-        ++n;
-        if (bad.size() < 5) bad.push_back(v);
-      }
-    }
-    if (n)
-      d.findings.push_back({"nonfinite_coordinates", Severity::kFatal, n,
-                            plural(n, "vertex", "vertices") + " with NaN or infinite coordinates" +
-                                examples(bad, [](std::size_t v) { return "v" + std::to_string(v); })});
-  }
-  std::size_t out_of_range = 0, too_small = 0, polygons = 0, repeated = 0;
-  std::vector<std::string> ex_range, ex_small, ex_poly, ex_rep;
+  check_nonfinite_coordinates(soup, d);
   std::vector<std::uint8_t> used(P, 0);
-  for (std::size_t f = 0; f < F; ++f) {
-    const std::size_t n = soup.face_size(f);
-    const std::int64_t* ids = soup.face(f);
-    bool in_range = true;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (ids[k] < 0 || static_cast<std::size_t>(ids[k]) >= P) {
-        in_range = false;
-        if (ex_range.size() < 5)
-          ex_range.push_back("face " + std::to_string(f) + " -> " + std::to_string(ids[k]));
-      } else {
-        used[ids[k]] = 1;
-      }
-    }
-    if (!in_range) ++out_of_range;
-    if (n < 3) {
-      ++too_small;
-      if (ex_small.size() < 5) ex_small.push_back("face " + std::to_string(f));
-      continue;
-    }
-    if (n > 3) {
-      ++polygons;
-      if (ex_poly.size() < 5) ex_poly.push_back("face " + std::to_string(f) + " has " + std::to_string(n));
-    }
-    bool rep = false;
-    for (std::size_t a = 0; a < n && !rep; ++a)
-      for (std::size_t b = a + 1; b < n && !rep; ++b) rep = ids[a] == ids[b];
-    if (rep) {
-      ++repeated;
-      if (ex_rep.size() < 5) ex_rep.push_back("face " + std::to_string(f));
-    }
-  }
-  auto ex = [](const std::vector<std::string>& v) { return examples(v, [](const std::string& s) { return s; }); };
-  if (out_of_range)
-    d.findings.push_back({"index_out_of_range", Severity::kFatal, out_of_range,
-                          plural(out_of_range, "face references", "faces reference") +
-                              " vertex ids outside 0.." + std::to_string(P == 0 ? 0 : P - 1) + ex(ex_range)});
-  if (too_small)
-    d.findings.push_back({"faces_too_small", Severity::kDefect, too_small,
-                          plural(too_small, "face has", "faces have") + " fewer than 3 vertices" + ex(ex_small)});
-  if (polygons)
-    d.findings.push_back({"non_triangle_faces", Severity::kRepaired, polygons,
-                          plural(polygons, "face is a polygon", "faces are polygons") +
-                              " with more than 3 vertices, fan-triangulated" + ex(ex_poly)});
-  if (repeated)
-    d.findings.push_back({"degenerate_faces", Severity::kDefect, repeated,
-                          plural(repeated, "degenerate face repeats", "degenerate faces repeat") +
-                              " a vertex id" + ex(ex_rep)});
-  if (out_of_range) return d;  // the checks below index points
-
-  {  // Duplicate faces: same vertex set (either orientation).
-    std::vector<std::pair<std::vector<std::int64_t>, std::size_t>> keys;
-    keys.reserve(F);
-    for (std::size_t f = 0; f < F; ++f) {
-      std::vector<std::int64_t> k(soup.face(f), soup.face(f) + soup.face_size(f));
-      std::sort(k.begin(), k.end());
-      keys.emplace_back(std::move(k), f);
-    }
-    std::sort(keys.begin(), keys.end());
-    std::size_t dup = 0;
-    std::vector<std::string> ex_dup;
-    for (std::size_t i = 1; i < keys.size(); ++i) {
-      if (keys[i].first == keys[i - 1].first) {
-        ++dup;
-        if (ex_dup.size() < 5)
-          ex_dup.push_back("face " + std::to_string(keys[i].second) + " = face " +
-                           std::to_string(keys[i - 1].second));
-      }
-    }
-    if (dup)
-      d.findings.push_back({"duplicate_faces", Severity::kDefect, dup,
-                            plural(dup, "duplicate face uses", "duplicate faces use") +
-                                " the same vertices as another face" + ex(ex_dup)});
-  }
-  {  // Unreferenced vertices.
-    std::size_t n = 0;
-    std::vector<std::string> exv;
-    for (std::size_t v = 0; v < P; ++v)
-      if (!used[v]) {
-        ++n;
-        if (exv.size() < 5) exv.push_back("v" + std::to_string(v));
-      }
-    if (n)
-      d.findings.push_back({"unreferenced_vertices", Severity::kRepaired, n,
-                            plural(n, "vertex is", "vertices are") + " not used by any face (ignored)" + ex(exv)});
-  }
-  {  // Coincident points: distinct referenced vertices at exactly the same position.
-    std::vector<std::uint32_t> order;
-    order.reserve(P);
-    for (std::size_t v = 0; v < P; ++v)
-      if (used[v]) order.push_back(static_cast<std::uint32_t>(v));
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return soup.points[a] < soup.points[b] || (soup.points[a] == soup.points[b] && a < b);
-    });
-    std::size_t extra = 0;
-    std::vector<std::string> exc;
-    for (std::size_t i = 1; i < order.size(); ++i) {
-      if (soup.points[order[i]] == soup.points[order[i - 1]]) {
-        ++extra;
-        if (exc.size() < 5) exc.push_back("v" + std::to_string(order[i]) + " = v" + std::to_string(order[i - 1]));
-      }
-    }
-    if (extra)
-      d.findings.push_back({"coincident_vertices", Severity::kNote, extra,
-                            plural(extra, "vertex duplicates", "vertices duplicate") +
-                                " the position of another (an unwelded seam? weld them before use)" + ex(exc)});
-  }
+  if (!check_faces(soup, used, d)) return d;  // the checks below index points
+  check_duplicate_faces(soup, d);
+  check_unreferenced_vertices(used, d);
+  check_coincident_vertices(soup, used, d);
   return d;
 }
 

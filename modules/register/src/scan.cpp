@@ -8,13 +8,12 @@
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
-#include <vtkXMLPolyDataWriter.h>
 
 #include <cmath>
-#include <fstream>
 
-#include "colonflat/core/atomic_file.h"
+#include "colonflat/core/candidate_list.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/stage.h"
 #include "colonflat/core/vtk_messages.h"
 
 namespace cf {
@@ -41,32 +40,6 @@ vtkSmartPointer<vtkPolyData> read_vtp(const fs::path& path) {
   return pd;
 }
 
-nlohmann::json read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open");
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded()) throw InputError(path.string(), "not valid JSON");
-  return j;
-}
-
-// A 3-vector from the first key of `keys` present in `e`.
-bool vector3_from(const nlohmann::json& e, std::initializer_list<const char*> keys, Eigen::Vector3d& v) {
-  for (const char* k : keys) {
-    if (!e.contains(k)) continue;
-    const auto& a = e[k];
-    if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number()) return false;
-    v = {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
-    return std::isfinite(v.sum());
-  }
-  return false;
-}
-
-double number_from(const nlohmann::json& e, std::initializer_list<const char*> keys, double fallback) {
-  for (const char* k : keys)
-    if (e.contains(k) && e[k].is_number()) return e[k].get<double>();
-  return fallback;
-}
-
 void read_vector_array(vtkDataArray* a, std::vector<Eigen::Vector3d>& out) {
   out.resize(size_t(a->GetNumberOfTuples()));
   for (vtkIdType i = 0; i < a->GetNumberOfTuples(); ++i) a->GetTuple(i, out[size_t(i)].data());
@@ -75,25 +48,9 @@ void read_vector_array(vtkDataArray* a, std::vector<Eigen::Vector3d>& out) {
 }  // namespace
 
 std::vector<ScanCandidate> scan_candidates_from_json(const nlohmann::json& j, const std::string& name) {
-  const nlohmann::json* list = &j;
-  if (j.is_object()) {
-    if (!j.contains("candidates") || !j["candidates"].is_array())
-      throw InputError(name, "no \"candidates\" list");
-    list = &j["candidates"];
-  } else if (!j.is_array()) {
-    throw InputError(name, "expected a candidate list or an object with \"candidates\"");
-  }
   std::vector<ScanCandidate> out;
-  for (size_t k = 0; k < list->size(); ++k) {
-    const auto& e = (*list)[k];
-    ScanCandidate c;
-    if (!e.is_object() || !vector3_from(e, {"position_lps_mm", "center_lps_mm", "center", "position"}, c.lps))
-      throw InputError(name, "candidate " + std::to_string(k + 1) + " has no position_lps_mm [L, P, S]");
-    c.id = e.contains("id") && e["id"].is_number_integer() ? e["id"].get<int>() : int(k + 1);
-    c.size_mm = number_from(e, {"size_mm", "diameter_mm"}, 0.0);
-    c.score = number_from(e, {"score"}, 1.0);
-    out.push_back(c);
-  }
+  for (const CandidateEntry& e : candidate_list_from_json(j, name))
+    out.push_back({e.id, Eigen::Vector3d(e.lps_mm[0], e.lps_mm[1], e.lps_mm[2]), e.size_mm, e.score.value_or(1.0)});
   return out;
 }
 
@@ -140,40 +97,15 @@ ColonScan read_run_dir(const fs::path& dir) {
   if (!fs::is_directory(dir)) throw InputError(dir.string(), "no such run directory");
   ColonScan s = scan_from_polydata(read_vtp(dir / "flat.vtp"), (dir / "flat.vtp").string());
   s.name = dir.string();
-  for (const char* file : {"candidates.json", "polyps.json"}) {
-    if (!fs::exists(dir / file)) continue;
-    s.candidates = scan_candidates_from_json(read_json(dir / file), (dir / file).string());
-    s.candidates_file = file;
-    break;
+  if (const fs::path file = find_candidate_file(dir); !file.empty()) {
+    s.candidates = scan_candidates_from_json(read_json_file(file), file.string());
+    s.candidates_file = file.filename().string();
   }
   if (fs::exists(dir / "run_report.json")) {
-    s.run_report = read_json(dir / "run_report.json");
+    s.run_report = read_json_file(dir / "run_report.json");
     if (!s.run_report.is_object()) throw InputError((dir / "run_report.json").string(), "not a JSON object");
   }
   return s;
-}
-
-void write_run_dir(const ColonScan& scan, const fs::path& dir) {
-  fs::create_directories(dir);
-  OutputTransaction tx;
-  const fs::path flat_tmp = tx.stage(dir / "flat.vtp");
-  {
-    VtkMessageCapture msgs;
-    vtkNew<vtkXMLPolyDataWriter> w;
-    w->SetFileName(flat_tmp.c_str());
-    w->SetInputData(scan.flat);
-    w->SetDataModeToAppended();
-    if (!w->Write() || !msgs.first_problem().empty())
-      throw Error((dir / "flat.vtp").string() + ": cannot write: " + msgs.first_problem());
-  }
-  nlohmann::json cands = nlohmann::json::array();
-  for (const auto& c : scan.candidates)
-    cands.push_back({{"id", c.id}, {"position_lps_mm", {c.lps.x(), c.lps.y(), c.lps.z()}},
-                     {"size_mm", c.size_mm}, {"score", c.score}});
-  std::ofstream(tx.stage(dir / "candidates.json"))
-      << nlohmann::json{{"units", "mm"}, {"coordinate_system", "LPS"}, {"candidates", cands}}.dump(1);
-  std::ofstream(tx.stage(dir / "run_report.json")) << scan.run_report.dump(1);
-  tx.commit();
 }
 
 }  // namespace cf

@@ -87,20 +87,8 @@ void ring(vtkImageCanvasSource2D* canvas, const Layout& l, const Marker& m) {
   }
 }
 
-}  // namespace
-
-vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, const SideBySideOptions& o) {
-  const Layout l = make_layout(reg, o);
-  vtkNew<vtkImageData> bands;
-  bands->SetExtent(0, l.width - 1, 0, l.height - 1, 0, 0);
-  bands->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
-  std::fill_n(static_cast<unsigned char*>(bands->GetScalarPointer()), size_t(l.width) * l.height * 3, (unsigned char)25);
-  paint_bands(reg, l, bands);
-  vtkNew<vtkImageCanvasSource2D> canvas;
-  canvas->SetScalarTypeToUnsignedChar();
-  canvas->SetNumberOfScalarComponents(3);
-  canvas->SetExtent(0, l.width - 1, 0, l.height - 1, 0, 0);
-  canvas->DrawImage(0, 0, bands);
+// Each candidate of both scans at its place on the supine length axis (prone ones mapped over).
+std::vector<Marker> place_markers(const ColonRegistration& reg, const Layout& l) {
   std::vector<Marker> marks;
   auto place = [&](const ScanCandidate& c, bool supine) {
     auto [s, theta] = reg.locate(c.lps, supine ? Direction::kSupineToProne : Direction::kProneToSupine);
@@ -112,6 +100,13 @@ vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, 
   };
   for (const auto& c : reg.supine().candidates) place(c, true);
   for (const auto& c : reg.prone().candidates) place(c, false);
+  return marks;
+}
+
+// Green links between paired candidates, green rings on paired ones, orange on the others, and the
+// 100 mm ticks of the length axis.
+void draw_matches(vtkImageCanvasSource2D* canvas, const ColonRegistration& reg, const Layout& l,
+                  const std::vector<Marker>& marks) {
   auto find = [&](int id, bool supine) -> const Marker* {
     for (const auto& m : marks)
       if (m.supine == supine && m.id == id) return &m;
@@ -132,12 +127,12 @@ vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, 
   canvas->SetDrawColor(255, 255, 255);
   for (int s = 0; s <= int(l.band_cols * l.pixel); s += 100)
     canvas->FillBox(l.column(s), l.column(s) + 1, kAxis - 22, kAxis - 12);
-  canvas->Update();
-  auto out = vtkSmartPointer<vtkImageData>::New();
-  out->DeepCopy(canvas->GetOutput());
+}
+
+// Title, band names, axis numbers and caption, marker labels and the legend.
+void write_text(vtkImageData* out, const ColonRegistration& reg, const Layout& l, const std::vector<Marker>& marks) {
   const double white[3] = {1, 1, 1}, orange[3] = {1, 0.6, 0};
   draw_text(out, "Supine / prone on one length axis", kLeft, 10, 15, white);
-
   draw_text(out, "supine", 8, l.supine_top + l.band / 2 - 8, 15, white);
   draw_text(out, "prone", 8, l.prone_top + l.band / 2 - 8, 15, white);
   for (int s = 0; s <= int(l.band_cols * l.pixel); s += 100)
@@ -149,6 +144,28 @@ vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, 
   legend << reg.matching().pairs.size() << " matched pairs (green), " << reg.matching().supine_only.size()
          << " supine-only and " << reg.matching().prone_only.size() << " prone-only candidates (orange)";
   draw_text(out, legend.str(), kLeft, l.prone_top - kGap / 2 - 8, 13, orange);
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, const SideBySideOptions& o) {
+  const Layout l = make_layout(reg, o);
+  vtkNew<vtkImageData> bands;
+  bands->SetExtent(0, l.width - 1, 0, l.height - 1, 0, 0);
+  bands->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  std::fill_n(static_cast<unsigned char*>(bands->GetScalarPointer()), size_t(l.width) * l.height * 3, (unsigned char)25);
+  paint_bands(reg, l, bands);
+  vtkNew<vtkImageCanvasSource2D> canvas;
+  canvas->SetScalarTypeToUnsignedChar();
+  canvas->SetNumberOfScalarComponents(3);
+  canvas->SetExtent(0, l.width - 1, 0, l.height - 1, 0, 0);
+  canvas->DrawImage(0, 0, bands);
+  const std::vector<Marker> marks = place_markers(reg, l);
+  draw_matches(canvas, reg, l, marks);
+  canvas->Update();
+  auto out = vtkSmartPointer<vtkImageData>::New();
+  out->DeepCopy(canvas->GetOutput());
+  write_text(out, reg, l, marks);
   return out;
 }
 

@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "colonflat/register/register_tool.h"
-#include "colonflat/register/synthetic_pair.h"
+#include "colonflat/testdata/synthetic_pair.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace cf {

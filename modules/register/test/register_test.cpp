@@ -6,7 +6,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/register/register.h"
-#include "colonflat/register/synthetic_pair.h"
+#include "colonflat/testdata/synthetic_pair.h"
 
 namespace cf {
 namespace {

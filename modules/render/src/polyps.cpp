@@ -119,80 +119,138 @@ Curvature surface_curvature(const TriangleList& s, const std::vector<std::array<
   return c;
 }
 
-std::vector<PolypCandidate> detect_polyps(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
-                                          const PolypOptions& o, Curvature* curvature_out) {
-  const int nv = int(s.points.size());
-  Curvature c = surface_curvature(s, normals, o.fit_radius);
-  const Graph g = vertex_graph(s);
-  const std::vector<double> area = vertex_areas(s);
-  auto in_cap = [&](int v) { return c.si[v] >= o.grow_si && c.cv[v] >= 0.5 * o.min_curvedness && c.cv[v] <= 2 * o.max_curvedness; };
-  auto seed = [&](int v) { return c.si[v] >= o.seed_si && c.cv[v] >= o.min_curvedness && c.cv[v] <= o.max_curvedness; };
-  std::vector<int> region(nv, -1);
-  std::vector<PolypCandidate> out;
-  std::vector<int> stack, fp_stamp(nv, -1);
-  int nreg = 0;
-  for (int v0 = 0; v0 < nv; ++v0) {
-    if (region[v0] >= 0 || !seed(v0)) continue;
-    std::vector<int> cap{v0};
-    region[v0] = nreg;
-    for (std::size_t k = 0; k < cap.size(); ++k)
-      for (int q = g.start[cap[k]]; q < g.start[cap[k] + 1]; ++q) {
-        const int w = g.nbr[q];
-        if (region[w] < 0 && in_cap(w)) region[w] = nreg, cap.push_back(w);
-      }
-    ++nreg;
-    PolypCandidate pc;
-    V3 cen = V3::Zero();
-    double a = 0, si = 0, cv = 0;
-    for (int v : cap) cen += area[v] * P(s, v), a += area[v], si += area[v] * c.si[v], cv += area[v] * c.cv[v];
-    if (a <= 0) continue;
-    cen /= a;
-    pc.cap_area_mm2 = a;
-    pc.mean_si = si / a;
-    pc.mean_cv = cv / a;
-    int apex = cap[0];
-    for (int v : cap)
-      if ((P(s, v) - cen).squaredNorm() < (P(s, apex) - cen).squaredNorm()) apex = v;
-    pc.vertex = apex;
-    pc.center_lps_mm = s.points[apex];
-    // Footprint: the convex part around the cap, within max_radius of the apex.
-    const V3 pa = P(s, apex);
-    std::vector<int> fp(cap);
-    for (int v : fp) fp_stamp[v] = nreg;
-    double fa = 0;
-    for (std::size_t k = 0; k < fp.size(); ++k) {
-      fa += area[fp[k]];
-      for (int q = g.start[fp[k]]; q < g.start[fp[k] + 1]; ++q) {
-        const int w = g.nbr[q];
-        if (fp_stamp[w] == nreg || c.si[w] < o.footprint_si || (P(s, w) - pa).norm() > o.max_radius) continue;
-        fp_stamp[w] = nreg;
-        fp.push_back(w);
-      }
-    }
-    pc.footprint_area_mm2 = fa;
-    pc.footprint = std::move(fp);
-    // Elongation of the cap (fold tips are long, polyp heads round): spread of its vertices.
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int v : cap) {
-      const V3 d = P(s, v) - cen;
-      cov += area[v] * d * d.transpose();
-    }
-    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov / a).eigenvalues();  // ascending
-    pc.elongation = ev[1] > 1e-12 ? std::sqrt(ev[2] / ev[1]) : 99.0;
-    // Size: diameter of the sphere with the cap's curvature (2 / CV); the cap of a polyp head is
-    // close to a sphere, a fold is not a cap at all.
-    pc.size_mm = 2.0 / std::max(1e-6, pc.mean_cv);
-    // Score: how cap-like (mean SI), how much of the sphere the cap covers, how round it is.
-    const double s_si = std::clamp((pc.mean_si - o.grow_si) / (1 - o.grow_si), 0.0, 1.0);
-    const double s_area = std::clamp(pc.cap_area_mm2 * pc.mean_cv * pc.mean_cv / M_PI / 0.6, 0.0, 1.0);
-    const double s_round = std::clamp((2.5 - pc.elongation) / 1.5, 0.0, 1.0);
-    pc.score = 0.4 * s_si + 0.3 * s_area + 0.3 * s_round;
-    if (pc.cap_area_mm2 < o.min_cap_area || pc.size_mm < o.min_size || pc.size_mm > o.max_size ||
-        pc.score < o.min_score)
-      continue;
-    out.push_back(std::move(pc));
+namespace {
+
+// detect_polyps() as named steps: seeds grown into cap regions, each cap measured (centre, apex,
+// footprint, elongation, size, score), then candidates of one polyp merged.
+class PolypDetector {
+ public:
+  PolypDetector(const TriangleList& s, const std::vector<std::array<double, 3>>& normals, const PolypOptions& o)
+      : s_(s), o_(o), c_(surface_curvature(s, normals, o.fit_radius)), g_(vertex_graph(s)), area_(vertex_areas(s)),
+        region_(s.points.size(), -1), footprint_stamp_(s.points.size(), -1) {}
+  std::vector<PolypCandidate> run(Curvature* curvature_out);
+
+ private:
+  bool in_cap(int v) const {
+    return c_.si[v] >= o_.grow_si && c_.cv[v] >= 0.5 * o_.min_curvedness && c_.cv[v] <= 2 * o_.max_curvedness;
   }
-  // Merge candidates whose apexes are closer than the larger radius (one polyp, several caps).
+  bool seed(int v) const { return c_.si[v] >= o_.seed_si && c_.cv[v] >= o_.min_curvedness && c_.cv[v] <= o_.max_curvedness; }
+  std::vector<int> grow_cap(int v0);
+  bool measure_cap(const std::vector<int>& cap, PolypCandidate& pc, V3& centre) const;
+  void grow_footprint(const std::vector<int>& cap, PolypCandidate& pc);
+  double elongation(const std::vector<int>& cap, const V3& centre, double cap_area) const;
+  void size_and_score(PolypCandidate& pc) const;
+  bool passes(const PolypCandidate& pc) const;
+
+  const TriangleList& s_;
+  const PolypOptions& o_;
+  Curvature c_;
+  const Graph g_;
+  const std::vector<double> area_;  // per vertex, a third of its triangles' area (mm^2)
+  std::vector<int> region_;         // cap region of each vertex, -1 when none
+  std::vector<int> footprint_stamp_;
+  int regions_ = 0;
+};
+
+std::vector<PolypCandidate> PolypDetector::run(Curvature* curvature_out) {
+  std::vector<PolypCandidate> out;
+  for (int v0 = 0; v0 < int(s_.points.size()); ++v0) {
+    if (region_[v0] >= 0 || !seed(v0)) continue;
+    const std::vector<int> cap = grow_cap(v0);
+    PolypCandidate pc;
+    V3 centre;
+    if (!measure_cap(cap, pc, centre)) continue;
+    grow_footprint(cap, pc);
+    pc.elongation = elongation(cap, centre, pc.cap_area_mm2);
+    size_and_score(pc);
+    if (passes(pc)) out.push_back(std::move(pc));
+  }
+  if (curvature_out) *curvature_out = std::move(c_);
+  return out;
+}
+
+// The seed's cap region: connected vertices with cap-like shape index and curvedness in range.
+std::vector<int> PolypDetector::grow_cap(int v0) {
+  std::vector<int> cap{v0};
+  region_[v0] = regions_;
+  for (std::size_t k = 0; k < cap.size(); ++k)
+    for (int q = g_.start[cap[k]]; q < g_.start[cap[k] + 1]; ++q) {
+      const int w = g_.nbr[q];
+      if (region_[w] < 0 && in_cap(w)) region_[w] = regions_, cap.push_back(w);
+    }
+  ++regions_;
+  return cap;
+}
+
+// Area-weighted means over the cap; the apex is the cap vertex nearest the cap's centroid.
+// False for a cap without area.
+bool PolypDetector::measure_cap(const std::vector<int>& cap, PolypCandidate& pc, V3& cen) const {
+  cen = V3::Zero();
+  double a = 0, si = 0, cv = 0;
+  for (int v : cap) cen += area_[v] * P(s_, v), a += area_[v], si += area_[v] * c_.si[v], cv += area_[v] * c_.cv[v];
+  if (a <= 0) return false;
+  cen /= a;
+  pc.cap_area_mm2 = a;
+  pc.mean_si = si / a;
+  pc.mean_cv = cv / a;
+  int apex = cap[0];
+  for (int v : cap)
+    if ((P(s_, v) - cen).squaredNorm() < (P(s_, apex) - cen).squaredNorm()) apex = v;
+  pc.vertex = apex;
+  pc.center_lps_mm = s_.points[apex];
+  return true;
+}
+
+// Footprint: the convex part around the cap, within max_radius of the apex.
+void PolypDetector::grow_footprint(const std::vector<int>& cap, PolypCandidate& pc) {
+  const V3 pa = P(s_, pc.vertex);
+  std::vector<int> fp(cap);
+  for (int v : fp) footprint_stamp_[v] = regions_;
+  double fa = 0;
+  for (std::size_t k = 0; k < fp.size(); ++k) {
+    fa += area_[fp[k]];
+    for (int q = g_.start[fp[k]]; q < g_.start[fp[k] + 1]; ++q) {
+      const int w = g_.nbr[q];
+      if (footprint_stamp_[w] == regions_ || c_.si[w] < o_.footprint_si || (P(s_, w) - pa).norm() > o_.max_radius)
+        continue;
+      footprint_stamp_[w] = regions_;
+      fp.push_back(w);
+    }
+  }
+  pc.footprint_area_mm2 = fa;
+  pc.footprint = std::move(fp);
+}
+
+// Elongation of the cap (fold tips are long, polyp heads round): spread of its vertices.
+double PolypDetector::elongation(const std::vector<int>& cap, const V3& cen, double a) const {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int v : cap) {
+    const V3 d = P(s_, v) - cen;
+    cov += area_[v] * d * d.transpose();
+  }
+  const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov / a).eigenvalues();  // ascending
+  return ev[1] > 1e-12 ? std::sqrt(ev[2] / ev[1]) : 99.0;
+}
+
+void PolypDetector::size_and_score(PolypCandidate& pc) const {
+  // Size: diameter of the sphere with the cap's curvature (2 / CV); the cap of a polyp head is
+  // close to a sphere, a fold is not a cap at all.
+  pc.size_mm = 2.0 / std::max(1e-6, pc.mean_cv);
+  // Score: how cap-like (mean SI), how much of the sphere the cap covers, how round it is.
+  const double s_si = std::clamp((pc.mean_si - o_.grow_si) / (1 - o_.grow_si), 0.0, 1.0);
+  const double s_area = std::clamp(pc.cap_area_mm2 * pc.mean_cv * pc.mean_cv / M_PI / 0.6, 0.0, 1.0);
+  const double s_round = std::clamp((2.5 - pc.elongation) / 1.5, 0.0, 1.0);
+  pc.score = 0.4 * s_si + 0.3 * s_area + 0.3 * s_round;
+}
+
+bool PolypDetector::passes(const PolypCandidate& pc) const {
+  return !(pc.cap_area_mm2 < o_.min_cap_area || pc.size_mm < o_.min_size || pc.size_mm > o_.max_size ||
+           pc.score < o_.min_score);
+}
+
+// Merge candidates whose apexes are closer than the larger radius (one polyp, several caps);
+// the best score wins; ids 1.. by decreasing score.
+std::vector<PolypCandidate> merge_one_polyp_caps(std::vector<PolypCandidate> out) {
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });
   std::vector<PolypCandidate> kept;
   for (auto& p : out) {
@@ -205,8 +263,14 @@ std::vector<PolypCandidate> detect_polyps(const TriangleList& s, const std::vect
     if (!dup) kept.push_back(std::move(p));
   }
   for (std::size_t i = 0; i < kept.size(); ++i) kept[i].id = int(i) + 1;
-  if (curvature_out) *curvature_out = std::move(c);
   return kept;
+}
+
+}  // namespace
+
+std::vector<PolypCandidate> detect_polyps(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
+                                          const PolypOptions& o, Curvature* curvature_out) {
+  return merge_one_polyp_caps(PolypDetector(s, normals, o).run(curvature_out));
 }
 
 std::vector<KnownPolyp> known_polyps_from_json(const nlohmann::json& j0, const std::string& name) {

@@ -109,9 +109,7 @@ std::string ensure_display() {
   return disp;
 }
 
-ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
-  ensure_display();
-  VtkMessageCapture msgs;
+vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
   for (const auto& p : surface.points) pts->InsertNextPoint(p.data());
@@ -120,114 +118,185 @@ ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const 
     vtkIdType c[3] = {t[0], t[1], t[2]};
     polys->InsertNextCell(3, c);
   }
-  vtkNew<vtkPolyData> pd;
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetPolys(polys);
+  return pd;
+}
+
+vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook& look) {
   vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(pd);
+  normals->SetInputData(surface);
   normals->SplittingOff();
   normals->ConsistencyOff();
   vtkNew<vtkPolyDataMapper> mapper;
   mapper->SetInputConnection(normals->GetOutputPort());
-  vtkNew<vtkActor> actor;
+  auto actor = vtkSmartPointer<vtkActor>::New();
   actor->SetMapper(mapper);
-  actor->GetProperty()->SetColor(0.88, 0.62, 0.56);
-  actor->GetProperty()->SetSpecular(0.2);
-  actor->GetProperty()->SetSpecularPower(20);
-  vtkNew<vtkRenderer> ren;
-  ren->AddActor(actor);
-  ren->SetBackground(0.12, 0.13, 0.16);
-  ren->SetBackground2(0.3, 0.32, 0.38);
-  ren->GradientBackgroundOn();
-  double b[6];
-  pd->GetBounds(b);
-  const double diag = std::sqrt((b[1] - b[0]) * (b[1] - b[0]) + (b[3] - b[2]) * (b[3] - b[2]) + (b[5] - b[4]) * (b[5] - b[4]));
-  if (loops && loops->GetNumberOfPoints() > 0) {
-    actor->GetProperty()->SetOpacity(0.55);
-    vtkNew<vtkTubeFilter> tubes;
-    tubes->SetInputData(loops);
-    tubes->SetRadius(std::max(0.8, diag / 250));
-    tubes->SetNumberOfSides(10);
-    vtkNew<vtkPolyDataMapper> lm;
-    lm->SetInputConnection(tubes->GetOutputPort());
-    vtkNew<vtkLookupTable> lut;
-    lut->SetNumberOfTableValues(2);
-    lut->SetTableValue(0, 0.95, 0.15, 0.1, 1);  // handle
-    lut->SetTableValue(1, 0.15, 0.45, 1.0, 1);  // tunnel
-    lut->SetTableRange(0, 1);
-    lut->Build();
-    if (loops->GetCellData()->GetArray("type")) {
-      lm->SetScalarModeToUseCellFieldData();
-      lm->SelectColorArray("type");
-      lm->SetLookupTable(lut);
-      lm->SetScalarRange(0, 1);
-      lm->ScalarVisibilityOn();
-    } else {
-      lm->ScalarVisibilityOff();
-    }
-    vtkNew<vtkActor> la;
-    la->SetMapper(lm);
-    la->GetProperty()->SetColor(1.0, 0.55, 0.0);
-    ren->AddActor(la);
-    // Loops are often a few mm long: a translucent ball around each makes it findable.
-    vtkDataArray* type = loops->GetCellData()->GetArray("type");
-    vtkNew<vtkIdList> ids;
-    for (vtkIdType c = 0; c < loops->GetNumberOfCells(); ++c) {
-      loops->GetCellPoints(c, ids);
-      if (ids->GetNumberOfIds() == 0) continue;
-      double m[3] = {0, 0, 0};
-      for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
-        double q[3];
-        loops->GetPoint(ids->GetId(k), q);
-        for (int d = 0; d < 3; ++d) m[d] += q[d] / double(ids->GetNumberOfIds());
-      }
-      vtkNew<vtkSphereSource> ball;
-      ball->SetCenter(m);
-      ball->SetRadius(std::max(4.0, diag / 70));
-      ball->SetThetaResolution(24);
-      ball->SetPhiResolution(16);
-      vtkNew<vtkPolyDataMapper> bm;
-      bm->SetInputConnection(ball->GetOutputPort());
-      vtkNew<vtkActor> ba;
-      ba->SetMapper(bm);
-      const bool tunnel = type && type->GetTuple1(c) > 0.5;
-      if (tunnel) ba->GetProperty()->SetColor(0.2, 0.5, 1.0);
-      else ba->GetProperty()->SetColor(1.0, 0.2, 0.1);
-      ba->GetProperty()->SetOpacity(0.45);
-      ren->AddActor(ba);
-    }
+  actor->GetProperty()->SetColor(look.color[0], look.color[1], look.color[2]);
+  actor->GetProperty()->SetSpecular(look.specular);
+  actor->GetProperty()->SetSpecularPower(look.specular_power);
+  return actor;
+}
+
+namespace {
+
+// render_snapshot() as named steps: the scene (surface, loops as tubes with a ball around each,
+// caption), the camera, and the off-screen grab.
+class SnapshotScene {
+ public:
+  SnapshotScene(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts)
+      : surface_(surface_polydata(surface)), loops_(loops), opts_(opts) {}
+  ImagePtr run();
+
+ private:
+  void add_surface();
+  void add_loop_tubes();
+  void add_loop_balls();
+  void add_caption();
+  void place_camera();
+  ImagePtr grab();
+
+  VtkMessageCapture messages_;
+  vtkSmartPointer<vtkPolyData> surface_;
+  vtkPolyData* loops_;  // may be null
+  const SnapshotOptions& opts_;
+  vtkNew<vtkRenderer> renderer_;
+  vtkNew<vtkRenderWindow> window_;
+  vtkSmartPointer<vtkActor> surface_actor_;
+  double bounds_[6] = {0, 0, 0, 0, 0, 0};
+  double diagonal_ = 0;  // of the surface's bounding box (mm)
+};
+
+ImagePtr SnapshotScene::run() {
+  add_surface();
+  if (loops_ && loops_->GetNumberOfPoints() > 0) {
+    surface_actor_->GetProperty()->SetOpacity(0.55);
+    add_loop_tubes();
+    add_loop_balls();
   }
-  if (!o.caption.empty()) {
-    vtkNew<vtkTextActor> ta;
-    ta->SetInput(o.caption.c_str());
-    ta->GetTextProperty()->SetFontSize(20);
-    ta->GetTextProperty()->SetColor(1, 1, 1);
-    ta->SetDisplayPosition(12, o.height - 34);
-    ren->AddViewProp(ta);
+  add_caption();
+  window_->SetOffScreenRendering(1);
+  window_->SetMultiSamples(0);
+  window_->AddRenderer(renderer_);
+  window_->SetSize(opts_.width, opts_.height);
+  place_camera();
+  return grab();
+}
+
+// The surface in skin colour over a dark gradient; its bounding box sizes the rest.
+void SnapshotScene::add_surface() {
+  surface_actor_ = surface_actor(surface_, SurfaceLook{});
+  renderer_->AddActor(surface_actor_);
+  renderer_->SetBackground(0.12, 0.13, 0.16);
+  renderer_->SetBackground2(0.3, 0.32, 0.38);
+  renderer_->GradientBackgroundOn();
+  surface_->GetBounds(bounds_);
+  const double* b = bounds_;
+  diagonal_ = std::sqrt((b[1] - b[0]) * (b[1] - b[0]) + (b[3] - b[2]) * (b[3] - b[2]) + (b[5] - b[4]) * (b[5] - b[4]));
+}
+
+// The loops as tubes: handles red, tunnels blue (cell data "type"), else orange.
+void SnapshotScene::add_loop_tubes() {
+  vtkNew<vtkTubeFilter> tubes;
+  tubes->SetInputData(loops_);
+  tubes->SetRadius(std::max(0.8, diagonal_ / 250));
+  tubes->SetNumberOfSides(10);
+  vtkNew<vtkPolyDataMapper> lm;
+  lm->SetInputConnection(tubes->GetOutputPort());
+  vtkNew<vtkLookupTable> lut;
+  lut->SetNumberOfTableValues(2);
+  lut->SetTableValue(0, 0.95, 0.15, 0.1, 1);  // handle
+  lut->SetTableValue(1, 0.15, 0.45, 1.0, 1);  // tunnel
+  lut->SetTableRange(0, 1);
+  lut->Build();
+  if (loops_->GetCellData()->GetArray("type")) {
+    lm->SetScalarModeToUseCellFieldData();
+    lm->SelectColorArray("type");
+    lm->SetLookupTable(lut);
+    lm->SetScalarRange(0, 1);
+    lm->ScalarVisibilityOn();
+  } else {
+    lm->ScalarVisibilityOff();
   }
-  vtkNew<vtkRenderWindow> win;
-  win->SetOffScreenRendering(1);
-  win->SetMultiSamples(0);
-  win->AddRenderer(ren);
-  win->SetSize(o.width, o.height);
-  vtkCamera* cam = ren->GetActiveCamera();
+  vtkNew<vtkActor> la;
+  la->SetMapper(lm);
+  la->GetProperty()->SetColor(1.0, 0.55, 0.0);
+  renderer_->AddActor(la);
+}
+
+// Loops are often a few mm long: a translucent ball around each makes it findable.
+void SnapshotScene::add_loop_balls() {
+  vtkDataArray* type = loops_->GetCellData()->GetArray("type");
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < loops_->GetNumberOfCells(); ++c) {
+    loops_->GetCellPoints(c, ids);
+    if (ids->GetNumberOfIds() == 0) continue;
+    double m[3] = {0, 0, 0};
+    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
+      double q[3];
+      loops_->GetPoint(ids->GetId(k), q);
+      for (int d = 0; d < 3; ++d) m[d] += q[d] / double(ids->GetNumberOfIds());
+    }
+    vtkNew<vtkSphereSource> ball;
+    ball->SetCenter(m);
+    ball->SetRadius(std::max(4.0, diagonal_ / 70));
+    ball->SetThetaResolution(24);
+    ball->SetPhiResolution(16);
+    vtkNew<vtkPolyDataMapper> bm;
+    bm->SetInputConnection(ball->GetOutputPort());
+    vtkNew<vtkActor> ba;
+    ba->SetMapper(bm);
+    const bool tunnel = type && type->GetTuple1(c) > 0.5;
+    if (tunnel) ba->GetProperty()->SetColor(0.2, 0.5, 1.0);
+    else ba->GetProperty()->SetColor(1.0, 0.2, 0.1);
+    ba->GetProperty()->SetOpacity(0.45);
+    renderer_->AddActor(ba);
+  }
+}
+
+void SnapshotScene::add_caption() {
+  if (opts_.caption.empty()) return;
+  vtkNew<vtkTextActor> ta;
+  ta->SetInput(opts_.caption.c_str());
+  ta->GetTextProperty()->SetFontSize(20);
+  ta->GetTextProperty()->SetColor(1, 1, 1);
+  ta->SetDisplayPosition(12, opts_.height - 34);
+  renderer_->AddViewProp(ta);
+}
+
+// Looking at the box centre from the front (anterior, LPS -y) or the patient's left (+x),
+// superior up, the whole surface in view.
+void SnapshotScene::place_camera() {
+  const double* b = bounds_;
+  vtkCamera* cam = renderer_->GetActiveCamera();
   const double c[3] = {0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])};
   cam->SetFocalPoint(c);
-  if (o.view == "left") cam->SetPosition(c[0] + diag, c[1], c[2]);
-  else cam->SetPosition(c[0], c[1] - diag, c[2]);  // anterior: LPS -y
-  cam->SetViewUp(0, 0, 1);                          // superior: LPS +z
-  ren->ResetCamera();
+  if (opts_.view == "left") cam->SetPosition(c[0] + diagonal_, c[1], c[2]);
+  else cam->SetPosition(c[0], c[1] - diagonal_, c[2]);  // anterior: LPS -y
+  cam->SetViewUp(0, 0, 1);                                 // superior: LPS +z
+  renderer_->ResetCamera();
   cam->Zoom(1.15);
-  win->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(win);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  if (!msgs.errors().empty()) throw Error("off-screen rendering failed: " + msgs.errors().front());
+}
+
+ImagePtr SnapshotScene::grab() {
+  window_->Render();
+  vtkNew<vtkWindowToImageFilter> grabber;
+  grabber->SetInput(window_);
+  grabber->SetInputBufferTypeToRGB();
+  grabber->ReadFrontBufferOff();
+  grabber->Update();
+  if (!messages_.errors().empty()) throw Error("off-screen rendering failed: " + messages_.errors().front());
   ImagePtr img = ImagePtr::New();
-  img->DeepCopy(grab->GetOutput());
+  img->DeepCopy(grabber->GetOutput());
   return img;
+}
+
+}  // namespace
+
+ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
+  ensure_display();
+  return SnapshotScene(surface, loops, o).run();
 }
 
 }  // namespace cf

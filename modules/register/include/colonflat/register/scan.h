@@ -50,8 +50,4 @@ ColonScan scan_from_polydata(vtkSmartPointer<vtkPolyData> flat, const std::strin
 // Throws InputError(name, ...) on a malformed entry.
 std::vector<ScanCandidate> scan_candidates_from_json(const nlohmann::json& j, const std::string& name);
 
-// Writes a scan as a run directory (flat.vtp, candidates.json, run_report.json); for tests and
-// benchmarks building synthetic pairs.
-void write_run_dir(const ColonScan& scan, const std::filesystem::path& dir);
-
 }  // namespace cf

@@ -9,6 +9,8 @@
 #include "colonflat/core/soup.h"
 #include "colonflat/render/artifacts.h"
 
+class vtkActor;
+
 namespace cf {
 
 // Returns the display in use (":N"). Throws Error when no display can be had.
@@ -19,6 +21,19 @@ struct SnapshotOptions {
   std::string caption;
   std::string view = "anterior";  // "anterior" (from -y, LPS) or "left" (from +x)
 };
+
+// The triangles as a vtkPolyData (double points, triangle cells; point i = surface.points[i]).
+vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface);
+
+// How a wall surface looks: diffuse colour (RGB 0-1) and specular highlight.
+struct SurfaceLook {
+  double color[3] = {0.88, 0.62, 0.56};
+  double specular = 0.2;
+  double specular_power = 20;
+};
+// A lit actor of the surface: smooth point normals (vtkPolyDataNormals, no splitting, triangle
+// order kept), the look's colour and highlight. The pipeline updates when the actor is rendered.
+vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook& look);
 
 // The surface (LPS mm) seen from outside, with `loops` (polylines; may be null) as thick tubes
 // (handles red, tunnels blue when cell data "type" is there, else orange).

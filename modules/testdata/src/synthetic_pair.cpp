@@ -1,14 +1,6 @@
-#include "colonflat/register/synthetic_pair.h"
+#include "colonflat/testdata/synthetic_pair.h"
 
-#include <vtkCellArray.h>
-#include <vtkDoubleArray.h>
-#include <vtkFieldData.h>
-#include <vtkIntArray.h>
-#include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkStringArray.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +8,8 @@
 #include <random>
 
 #include <Eigen/Geometry>
+
+#include "colonflat/flatten/flat_artifact.h"
 
 namespace cf {
 namespace {
@@ -107,47 +101,48 @@ struct Grid {
   int rings = 0, around = 0;
 };
 
-vtkSmartPointer<vtkPolyData> grid_polydata(const Tube& tube, const Placement& pl, const Grid& g,
-                                           const std::function<double(double)>& flat_x, double cut, bool with_arc) {
-  const vtkIdType n = vtkIdType(g.sigma.size());
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  vtkNew<vtkDoubleArray> pos, nrm, arc;
-  pos->SetName("position_lps_mm"), pos->SetNumberOfComponents(3);
-  nrm->SetName("Normals"), nrm->SetNumberOfComponents(3);
-  arc->SetName("centreline_mm");
-  vtkNew<vtkIntArray> seg, src;
-  seg->SetName("segment_id"), src->SetName("source_vertex");
+// Out of the lumen at material (sigma, phi): the cross product of the wall's two tangents.
+Eigen::Vector3d wall_normal(const Tube& tube, const Placement& pl, double s, double f) {
   const double ds = 0.5, dp = 0.01;
-  for (vtkIdType v = 0; v < n; ++v) {
-    const double s = g.sigma[size_t(v)], f = g.phi[size_t(v)];
-    const Eigen::Vector3d p = wall_point(tube, pl, s, f);
-    Eigen::Vector3d normal = (wall_point(tube, pl, s + ds, f) - wall_point(tube, pl, s - ds, f))
-                                 .cross(wall_point(tube, pl, s, f + dp) - wall_point(tube, pl, s, f - dp));
-    const Eigen::Vector3d centre = pl.curve->p[pl.curve->at_arc(pl.arc_of_sigma(s))];
-    if (normal.dot(p - centre) < 0) normal = -normal;  // out of the lumen
-    pts->InsertNextPoint(flat_x(s), tube.o.radius_mm * std::fmod(f - cut + 2 * kTwoPi, kTwoPi), 0.0);
-    pos->InsertNextTuple(p.data());
-    nrm->InsertNextTuple(normal.normalized().data());
-    arc->InsertNextValue(pl.arc_of_sigma(s));
-    seg->InsertNextValue(0), src->InsertNextValue(int(v));
+  Eigen::Vector3d normal = (wall_point(tube, pl, s + ds, f) - wall_point(tube, pl, s - ds, f))
+                               .cross(wall_point(tube, pl, s, f + dp) - wall_point(tube, pl, s, f - dp));
+  const Eigen::Vector3d centre = pl.curve->p[pl.curve->at_arc(pl.arc_of_sigma(s))];
+  if (normal.dot(wall_point(tube, pl, s, f) - centre) < 0) normal = -normal;
+  return normal.normalized();
+}
+
+// One scan's flat map: the grid at flat x = flat_x(sigma), y = radius x angle from the cut; with
+// `with_arc`, centreline_mm (and angle_rad) per vertex and the ends labelled rectum / cecum.
+FlatMap grid_flat_map(const Tube& tube, const Placement& pl, const Grid& g, const std::function<double(double)>& flat_x,
+                      double cut, double length, bool with_arc) {
+  FlatMap flat;
+  for (size_t v = 0; v < g.sigma.size(); ++v) {
+    const double s = g.sigma[v], f = g.phi[v];
+    const double angle = std::fmod(f - cut + 2 * kTwoPi, kTwoPi);
+    const Eigen::Vector3d p = wall_point(tube, pl, s, f), n = wall_normal(tube, pl, s, f);
+    flat.uv.push_back({flat_x(s), tube.o.radius_mm * angle});
+    flat.position.push_back({p.x(), p.y(), p.z()});
+    flat.normal.push_back({n.x(), n.y(), n.z()});
+    flat.segment.push_back(0);
+    flat.source_vertex.push_back(int(v));
+    if (with_arc) flat.centreline_mm.push_back(pl.arc_of_sigma(s)), flat.angle_rad.push_back(angle);
   }
-  vtkNew<vtkCellArray> polys;
   for (int r = 0; r + 1 < g.rings; ++r)
     for (int a = 0; a + 1 < g.around; ++a) {
-      const vtkIdType v = vtkIdType(r * g.around + a);
-      const vtkIdType t1[3] = {v, v + g.around, v + 1}, t2[3] = {v + 1, v + g.around, v + g.around + 1};
-      polys->InsertNextCell(3, t1), polys->InsertNextCell(3, t2);
+      const int v = r * g.around + a;
+      flat.triangles.push_back({v, v + g.around, v + 1});
+      flat.triangles.push_back({v + 1, v + g.around, v + g.around + 1});
     }
-  auto pd = vtkSmartPointer<vtkPolyData>::New();
-  pd->SetPoints(pts);
-  pd->SetPolys(polys);
-  pd->GetPointData()->AddArray(pos);
-  pd->GetPointData()->SetNormals(nrm);
-  pd->GetPointData()->AddArray(seg);
-  pd->GetPointData()->AddArray(src);
-  if (with_arc) pd->GetPointData()->AddArray(arc);
-  return pd;
+  FlatSegment seg;
+  seg.length = length;
+  seg.period = kTwoPi * tube.o.radius_mm;
+  if (with_arc) {  // contract 1: a map along the centreline, ends named
+    seg.map = "area-balanced";
+    seg.centreline_length = pl.arc_of_sigma(g.sigma.back());
+    seg.x0_end = "rectum", seg.x1_end = "cecum";
+  }
+  flat.segments.push_back(seg);
+  return flat;
 }
 
 Grid make_grid(double length, double spacing, double radius, double phase) {
@@ -160,15 +155,6 @@ Grid make_grid(double length, double spacing, double radius, double phase) {
       g.phi.push_back(std::fmod(kTwoPi * (a + phase) / g.around, kTwoPi));
     }
   return g;
-}
-
-void add_segments_json(vtkPolyData* pd, double length, bool labels, bool reversed) {
-  nlohmann::json seg = {{"id", 0}, {"rectangle_mm", {{"x0", 0}, {"y0", 0}, {"length", length}}}};
-  if (labels) seg["x0_end"] = reversed ? "cecum" : "rectum", seg["x1_end"] = reversed ? "rectum" : "cecum";
-  vtkNew<vtkStringArray> js;
-  js->SetName("FlatSegments");
-  js->InsertNextValue(nlohmann::json{{"segments", {seg}}}.dump());
-  pd->GetFieldData()->AddArray(js);
 }
 
 }  // namespace
@@ -192,12 +178,10 @@ SyntheticPair make_synthetic_pair(const SyntheticPairOptions& o) {
   const Grid gs = make_grid(L, o.spacing_mm, o.radius_mm, 0.0), gp = make_grid(L, 1.1 * o.spacing_mm, o.radius_mm, 0.37);
   const double pro_len = pro.arc_of_sigma(L);
   auto pro_x = [&](double s) { return o.reverse_prone ? pro_len - 0.95 * pro.arc_of_sigma(s) : 0.95 * pro.arc_of_sigma(s); };
-  auto sup_pd = grid_polydata(tube, sup, gs, [](double s) { return s; }, 0.3, o.centreline);
-  auto pro_pd = grid_polydata(tube, pro, gp, pro_x, 2.0, o.centreline && !o.reverse_prone);
-  add_segments_json(sup_pd, L, o.centreline, false);
-  add_segments_json(pro_pd, 0.95 * pro_len, o.centreline && !o.reverse_prone, false);
-  out.supine = scan_from_polydata(sup_pd, "synthetic supine");
-  out.prone = scan_from_polydata(pro_pd, "synthetic prone");
+  const FlatMap sup_flat = grid_flat_map(tube, sup, gs, [](double s) { return s; }, 0.3, L, o.centreline);
+  const FlatMap pro_flat = grid_flat_map(tube, pro, gp, pro_x, 2.0, 0.95 * pro_len, o.centreline && !o.reverse_prone);
+  out.supine = scan_from_polydata(flat_to_polydata(sup_flat), "synthetic supine");
+  out.prone = scan_from_polydata(flat_to_polydata(pro_flat), "synthetic prone");
   out.supine_sigma = gs.sigma, out.supine_phi = gs.phi, out.prone_sigma = gp.sigma, out.prone_phi = gp.phi;
   std::mt19937_64 rng(o.seed + 17);
   std::uniform_real_distribution<double> u(0, 1);

@@ -1,6 +1,7 @@
 #pragma once
-// Synthetic meshes of known topology, for tests and benchmarks. All closed surfaces are
-// consistently oriented with outward normals.
+// Synthetic meshes of known topology, for tests and benchmarks (test-support library
+// colonflat_testdata: linked by every test and bench, never by the colonflat binary). All closed
+// surfaces are consistently oriented with outward normals.
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/soup.h"
 

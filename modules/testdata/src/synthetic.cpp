@@ -1,4 +1,4 @@
-#include "colonflat/core/synthetic.h"
+#include "colonflat/testdata/synthetic.h"
 
 #include <cmath>
 #include <map>

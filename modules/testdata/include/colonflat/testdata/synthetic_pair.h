@@ -1,11 +1,14 @@
 #pragma once
-// A synthetic supine/prone pair with known correspondence, for tests and benchmarks: one tube
+// A synthetic supine/prone pair with known correspondence, for tests and benchmarks (test-support
+// library colonflat_testdata_register; each scan's flat.vtp is written by flatten's
+// flat_to_polydata, the same writer as `colonflat flatten`): one tube
 // (calibre changes, crescent haustral folds, polyps as bumps) given in material coordinates
 // (sigma = mm along the supine centre line, phi = angle around), placed twice: supine, and prone
 // with its middle shifted sideways, the wall slid along the colon, optionally rotated around the
 // centre line and with the flat x running from the other end. Every wall vertex knows its
 // material coordinates, so the registration error of any vertex is known.
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include "colonflat/register/scan.h"
@@ -40,5 +43,8 @@ struct SyntheticPair {
 };
 
 SyntheticPair make_synthetic_pair(const SyntheticPairOptions& opts);
+
+// Writes a scan as a run directory (flat.vtp, candidates.json, run_report.json), atomically.
+void write_run_dir(const ColonScan& scan, const std::filesystem::path& dir);
 
 }  // namespace cf

@@ -1,0 +1,242 @@
+// render_colon_image, steps 4-5: overlays drawn with VTK's canvas (markers, not-shown rings, scale
+// bar, axis ticks), then the text drawn with FreeType (scale, tick labels, band captions, legend,
+// title, marker labels, in that order: later text covers earlier).
+#include <vtkImageCanvasSource2D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "colon_image_steps.h"
+
+namespace cf::detail {
+namespace {
+
+std::string fmt2(double v) {
+  std::ostringstream t;
+  t.precision(2);
+  t << v;
+  return t.str();
+}
+
+std::string fmt0(double v) {
+  std::ostringstream t;
+  t.setf(std::ios::fixed);
+  t.precision(0);
+  t << v;
+  return t.str();
+}
+
+double nice_length(double target) {
+  const double c[] = {5, 10, 20, 25, 50, 100, 200, 250, 500, 1000};
+  double best = c[0];
+  for (double v : c)
+    if (std::abs(std::log(v / target)) < std::abs(std::log(best / target))) best = v;
+  return best;
+}
+
+// Band x (mm) of a centreline distance (mm from the band's x0 end): the segment's table when
+// present (area-balanced map: x follows the wall area, not exactly the centreline), else x itself.
+double x_of_centreline(const FlatSegment& s, double d) {
+  const auto& t = s.centreline_x;
+  if (t.size() < 2) return d;
+  if (d <= t.front()[0]) return t.front()[1];
+  if (d >= t.back()[0]) return t.back()[1];
+  std::size_t i = 1;
+  while (t[i][0] < d) ++i;
+  const double a = (d - t[i - 1][0]) / std::max(1e-12, t[i][0] - t[i - 1][0]);
+  return t[i - 1][1] + a * (t[i][1] - t[i - 1][1]);
+}
+
+// Where the wall the map does not show (flatten's coverage clusters, >= kNotShownMinArea) lies on
+// the image: at the mapped vertex nearest to each cluster's LPS centroid (on its rim when the
+// cluster is missing from the map, inside it when it is only compressed). The cluster's own pixels
+// are too few to see, so the image rings them instead.
+constexpr double kNotShownMinArea = 25.0;  // mm^2 of 3D wall
+struct NotShownMark {
+  int segment = 0;
+  double x = 0, y = 0;  // flat layout position (mm)
+  double area_mm2 = 0;
+};
+std::vector<NotShownMark> not_shown_marks(const FlatMap& f) {
+  std::vector<NotShownMark> marks;
+  for (const FlatSegment& s : f.segments)
+    for (const auto& cl : s.coverage.not_shown) {
+      if (cl.area_mm2 < kNotShownMinArea) continue;
+      double best = std::numeric_limits<double>::infinity();
+      NotShownMark m;
+      m.segment = s.id;
+      m.area_mm2 = cl.area_mm2;
+      for (std::size_t v = 0; v < f.position.size(); ++v) {
+        if (f.segment[v] != s.id) continue;
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += (f.position[v][k] - cl.centroid_lps_mm[k]) * (f.position[v][k] - cl.centroid_lps_mm[k]);
+        if (d < best) best = d, m.x = f.uv[v][0], m.y = f.uv[v][1];
+      }
+      if (best < std::numeric_limits<double>::infinity()) marks.push_back(m);
+    }
+  return marks;
+}
+
+// Ticks below each band: every 1 cm (short), 5 cm (medium) and 10 cm (long, labelled in cm) of
+// x = centreline distance from the band's x0 end plus the centreline length of earlier segments.
+std::vector<Tick> axis_ticks(const FlatMap& f, const std::vector<Band>& bands, double px) {
+  std::vector<Tick> ticks;
+  for (const Band& b : bands) {
+    const FlatSegment& s = f.segments[b.seg];
+    const double off = s.centreline_offset;
+    const double step = 10.0 / px < 4 ? 50.0 : 10.0;  // mm; 1 cm ticks only when they are >= 4 px apart
+    const double len = s.centreline_length > 0 ? s.centreline_length : s.length;
+    for (double mm = std::ceil(off / step) * step; mm <= off + len + 1e-9; mm += step) {
+      Tick t;
+      t.col = b.col0 + int(std::lround(x_of_centreline(s, mm - off) / px));
+      t.row_bottom = b.row0 - 1;
+      const long cm = std::lround(mm / 10);
+      t.len = cm % 10 == 0 ? 12 : cm % 5 == 0 ? 8 : 4;
+      if (cm % 10 == 0) t.text = std::to_string(cm);
+      ticks.push_back(t);
+    }
+  }
+  return ticks;
+}
+
+}  // namespace
+
+// The shaded bands copied into a VTK canvas, the shapes drawn on it, and the result kept.
+void ColonImagePainter::compose_overlays() {
+  vtkNew<vtkImageCanvasSource2D> canvas;
+  canvas->SetScalarTypeToUnsignedChar();
+  canvas->SetNumberOfScalarComponents(3);
+  canvas->SetExtent(0, width_ - 1, 0, height_ - 1, 0, 0);
+  canvas->DrawImage(0, 0, image_);
+  draw_markers(canvas);
+  draw_not_shown_rings(canvas);
+  draw_scale_bar(canvas);
+  draw_ticks(canvas);
+  canvas->Update();
+  ImagePtr final_img = ImagePtr::New();
+  final_img->DeepCopy(canvas->GetOutput());
+  image_ = final_img;
+  pixels_ = nullptr;
+}
+
+void ColonImagePainter::draw_markers(vtkImageCanvasSource2D* canvas) {
+  for (auto& mk : markers_)
+    if (const Band* band = band_of(mk.segment)) draw_marker(canvas, mk, *band);
+}
+
+// A circle (dashed green for a known polyp, yellow for a candidate) with its label beside it; the
+// marker's pixel position is recorded.
+void ColonImagePainter::draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& mk, const Band& band) {
+  const FlatSegment& s = flat_.segments[mk.segment];
+  const double y = rolled_y(band, mk.y);
+  const double cx = band.col0 + (mk.x - s.x0) / px_, cy = band.row0 + y / px_;
+  mk.px = cx;
+  mk.py = height_ - 1 - cy;
+  const double r = std::max(6.0, mk.radius_mm / px_ + 4);
+  if (mk.known) canvas->SetDrawColor(60, 230, 90);
+  else canvas->SetDrawColor(255, 230, 0);
+  const int nseg = 36;
+  for (int k = 0; k < nseg; ++k) {
+    if (mk.known && k % 2) continue;
+    const double a0 = 2 * M_PI * k / nseg, a1 = 2 * M_PI * (k + 1) / nseg;
+    canvas->FillTube(int(cx + r * std::cos(a0)), int(cy + r * std::sin(a0)), int(cx + r * std::cos(a1)),
+                     int(cy + r * std::sin(a1)), 1.3);
+  }
+  Label l{mk.label, int(cx + r * 0.75), int(height_ - 1 - (cy + r * 0.75)) - 16, {1, 0.9, 0}, 14, 0.55};
+  if (mk.known) l.col[0] = 0.25, l.col[1] = 0.95, l.col[2] = 0.4, l.y = int(height_ - 1 - (cy - r * 0.75)) + 2;
+  labels_.push_back(l);
+}
+
+// Wall not shown: a red square ring at its place, labelled with its 3D area.
+void ColonImagePainter::draw_not_shown_rings(vtkImageCanvasSource2D* canvas) {
+  canvas->SetDrawColor(255, 60, 60);
+  for (const NotShownMark& m : not_shown_marks(flat_)) {
+    const Band* band = band_of(m.segment);
+    if (!band) continue;
+    const FlatSegment& s = flat_.segments[m.segment];
+    const double y = rolled_y(*band, m.y);
+    const int cx = int(band->col0 + (m.x - s.x0) / px_), cy = int(band->row0 + y / px_), r = 9;
+    canvas->FillBox(cx - r, cx + r, cy - r, cy - r + 1);
+    canvas->FillBox(cx - r, cx + r, cy + r - 1, cy + r);
+    canvas->FillBox(cx - r, cx - r + 1, cy - r, cy + r);
+    canvas->FillBox(cx + r - 1, cx + r, cy - r, cy + r);
+    const std::string area = m.area_mm2 < 1000 ? fmt0(m.area_mm2) + " mm2" : fmt0(m.area_mm2 / 100.0) + " cm2";
+    labels_.push_back({area + " not shown", cx + r + 2, height_ - 1 - cy - 6, {1, 0.45, 0.45}, 12, 0.55});
+  }
+}
+
+// Scale bar (bottom left), in mm at the mean (area-preserving) scale.
+void ColonImagePainter::draw_scale_bar(vtkImageCanvasSource2D* canvas) {
+  const int margin = margin_;
+  bar_mm_ = nice_length(0.12 * (width_ - 2 * margin) * px_);
+  bar_px_ = int(std::lround(bar_mm_ / px_));
+  canvas->SetDrawColor(255, 255, 255);
+  canvas->FillBox(margin, margin + bar_px_, 28, 34);
+  canvas->FillBox(margin, margin + 2, 22, 40);
+  canvas->FillBox(margin + bar_px_ - 2, margin + bar_px_, 22, 40);
+}
+
+void ColonImagePainter::draw_ticks(vtkImageCanvasSource2D* canvas) {
+  ticks_ = axis_ticks(flat_, bands_, px_);
+  canvas->SetDrawColor(230, 230, 230);
+  for (const Tick& t : ticks_) canvas->FillBox(t.col, t.col + 1, t.row_bottom - t.len, t.row_bottom);
+}
+
+// The scale bar's length and pixel size, and the cm labels under the long ticks.
+void ColonImagePainter::write_scale_text() {
+  const double white[3] = {1, 1, 1}, grey[3] = {0.85, 0.85, 0.85};
+  const int margin = margin_;
+  std::ostringstream sb;
+  sb << bar_mm_ << " mm";
+  draw_text(image_, sb.str(), margin + bar_px_ + 10, height_ - 44, 16, white);
+  std::ostringstream q;
+  q.precision(2);
+  q << px_;
+  draw_text(image_, "(scale at the mean, area-preserving map scale; 1 px = " + q.str() + " mm)",
+            margin + bar_px_ + 80, height_ - 42, 12, grey);
+  for (const Tick& t : ticks_)
+    if (!t.text.empty()) draw_text(image_, t.text, t.col - 4 * int(t.text.size()), height_ - t.row_bottom + 2, 12, grey);
+}
+
+// Above each band: what it shows and its x axis; its two ends named at its corners.
+void ColonImagePainter::write_band_captions() {
+  const double grey[3] = {0.85, 0.85, 0.85}, end_col[3] = {1, 0.85, 0.35};
+  for (const Band& b : bands_) {
+    const FlatSegment& s = flat_.segments[b.seg];
+    const bool along = !s.map.empty() && s.map != "conformal";
+    std::string t = "segment " + std::to_string(s.id + 1) + ": " + fmt0(s.length) + " mm long x " + fmt0(s.period) +
+                    " mm around; " + s.x0_end + " (left) to " + s.x1_end + " (right); " +
+                    (along ? "x axis: cm along the centreline from the " + s.x0_end
+                           : "x axis: cm of the conformal map (not centreline length)");
+    draw_text(image_, t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
+    const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
+    draw_text(image_, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
+    draw_text(image_, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
+  }
+}
+
+// The hatching legend (bottom), the title (top), then the marker and ring labels over everything.
+void ColonImagePainter::write_legend_and_title() {
+  const double white[3] = {1, 1, 1}, grey[3] = {0.85, 0.85, 0.85};
+  const int margin = margin_;
+  draw_text(image_, "hatched blue: wall compressed below " + fmt2(opts_.compressed_ratio) +
+                        " x its area; hatched red: wall not in the map; red squares: wall the image cannot show (its 3D area)",
+            margin, height_ - 22, 12, grey);
+  draw_text(image_, opts_.title.empty() ? automatic_title() : opts_.title, margin, 12, 18, white);
+  for (const auto& l : labels_) draw_text(image_, l.text, l.x, l.y, l.size, l.col, l.bg);
+}
+
+std::string ColonImagePainter::automatic_title() const {
+  int nc = 0, nk = 0;
+  for (const auto& m : markers_) (m.known ? nk : nc)++;
+  const std::string map =
+      flat_.segments.empty() || flat_.segments[0].map.empty() ? std::string("conformal") : flat_.segments[0].map;
+  return "ColonFlat: unrolled colon wall (" + map + " map), " + std::to_string(nc) + " polyp candidate" +
+         (nc == 1 ? "" : "s") + " (yellow)" + (nk ? ", " + std::to_string(nk) + " known polyps (green, dashed)" : "");
+}
+
+}  // namespace cf::detail

@@ -1,0 +1,245 @@
+// render_colon_image, steps 2-3: each band's triangles rasterised with VTK's probe filter and every
+// pixel shaded from its 3D normal (or hatched where the wall is missing or compressed).
+#include <vtkCellArray.h>
+#include <vtkCharArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkImageData.h>
+#include <vtkImageGaussianSmooth.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkProbeFilter.h>
+#include <vtkStaticCellLocator.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "colonflat/core/error.h"
+#include "colon_image_steps.h"
+
+namespace cf::detail {
+
+std::vector<double> vertex_area_ratio(const FlatMap& f) {
+  std::vector<double> a2(f.triangles.size()), a3(f.triangles.size());
+  std::vector<double> seg2(f.segments.size(), 0.0), seg3(f.segments.size(), 0.0);
+  for (std::size_t i = 0; i < f.triangles.size(); ++i) {
+    const auto& t = f.triangles[i];
+    const auto &q0 = f.uv[t[0]], &q1 = f.uv[t[1]], &q2 = f.uv[t[2]];
+    a2[i] = 0.5 * ((q1[0] - q0[0]) * (q2[1] - q0[1]) - (q1[1] - q0[1]) * (q2[0] - q0[0]));
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) e1[k] = f.position[t[1]][k] - f.position[t[0]][k], e2[k] = f.position[t[2]][k] - f.position[t[0]][k];
+    a3[i] = 0.5 * std::sqrt(std::pow(e1[1] * e2[2] - e1[2] * e2[1], 2) + std::pow(e1[2] * e2[0] - e1[0] * e2[2], 2) +
+                            std::pow(e1[0] * e2[1] - e1[1] * e2[0], 2));
+    seg2[f.segment[t[0]]] += std::abs(a2[i]);
+    seg3[f.segment[t[0]]] += a3[i];
+  }
+  std::vector<double> r(f.uv.size(), 1e9);
+  for (std::size_t i = 0; i < f.triangles.size(); ++i) {
+    const int sg = f.segment[f.triangles[i][0]];
+    const double scale = seg2[sg] > 0 ? seg3[sg] / seg2[sg] : 1.0;
+    const double q = a3[i] > 1e-12 ? a2[i] * scale / a3[i] : 1.0;
+    for (int v : f.triangles[i]) r[v] = std::min(r[v], q);
+  }
+  return r;
+}
+
+void colour_of_shape_index(double si, double rgb[3]) {
+  // cup/rut blue -> saddle pale -> ridge yellow -> cap red
+  struct Stop { double s, r, g, b; };
+  static const Stop stops[] = {{-1, 0.25, 0.35, 0.85}, {-0.5, 0.45, 0.6, 0.9}, {0, 0.92, 0.85, 0.8},
+                               {0.5, 0.95, 0.8, 0.3}, {0.85, 0.95, 0.45, 0.2}, {1, 0.9, 0.1, 0.1}};
+  si = std::clamp(si, -1.0, 1.0);
+  for (int i = 0; i < 5; ++i)
+    if (si <= stops[i + 1].s) {
+      const double a = (si - stops[i].s) / (stops[i + 1].s - stops[i].s);
+      rgb[0] = stops[i].r + a * (stops[i + 1].r - stops[i].r);
+      rgb[1] = stops[i].g + a * (stops[i + 1].g - stops[i].g);
+      rgb[2] = stops[i].b + a * (stops[i + 1].b - stops[i].b);
+      return;
+    }
+  rgb[0] = stops[5].r, rgb[1] = stops[5].g, rgb[2] = stops[5].b;
+}
+
+// One band: rasterise, smooth the view normals, then shade (or hatch) each pixel into the image.
+void ColonImagePainter::paint_band(const Band& b) {
+  const FlatSegment& s = flat_.segments[b.seg];
+  out_.roll[b.seg] = b.c0;
+  const vtkSmartPointer<vtkPolyData> rolled = rolled_segment(s, b.c0);
+  const ProbedBand probed = probe_band(b, rolled);
+  ImagePtr view = view_normals(b, probed);
+  ImagePtr mean = smoothed_normals(view);
+  const auto* vnp = static_cast<const double*>(view->GetScalarPointer());
+  const auto* mp = static_cast<const double*>(mean->GetScalarPointer());
+  for (int j = 0; j < b.h; ++j)
+    for (int i = 0; i < b.w; ++i) {
+      const vtkIdType id = vtkIdType(j) * b.w + i;
+      unsigned char* d = pixels_ + (std::size_t(b.row0 + j) * width_ + b.col0 + i) * 3;
+      const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
+      if (!probed.valid->GetValue(id) && (i + 0.5) * px_ > s.length) continue;  // past the band's end (rounding)
+      if (!probed.valid->GetValue(id)) {
+        hatch_missing(stripe, d);
+        continue;
+      }
+      const PixelGeometry g = pixel_geometry(b, probed, vnp, mp, i, j);
+      shade_pixel(g, probed.shape_index->GetTuple1(id), probed.ratio->GetTuple1(id), stripe, d);
+    }
+}
+
+// The triangles of one segment with y rolled into [c0, c0 + P), plus copies across the cut.
+vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_segment(const FlatSegment& s, double c0) const {
+  const FlatMap& f = flat_;
+  const double P = s.period;
+  std::map<std::pair<int, int>, vtkIdType> ids;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> nrm, pos, shp, rat;
+  nrm->SetName("n");
+  nrm->SetNumberOfComponents(3);
+  pos->SetName("p");
+  pos->SetNumberOfComponents(3);
+  shp->SetName("si");
+  rat->SetName("ratio");
+  vtkNew<vtkCellArray> polys;
+  auto vid = [&](int v, int copy) {
+    auto it = ids.find({v, copy});
+    if (it != ids.end()) return it->second;
+    const vtkIdType id = pts->InsertNextPoint(f.uv[v][0], f.uv[v][1] + copy * P, 0.0);
+    nrm->InsertNextTuple(f.normal[v].data());
+    pos->InsertNextTuple(f.position[v].data());
+    shp->InsertNextValue(shape_index_.empty() ? 0.0 : shape_index_[v]);
+    rat->InsertNextValue(vertex_ratio_[v]);
+    ids.emplace(std::make_pair(v, copy), id);
+    return id;
+  };
+  for (const auto& t : f.triangles) {
+    if (f.segment[t[0]] != s.id) continue;
+    const double cy = (f.uv[t[0]][1] + f.uv[t[1]][1] + f.uv[t[2]][1]) / 3;
+    const int k = int(std::floor((cy - c0) / P));
+    const double ymin = std::min({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
+    const double ymax = std::max({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
+    for (int extra : {0, -1, 1}) {
+      if (extra == -1 && ymax < c0 + P) continue;  // crosses the top: copy one period down
+      if (extra == 1 && ymin > c0) continue;       // crosses the bottom: copy one period up
+      const int kk = -k + (extra == -1 ? -1 : extra == 1 ? 1 : 0);
+      vtkIdType c[3] = {vid(t[0], kk), vid(t[1], kk), vid(t[2], kk)};
+      polys->InsertNextCell(3, c);
+    }
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  pd->GetPointData()->AddArray(nrm);
+  pd->GetPointData()->AddArray(pos);
+  pd->GetPointData()->AddArray(shp);
+  pd->GetPointData()->AddArray(rat);
+  return pd;
+}
+
+// The rolled triangles sampled at the band's pixel centres (probe filter, static cell locator).
+ProbedBand ColonImagePainter::probe_band(const Band& b, vtkPolyData* rolled) const {
+  const FlatSegment& s = flat_.segments[b.seg];
+  vtkNew<vtkImageData> grid;
+  grid->SetDimensions(b.w, b.h, 1);
+  grid->SetOrigin(s.x0 + 0.5 * px_, b.c0 + 0.5 * px_, 0);
+  grid->SetSpacing(px_, px_, 1);
+  ProbedBand r;
+  r.probe = vtkSmartPointer<vtkProbeFilter>::New();
+  r.probe->SetInputData(grid);
+  r.probe->SetSourceData(rolled);
+  vtkNew<vtkStaticCellLocator> loc;
+  r.probe->SetCellLocatorPrototype(loc);
+  r.probe->Update();
+  vtkPointData* pd = r.probe->GetOutput()->GetPointData();
+  r.valid = vtkCharArray::SafeDownCast(pd->GetArray(r.probe->GetValidPointMaskArrayName()));
+  r.normal = pd->GetArray("n");
+  r.position = pd->GetArray("p");
+  r.shape_index = pd->GetArray("si");
+  r.ratio = pd->GetArray("ratio");
+  if (!r.valid || !r.normal || !r.position || !r.shape_index || !r.ratio)
+    throw Error("rasterising the flat map failed: " + messages_.first_problem());
+  return r;
+}
+
+// Unit normal into the lumen per pixel (0 where no wall), as a 3-component double image.
+ImagePtr ColonImagePainter::view_normals(const Band& b, const ProbedBand& probed) const {
+  ImagePtr vn = ImagePtr::New();
+  vn->SetDimensions(b.w, b.h, 1);
+  vn->AllocateScalars(VTK_DOUBLE, 3);
+  auto* vnp = static_cast<double*>(vn->GetScalarPointer());
+  const vtkIdType n = vtkIdType(b.w) * b.h;
+  for (vtkIdType i = 0; i < n; ++i) {
+    double q[3];
+    probed.normal->GetTuple(i, q);
+    const double l = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    for (int k = 0; k < 3; ++k) vnp[3 * i + k] = probed.valid->GetValue(i) && l > 0 ? -q[k] / l : 0.0;
+  }
+  return vn;
+}
+
+// The large-scale wall normal: view normals Gaussian-smoothed with sigma smooth_normal (mm).
+ImagePtr ColonImagePainter::smoothed_normals(vtkImageData* view) const {
+  vtkNew<vtkImageGaussianSmooth> smooth;
+  smooth->SetInputData(view);
+  smooth->SetDimensionality(2);
+  const double sd = std::max(1.0, opts_.smooth_normal / px_);
+  smooth->SetStandardDeviations(sd, sd, 0);
+  smooth->SetRadiusFactors(2.5, 2.5, 0);
+  smooth->Update();
+  return smooth->GetOutput();
+}
+
+// The tangent along the colon from the 3D positions of the neighbouring pixels (the pixel itself
+// where a neighbour has no wall).
+PixelGeometry ColonImagePainter::pixel_geometry(const Band& b, const ProbedBand& probed, const double* view,
+                                                const double* mean, int i, int j) const {
+  const vtkIdType id = vtkIdType(j) * b.w + i;
+  PixelGeometry g;
+  g.view = view + 3 * id;
+  for (int k = 0; k < 3; ++k) g.mean[k] = mean[3 * id + k];
+  double pa[3], pb[3];
+  const vtkIdType ia = j * b.w + std::max(0, i - 1), ib = j * b.w + std::min(b.w - 1, i + 1);
+  probed.position->GetTuple(probed.valid->GetValue(ia) ? ia : id, pa);
+  probed.position->GetTuple(probed.valid->GetValue(ib) ? ib : id, pb);
+  for (int k = 0; k < 3; ++k) g.tangent[k] = pb[k] - pa[k];
+  return g;
+}
+
+// Diffuse + specular shading against a light tilted from the large-scale normal towards the colon
+// axis; curvature colouring and blue hatching (compressed wall) on top.
+void ColonImagePainter::shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe,
+                                    unsigned char* d) {
+  const double* v = g.view;
+  const double* m = g.mean;
+  const double* t = g.tangent;
+  const double mn = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+  const double tn = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+  double L[3];
+  for (int k = 0; k < 3; ++k) L[k] = (mn > 0 ? m[k] / mn : v[k]) + (tn > 0 ? -opts_.light_tilt * t[k] / tn : 0.0);
+  const double ln = std::sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2]);
+  const double diff = std::max(0.0, (v[0] * L[0] + v[1] * L[1] + v[2] * L[2]) / ln);
+  const double shade = 0.22 + 0.78 * diff;
+  const double spec = 0.18 * std::pow(diff, 24);
+  double base[3] = {0.90, 0.58, 0.52};
+  if (opts_.color == "curvature") {
+    double c[3];
+    colour_of_shape_index(shape_index, c);
+    for (int k = 0; k < 3; ++k) base[k] = 0.35 * base[k] + 0.65 * c[k];
+  }
+  const bool compressed = ratio < opts_.compressed_ratio;
+  if (compressed) ++out_.compressed_pixels;
+  for (int k = 0; k < 3; ++k) {
+    double val = 255.0 * (base[k] * shade + spec);
+    if (compressed && stripe) val = 0.45 * val + 0.55 * 255.0 * (k == 2 ? 1.0 : k == 1 ? 0.9 : 0.2);
+    d[k] = static_cast<unsigned char>(std::clamp(val, 0.0, 255.0));
+  }
+}
+
+// Wall not in the map: hatched dark red.
+void ColonImagePainter::hatch_missing(bool stripe, unsigned char* d) {
+  d[0] = stripe ? 120 : 40, d[1] = d[2] = stripe ? 20 : 10;
+  ++out_.missing_pixels;
+}
+
+}  // namespace cf::detail

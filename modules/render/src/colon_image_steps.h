@@ -1,0 +1,127 @@
+#pragma once
+// Internal to the render module: render_colon_image() as named steps. One ColonImagePainter per
+// call; each method is one step, in the order run() calls them:
+//   colon_image.cpp          lay out the bands (geometry + roll), fill the background;
+//   colon_image_raster.cpp   per band: roll the segment's triangles, probe them on the pixel grid,
+//                            smooth the view normals, shade or hatch every pixel;
+//   colon_image_overlay.cpp  markers, not-shown rings, scale bar and ticks (VTK canvas), then the
+//                            text (scale, tick labels, band captions, legend, title, marker labels).
+// Pixel rows count from the image bottom (VTK) unless a name says "from the top".
+#include <string>
+#include <vector>
+
+#include <vtkSmartPointer.h>
+
+#include "colonflat/core/vtk_messages.h"
+#include "colonflat/render/colon_image.h"
+
+class vtkCharArray;
+class vtkDataArray;
+class vtkImageCanvasSource2D;
+class vtkPolyData;
+class vtkProbeFilter;
+
+namespace cf::detail {
+
+// One segment's band with the roll chosen for it.
+struct Band {
+  int seg = 0;
+  int w = 0, h = 0;  // pixels
+  int col0 = 0;      // left column in the image
+  int row0 = 0;      // bottom row in VTK image coordinates
+  double c0 = 0;     // roll: y of the cut (mm)
+};
+
+// A tick below a band (canvas coordinates, row from the bottom); labelled ticks carry text.
+struct Tick {
+  int col = 0, row_bottom = 0, len = 0;
+  std::string text;
+};
+
+// A text drawn last, over everything (marker ids, not-shown areas).
+struct Label {
+  std::string text;
+  int x, y;  // top-left, row from the top
+  double col[3];
+  int size;
+  double bg;
+};
+
+// The probe filter's output on a band's pixel grid (pixel id = row * w + column).
+struct ProbedBand {
+  vtkSmartPointer<vtkProbeFilter> probe;  // owns the arrays below
+  vtkCharArray* valid = nullptr;          // 1 where a triangle covers the pixel centre
+  vtkDataArray* normal = nullptr;         // outward 3D normal
+  vtkDataArray* position = nullptr;       // LPS mm
+  vtkDataArray* shape_index = nullptr;
+  vtkDataArray* ratio = nullptr;          // 2D/3D area ratio (vertex_area_ratio)
+};
+
+// The wall seen at one pixel: unit view normal, large-scale normal, tangent along the colon.
+struct PixelGeometry {
+  const double* view;  // unit normal into the lumen
+  double mean[3];      // smoothed view normal (not unit)
+  double tangent[3];   // 3D difference of the neighbouring pixels along x
+};
+
+// Per flat vertex: the smallest 2D/3D area ratio of its triangles at its segment's
+// area-preserving scale (1 = true size; small = strongly compressed on the image).
+std::vector<double> vertex_area_ratio(const FlatMap& flat);
+
+// Shape index -> RGB (cup blue, saddle pale, ridge yellow, cap red).
+void colour_of_shape_index(double si, double rgb[3]);
+
+class ColonImagePainter {
+ public:
+  ColonImagePainter(const FlatMap& flat, const std::vector<double>& shape_index, std::vector<ImageMarker>& markers,
+                    const ColonImageOptions& opts);
+  ColonImage run();
+
+ private:
+  // Layout (colon_image.cpp).
+  void lay_out_bands();
+  void fill_background();
+  const Band* band_of(int segment) const;
+  double rolled_y(const Band& band, double y) const;  // y - roll, wrapped into [0, period)
+  // Rasterising and shading (colon_image_raster.cpp).
+  void paint_band(const Band& band);
+  vtkSmartPointer<vtkPolyData> rolled_segment(const FlatSegment& segment, double c0) const;
+  ProbedBand probe_band(const Band& band, vtkPolyData* rolled) const;
+  ImagePtr view_normals(const Band& band, const ProbedBand& probed) const;
+  ImagePtr smoothed_normals(vtkImageData* view) const;
+  PixelGeometry pixel_geometry(const Band& band, const ProbedBand& probed, const double* view, const double* mean,
+                               int column, int row) const;
+  void shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe, unsigned char* rgb);
+  void hatch_missing(bool stripe, unsigned char* rgb);
+  // Overlays (colon_image_overlay.cpp).
+  void draw_markers(vtkImageCanvasSource2D* canvas);
+  void draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& marker, const Band& band);
+  void draw_not_shown_rings(vtkImageCanvasSource2D* canvas);
+  void draw_scale_bar(vtkImageCanvasSource2D* canvas);
+  void draw_ticks(vtkImageCanvasSource2D* canvas);
+  void compose_overlays();
+  void write_scale_text();
+  void write_band_captions();
+  void write_legend_and_title();
+  std::string automatic_title() const;
+
+  VtkMessageCapture messages_;  // VTK's messages during the whole call (rasterising errors)
+  const FlatMap& flat_;
+  const std::vector<double>& shape_index_;
+  std::vector<ImageMarker>& markers_;
+  const ColonImageOptions& opts_;
+  ColonImage out_;
+  double px_ = 0;  // mm per pixel
+  int width_ = 0, height_ = 0;
+  int margin_ = 0;  // left margin of the bands and of the scale bar, legend and title (px)
+  std::vector<double> vertex_ratio_;
+  std::vector<Band> bands_;
+  ImagePtr image_;  // the shaded bands, then the final image with overlays and text
+  unsigned char* pixels_ = nullptr;
+  std::vector<Tick> ticks_;
+  std::vector<Label> labels_;
+  double bar_mm_ = 0;
+  int bar_px_ = 0;
+};
+
+}  // namespace cf::detail
