@@ -81,6 +81,29 @@ std::vector<NotShownMark> not_shown_marks(const FlatMap& f) {
   return marks;
 }
 
+// Where each side branch (a pouch shown as a band of its own) leaves its parent band: at the
+// parent's mapped vertex nearest to the branch's neck centre.
+struct NeckMark {
+  int segment = 0, branch = 0;
+  double x = 0, y = 0;  // flat layout position (mm)
+};
+std::vector<NeckMark> neck_marks(const FlatMap& f) {
+  std::vector<NeckMark> marks;
+  for (const FlatSegment& b : f.segments) {
+    if (b.kind != "branch" || b.parent < 0) continue;
+    NeckMark m{b.parent, b.id, 0, 0};
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t v = 0; v < f.position.size(); ++v) {
+      if (f.segment[v] != b.parent) continue;
+      double d = 0;
+      for (int k = 0; k < 3; ++k) d += (f.position[v][k] - b.attach_lps[k]) * (f.position[v][k] - b.attach_lps[k]);
+      if (d < best) best = d, m.x = f.uv[v][0], m.y = f.uv[v][1];
+    }
+    if (best < std::numeric_limits<double>::infinity()) marks.push_back(m);
+  }
+  return marks;
+}
+
 // Ticks below each band: every 1 cm (short), 5 cm (medium) and 10 cm (long, labelled in cm) of
 // x = centreline distance from the band's x0 end plus the centreline length of earlier segments.
 std::vector<Tick> axis_ticks(const FlatMap& f, const std::vector<Band>& bands, double px) {
@@ -114,6 +137,7 @@ void ColonImagePainter::compose_overlays() {
   canvas->DrawImage(0, 0, image_);
   draw_markers(canvas);
   draw_not_shown_rings(canvas);
+  draw_branch_necks(canvas);
   draw_scale_bar(canvas);
   draw_ticks(canvas);
   canvas->Update();
@@ -169,6 +193,21 @@ void ColonImagePainter::draw_not_shown_rings(vtkImageCanvasSource2D* canvas) {
   }
 }
 
+// A side branch's neck on its parent band: a cyan diamond labelled with the branch's band.
+void ColonImagePainter::draw_branch_necks(vtkImageCanvasSource2D* canvas) {
+  canvas->SetDrawColor(80, 220, 255);
+  for (const NeckMark& m : neck_marks(flat_)) {
+    const Band* band = band_of(m.segment);
+    if (!band) continue;
+    const FlatSegment& s = flat_.segments[m.segment];
+    const int cx = int(band->col0 + (m.x - s.x0) / px_), cy = int(band->row0 + rolled_y(*band, m.y) / px_), r = 10;
+    const int corner[5][2] = {{cx, cy - r}, {cx + r, cy}, {cx, cy + r}, {cx - r, cy}, {cx, cy - r}};
+    for (int k = 0; k < 4; ++k) canvas->FillTube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
+    labels_.push_back({"branch: segment " + std::to_string(m.branch + 1), cx + r + 2, height_ - 1 - cy - 6,
+                       {0.45, 0.9, 1}, 12, 0.55});
+  }
+}
+
 // Scale bar (bottom left), in mm at the mean (area-preserving) scale.
 void ColonImagePainter::draw_scale_bar(vtkImageCanvasSource2D* canvas) {
   const int margin = margin_;
@@ -208,10 +247,14 @@ void ColonImagePainter::write_band_captions() {
   for (const Band& b : bands_) {
     const FlatSegment& s = flat_.segments[b.seg];
     const bool along = !s.map.empty() && s.map != "conformal";
-    std::string t = "segment " + std::to_string(s.id + 1) + ": " + fmt0(s.length) + " mm long x " + fmt0(s.period) +
-                    " mm around; " + s.x0_end + " (left) to " + s.x1_end + " (right); " +
-                    (along ? "x axis: cm along the centreline from the " + s.x0_end
-                           : "x axis: cm of the conformal map (not centreline length)");
+    std::string t = "segment " + std::to_string(s.id + 1) + ": ";
+    if (s.kind == "branch")
+      t += "side branch (pouch) of segment " + std::to_string(s.parent + 1) + " at " + fmt0(s.attach_mm / 10) +
+           " cm, neck " + fmt0(s.neck_mm) + " mm around; ";
+    t += fmt0(s.length) + " mm long x " + fmt0(s.period) + " mm around; " + s.x0_end + " (left) to " + s.x1_end +
+         " (right); " +
+         (along ? "x axis: cm along the centreline from the " + s.x0_end
+                : "x axis: cm of the conformal map (not centreline length)");
     draw_text(image_, t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
     const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
     draw_text(image_, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);

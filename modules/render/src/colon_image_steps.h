@@ -97,6 +97,7 @@ class ColonImagePainter {
   void draw_markers(vtkImageCanvasSource2D* canvas);
   void draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& marker, const Band& band);
   void draw_not_shown_rings(vtkImageCanvasSource2D* canvas);
+  void draw_branch_necks(vtkImageCanvasSource2D* canvas);
   void draw_scale_bar(vtkImageCanvasSource2D* canvas);
   void draw_ticks(vtkImageCanvasSource2D* canvas);
   void compose_overlays();
