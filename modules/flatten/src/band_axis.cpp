@@ -46,27 +46,33 @@ DistortionStats axis_distortion(const SegmentWork& w, const std::vector<double>&
 
 // The band's x axis: among x(u) = B F_beta(u) (B the band length) (beta = 0: conformal spacing; 1: each slice as wide
 // as its wall area), the one with the smallest angle distortion whose area ratios stay in bounds
-// (5th percentile >= 0.3, 95th <= 3.5); else the one with the largest 5th percentile.
+// (5th percentile >= 0.3, 95th <= 3.5); when none is, the least distorting of those whose 5th
+// percentile is within 10 % of the best.
 std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double band, double yscale,
                                 const std::vector<char>& degenerate) {
-  double best_qc = 1e300;
-  std::vector<double> best = cl.blended_axis(1.0);
   w.seg.balance_strength = 1.0;
-  double best_p05 = -1;  // when no axis is within bounds: the one with the best 5th percentile
+  std::vector<std::pair<double, DistortionStats>> tried;
   for (int step = 0; step <= 10; ++step) {
     const double beta = 0.1 * step;
-    std::vector<double> axis = cl.blended_axis(beta);
-    const DistortionStats st = axis_distortion(w, axis, band, yscale, degenerate);
-    const bool within = st.area_p05 >= kAxisAreaLow && st.area_p95 <= kAxisAreaHigh;
+    const DistortionStats st = axis_distortion(w, cl.blended_axis(beta), band, yscale, degenerate);
     if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
       std::fprintf(stderr, "flatten debug axis beta %.1f (conformal length %.0f, band %.0f mm): qc mean %.3f area p05 %.3f p95 %.3f\n",
                    beta, w.seg.length, band, st.qc_mean, st.area_p05, st.area_p95);
-    if (within ? st.qc_mean < best_qc : best_qc == 1e300 && st.area_p05 > best_p05) {
-      if (within) best_qc = st.qc_mean;
-      best_p05 = st.area_p05, best = std::move(axis), w.seg.balance_strength = beta;
-    }
+    tried.emplace_back(beta, st);
   }
-  return best;
+  double best_p05 = 0;
+  bool any_within = false;
+  for (const auto& [beta, st] : tried) {
+    best_p05 = std::max(best_p05, st.area_p05);
+    any_within = any_within || (st.area_p05 >= kAxisAreaLow && st.area_p95 <= kAxisAreaHigh);
+  }
+  // Candidates: within bounds; when none is, within 10 % of the best 5th percentile.
+  double best_qc = 1e300;
+  for (const auto& [beta, st] : tried) {
+    const bool ok = any_within ? st.area_p05 >= kAxisAreaLow && st.area_p95 <= kAxisAreaHigh : st.area_p05 >= 0.9 * best_p05;
+    if (ok && st.qc_mean < best_qc) best_qc = st.qc_mean, w.seg.balance_strength = beta;
+  }
+  return cl.blended_axis(w.seg.balance_strength);
 }
 
 }  // namespace

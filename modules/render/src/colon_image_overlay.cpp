@@ -258,7 +258,8 @@ void ColonImagePainter::write_band_captions() {
     draw_text(image_, t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
     const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
     draw_text(image_, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
-    draw_text(image_, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
+    if (b.w > 10 * int(s.x0_end.size() + s.x1_end.size()) + 24)  // both names fit side by side
+      draw_text(image_, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
   }
 }
 
