@@ -77,7 +77,8 @@ void ColonImagePainter::paint_band(const Band& b) {
       const vtkIdType id = vtkIdType(j) * b.w + i;
       unsigned char* d = pixels_ + (std::size_t(b.row0 + j) * width_ + b.col0 + i) * 3;
       const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
-      if (!probed.valid->GetValue(id) && (i + 0.5) * px_ > s.length) continue;  // past the band's end (rounding)
+      const bool past_edge = (i + 0.5) * px_ > s.length || (j + 0.5) * px_ > s.period;  // the last column / row (rounding)
+      if (!probed.valid->GetValue(id) && past_edge) continue;
       if (!probed.valid->GetValue(id)) {
         hatch_missing(stripe, d);
         continue;
