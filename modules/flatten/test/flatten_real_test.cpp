@@ -40,12 +40,19 @@ void expect_achieved(const FlatMap& f) {
   }
 }
 
-// Issue 11 targets NOT met yet (measured on the CTC mask: coverage 88.2 %, 110 424 faces left out,
-// qc mean 1.86; on the GCA surface qc mean 2.1): run with --gtest_also_run_disabled_tests.
-void expect_targets(const FlatMap& f) {
+// Issue 11's coverage and angle targets: at least 99.5 % of the wall shown, quasi-conformal mean <= 1.5.
+void expect_coverage_and_angles(const FlatMap& f) {
   EXPECT_GE(f.coverage.fraction, 0.995) << "missing " << f.coverage.missing_area_mm2 << " mm2, compressed "
                                         << f.coverage.compressed_area_mm2 << " mm2";
   EXPECT_LE(f.stats.qc_mean, 1.5);
+}
+
+// Issue 11 targets NOT met yet, run with --gtest_also_run_disabled_tests. Measured 2026-12-01 (session
+// 4): CTC mask 4 + 210 faces left out (slivers folded by the axis change, in the colon band and the
+// large side branch); GCA 100 k coverage 98.97 % and qc mean 1.97 (its area distortion is local,
+// across the circumference, which the 1D axis cannot trade and the local balancing does not fix).
+void expect_targets(const FlatMap& f) {
+  expect_coverage_and_angles(f);
   for (const auto& s : f.segments) EXPECT_EQ(s.crowded_faces, 0u) << "segment " << s.id;
 }
 
@@ -64,10 +71,14 @@ FlatMap gca_flat() {
   return flatten_colon(load_mesh(tmp / "denoised.vtp").mesh);
 }
 
-// Real CTC lumen mask (reconstruct -> denoise -> flatten).
+// Real CTC lumen mask (reconstruct -> denoise -> flatten): the bounds above, the whole wall shown
+// (>= 99.5 %, its blind pouch behind a 12 mm neck as a band of its own) with qc mean <= 1.5.
 TEST(FlattenReal, CtcLumenMask) {
   if (!std::filesystem::exists(kReal / "ctc_lumen_mask_a.nii.gz")) GTEST_SKIP() << "../shared/real absent";
-  expect_achieved(ctc_flat());
+  const FlatMap f = ctc_flat();
+  expect_achieved(f);
+  expect_coverage_and_angles(f);
+  EXPECT_GE(f.segments.size(), 2u);  // the colon band and its side branch
 }
 
 // Real segmented large intestine (100 k faces, genus 1 before denoise).
