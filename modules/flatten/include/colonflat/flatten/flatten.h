@@ -37,7 +37,7 @@ struct FlattenOptions {
   double area_ratio_high = 3.0;        // area-balanced: faces above this ratio seed a correction region
   int balance_iterations = 30;         // area-balanced: descent steps per correction pass
   double coverage_min_ratio = 0.1;     // a face counts as shown when its 2D/3D area ratio is at least this
-  double branch_min_area = 300.0;      // mm^2; area-balanced: a pouch the conformal map collapses over at
+  double branch_min_area = 50.0;       // mm^2; area-balanced: a pouch the conformal map collapses over at
                                        // least this area is cut at its neck and shown as a band of its own (0: never)
 };
 
