@@ -152,6 +152,13 @@ int main(int argc, char** argv) {
                 r.report["search"].dump().c_str());
     return 0;
   }
+  if (argc >= 4 && std::strcmp(argv[1], "--colon") == 0) {  // --colon VOXEL CONTACT [OUT.vtp]: one colon-like case
+    const Mesh m = bench::colon_like_surface({std::atof(argv[2]), std::atof(argv[3]), true, true, true});
+    if (argc >= 5) write_mesh(m, argv[4]);
+    header();
+    row("colonlike", m, "exact");
+    return 0;
+  }
   bool quick = false;
   std::string only;
   for (int i = 1; i < argc; ++i) {
