@@ -89,6 +89,7 @@ class ExactGreedy {
   std::vector<Mesh::VertexHandle> same_class_loop(const std::vector<Mesh::VertexHandle>& loop,
                                                   const std::vector<std::uint64_t>& reduced, double tube);
   static constexpr std::size_t kFallbackSources = 24;
+  static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
   // exact_method.cpp
   double search_limit(int slot);
   CycleCandidate search_from(int slot, double limit);

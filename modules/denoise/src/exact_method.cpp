@@ -88,7 +88,7 @@ double ExactGreedy::search_limit(int slot) {
   const double m = slots_[slot].bound.value;
   double limit = std::max({first_radius_, 2.0 * m, 2.0 * slots_[slot].own_limit});
   const double best = best_exact_value();
-  if (std::isfinite(best) && best > m) limit = 2.0 * best;
+  if (std::isfinite(best) && best > m) limit = kBestFactor * best;
   limit = std::max(limit, 1.05 * m);
   return std::min(limit, opts_.max_loop_length);
 }
