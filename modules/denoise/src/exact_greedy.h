@@ -78,7 +78,7 @@ class ExactGreedy {
   void set_bound(int slot, const SourceBound& b);
   double best_exact_value();
   int farthest_pending(double best);
-  void spread_bounds(const FundamentalCycleSearch& search, int centre_slot, double bound);
+  void spread_bounds(int centre_slot, double bound);
   void add_surgery_sources(const SurgeryResult& sr);
   void lower_bounds_near(const SurgeryResult& sr);
   // exact_fallback.cpp
@@ -92,11 +92,7 @@ class ExactGreedy {
   static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
   // exact_method.cpp
   double search_limit(int slot);
-  CycleCandidate run_on(FundamentalCycleSearch& search, int slot, double limit) const;
-  void record_search(const FundamentalCycleSearch& search, int slot, double limit, const CycleCandidate& c);
   CycleCandidate search_from(int slot, double limit);
-  bool search_two(int first, double best);
-  static constexpr double kParallelLimitEdges = 40;
   bool stop_before(const QueueEntry& top, std::string* reason) const;
   void cut(int slot, const CycleCandidate& c, int iteration);
   int total_genus_left() const;
@@ -110,8 +106,7 @@ class ExactGreedy {
   FundamentalCycleSearch::Accept accept_;
   HomologyBasis homology_;
   Z2Span span_;
-  std::unique_ptr<FundamentalCycleSearch> search_, search2_;  // search2_: second thread
-  bool parallel_ = false;
+  std::unique_ptr<FundamentalCycleSearch> search_;
   bool crossing_wanted_ = false;  // closed, total genus 1, policy shortest: use crossing families
   int closed_ = 0;               // mesh without boundary: 1, with: -1, unknown: 0
   bool crossing_ = false;         // crossing families in use (span family inactive)

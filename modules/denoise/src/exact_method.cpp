@@ -5,7 +5,6 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
-#include <thread>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/geodesic_ball.h"
@@ -67,7 +66,6 @@ ExactGreedy::ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_
   want_type_ = o.policy != "shortest";
   wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
   accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
-  parallel_ = std::thread::hardware_concurrency() >= 2;
 }
 
 // Crossing families need a closed surface (every class has a cycle avoiding boundary vertices)
@@ -95,58 +93,22 @@ double ExactGreedy::search_limit(int slot) {
   return std::min(limit, opts_.max_loop_length);
 }
 
-// One search from a slot on `search` (reads the mesh only: two may run at once).
-CycleCandidate ExactGreedy::run_on(FundamentalCycleSearch& search, int slot, double limit) const {
+CycleCandidate ExactGreedy::search_from(int slot, double limit) {
+  Stopwatch sw;
   const int family = slots_[slot].family;
-  search.set_cochain(family == 0 ? nullptr : &families_[family].cochain);
-  return search.run(Mesh::VertexHandle(slots_[slot].vertex), limit, want_type_ ? &accept_ : nullptr);
-}
-
-// The slot's new bound from a finished search, shared with the sources it settled.
-void ExactGreedy::record_search(const FundamentalCycleSearch& search, int slot, double limit, const CycleCandidate& c) {
+  search_->set_cochain(family == 0 ? nullptr : &families_[family].cochain);
+  const int v = slots_[slot].vertex;
+  const CycleCandidate c = search_->run(Mesh::VertexHandle(v), limit, want_type_ ? &accept_ : nullptr);
   ++searches_;
-  settled_ += static_cast<long long>(search.last_settled());
+  settled_ += static_cast<long long>(search_->last_settled());
   largest_limit_ = std::max(largest_limit_, limit);
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
-  set_bound(slot, SourceBound{own, c.found, slots_[slot].vertex, 0});
-  if (!want_type_) spread_bounds(search, slot, own);  // with a type filter F is no closed-walk minimum
-}
-
-CycleCandidate ExactGreedy::search_from(int slot, double limit) {
-  Stopwatch sw;
-  const CycleCandidate c = run_on(*search_, slot, limit);
-  record_search(*search_, slot, limit, c);
+  set_bound(slot, SourceBound{own, c.found, v, 0});
+  if (!want_type_) spread_bounds(slot, own);  // with a type filter F is no closed-walk minimum
   if (crossing_ && families_.size() == 2 && c.found) add_transversal_family(c);  // Z
   st_.t.search += sw.seconds();
   return c;
-}
-
-// Two pending sources searched at once on two threads (any order of certifying keeps the result
-// exact; the bounds are applied one after the other). Only for searches large enough to pay for
-// a thread: limit >= kParallelLimitEdges mean edges.
-bool ExactGreedy::search_two(int first, double best) {
-  if (!parallel_ || search_limit(first) < kParallelLimitEdges * st_.mean_edge) return false;
-  const int second = farthest_pending(best);
-  if (second < 0) return false;
-  Stopwatch sw;
-  const double limit1 = search_limit(first), limit2 = search_limit(second);
-  CycleCandidate c2;
-  std::thread worker([&] { c2 = run_on(*search2_, second, limit2); });
-  const CycleCandidate c1 = run_on(*search_, first, limit1);
-  worker.join();
-  record_search(*search_, first, limit1, c1);
-  const bool makes_z = crossing_ && families_.size() == 2 && c1.found;
-  if (makes_z) add_transversal_family(c1);
-  st_.t.search += sw.seconds();
-  if (crossing_ && families_.size() == 2 && c2.found) {
-    search_from(second, limit2);  // Z comes from search_'s tree: search it there again
-  } else {
-    Stopwatch sw2;
-    record_search(*search2_, second, limit2, c2);
-    st_.t.search += sw2.seconds();
-  }
-  return true;
 }
 
 bool ExactGreedy::stop_before(const QueueEntry& top, std::string* reason) const {
@@ -180,7 +142,6 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
         continue;
       }
       const int far = want_type_ ? -1 : farthest_pending(best);
-      if (far >= 0 && search_two(far, best)) continue;
       const int s = far >= 0 ? far : top.slot;
       search_from(s, search_limit(s));
       continue;
