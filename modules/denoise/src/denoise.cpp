@@ -155,6 +155,8 @@ nlohmann::json loop_json(const LoopRecord& L) {
           {"type", L.type},
           {"separating", L.separating},
           {"cap_intersections", L.cap_intersections},
+          {"replaces_loop_of_mm", L.replaced_length},
+          {"replaced_loop_cap_intersections", L.replaced_intersections},
           {"centroid_lps_mm", vec_json(L.centroid)},
           {"diameter_mm", L.diameter_mm},
           {"cross_section_area_mm2", L.cross_section_area_mm2},
