@@ -3,9 +3,13 @@
 // the ColonSegmenter holding the state of one segmentation with one method per step.
 #include <itkImage.h>
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +20,9 @@
 
 namespace cf::segment_detail {
 
+class LinkGrid;
+struct Contact;
+struct LocalShape;
 using LabelImage = itk::Image<std::uint32_t, 3>;
 
 struct Dims {
@@ -77,7 +84,8 @@ struct BodyStats {
 
 class ColonSegmenter {
  public:
-  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts) : ct_(ct), opts_(opts) {}
+  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts);
+  ~ColonSegmenter();
   MaskImage::Pointer run(SegmentStats* stats);
 
  private:
@@ -103,14 +111,14 @@ class ColonSegmenter {
   void mark_layer();
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
+  void check_colon_found(const std::vector<double>& vols) const;
+  std::vector<BodyStats> body_stats(const std::uint32_t* labels, std::uint32_t n, const std::function<bool(std::size_t)>& gas) const;
   void link_tagged_stretches();
-  std::size_t link_pass(bool last);
-  void nearest_colon(const std::vector<BodyStats>& bodies, std::vector<std::size_t>& from, std::vector<std::size_t>& to,
-                     std::vector<double>& gap) const;
-  std::size_t local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
-                          std::array<double, 3>& centroid, std::array<double, 3>& axis) const;
-  bool continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const;
-  bool continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius, std::string& why) const;
+  std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
+  bool continues_colon(const Contact& c, std::string& why) const;
+  bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
+  void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
+  void report_candidate(const BodyStats& b, double kept_gap, const std::string& why);
   // Helpers.
   std::array<double, 3> lps_of(const double crop_voxel[3]) const;
   void decide(const std::string& what, double ml, const double centroid_crop[3], bool kept, const std::string& reason);
@@ -135,9 +143,8 @@ class ColonSegmenter {
   std::vector<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
-  std::vector<std::uint32_t> cand_label_;  // fully tagged candidates (during link_tagged_stretches)
-  std::vector<std::uint32_t> seg_label_;   // kept colon segments (until the stretches are linked)
-  int linked_ = 0;                         // candidates linked so far
+  std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
+  std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   std::vector<unsigned char> state_;   // crop: final 0/1 (after the graph cut)
   std::vector<unsigned char> lumen0_;  // crop: initial lumen
   std::vector<Decision> decisions_;
