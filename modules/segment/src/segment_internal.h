@@ -93,10 +93,14 @@ class ColonSegmenter {
   void check_input();
   void gravity_from_metadata();
   void find_gas_bodies();
-  void trim_rectal_tube(const std::uint32_t* labels, std::uint32_t count, std::vector<unsigned char>& drop,
-                        unsigned char* gas);
-  std::size_t follow_tube_lumen(const std::uint32_t* labels, std::uint32_t label, std::size_t first_slice,
-                                unsigned char* gas, double sum[3]);
+  // Rectal tube (segment_tube.cpp).
+  void trim_rectal_tube(const std::uint32_t* labels, const std::vector<unsigned char>& drop, unsigned char* gas);
+  std::size_t track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]);
+  std::size_t slice_index(std::size_t s, long a, long b) const;
+  std::vector<std::pair<long, long>> slice_component(std::size_t s, const std::vector<std::pair<long, long>>& seeds,
+                                                     const unsigned char* gas, std::size_t limit) const;
+  std::vector<std::pair<long, long>> gas_in_disc(std::size_t s, double ca, double cb, double r_px, const unsigned char* gas) const;
+  void exclude_disc(std::size_t s, double ca, double cb, double r_px);
   void crop_to_gas(const unsigned char* gas);
   void class_means();
   void refine_boundary();
@@ -139,7 +143,8 @@ class ColonSegmenter {
   std::string gravity_source_;
   std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
   std::vector<float> hu_;              // CT in the crop
-  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate
+  std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
+  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
   std::vector<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
