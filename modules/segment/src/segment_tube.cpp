@@ -1,12 +1,14 @@
 // Rectal tube (docs/segment.md step 2): a catheter's air channel enters the volume through its
 // inferior face and runs up into the rectum, walled off from the rectal gas by its plastic. It is
-// tracked slice by slice from the inferior face: each slice's channel is the in-plane gas component
-// over the channel's disc (the previous slice's centroid, the channel's radius + 1 voxel), as long
-// as it stays enclosed (thinner than --tube-area); a few slices without enclosure mark the open tip.
+// tracked slice by slice from the inferior face: each slice's channel is the gas in the channel's
+// disc (the previous slice's centroid, the channel's radius + 1 voxel), as long as a wall (non-gas)
+// fills enough of the ring around it; a few slices with gas all round mark the open tip.
 // The channel is trimmed from the gas, and the channel with its wall (the non-gas voxels within
 // the channel's radius + kWallMm) is excluded from the lumen in every later step.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 
 #include "segment_internal.h"
@@ -15,6 +17,8 @@ namespace cf::segment_detail {
 namespace {
 constexpr double kWallMm = 2.0;         // catheter wall (plastic and partial volume) beyond the air channel
 constexpr double kOpenTipMm = 3.0;      // channel not enclosed over this length: its open tip
+constexpr double kRingMm = 1.5;         // ring outside the channel in which the wall is looked for
+constexpr double kOpenGas = 0.9;        // gas fraction of that ring above which the channel is open
 }  // namespace
 
 // In-plane pixel (a, b) of slice s (counted from the inferior face) -> full-volume index.
@@ -77,12 +81,13 @@ void ColonSegmenter::trim_rectal_tube(const std::uint32_t* glb, const std::vecto
          "rectal tube / anal canal: an enclosed channel thinner than --tube-area from the inferior face to its open tip");
 }
 
-// Follows one channel up from the face slice; trims it and records it and its wall in tube_.
-// Returns the voxels trimmed; sum: their coordinate sums (full-volume voxels).
+// Follows one channel up from the face slice: each next slice's channel is the gas within the
+// channel's radius + 1 voxel of the previous centroid; the channel is enclosed while less than
+// kOpenGas of the ring just outside it (kRingMm wide) is gas (the catheter's wall, or tissue). Trims
+// the channel, records it and its wall in tube_; returns the voxels trimmed (sum: coordinate sums).
 std::size_t ColonSegmenter::track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]) {
   const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
   const double pixel_mm2 = full_.sp[u] * full_.sp[v], px = std::sqrt(pixel_mm2);
-  const std::size_t limit = std::size_t(std::ceil(opts_.tube_area / pixel_mm2));
   const double radius = std::sqrt(double(channel.size()) * pixel_mm2 / 3.14159265358979);  // mm
   const int open_slices = std::max(1, int(std::lround(kOpenTipMm / full_.sp[sup_axis_])));
   std::size_t trimmed = 0;
@@ -102,13 +107,29 @@ std::size_t ColonSegmenter::track_tube(std::vector<std::pair<long, long>> channe
     trimmed += channel.size();
     exclude_disc(s, ca, cb, (radius + kWallMm) / px);
     if (s + 1 == full_.n[sup_axis_]) break;
-    const auto disc = gas_in_disc(s + 1, ca, cb, radius / px + 1.0, gas);
-    const auto next = disc.empty() ? disc : slice_component(s + 1, disc, gas, limit);
-    if (next.size() < limit) open = 0, channel = next;
-    else if (++open > open_slices) break;  // the open tip: rectal gas all round
-    else channel = disc;
+    channel = gas_in_disc(s + 1, ca, cb, radius / px + 1.0, gas);
+    const double ring_gas = gas_fraction_in_ring(s + 1, ca, cb, radius / px + 0.5, (radius + kRingMm) / px + 0.5, gas);
+    if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
+      std::fprintf(stderr, "tube slice %zu: channel %zu ring gas %.2f open %d\n", s + 1, channel.size(), ring_gas, open);
+    open = ring_gas < kOpenGas ? 0 : open + 1;
+    if (open > open_slices) break;  // the open tip: rectal gas all round
   }
   return trimmed;
+}
+
+// Fraction of the pixels of slice s between r0_px and r1_px from (ca, cb) that are gas (1 if none).
+double ColonSegmenter::gas_fraction_in_ring(std::size_t s, double ca, double cb, double r0_px, double r1_px,
+                                            const unsigned char* gas) const {
+  const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
+  std::size_t n = 0, g = 0;
+  for (long b = std::max(0L, long(std::floor(cb - r1_px))); b <= std::min(long(full_.n[v]) - 1, long(std::ceil(cb + r1_px))); ++b)
+    for (long a = std::max(0L, long(std::floor(ca - r1_px))); a <= std::min(long(full_.n[u]) - 1, long(std::ceil(ca + r1_px))); ++a) {
+      const double d2 = (a - ca) * (a - ca) + (b - cb) * (b - cb);
+      if (d2 < r0_px * r0_px || d2 > r1_px * r1_px) continue;
+      ++n;
+      g += gas[slice_index(s, a, b)] != 0;
+    }
+  return n ? double(g) / double(n) : 1.0;
 }
 
 // Gas pixels of slice s within r_px of (ca, cb).
