@@ -101,7 +101,7 @@ class ColonSegmenter {
                                                      const unsigned char* gas, std::size_t limit) const;
   std::vector<std::pair<long, long>> gas_in_disc(std::size_t s, double ca, double cb, double r_px, const unsigned char* gas) const;
   void exclude_disc(std::size_t s, double ca, double cb, double r_px);
-  double gas_fraction_in_ring(std::size_t s, double ca, double cb, double r0_px, double r1_px, const unsigned char* gas) const;
+  double ring_mean_hu(std::size_t s, double ca, double cb, double r0_px, double r1_px) const;
   void crop_to_gas(const unsigned char* gas);
   void class_means();
   void refine_boundary();

@@ -1,8 +1,8 @@
 // Rectal tube (docs/segment.md step 2): a catheter's air channel enters the volume through its
 // inferior face and runs up into the rectum, walled off from the rectal gas by its plastic. It is
 // tracked slice by slice from the inferior face: each slice's channel is the gas in the channel's
-// disc (the previous slice's centroid, the channel's radius + 1 voxel), as long as a wall (non-gas)
-// fills enough of the ring around it; a few slices with gas all round mark the open tip.
+// disc (the previous slice's centroid, the channel's radius + 1 voxel), as long as the ring around
+// it holds a wall (mean HU above -900); a few slices with gas all round mark the open tip.
 // The channel is trimmed from the gas, and the channel with its wall (the non-gas voxels within
 // the channel's radius + kWallMm) is excluded from the lumen in every later step.
 #include <algorithm>
@@ -18,7 +18,7 @@ namespace {
 constexpr double kWallMm = 2.0;         // catheter wall (plastic and partial volume) beyond the air channel
 constexpr double kOpenTipMm = 3.0;      // channel not enclosed over this length: its open tip
 constexpr double kRingMm = 1.5;         // ring outside the channel in which the wall is looked for
-constexpr double kOpenGas = 0.9;        // gas fraction of that ring above which the channel is open
+constexpr double kOpenHu = -900;        // HU; a ring darker than this on average is gas all round: the channel is open
 }  // namespace
 
 // In-plane pixel (a, b) of slice s (counted from the inferior face) -> full-volume index.
@@ -82,8 +82,9 @@ void ColonSegmenter::trim_rectal_tube(const std::uint32_t* glb, const std::vecto
 }
 
 // Follows one channel up from the face slice: each next slice's channel is the gas within the
-// channel's radius + 1 voxel of the previous centroid; the channel is enclosed while less than
-// kOpenGas of the ring just outside it (kRingMm wide) is gas (the catheter's wall, or tissue). Trims
+// channel's radius + 1 voxel of the previous centroid; the channel is enclosed while the ring just
+// outside it (kRingMm wide) holds a wall: its mean HU stays above kOpenHu (the catheter's plastic,
+// even partly resolved, or tissue), where gas all round gives about -1000 HU. Trims
 // the channel, records it and its wall in tube_; returns the voxels trimmed (sum: coordinate sums).
 std::size_t ColonSegmenter::track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]) {
   const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
@@ -92,10 +93,10 @@ std::size_t ColonSegmenter::track_tube(std::vector<std::pair<long, long>> channe
   const int open_slices = std::max(1, int(std::lround(kOpenTipMm / full_.sp[sup_axis_])));
   std::size_t trimmed = 0;
   int open = 0;
+  double ca = 0, cb = 0;  // the channel's centre in the slice
+  for (const auto& p : channel) ca += double(p.first), cb += double(p.second);
+  ca /= double(channel.size()), cb /= double(channel.size());
   for (std::size_t s = 0; s < full_.n[sup_axis_] && !channel.empty(); ++s) {
-    double ca = 0, cb = 0;
-    for (const auto& p : channel) ca += double(p.first), cb += double(p.second);
-    ca /= double(channel.size()), cb /= double(channel.size());
     for (const auto& p : channel) {
       const std::size_t q = slice_index(s, p.first, p.second);
       gas[q] = 0;
@@ -108,28 +109,35 @@ std::size_t ColonSegmenter::track_tube(std::vector<std::pair<long, long>> channe
     exclude_disc(s, ca, cb, (radius + kWallMm) / px);
     if (s + 1 == full_.n[sup_axis_]) break;
     channel = gas_in_disc(s + 1, ca, cb, radius / px + 1.0, gas);
-    const double ring_gas = gas_fraction_in_ring(s + 1, ca, cb, radius / px + 0.5, (radius + kRingMm) / px + 0.5, gas);
+    const auto core = gas_in_disc(s + 1, ca, cb, radius / px, gas);  // re-centred on the inner disc only: no drift into rectal gas
+    if (!core.empty()) {
+      double na = 0, nb = 0;
+      for (const auto& p : core) na += double(p.first), nb += double(p.second);
+      ca = na / double(core.size()), cb = nb / double(core.size());
+    }
+    const double ring_hu = ring_mean_hu(s + 1, ca, cb, radius / px + 0.5, (radius + kRingMm) / px + 0.5);
     if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
-      std::fprintf(stderr, "tube slice %zu: channel %zu ring gas %.2f open %d\n", s + 1, channel.size(), ring_gas, open);
-    open = ring_gas < kOpenGas ? 0 : open + 1;
+      std::fprintf(stderr, "tube slice %zu: channel %zu ring %.0f HU open %d\n", s + 1, channel.size(), ring_hu, open);
+    open = ring_hu >= kOpenHu ? 0 : open + 1;
     if (open > open_slices) break;  // the open tip: rectal gas all round
   }
   return trimmed;
 }
 
-// Fraction of the pixels of slice s between r0_px and r1_px from (ca, cb) that are gas (1 if none).
-double ColonSegmenter::gas_fraction_in_ring(std::size_t s, double ca, double cb, double r0_px, double r1_px,
-                                            const unsigned char* gas) const {
+// Mean HU of the pixels of slice s between r0_px and r1_px from (ca, cb) (-1000 if none).
+double ColonSegmenter::ring_mean_hu(std::size_t s, double ca, double cb, double r0_px, double r1_px) const {
   const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
-  std::size_t n = 0, g = 0;
+  const float* fhu = ct_->GetBufferPointer();
+  std::size_t n = 0;
+  double sum = 0;
   for (long b = std::max(0L, long(std::floor(cb - r1_px))); b <= std::min(long(full_.n[v]) - 1, long(std::ceil(cb + r1_px))); ++b)
     for (long a = std::max(0L, long(std::floor(ca - r1_px))); a <= std::min(long(full_.n[u]) - 1, long(std::ceil(ca + r1_px))); ++a) {
       const double d2 = (a - ca) * (a - ca) + (b - cb) * (b - cb);
       if (d2 < r0_px * r0_px || d2 > r1_px * r1_px) continue;
       ++n;
-      g += gas[slice_index(s, a, b)] != 0;
+      sum += fhu[slice_index(s, a, b)];
     }
-  return n ? double(g) / double(n) : 1.0;
+  return n ? sum / double(n) : -1000.0;
 }
 
 // Gas pixels of slice s within r_px of (ca, cb).
