@@ -28,6 +28,7 @@ void ColonSegmenter::find_gas_bodies() {
   for (std::size_t k = 0, q = 0; k < full_.n[2]; ++k)
     for (std::size_t j = 0; j < full_.n[1]; ++j)
       for (std::size_t i = 0; i < full_.n[0]; ++i, ++q) {
+        if (!glb[q]) continue;  // not gas (most of the volume)
         BodyStats& b = bodies[glb[q]];
         ++b.voxels;
         b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
