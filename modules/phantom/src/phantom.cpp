@@ -24,7 +24,8 @@ using namespace phantom_detail;
 namespace {
 
 void validate(const PhantomOptions& o) {
-  if (o.size != "small" && o.size != "full") throw UsageError("--size must be small or full (got '" + o.size + "')");
+  if (o.size != "small" && o.size != "medium" && o.size != "full")
+    throw UsageError("--size must be small, medium or full (got '" + o.size + "')");
   if (!(o.noise_hu >= 0 && o.noise_hu <= 500)) throw UsageError("--noise must be in [0, 500] HU");
   if (!(o.blur_mm >= 0 && o.blur_mm <= 5)) throw UsageError("--blur must be in [0, 5] mm");
   if (o.position != "supine" && o.position != "prone")
