@@ -33,6 +33,11 @@ const CtWindow& soft_tissue_window() {
   return w;
 }
 
+const CtWindow& mask_window() {
+  static const CtWindow w{"mask", 0.5, 1};
+  return w;
+}
+
 PlaneAxes plane_axes(Plane p) {
   // LPS: +x left, +y posterior, +z superior. Screen right = patient left (+x) or posterior (+y,
   // sagittal); screen down = posterior (+y, axial) or inferior (-z).
@@ -128,7 +133,7 @@ nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::arra
     const double fixed = f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm;
     const PlaneImage im = sample_plane(ct, plane, fixed, ur[0], vr[0], w, h, o.pixel_mm);
     const std::string name = std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png";
-    write_windowed_png(im, lung_window(), dir / name);
+    write_windowed_png(im, o.window ? *o.window : lung_window(), dir / name);
     j["positions"].push_back(std::round(fixed * 100) / 100);
     j["files"].push_back(rel_prefix + name);
   }

@@ -24,6 +24,7 @@ struct CtWindow {
 };
 const CtWindow& lung_window();         // L -200 / W 1500 (CT colonography 2D reading)
 const CtWindow& soft_tissue_window();  // L 40 / W 400
+const CtWindow& mask_window();         // L 0.5 / W 1: a 0/1 lumen mask, lumen white
 
 // On-screen axes of a plane: LPS axis index and sign of the screen's right (u) and down (v)
 // directions, and the LPS axis fixed by the plane (its normal).
@@ -57,6 +58,7 @@ struct SliceStackOptions {
   double step_mm = 5;      // between planes
   double pixel_mm = 1;     // in-plane pixel size
   double margin_mm = 25;   // added around the box
+  const CtWindow* window = nullptr;  // null: lung window
 };
 nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::array<double, 3>& box_min,
                                  const std::array<double, 3>& box_max, const SliceStackOptions& opts,
