@@ -64,8 +64,8 @@ struct Builder {
 
   // The CT geometry and the stacks of planes a click on the map shows.
   void add_ct() {
-    if (!run.ct) return;
-    data["ct"] = ct_geometry_json(run.ct);
+    if (!run.ct && !run.mask) return;
+    data["ct"] = run.ct ? ct_geometry_json(run.ct.GetPointer()) : ct_geometry_json(run.mask.GetPointer());
     data["ct"]["file"] = run.ct_path.string();
     data["ct"]["is_mask"] = run.volume_is_mask;
     std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
@@ -81,7 +81,8 @@ struct Builder {
     so.pixel_mm = opts.stack_pixel_mm;
     if (run.volume_is_mask) so.window = &mask_window();
     for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-      data["stacks"][plane_name(p)] = write_slice_stack(run.ct, p, lo, hi, so, files_dir, "report_files/");
+      data["stacks"][plane_name(p)] = run.ct ? write_slice_stack(run.ct.GetPointer(), p, lo, hi, so, files_dir, "report_files/")
+                                             : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
       result.images += int(data["stacks"][plane_name(p)]["files"].size());
     }
   }

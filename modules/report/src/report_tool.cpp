@@ -83,6 +83,7 @@ class ReportTool : public Tool, public RunFinisher {
     ProgressScope scope(run.log, "report");
     // The meshes are written; free them before the report's views allocate.
     for (const char* done : {"surface", "denoised", "loops"}) run.artifacts->erase(done);
+    phase_done("meshes released");
     RunData data = run_from_artifacts(*run.artifacts, run.dir, *run.report, run.input);
     for (const auto& target : tx.targets())
       if (target.parent_path() == run.dir) data.staged_files.push_back(target.filename().string());

@@ -9,7 +9,6 @@
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
 
-#include <itkCastImageFilter.h>
 
 #include <algorithm>
 #include <cmath>
@@ -97,14 +96,6 @@ bool run_started_from_mask(const nlohmann::json& run_report) {
   return !stages.empty() && stages[0].value("stage", "") == "reconstruct";
 }
 
-CtImage::Pointer mask_as_volume(const MaskImage::Pointer& mask) {
-  using Cast = itk::CastImageFilter<MaskImage, CtImage>;
-  auto cast = Cast::New();
-  cast->SetInput(mask);
-  cast->Update();
-  return cast->GetOutput();
-}
-
 void set_flat(RunData& run, FlatMap flat) {
   if (flat.centreline_mm.size() == flat.uv.size()) run.centreline_mm = flat.centreline_mm;
   run.flat_segments = flat_report(flat).value("segments", nlohmann::json::array());
@@ -140,7 +131,7 @@ void load_truth(RunData& run, const RunLoadOptions& opts) {
 // What both loaders share: the truth polyps, findings placed on the flat map, missing pieces.
 void complete_run(RunData& run, const RunLoadOptions& opts) {
   if (!run.flat) run.warnings.push_back("no flat map: no colon map lookup, no positions along the colon");
-  if (!run.ct) run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
+  if (!run.ct && !run.mask) run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
   else if (run.volume_is_mask) run.warnings.push_back("the run started from a lumen mask: the views show the mask, not a CT");
   load_truth(run, opts);
   if (run.flat) {
@@ -187,9 +178,10 @@ RunData load_run(const fs::path& dir, const RunLoadOptions& opts) {
   if (fs::exists(dir / "flat.vtp")) load_flat(run, dir / "flat.vtp");
   run.ct_path = find_ct(run, opts);
   if (!run.ct_path.empty()) {
-    run.ct = read_ct_volume(run.ct_path);
     run.volume_is_mask = opts.ct.empty() && run_started_from_mask(run.run_report) &&
                          fs::path(run.run_report.value("input", "")).filename() == run.ct_path.filename();
+    if (run.volume_is_mask) run.mask = read_mask(run.ct_path);
+    else run.ct = read_ct_volume(run.ct_path);
   }
   complete_run(run, opts);
   return run;
@@ -216,7 +208,7 @@ RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann
     run.ct = bag.get<CtImage::Pointer>("ct");
     run.ct_path = input;
   } else if (bag.has("mask")) {
-    run.ct = mask_as_volume(bag.get<MaskImage::Pointer>("mask"));
+    run.mask = bag.get<MaskImage::Pointer>("mask");
     run.ct_path = input;
     run.volume_is_mask = true;
   }

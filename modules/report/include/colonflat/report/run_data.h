@@ -47,7 +47,8 @@ struct RunData {
   std::vector<double> centreline_mm;           // per flat vertex (contract 1); empty when absent
   nlohmann::json flat_segments = nlohmann::json::array();  // FlatSegments "segments" (as written)
   CtImage::Pointer ct;                         // null when no CT was found
-  bool volume_is_mask = false;                 // `ct` holds the lumen mask (0/1) of a run without a CT
+  MaskImage::Pointer mask;                     // without a CT: the lumen mask the run started from
+  bool volume_is_mask = false;                 // the views show `mask` (0/1), not a CT
   ImagePtr colon_image;                        // colon.png in memory; null: read from the run folder
   std::filesystem::path ct_path, truth_path;
   std::vector<std::string> warnings;           // what is missing or inconsistent, for the page
@@ -63,7 +64,7 @@ RunData load_run(const std::filesystem::path& dir, const RunLoadOptions& opts = 
 
 // The same from the artifacts `colonflat run` still holds after its last stage (no file is read
 // but the truth polyps.json): "flat" is moved out of `bag`; the view volume is "ct", else the
-// lumen mask "mask" (as 0/1 values, volume_is_mask); "colon_image" and "candidates" are shared.
+// lumen mask "mask" (volume_is_mask); "colon_image" and "candidates" are shared.
 // `run_report` is the run's report so far; `input` the run's input (shown as the CT's file).
 RunData run_from_artifacts(ArtifactBag& bag, const std::filesystem::path& dir, const nlohmann::json& run_report,
                            const std::string& input, const RunLoadOptions& opts = {});
