@@ -408,7 +408,7 @@
     buildFiles();
     const first = (R.candidates || [])[0] || (R.known || [])[0];
     if (first) focusFinding(first.key, false, true);
-    else $("ct-title").textContent = "CT: click the map";
+    else $("ct-title").textContent = volumeName() + ": click the map";
     document.body.setAttribute("data-ready", "1");
   }
   start();
