@@ -30,6 +30,9 @@ void write_atomically(const std::filesystem::path& target,
 class OutputTransaction {
  public:
   OutputTransaction() = default;
+  // The older form with a staging root: no longer needed (every output folder gets its staging
+  // folder); kept so that callers written against it still build.
+  explicit OutputTransaction(const std::filesystem::path& /*staging_root*/) {}
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
   ~OutputTransaction();
