@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/topology.h"
 #include "flatten_internal.h"
 
@@ -204,6 +205,7 @@ SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::
   double total_area = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f) total_area += face_area_3d(s, int(f));
   const auto loops = open_annulus(s, ct.boundary_loops, o, c, w);
+  phase_done("ends opened");
   const Surface& ann = w.ann;
   const Edges E = build_edges(ann.t);
   const V3 ca = loop_centre(ann, loops[0]), cb = loop_centre(ann, loops[1]);
@@ -218,6 +220,7 @@ SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::
     for (int v : l) fixed[v] = 1;
   const auto vf = vertex_faces(ann);
   w.emb = conformal_step(w, E, loops, vf, fixed, degenerate, o);
+  phase_done("conformal map");
   w.seg.length = w.seg.area_3d / w.emb.period;  // the conformal rectangle: length x period = area
   w.seg.period = w.emb.period;
   std::vector<double> u(ann.p.size());
@@ -233,12 +236,15 @@ SegmentWork flatten_segment(const Surface& s, const ComponentTopology& ct, std::
   w.seg.centreline_length = cl.length;
   w.along.resize(ann.p.size());
   for (std::size_t v = 0; v < ann.p.size(); ++v) w.along[v] = cl.s_of_u(u[v]);
+  phase_done("centreline");
   debug_stats("conformal", w, degenerate);
   if (o.map == "area-balanced") area_balanced_step(w, cl, vf, fixed, degenerate, o);
+  if (o.map == "area-balanced") phase_done("area balance");
   debug_stats("final", w, degenerate);
   w.seg.faces = ann.t.size();
   w.seg.vertices = ann.p.size();
   measure(w, E, degenerate, o, total_area - w.seg.area_3d);
+  phase_done("distortion and coverage");
   return w;
 }
 

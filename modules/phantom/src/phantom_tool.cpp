@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/phantom/phantom.h"
 
@@ -67,9 +68,11 @@ class PhantomTool : public Tool {
         if (app.count("--fully-tagged-segments") == 0) o.fully_tagged_segments = 2;
       }
       Stopwatch t;
+      ProgressScope phases(quiet ? nullptr : &err, "phantom");
       Phantom p = generate_phantom(o);
       const double gen = t.seconds();
       write_phantom(p, dir, format);
+      phase_done("written");
       if (!quiet) {
         err << std::fixed << std::setprecision(2) << "phantom: colon "
             << p.description["colon"]["length_mm"].get<double>() / 1000.0 << " m, lumen "
