@@ -28,7 +28,6 @@ import sys
 SOURCE_EXT = (".cpp", ".cc", ".cxx", ".h", ".hpp")
 DEFAULT_DIRS = ("modules", "pipeline", "apps")
 CONTROL = {"if", "for", "while", "switch", "catch", "do", "else", "try", "return", "sizeof", "decltype"}
-IDENT = re.compile(r"[A-Za-z_~][A-Za-z0-9_:~<>,\s*&]*$")
 
 
 TOKENS = re.compile(

@@ -11,6 +11,7 @@ namespace cf::bench {
 
 BenchCli::BenchCli(std::string name, std::string description) : name_(std::move(name)), app_(description, name_) {
   app_.allow_extras();
+  app_.option_defaults()->always_capture_default();
 }
 
 int BenchCli::run(int argc, char** argv, const std::function<int()>& body) {
@@ -20,7 +21,13 @@ int BenchCli::run(int argc, char** argv, const std::function<int()>& body) {
     return app_.exit(e);
   }
   passed_on_ = {argv[0]};
-  for (const std::string& extra : app_.remaining()) passed_on_.push_back(extra);
+  for (const std::string& extra : app_.remaining()) {
+    if (extra.rfind("--benchmark_", 0) != 0) {  // refused before any work, not after the table
+      std::fprintf(stderr, "%s: error: unknown argument '%s' (see --help)\n", name_.c_str(), extra.c_str());
+      return 2;
+    }
+    passed_on_.push_back(extra);
+  }
   try {
     return body();
   } catch (const std::exception& e) {

@@ -8,10 +8,10 @@
 //     return cli.run(argc, argv, [&] { ...; return cli.run_google_benchmarks(); });
 //   }
 //
-// Options a bench does not declare (Google Benchmark's --benchmark_*) are passed on to
-// benchmark::Initialize. `--help` lists the bench's own options. A parse error prints CLI11's
-// message and exits 2 (106 for an extra positional, as CLI11 does); an exception thrown by the
-// body prints one line `NAME: error: WHAT` and exits 1.
+// Google Benchmark's own options (--benchmark_*) are passed on to benchmark::Initialize; any other
+// undeclared argument is refused (exit 2) before the bench does any work. `--help` lists the
+// bench's own options. A parse error prints CLI11's message with its exit code; an exception
+// thrown by the body prints one line `NAME: error: WHAT` and exits 1.
 #include <functional>
 #include <string>
 #include <utility>

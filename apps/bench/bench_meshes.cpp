@@ -1,6 +1,8 @@
 // Shared meshes for the benchmark apps (compiled into each *_bench executable).
 #include "bench_meshes.h"
 
+#include "colonflat/core/synthetic.h"
+
 #include <vtkFlyingEdges3D.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
@@ -196,6 +198,43 @@ Mesh colon_like_surface(const ColonLikeOptions& o) {
         d[(static_cast<std::size_t>(k) * ny + j) * nx + i] = lumen ? -1.0f : 1.0f;  // a binary mask
       }
   return iso_surface(img);
+}
+
+namespace {
+
+// Torus whose tube radius is r0 (1 - amp cos(u - thin_at)) (thinnest at u = thin_at).
+TriangleList varying_torus(double R, double r0, double amp, double thin_at, int nu, int nv) {
+  constexpr double kPi = 3.14159265358979323846;
+  TriangleList t;
+  for (int i = 0; i < nu; ++i) {
+    const double u = 2 * kPi * i / nu, r = r0 * (1 - amp * std::cos(u - thin_at));
+    for (int j = 0; j < nv; ++j) {
+      const double v = 2 * kPi * j / nv;
+      t.points.push_back({(R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)});
+    }
+  }
+  auto id = [&](int i, int j) { return (i % nu) * nv + (j % nv); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      t.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      t.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return t;
+}
+
+}  // namespace
+
+Mesh blocked_torus(bool ring) {
+  constexpr double kPi = 3.14159265358979323846;
+  const TriangleList outer = varying_torus(4, 1, 0.15, 0, 64, 16);
+  TriangleList blocker;
+  if (ring) {
+    blocker = varying_torus(4, 0.15, 0.15, kPi, 64, 8);
+  } else {
+    blocker = synthetic::sphere(1, 16, 8);
+    for (auto& p : blocker.points) p = {4 + 0.15 * p[0], 1.4 * p[1], 0.15 * p[2]};
+  }
+  return synthetic::to_mesh(synthetic::disjoint_union(outer, blocker));
 }
 
 }  // namespace cf::bench

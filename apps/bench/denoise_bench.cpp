@@ -9,7 +9,8 @@
 // Each with the default (exact) method and the paper's method (real and colon-like cases).
 // Times are wall-clock per phase (report's time_s) and in total; cpu_s is the process CPU time
 // of the row (both threads), the figure to compare when the machine is shared.
-// Run in Release: ./build/apps/denoise_bench [--quick] [--only real|colon|shared|spheres]
+// Run in Release: ./build/apps/denoise_bench [--quick] [--exact-only] [--only real|colon|shared|spheres]
+//   or one case: --sphere RADIUS HANDLES VOXEL, --colon VOXEL CONTACT_MM [OUT.vtp]
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -37,7 +38,10 @@ void header() {
               "cpu_s", "peak_MiB", "g_aft", "note");
 }
 
+bool g_exact_only = false;  // --exact-only: skip the paper method's rows
+
 void row(const std::string& name, const Mesh& m, const std::string& method, int max_loops = -1) {
+  if (g_exact_only && method != "exact") return;
   DenoiseOptions o;
   o.method = method;
   const int genus = *analyze_topology(m).genus;
@@ -146,16 +150,28 @@ void sphere_cases(bool quick) {
 int main(int argc, char** argv) {
   if (argc == 5 && std::strcmp(argv[1], "--sphere") == 0) {  // --sphere RADIUS HANDLES VOXEL: one case, phases
     Mesh m = bench::sphere_with_handles(std::atof(argv[2]), std::atoi(argv[3]), std::atof(argv[4]));
+    Stopwatch sw;
+    const std::clock_t cpu0 = std::clock();
     DenoiseResult r = denoise(m, DenoiseOptions{});
+    std::printf("wall %.2f s, cpu %.2f s, peak %.0f MiB\n", sw.seconds(), double(std::clock() - cpu0) / CLOCKS_PER_SEC,
+                peak_memory_mib());
     std::printf("faces %zu genus %s -> %s\ntime %s\nsearch %s\n", m.n_faces(), r.report["genus_before"].dump().c_str(),
                 r.report["genus_after"].dump().c_str(), r.report["time_s"].dump().c_str(),
                 r.report["search"].dump().c_str());
+    return 0;
+  }
+  if (argc >= 4 && std::strcmp(argv[1], "--colon") == 0) {  // --colon VOXEL CONTACT [OUT.vtp]: one colon-like case
+    const Mesh m = bench::colon_like_surface({std::atof(argv[2]), std::atof(argv[3]), true, true, true});
+    if (argc >= 5) write_mesh(m, argv[4]);
+    header();
+    row("colonlike", m, "exact");
     return 0;
   }
   bool quick = false;
   std::string only;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+    else if (std::strcmp(argv[i], "--exact-only") == 0) g_exact_only = true;
     else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc) only = argv[++i];
   }
   header();

@@ -6,7 +6,7 @@
 //   segment_bench --table-only        the table without Google Benchmark.
 //   segment_bench --size small --seeds 1,2 --no-dicom   other sizes / seeds.
 //   segment_bench --collapsed --seeds 1 --no-dicom      phantoms with a collapsed stretch (2 segments).
-//   segment_bench --realistic --seeds 1,2 [--pad-to 450] issue 13: supine and prone phantoms with 2 fully
+//   segment_bench --realistic --seeds 1,2 [--size medium] [--pad-to 450] issue 13: supine and prone phantoms (full size unless --size) with 2 fully
 //                                     tagged stretches, oral contrast, bladder, aorta, rectal tube (written
 //                                     and read as NRRD, PatientPosition included); --pad-to N appends copies
 //                                     of the inferior slice so the scan has N slices (timing of 512x512xN).
@@ -257,10 +257,10 @@ RealisticScore score_realistic(const cf::MaskImage* seg, const cf::Phantom& p) {
   return r;
 }
 
-void realistic_table(const std::vector<int>& seeds, int pad_to) {
+void realistic_table(const std::string& size, const std::vector<int>& seeds, int pad_to) {
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_r" + std::to_string(::getpid()));
-  std::printf("segment_bench --realistic: full-size phantoms, 2 fully tagged stretches, oral contrast, bladder, aorta, "
-              "rectal tube%s\n", pad_to > 0 ? (", padded to " + std::to_string(pad_to) + " slices").c_str() : "");
+  std::printf("segment_bench --realistic: %s phantoms, 2 fully tagged stretches, oral contrast, bladder, aorta, "
+              "rectal tube%s\n", size.c_str(), pad_to > 0 ? (", padded to " + std::to_string(pad_to) + " slices").c_str() : "");
   std::printf("%4s %7s %7s %7s %7s %7s %8s %7s %9s %8s %7s %7s %6s %s\n", "seed", "pos", "slices", "gen_s", "read_s", "seg_s",
               "seg_MiB", "dice", "stretches", "sb_vox", "bl_vox", "ao_vox", "tube", "gravity");
   for (int seed : seeds)
@@ -268,7 +268,7 @@ void realistic_table(const std::vector<int>& seeds, int pad_to) {
       fs::remove_all(tmp);
       cf::Stopwatch t;
       cf::PhantomOptions o;
-      o.size = "full";
+      o.size = size;
       o.seed = std::uint64_t(seed);
       o.position = position;
       o.fully_tagged_segments = 2;
@@ -346,7 +346,7 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  if (realistic) realistic_table(seeds, pad_to);
+  if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);
   if (table_only) return 0;
   int n = int(rest.size());

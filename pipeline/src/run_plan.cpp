@@ -89,6 +89,16 @@ void check_port_chain(const RunPlan& plan) {
   }
 }
 
+// Registered tools that are also RunFinishers and apply to the stages of this run.
+void choose_finishers(RunPlan& plan) {
+  std::vector<std::string> names;
+  for (const auto& st : plan.stages) names.push_back(st->spec().name);
+  for (auto& tool : registered_module_tools()) {
+    auto* finisher = dynamic_cast<RunFinisher*>(tool.get());
+    if (finisher && finisher->applies_to(names)) plan.finishers.push_back(std::move(tool));
+  }
+}
+
 void check_input(RunOptions& o, const RunPlan& plan) {
   const Port& head = plan.stages.front()->spec().inputs.at(0);
   if (o.input.empty()) {
@@ -117,6 +127,10 @@ void check_outputs(const RunOptions& o, const RunPlan& plan) {
   if (!o.debug_dir.empty()) paths.output_folder(o.debug_dir, "--debug-dir");
   for (const auto& st : plan.stages)
     for (const Port& p : st->spec().outputs) plan_port_output(paths, p, out / p.file_name, "-o (" + p.name + ")");
+  for (const auto& tool : plan.finishers) {
+    for (const auto& file : as_finisher(*tool).planned_outputs(out)) paths.output(file, "-o (" + tool->name() + ")");
+    for (const auto& dir : as_finisher(*tool).planned_folders(out)) paths.output_folder(dir, "-o (" + tool->name() + ")");
+  }
   paths.output(out / "run_report.json", "-o (run report)");
   paths.output(out / "run_report.txt", "-o (run report)");
   if (!o.params_out.empty()) paths.output(o.params_out, "--params-out", {".json"});
@@ -124,6 +138,12 @@ void check_outputs(const RunOptions& o, const RunPlan& plan) {
 }
 
 }  // namespace
+
+RunFinisher& as_finisher(Tool& tool) {
+  auto* finisher = dynamic_cast<RunFinisher*>(&tool);
+  if (!finisher) throw Error(tool.name() + " does not finish runs");
+  return *finisher;
+}
 
 std::vector<std::string> available_stages() {
   std::vector<std::string> v;
@@ -139,6 +159,7 @@ RunPlan plan_run(RunOptions& o) {
   for (const auto& s : o.sets) apply_set(s, plan);
   for (const auto& st : plan.stages) st->validate_params();
   check_port_chain(plan);
+  choose_finishers(plan);
   check_input(o, plan);
   check_outputs(o, plan);
   plan.generate_input = o.input.empty();

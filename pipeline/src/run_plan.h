@@ -8,12 +8,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/run_finisher.h"
 #include "colonflat/core/stage.h"
 
 namespace cf {
 
 struct RunOptions {
   std::string input, outdir = "colonflat_out", debug_dir, from, to, params_in, params_out;
+  std::string prone;  // two-scan mode: the prone scan of the same patient (INPUT is the supine one)
   std::vector<std::string> sets;
   bool quiet = false;
 };
@@ -25,7 +27,12 @@ struct RunPlan {
   std::vector<std::string> not_run;            // pipeline stages outside --from/--to or not built
   std::size_t first_index = 0;                 // of stages[0] in the pipeline order (debug folders)
   bool generate_input = false;                 // no INPUT: the phantom is generated first
+  // Registered tools that finish this run on its memory (the review report), in registry order.
+  std::vector<std::unique_ptr<Tool>> finishers;
 };
+
+// The finisher interface of a planned finisher tool.
+RunFinisher& as_finisher(Tool& tool);
 
 // Validates the whole run (stage range, parameters, port chain and types, input file, output
 // paths) and throws UsageError/InputError naming the first problem. Does no work and writes nothing.

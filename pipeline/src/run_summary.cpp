@@ -85,6 +85,9 @@ std::string run_report_text(const nlohmann::json& r) {
     t << std::left << std::setw(13) << s.value("stage", "") << std::right << std::setw(9) << number(s["time_s"], 2)
       << std::setw(11) << number(s["peak_memory_mib"], 0) << "  " << key_results(s.value("result", nlohmann::json{}))
       << "\n";
+  for (const auto& f : r.value("after_stages", nlohmann::json::array()))
+    t << std::left << std::setw(13) << f.value("step", "") << std::right << std::setw(9)
+      << number(f.value("time_s", nlohmann::json()), 2) << std::setw(11) << "" << "  after the stages\n";
   t << std::left << std::setw(13) << "total" << std::right << std::setw(9) << number(r["total_time_s"], 2)
     << std::setw(11) << number(r["peak_memory_mib"], 0) << "\n";
   if (r.contains("not_run")) t << "\nnot run: " << r["not_run"].get<std::string>() << "\n";

@@ -1,12 +1,14 @@
-// `colonflat run [INPUT] -o OUTDIR`: chains the stages in memory (pipeline_stage_order()).
-// Everything is checked first (run_plan.cpp); outputs go to OUTDIR/.colonflat-staging-<pid>/ and
-// are renamed into OUTDIR only when every stage succeeded.
+// `colonflat run [INPUT] -o OUTDIR`: chains the stages in memory (pipeline_stage_order()), then
+// the finishers (the review report) on the artifacts still in memory. Everything is checked
+// first (run_plan.cpp); outputs go to OUTDIR/.colonflat-staging-<pid>-<n>/ and are renamed into
+// OUTDIR only when every stage and finisher succeeded.
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/output_check.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/stage_runner.h"
 #include "colonflat/pipeline/registry.h"
@@ -32,18 +34,11 @@ class RunTool : public Tool {
     RunOptions o;
     add_options(app, o, all);
     return run_cli(app, name(), args, out, err, [&]() -> int {
+      if (!o.prone.empty()) return run_two_scans(o, out, err);
       RunPlan plan = plan_run(o);
       std::ostream* log = o.quiet ? nullptr : &err;
       if (plan.generate_input) o.input = generate_default_input(o.outdir, err, log);
       const nlohmann::json report = execute(plan, o, log);
-      // The review report (report module) once the last stage has run: report.html, polyps.mrk.json.
-      // It reads the committed run folder.
-      if (!plan.stages.empty() && plan.stages.back()->spec().name == available_stages().back())
-        for (auto& t : registered_module_tools())
-          if (t->name() == "report") {
-            const int rc = t->run(o.quiet ? std::vector<std::string>{o.outdir, "-q"} : std::vector<std::string>{o.outdir}, out, err);
-            if (rc != kExitOk) return rc;
-          }
       if (!o.quiet) out << run_summary_text(report, o.outdir);
       return kExitOk;
     });
@@ -65,20 +60,86 @@ class RunTool : public Tool {
     app.add_option("--params-out", o.params_out, "write every effective parameter as JSON")->type_name("FILE.json");
     app.add_option("--set", o.sets, "set one parameter, e.g. --set denoise.max-loop-length=20 (repeatable)")
         ->type_name("STAGE.PARAM=VALUE");
+    app.add_option("--prone", o.prone,
+                   "two-scan mode: the prone scan of the same patient (INPUT is the supine one); both are run "
+                   "into OUTDIR/supine and OUTDIR/prone, then registered into OUTDIR/registration")
+        ->type_name("FILE");
     app.add_flag("-q,--quiet", o.quiet, "print nothing but errors");
   }
 
-  static nlohmann::json execute(RunPlan& plan, const RunOptions& o, std::ostream* log) {
+  // `--prone PRONE`: both scans planned (every check) before any work, each run into its folder
+  // and committed when done, then `colonflat register` of the two run folders.
+  static int run_two_scans(const RunOptions& o, std::ostream& out, std::ostream& err) {
+    Tool* reg = nullptr;
+    auto tools = registered_module_tools();
+    for (auto& t : tools)
+      if (t->name() == "register") reg = t.get();
+    if (!reg) throw UsageError("--prone needs the register command, which this build lacks");
+    if (o.input.empty()) throw UsageError("--prone needs INPUT, the supine scan");
     const fs::path outdir(o.outdir);
+    RunOptions sup = o, pro = o;
+    sup.prone = pro.prone = "";
+    sup.outdir = (outdir / "supine").string();
+    pro.outdir = (outdir / "prone").string();
+    pro.input = o.prone;
+    pro.params_out = "";  // the same parameters: written once
+    if (!o.debug_dir.empty()) {
+      sup.debug_dir = (fs::path(o.debug_dir) / "supine").string();
+      pro.debug_dir = (fs::path(o.debug_dir) / "prone").string();
+    }
+    RunPlan sup_plan = plan_run(sup), pro_plan = plan_run(pro);
+    if (sup_plan.stages.back()->spec().name != "render")
+      throw UsageError("--prone: the run must go through render (registration reads flat maps and candidates)");
+    PathPlan paths;
+    paths.input(o.input);
+    paths.input(o.prone);
+    paths.output_folder(outdir / "registration", "-o (registration)");
+    paths.check();
+    if (same_file(o.input, o.prone)) throw UsageError(o.prone + ": --prone is the same file as INPUT");
+    std::ostream* log = o.quiet ? nullptr : &err;
+    if (log) *log << "colonflat run: supine scan " << o.input << " -> " << sup.outdir << "\n";
+    const nlohmann::json sup_report = execute(sup_plan, sup, log);
+    if (log) *log << "colonflat run: prone scan " << o.prone << " -> " << pro.outdir << "\n";
+    const nlohmann::json pro_report = execute(pro_plan, pro, log);
+    std::vector<std::string> reg_args = {sup.outdir, pro.outdir, "-o", (outdir / "registration").string()};
+    if (o.quiet) reg_args.push_back("-q");
+    const int rc = reg->run(reg_args, out, err);
+    if (rc != kExitOk) return rc;
+    if (!o.quiet) out << run_summary_text(sup_report, sup.outdir) << run_summary_text(pro_report, pro.outdir);
+    return kExitOk;
+  }
+
+  static nlohmann::json execute(RunPlan& plan, const RunOptions& o, std::ostream* log) {
     ArtifactBag bag;
     const Port& in_port = plan.stages.front()->spec().inputs.at(0);
     if (log) *log << "colonflat run: reading " << o.input << " as " << in_port.type->name << "\n";
     bag.put(in_port.name, in_port.type->read(o.input));
     nlohmann::json report = {{"version", colonflat_version()}, {"input", o.input},           {"units", "mm"},
                              {"coordinate_system", "LPS"},     {"stages", nlohmann::json::array()}};
-    nlohmann::json all_params = nlohmann::json::object();
     Stopwatch total;
-    OutputTransaction tx(outdir);
+    OutputTransaction tx;
+    const nlohmann::json params = run_stages(plan, o, bag, tx, report, log);
+    std::string rest;
+    for (const auto& s : plan.not_run) rest += (rest.empty() ? "" : ", ") + s;
+    if (!rest.empty()) report["not_run"] = rest;
+    report["stages_time_s"] = report["total_time_s"] = total.seconds();
+    report["peak_memory_mib"] = peak_memory_mib();
+    run_finishers(plan, o, bag, tx, report, log);
+    report["total_time_s"] = total.seconds();
+    report["peak_memory_mib"] = peak_memory_mib();
+    const fs::path outdir(o.outdir);
+    std::ofstream(tx.stage(outdir / "run_report.json")) << report.dump(2) << "\n";
+    std::ofstream(tx.stage(outdir / "run_report.txt")) << run_report_text(report);
+    if (!o.params_out.empty()) std::ofstream(tx.stage(o.params_out)) << params.dump(2) << "\n";
+    tx.commit();
+    return report;
+  }
+
+  // Every stage in order, its outputs staged in `tx`; returns every stage's parameters.
+  static nlohmann::json run_stages(RunPlan& plan, const RunOptions& o, ArtifactBag& bag, OutputTransaction& tx,
+                                   nlohmann::json& report, std::ostream* log) {
+    const fs::path outdir(o.outdir);
+    nlohmann::json all_params = nlohmann::json::object();
     for (std::size_t i = 0; i < plan.stages.size(); ++i) {
       Stage& st = *plan.stages[i];
       if (log) *log << "[" << (i + 1) << "/" << plan.stages.size() << "] " << st.spec().name << ": " << st.spec().summary << "\n";
@@ -94,16 +155,28 @@ class RunTool : public Tool {
                     << " s, peak " << std::setprecision(0) << peak_memory_mib() << " MiB\n";
       report["stages"].push_back(record);
     }
-    std::string rest;
-    for (const auto& s : plan.not_run) rest += (rest.empty() ? "" : ", ") + s;
-    if (!rest.empty()) report["not_run"] = rest;
-    report["total_time_s"] = total.seconds();
-    report["peak_memory_mib"] = peak_memory_mib();
-    std::ofstream(tx.stage(outdir / "run_report.json")) << report.dump(2) << "\n";
-    std::ofstream(tx.stage(outdir / "run_report.txt")) << run_report_text(report);
-    if (!o.params_out.empty()) std::ofstream(tx.stage(o.params_out)) << all_params.dump(2) << "\n";
-    tx.commit();
-    return report;
+    return all_params;
+  }
+
+  // The finishers (review report) on the run's memory; their outputs staged with the stages'.
+  static void run_finishers(RunPlan& plan, const RunOptions& o, ArtifactBag& bag, OutputTransaction& tx,
+                            nlohmann::json& report, std::ostream* log) {
+    if (plan.finishers.empty()) return;
+    FinishedRun run;
+    run.dir = o.outdir;
+    run.input = o.input;
+    for (const auto& st : plan.stages) run.stages.push_back(st->spec().name);
+    run.report = &report;
+    run.artifacts = &bag;
+    run.log = log;
+    nlohmann::json records = nlohmann::json::array();
+    for (auto& tool : plan.finishers) {
+      if (log) *log << "[after the stages] " << tool->name() << ": " << tool->summary() << "\n";
+      nlohmann::json record = as_finisher(*tool).finish(run, tx);
+      if (log) *log << "    done in " << std::fixed << std::setprecision(2) << record.value("time_s", 0.0) << " s\n";
+      records.push_back(record);
+    }
+    report["after_stages"] = records;
   }
 
   static void write_debug(const Stage& st, const ArtifactBag& bag, const nlohmann::json& record, const fs::path& dir,
@@ -122,7 +195,9 @@ class RunTool : public Tool {
       const std::string dir = (fs::path(outdir) / "phantom").string();
       if (log) *log << "colonflat run: no INPUT; generating the full-size phantom (seed 1) into " << dir << "\n";
       std::ostringstream sink;
-      const int rc = t->run({"-o", dir, "--seed", "1", "--size", "full"}, log ? *log : sink, err);
+      std::vector<std::string> args = {"-o", dir, "--seed", "1", "--size", "full"};
+      if (!log) args.push_back("-q");
+      const int rc = t->run(args, log ? *log : sink, err);
       if (rc != kExitOk) throw Error("phantom generation failed (exit " + std::to_string(rc) + ")");
       return (fs::path(dir) / "ct.nrrd").string();
     }

@@ -55,14 +55,30 @@ TEST_F(RobustPaths, SamePathTwiceRefused) {
 }
 
 // An empty output name, an unknown output format and an unwritable folder are refused up front.
+// Root ignores permission bits, so as root the unwritable case runs as the user nobody.
 TEST_F(RobustPaths, EmptyUnknownAndUnwritableOutputsRefused) {
   expect_refused(colonflat({"denoise", input_.string(), "-o", ""}), "denoise", "empty output path");
   expect_refused(colonflat({"denoise", input_.string(), "-o", dir_.str("d.xyz")}), "denoise", "unknown format");
   fs::create_directory(dir_ / "ro");
-  fs::permissions(dir_ / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+  using P = fs::perms;
+  fs::permissions(dir_ / "ro", P::owner_read | P::owner_exec | P::group_read | P::group_exec | P::others_read | P::others_exec);
   before_ = {"ro", "t.off"};
-  if (::access((dir_ / "ro").c_str(), W_OK) == 0) GTEST_SKIP() << "running as root: permissions not enforced";
-  expect_refused(colonflat({"denoise", input_.string(), "-o", dir_.str("ro/d.vtp")}), "denoise", "not writable");
+  const std::vector<std::string> args = {"denoise", input_.string(), "-o", dir_.str("ro/d.vtp")};
+  const CommandResult r = ::geteuid() == 0 ? colonflat_as_nobody(args) : colonflat(args);
+  ASSERT_NE(r.code, 125) << r.err;
+  expect_refused(r, "denoise", "is not writable");
+}
+
+// The same as nobody in a folder that is writable for nobody: the dropped rights do not by
+// themselves make the command fail (the refusal above is the folder's permissions).
+TEST_F(RobustPaths, UnprivilegedRunWritesWhereAllowed) {
+  if (::geteuid() != 0) GTEST_SKIP() << "not root: the test above already ran unprivileged";
+  fs::create_directory(dir_ / "rw");
+  fs::permissions(dir_ / "rw", fs::perms::all);
+  const CommandResult r = colonflat_as_nobody({"denoise", input_.string(), "-o", dir_.str("rw/d.vtp"), "-q"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "rw" / "d.vtp"));
+  EXPECT_TRUE(leftovers(dir_.path()).empty());
 }
 
 // `run --params-out INPUT` is refused before the first stage.
@@ -118,6 +134,47 @@ TEST_F(RobustPaths, StaleTemporariesCleaned) {
   EXPECT_EQ(leftovers(dir_ / "out"), std::vector<std::string>{".denoised.tmp-" + live + "-0.vtp"});
 }
 
+// Issue 14 item 2 for stand-alone commands: every output of a folder goes into that folder's one
+// staging folder under its own name (nothing else appears beside the targets), and appears
+// only at the commit; a second folder gets its own staging folder.
+TEST(RobustTransaction, OneStagingFolderPerOutputFolder) {
+  testing::TempDir dir;
+  OutputTransaction tx;
+  const fs::path a = tx.stage(dir / "a.vtp"), b = tx.stage(dir / "b.json"), c = tx.stage(dir / "sub" / "c.png");
+  EXPECT_EQ(a.parent_path(), b.parent_path());
+  EXPECT_EQ(a.parent_path(), tx.staging_folder(dir.path()));
+  EXPECT_EQ(a.parent_path().parent_path(), dir.path());
+  EXPECT_EQ(a.filename(), "a.vtp");
+  EXPECT_EQ(c.parent_path(), tx.staging_folder(dir / "sub"));
+  EXPECT_NE(c.parent_path(), a.parent_path());
+  spit(a, "a"), spit(b, "b"), spit(c, "c");
+  const auto staged = listing(dir.path());
+  EXPECT_EQ(std::count_if(staged.begin(), staged.end(), [](const std::string& f) { return f.find('/') == std::string::npos; }),
+            2);  // the staging folder and sub/: no file beside the targets yet
+  tx.commit();
+  EXPECT_EQ(slurp(dir / "a.vtp"), "a");
+  EXPECT_EQ(slurp(dir / "sub" / "c.png"), "c");
+  EXPECT_THROW(tx.stage(dir / "a.vtp"), Error);  // the same target twice in one transaction
+}
+
+// A staged folder (the review report's report_files/) replaces an existing folder of that name on
+// commit, and an uncommitted transaction leaves the old folder as it was.
+TEST(RobustTransaction, StagedFolderReplacesOldFolderOnlyOnCommit) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "files");
+  spit(dir / "files" / "old.png", "old");
+  for (const bool commit : {false, true}) {
+    {
+      OutputTransaction tx;
+      const fs::path staged = tx.stage(dir / "files");
+      fs::create_directories(staged);
+      spit(staged / "new.png", "new");
+      if (commit) tx.commit();
+    }
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"files", commit ? "files/new.png" : "files/old.png"}));
+  }
+}
+
 // SIGTERM and SIGINT during writing remove the staging folder and temporaries (the process then
 // dies of the signal, as it should).
 TEST(RobustSignals, InterruptRemovesStagingAndTemporaries) {
@@ -125,7 +182,7 @@ TEST(RobustSignals, InterruptRemovesStagingAndTemporaries) {
   for (int sig : {SIGTERM, SIGINT}) {
     const pid_t child = ::fork();
     if (child == 0) {
-      OutputTransaction tx(dir.path());
+      OutputTransaction tx;
       spit(tx.stage(dir / "a.vtp"), "staged in the staging folder");
       spit(tx.stage(dir / "sub" / "b.json"), "a temporary sibling");
       ::raise(sig);

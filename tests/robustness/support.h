@@ -1,7 +1,10 @@
 #pragma once
 // Helpers of the robustness suite (ctest label `robustness`): tiny generated inputs, file
 // snapshots, leftover detection and the one-line error check.
+#include <grp.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -46,6 +49,42 @@ inline std::vector<std::string> listing(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir)) v.push_back(e.path().lexically_relative(dir).string());
   std::sort(v.begin(), v.end());
   return v;
+}
+
+// Runs `colonflat ARGS` in a child process with the rights of the user nobody (uid and gid
+// 65534), so that folder permissions apply when the tests run as root (root ignores them). The
+// child reports its exit code and output through a pipe; code 125 when it cannot drop its rights.
+inline CommandResult colonflat_as_nobody(const std::vector<std::string>& args) {
+  int fd[2];
+  if (::pipe(fd) != 0) return {125, "", "pipe failed"};
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::close(fd[0]);
+    CommandResult r{125, "", "cannot drop privileges to nobody"};
+    if (::setgroups(0, nullptr) == 0 && ::setgid(65534) == 0 && ::setuid(65534) == 0) r = colonflat(args);
+    const std::string payload = std::to_string(r.code) + "\n" + std::to_string(r.out.size()) + "\n" + r.out + r.err;
+    for (std::size_t done = 0; done < payload.size();) {
+      const ssize_t n = ::write(fd[1], payload.data() + done, payload.size() - done);
+      if (n <= 0) break;
+      done += std::size_t(n);
+    }
+    ::_exit(0);
+  }
+  ::close(fd[1]);
+  std::string payload;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(fd[0], buf, sizeof buf)) > 0;) payload.append(buf, std::size_t(n));
+  ::close(fd[0]);
+  ::waitpid(child, nullptr, 0);
+  std::istringstream in(payload);
+  CommandResult r{125, "", ""};
+  std::size_t out_size = 0;
+  in >> r.code >> out_size;
+  in.get();
+  const std::string rest(std::istreambuf_iterator<char>(in), {});
+  r.out = rest.substr(0, out_size);
+  r.err = rest.substr(std::min(out_size, rest.size()));
+  return r;
 }
 
 // Hidden temporaries or staging folders below `dir`.

@@ -39,7 +39,8 @@ void commit_rename(const fs::path& tmp, const fs::path& target) {
   std::error_code ec;
   fs::rename(tmp, target, ec);
   if (ec) {
-    fs::remove(tmp, ec);
+    std::error_code rec;
+    fs::remove_all(tmp, rec);
     throw Error(target.string() + ": cannot write: " + ec.message());
   }
 }
@@ -98,21 +99,49 @@ void write_atomically(const fs::path& target, const std::function<void(const fs:
   unregister_for_cleanup(tmp);
 }
 
-OutputTransaction::OutputTransaction(fs::path staging_root) : root_(std::move(staging_root)) {}
-
 OutputTransaction::~OutputTransaction() {
   std::error_code ec;
   if (!committed_)
-    for (auto& [tmp, target] : staged_) fs::remove(tmp, ec);
+    for (auto& [tmp, target] : staged_) fs::remove_all(tmp, ec);
   for (auto& [tmp, target] : staged_) unregister_for_cleanup(tmp);
-  if (!staging_.empty()) {
-    fs::remove_all(staging_, ec);
-    unregister_for_cleanup(staging_);
+  for (auto& [folder, staging] : staging_) {
+    fs::remove_all(staging, ec);
+    unregister_for_cleanup(staging);
   }
   for (auto it = created_dirs_.rbegin(); it != created_dirs_.rend(); ++it) {
     if (!committed_) fs::remove(*it, ec);  // only removes a folder left empty
     unregister_for_cleanup(*it);
   }
+}
+
+std::vector<fs::path> OutputTransaction::targets() const {
+  std::vector<fs::path> v;
+  for (const auto& [tmp, target] : staged_) v.push_back(target);
+  return v;
+}
+
+fs::path OutputTransaction::staging_folder(const fs::path& folder) const {
+  std::error_code ec;
+  for (const auto& [f, staging] : staging_)
+    if (f == folder || fs::equivalent(f, folder, ec)) return staging;
+  return {};
+}
+
+// One staging folder per output folder; the counter keeps two transactions of one process apart.
+fs::path OutputTransaction::staging_for(const fs::path& folder, const fs::path& target) {
+  fs::path staging = staging_folder(folder);
+  if (!staging.empty()) return staging;
+  static std::atomic<unsigned> counter{0};
+  staging = folder / (kStagingPrefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  register_for_cleanup(staging);
+  std::error_code ec;
+  fs::create_directory(staging, ec);
+  if (ec) {
+    unregister_for_cleanup(staging);
+    throw Error(target.string() + ": cannot create staging folder " + staging.string() + ": " + ec.message());
+  }
+  staging_.emplace_back(folder, staging);
+  return staging;
 }
 
 fs::path OutputTransaction::stage(const fs::path& target) {
@@ -122,19 +151,9 @@ fs::path OutputTransaction::stage(const fs::path& target) {
     register_for_cleanup(d);
   }
   remove_stale_temporaries(dir);
-  fs::path tmp;
-  std::error_code ec;
-  if (!root_.empty() && fs::exists(root_, ec) && fs::equivalent(dir, root_, ec)) {
-    if (staging_.empty()) {
-      staging_ = root_ / (kStagingPrefix + std::to_string(::getpid()));
-      register_for_cleanup(staging_);
-      fs::create_directories(staging_, ec);
-      if (ec) throw Error(target.string() + ": cannot create staging folder " + staging_.string() + ": " + ec.message());
-    }
-    tmp = staging_ / target.filename();
-  } else {
-    tmp = temp_sibling(target);
-  }
+  for (const auto& [tmp, old_target] : staged_)
+    if (old_target == target) throw Error(target.string() + ": staged twice in one transaction");
+  const fs::path tmp = staging_for(dir, target) / target.filename();
   register_for_cleanup(tmp);
   staged_.emplace_back(tmp, target);
   return tmp;
@@ -142,7 +161,7 @@ fs::path OutputTransaction::stage(const fs::path& target) {
 
 void OutputTransaction::rollback(std::size_t renamed) {
   std::error_code ec;
-  for (std::size_t i = 0; i < renamed; ++i) fs::remove(staged_[i].second, ec);
+  for (std::size_t i = 0; i < renamed; ++i) fs::remove_all(staged_[i].second, ec);
   for (auto& [backup, target] : backups_) fs::rename(backup, target, ec);
   backups_.clear();
 }
@@ -154,8 +173,10 @@ void OutputTransaction::commit() {
   try {
     for (auto& [tmp, target] : staged_) {
       std::error_code ec;
-      if (fs::exists(target, ec) && !fs::is_directory(target, ec)) {
-        const fs::path backup = temp_sibling(target);  // not removed on a signal: it is the old file
+      // An existing file is kept aside until every rename succeeded; so is an existing folder
+      // that a staged folder replaces (never a folder in the place of a file target).
+      if (fs::exists(target, ec) && fs::is_directory(target, ec) == fs::is_directory(tmp, ec)) {
+        const fs::path backup = temp_sibling(target);  // not removed on a signal: it is the old content
         fs::rename(target, backup, ec);
         if (!ec) backups_.emplace_back(backup, target);
       }
@@ -168,7 +189,7 @@ void OutputTransaction::commit() {
   }
   std::error_code ec;
   for (auto& [backup, target] : backups_) {
-    fs::remove(backup, ec);
+    fs::remove_all(backup, ec);
     unregister_for_cleanup(backup);
   }
   backups_.clear();

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <thread>
 
+#include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
 
 namespace fs = std::filesystem;
@@ -14,11 +15,6 @@ namespace fs = std::filesystem;
 namespace cf {
 
 namespace {
-
-std::mutex& log_mutex() {
-  static std::mutex m;
-  return m;
-}
 
 // Prints "still running" lines from a second thread until destroyed.
 class Heartbeat {
@@ -54,14 +50,11 @@ class Heartbeat {
 
 }  // namespace
 
-void RunContext::progress(const std::string& line) const {
-  if (!log) return;
-  std::lock_guard<std::mutex> lock(log_mutex());
-  *log << line << std::endl;
-}
+void RunContext::progress(const std::string& line) const { write_progress_line(log, line); }
 
 nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ctx, double heartbeat_s) {
   Stopwatch clock;
+  ProgressScope phases(ctx.log, stage.spec().name);
   {
     Heartbeat beat(ctx, stage.spec().name, heartbeat_s);
     stage.run(bag, ctx);
@@ -70,6 +63,7 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
           {"parameters", stage.params_json()},
           {"result", ctx.report},
           {"time_s", clock.seconds()},
+          {"phases", phases.phases()},
           {"peak_memory_mib", peak_memory_mib()},
           {"outputs", nlohmann::json::object()}};
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/stumps.h"
 #include "denoise_internal.h"
@@ -155,6 +156,8 @@ nlohmann::json loop_json(const LoopRecord& L) {
           {"type", L.type},
           {"separating", L.separating},
           {"cap_intersections", L.cap_intersections},
+          {"replaces_loop_of_mm", L.replaced_length},
+          {"replaced_loop_cap_intersections", L.replaced_intersections},
           {"centroid_lps_mm", vec_json(L.centroid)},
           {"diameter_mm", L.diameter_mm},
           {"cross_section_area_mm2", L.cross_section_area_mm2},
@@ -191,6 +194,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   Stopwatch sw;
   res.before = analyze_topology(st.mesh);
   const double t_analysis = sw.seconds();
+  phase_done("topology analysis");
   const TopologyReport& b = res.before;
   check_input(b, o);
   init_state(st, b);
@@ -200,10 +204,12 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   if (needed > 0)
     reason = o.method == "exact" ? detail::run_exact(st, o, needed, progress, b.mean_edge_length, stats)
                                  : detail::run_paper(st, o, needed, progress, stats);
+  phase_done("loops found and cut");
   sw.restart();
   res.after = analyze_topology(st.mesh);
   st.t.verify += sw.seconds();
   const nlohmann::json comps = o.method == "exact" ? check_exact_result(st, b, res.after) : paper_components(res.after);
+  phase_done("verification");
   const nlohmann::json stumps = o.remove_stumps > 0 ? run_stumps(st, o, res.after) : nlohmann::json(nullptr);
   res.loops = st.loops;
   res.mesh = std::move(st.mesh);

@@ -64,7 +64,7 @@ void FundamentalCycleSearch::settle(int v) {
   const int pu = mesh_.from_vertex_handle(ph).idx();
   std::uint64_t* mine = &acc_[std::size_t(slot_[v]) * W_];
   const std::uint64_t* theirs = &acc_[std::size_t(slot_[pu]) * W_];
-  const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(ph));
+  const std::uint64_t* e = edge_bits(mesh_.edge_handle(ph));
   for (int i = 0; i < W_; ++i) mine[i] = theirs[i] ^ e[i];
 }
 
@@ -76,13 +76,9 @@ void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, dou
   const int vi = mesh_.from_vertex_handle(h).idx(), wi = mesh_.to_vertex_handle(h).idx();
   const std::uint64_t* a = &acc_[std::size_t(slot_[vi]) * W_];
   const std::uint64_t* b = &acc_[std::size_t(slot_[wi]) * W_];
-  const std::uint64_t* e = hom_.edge_class(mesh_.edge_handle(h));
-  bool zero = true;
-  for (int i = 0; i < W_; ++i) {
-    tmp_[i] = a[i] ^ b[i] ^ e[i];
-    zero = zero && tmp_[i] == 0;
-  }
-  if (zero || span_.reduce(tmp_.data())) return;
+  const std::uint64_t* e = edge_bits(mesh_.edge_handle(h));
+  for (int i = 0; i < W_; ++i) tmp_[i] = a[i] ^ b[i] ^ e[i];
+  if (!wanted(tmp_.data())) return;
   CycleCandidate c = best;
   c.found = true;
   c.value = value;
@@ -90,6 +86,17 @@ void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, dou
   c.v = Mesh::VertexHandle(wi);
   if (accept && !(*accept)(extract(c))) return;
   best = c;
+}
+
+void FundamentalCycleSearch::set_cochain(const std::vector<std::uint8_t>* cochain) {
+  cochain_ = cochain;
+  W_ = cochain_ ? 1 : hom_.words();
+  tmp_.assign(W_, 0);
+}
+
+bool FundamentalCycleSearch::wanted(std::uint64_t* cls) const {
+  if (cochain_) return (cls[0] & 1) != 0;
+  return !is_zero(cls, W_) && !span_.reduce(cls);
 }
 
 CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, const Accept* accept, bool frontier) {
@@ -112,7 +119,7 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
     const int parent_edge = parent_[vi] >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])).idx() : -1;
     for (auto h : mesh_.voh_range(v)) {
       const int wi = mesh_.to_vertex_handle(h).idx();
-      if (blocked_[wi]) continue;
+      if (blocked_[wi] || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
       const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
       if (stamp_[wi] == run_id_ && settled_flag_[wi]) {  // non-tree edge between settled vertices
         if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + dist_[wi], limit, accept, best);
@@ -136,20 +143,16 @@ double FundamentalCycleSearch::frontier_bound() {
     const int p = mesh_.from_vertex_handle(ph).idx();
     // Class of path(s, w) through its tentative parent.
     const std::uint64_t* ap = &acc_[std::size_t(slot_[p]) * W_];
-    const std::uint64_t* ae = hom_.edge_class(mesh_.edge_handle(ph));
+    const std::uint64_t* ae = edge_bits(mesh_.edge_handle(ph));
     for (auto h : mesh_.voh_range(w)) {
       const int u = mesh_.to_vertex_handle(h).idx();
       if (u == p || stamp_[u] != run_id_ || !settled_flag_[u]) continue;
       const double value = dist_[wi] + (mesh_.point(Mesh::VertexHandle(u)) - mesh_.point(w)).norm() + dist_[u];
       if (value >= bound) continue;
       const std::uint64_t* au = &acc_[std::size_t(slot_[u]) * W_];
-      const std::uint64_t* eu = hom_.edge_class(mesh_.edge_handle(h));
-      bool zero = true;
-      for (int i = 0; i < W_; ++i) {
-        cls[i] = ap[i] ^ ae[i] ^ au[i] ^ eu[i];
-        zero = zero && cls[i] == 0;
-      }
-      if (!zero && !span_.reduce(cls.data())) bound = value;
+      const std::uint64_t* eu = edge_bits(mesh_.edge_handle(h));
+      for (int i = 0; i < W_; ++i) cls[i] = ap[i] ^ ae[i] ^ au[i] ^ eu[i];
+      if (wanted(cls.data())) bound = value;
     }
   }
   return bound;
@@ -184,12 +187,24 @@ std::vector<Mesh::VertexHandle> FundamentalCycleSearch::extract(const CycleCandi
 }
 
 std::vector<std::uint64_t> FundamentalCycleSearch::cycle_class(const std::vector<Mesh::VertexHandle>& loop) const {
-  std::vector<std::uint64_t> c(W_, 0);
+  std::vector<std::uint64_t> c(hom_.words(), 0);
   for (std::size_t i = 0; i < loop.size(); ++i) {
     const auto h = mesh_.find_halfedge(loop[i], loop[(i + 1) % loop.size()]);
-    xor_into(c.data(), hom_.edge_class(mesh_.edge_handle(h)), W_);
+    xor_into(c.data(), hom_.edge_class(mesh_.edge_handle(h)), hom_.words());
   }
   return c;
+}
+
+std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop) {
+  std::vector<std::uint8_t> bits(mesh.n_edges(), 0);
+  const std::size_t k = loop.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    const auto out = mesh.find_halfedge(loop[i], loop[(i + 1) % k]);
+    const auto back = mesh.find_halfedge(loop[i], loop[(i + k - 1) % k]);
+    for (auto h = mesh.ccw_rotated_halfedge_handle(out); h != back; h = mesh.ccw_rotated_halfedge_handle(h))
+      bits[mesh.edge_handle(h).idx()] ^= 1;
+  }
+  return bits;
 }
 
 double loop_length(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop) {

@@ -14,6 +14,7 @@ namespace detail {
 SurgeryResult Surgery::run() {
   check_loop();
   gather_left_side();
+  record_undo();
   add_left_copies();
   repoint_left_fans();
   relink_left_faces();
@@ -72,6 +73,21 @@ void Surgery::gather_left_side() {
     auto a = mesh_.halfedge_handle(left_faces_[j]);
     face_cycle_[j] = {a, mesh_.next_halfedge_handle(a), mesh_.next_halfedge_handle(mesh_.next_halfedge_handle(a))};
   }
+}
+
+// What undo_surgery() restores: everything below only rewires the left fans and faces, the
+// loop's halfedges and vertices, moves loop vertices and appends new elements.
+void Surgery::record_undo() {
+  SurgeryUndo& u = result_.undo;
+  u.vertices = mesh_.n_vertices();
+  u.edges = mesh_.n_edges();
+  u.faces = mesh_.n_faces();
+  for (std::size_t i = 0; i < k_; ++i) {
+    for (auto o : fan_[i]) u.targets.push_back({mesh_.opposite_halfedge_handle(o), loop_[i]});
+    u.vertex_halfedges.push_back({loop_[i], mesh_.halfedge_handle(loop_[i])});
+    u.positions.push_back({loop_[i], mesh_.point(loop_[i])});
+  }
+  for (std::size_t j = 0; j < left_faces_.size(); ++j) u.face_cycles.push_back({left_faces_[j], face_cycle_[j]});
 }
 
 // 2. Left copies of the loop vertices and the new edges y_i: left^i -> left^(i+1) (x_i = opposite).
@@ -143,6 +159,20 @@ void Surgery::copy_loop_classes() {
 SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts,
                           HomologyBasis* homology) {
   return detail::Surgery(mesh, loop, opts, homology).run();
+}
+
+void undo_surgery(Mesh& mesh, const SurgeryUndo& undo) {
+  for (const auto& [h, v] : undo.targets) mesh.set_vertex_handle(h, v);
+  for (const auto& [f, c] : undo.face_cycles) {
+    for (int t = 0; t < 3; ++t) {
+      mesh.set_next_halfedge_handle(c[t], c[(t + 1) % 3]);
+      mesh.set_face_handle(c[t], f);
+    }
+    mesh.set_halfedge_handle(f, c[0]);
+  }
+  for (const auto& [v, h] : undo.vertex_halfedges) mesh.set_halfedge_handle(v, h);
+  for (const auto& [v, p] : undo.positions) mesh.set_point(v, p);
+  mesh.resize(undo.vertices, undo.edges, undo.faces);
 }
 
 bool vertices_connected(const Mesh& mesh, Mesh::VertexHandle a, Mesh::VertexHandle b) {

@@ -29,6 +29,7 @@ class Surgery {
   // The cut (surgery.cpp).
   void check_loop();
   void gather_left_side();
+  void record_undo();
   void add_left_copies();
   void repoint_left_fans();
   void relink_left_faces();

@@ -112,5 +112,43 @@ TEST(DenoiseCapIntersections, MarchingCubesJunctionsCutCleanly) {
   }
 }
 
+// When every placement of the shortest loop's caps crosses the surface (a rod inside the tube
+// pierces every cap of the thinnest meridian), the surgery is undone and another loop of the
+// same class away from the rod is cut instead: 0 intersecting pairs (CGAL), genus 0 per
+// component, and the report names the loop it replaced.
+TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
+  const Mesh m = bench::blocked_torus(false);
+  ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 1u);
+  const LoopRecord& loop = r.loops[0];
+  EXPECT_EQ(loop.cap_intersections, 0u);
+  EXPECT_GT(loop.replaced_intersections, 0u) << "the first placement must have been blocked";
+  const double thinnest = 2 * kPi * 0.85;  // circumference of the blocked meridian
+  EXPECT_NEAR(loop.replaced_length, thinnest, 0.05 * thinnest);
+  EXPECT_GT(loop.length, loop.replaced_length);
+  EXPECT_LT(loop.length, 2 * kPi * 1.15);  // still a meridian (same class), not the longitude
+  EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 1);
+  EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
+  const TopologyReport t = analyze_topology(r.mesh);
+  ASSERT_EQ(t.components.size(), 2u);
+  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
+  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
+  EXPECT_EQ(testing::count_self_intersections(r.mesh), 0u);
+}
+
+// With a ring along the whole tube core no meridian can be capped cleanly: the intersecting
+// pairs are reported (never hidden) and --strict turns them into an error.
+TEST(DenoiseCapIntersections, UncappableLoopIsReportedAndStrictFails) {
+  const Mesh m = bench::blocked_torus(true);
+  ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  EXPECT_GT(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
+  EXPECT_EQ(r.report["totals"]["loops_with_cap_intersections"].get<std::size_t>(), 1u);
+  DenoiseOptions strict;
+  strict.strict = true;
+  EXPECT_THROW(denoise(m, strict), Error);
+}
+
 }  // namespace
 }  // namespace cf

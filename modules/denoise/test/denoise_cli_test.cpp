@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_meshes.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/loops_io.h"
@@ -123,6 +124,29 @@ TEST(DenoiseCli, PaperMarksSeparatingLoops) {
   LoopSet loops = read_loops(dir / "loops.vtp");
   ASSERT_FALSE(loops.empty());
   EXPECT_TRUE(loops[0].separating);
+}
+
+// --strict on an input whose loop cannot be capped cleanly (a ring inside the torus tube crosses
+// every cap of its meridians): exit 1, one error line naming the input, no output written.
+TEST(DenoiseCli, StrictFailsWhenNoCleanCapExists) {
+  testing::TempDir dir;
+  write_mesh(bench::blocked_torus(true), dir / "in.off");
+  auto r = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--report", dir.str("report.json"), "--strict",
+                 "-q"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("colonflat denoise: error: ", 0), 0u) << r.err;  // -q: nothing but the error line
+  EXPECT_NE(r.err.find("--strict"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("intersect"), std::string::npos) << r.err;
+  std::size_t error_lines = 0;
+  std::istringstream lines(r.err);
+  for (std::string line; std::getline(lines, line);) error_lines += !line.empty();
+  EXPECT_EQ(error_lines, 1u) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out.vtp"));
+  EXPECT_FALSE(fs::exists(dir / "report.json"));
+  // Without --strict the same input is denoised and the intersections are reported.
+  auto ok = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--report", dir.str("report.json")});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("WARNING"), std::string::npos) << ok.err;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/topology.h"
 #include "flatten_internal.h"
 
@@ -297,24 +298,33 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.seg.component = int(c);
   w.seg.input_kind = nloops == 0 ? "closed" : nloops == 1 ? "one open end" : "tube";
   w.seg.map = o.map;
+  auto phase = [depth](const char* what) {  // progress lines for the colon segments, not their branches
+    if (depth == 0) phase_done(what);
+  };
   auto loops = open_annulus(s, nloops, o, c, w);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
   w.cap_area = surface_area(s) - surface_area(w.ann);
   Prepared p = prepare(w);
+  phase("ends opened");
   conformal(w, loops, p, o);
+  phase("conformal map");
   std::vector<SegmentWork> branches;
   if (o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth)
     branches = cut_branches(w, loops, p, o, depth);
+  if (!branches.empty()) phase("side branches cut and flattened, conformal map again");
   const Centreline cl = centreline_step(w, loops);
   attach_branches(w, branches);
+  phase("centreline");
   debug_stats("conformal", w, p.degenerate);
   if (o.map == "area-balanced") area_balanced_step(w, cl, p.vf, p.fixed, p.degenerate, o, depth > 0);
+  if (o.map == "area-balanced") phase("area balance");
   debug_stats("final", w, p.degenerate);
   w.seg.faces = w.ann.t.size();
   w.seg.vertices = w.ann.p.size();
   measure(w, p.E, p.degenerate, o);
+  phase("distortion and coverage");
   std::vector<SegmentWork> out;
   out.push_back(std::move(w));
   for (auto& b : branches) {

@@ -11,6 +11,7 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/tool.h"
 #include "phantom_description.h"
 #include "phantom_model.h"
@@ -24,7 +25,8 @@ using namespace phantom_detail;
 namespace {
 
 void validate(const PhantomOptions& o) {
-  if (o.size != "small" && o.size != "full") throw UsageError("--size must be small or full (got '" + o.size + "')");
+  if (o.size != "small" && o.size != "medium" && o.size != "full")
+    throw UsageError("--size must be small, medium or full (got '" + o.size + "')");
   if (!(o.noise_hu >= 0 && o.noise_hu <= 500)) throw UsageError("--noise must be in [0, 500] HU");
   if (!(o.blur_mm >= 0 && o.blur_mm <= 5)) throw UsageError("--blur must be in [0, 5] mm");
   if (o.position != "supine" && o.position != "prone")
@@ -106,13 +108,16 @@ Phantom generate_phantom(const PhantomOptions& o) {
   validate(o);
   Model md;
   PhantomLayout(o, md).run();
+  phase_done("colon layout");
   std::vector<unsigned char> mat(md.g.voxels());
   paint_body(md.g, mat);
   PhantomPainter(md, mat).run();
+  phase_done("tissues painted");
   Phantom out;
   VolumeCounts counts;
   CtImage::Pointer sharp = materials_to_images(md, mat, out, counts);
   out.ct = blur_and_noise(sharp, o, md.g);
+  phase_done("CT with blur and noise");
   out.patient_position = md.gravity > 0 ? "HFS" : "HFP";
   set_patient_position(out.ct.GetPointer(), out.patient_position);
   for (const Polyp& p : md.polyps) {

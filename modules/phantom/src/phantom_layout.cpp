@@ -44,6 +44,7 @@ void PhantomLayout::run() {
 void PhantomLayout::make_grid() {
   Grid& g = md_.g;
   if (o_.size == "full") g = {{512, 512, 400}, {0.7, 0.7, 1.0}, {-178.85, -178.85, -199.5}};
+  else if (o_.size == "medium") g = {{256, 256, 200}, {1.4, 1.4, 2.0}, {-178.5, -178.5, -199.0}};
   else g = {{128, 128, 128}, {2.8, 2.8, 3.125}, {-177.8, -177.8, -198.4375}};
   hmax_ = std::max({g.sp[0], g.sp[1], g.sp[2]});
   md_.gravity = o_.position == "prone" ? -1.0 : 1.0;

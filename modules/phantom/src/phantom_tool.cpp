@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/phantom/phantom.h"
 
@@ -30,9 +31,9 @@ class PhantomTool : public Tool {
     app.add_option("-o,--output", dir, "output folder")->required()->type_name("DIR");
     app.add_option("--seed", o.seed, "random seed (default 1)")->type_name("N")->check(
         CLI::Validator([](std::string& v) { return v.rfind('-', 0) == 0 ? "must be >= 0 (got " + v + ")" : std::string(); }, ""));
-    app.add_option("--size", o.size, "small: 128^3 at 2.8 x 2.8 x 3.125 mm (seconds); full: 512 x 512 x 400 at "
-                                     "0.7 x 0.7 x 1 mm (default small)")
-        ->type_name("small|full");
+    app.add_option("--size", o.size, "small: 128^3 at 2.8 x 2.8 x 3.125 mm (seconds); medium: 256 x 256 x 200 at "
+                                     "1.4 x 1.4 x 2 mm; full: 512 x 512 x 400 at 0.7 x 0.7 x 1 mm (default small)")
+        ->type_name("small|medium|full");
     app.add_option("--format", format, "volume format: nrrd (DIR/ct.nrrd) or dicom (DIR/dicom/, one file per slice) "
                                        "(default nrrd)")
         ->type_name("nrrd|dicom");
@@ -67,9 +68,11 @@ class PhantomTool : public Tool {
         if (app.count("--fully-tagged-segments") == 0) o.fully_tagged_segments = 2;
       }
       Stopwatch t;
+      ProgressScope phases(quiet ? nullptr : &err, "phantom");
       Phantom p = generate_phantom(o);
       const double gen = t.seconds();
       write_phantom(p, dir, format);
+      phase_done("written");
       if (!quiet) {
         err << std::fixed << std::setprecision(2) << "phantom: colon "
             << p.description["colon"]["length_mm"].get<double>() / 1000.0 << " m, lumen "

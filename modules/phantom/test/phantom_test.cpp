@@ -264,7 +264,7 @@ TEST(PhantomTool, DicomFormatMatchesNrrd) {
 // Bad options: exit 2, one error line, nothing written.
 TEST(PhantomTool, BadOptionsWriteNothing) {
   testing::TempDir tmp;
-  for (const auto& args : std::vector<std::vector<std::string>>{{"-o", tmp.str("x"), "--size", "medium"},
+  for (const auto& args : std::vector<std::vector<std::string>>{{"-o", tmp.str("x"), "--size", "huge"},
                                                                 {"-o", tmp.str("x"), "--format", "png"},
                                                                 {"-o", tmp.str("x"), "--noise", "-3"}}) {
     const auto r = run_tool(args);

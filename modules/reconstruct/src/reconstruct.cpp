@@ -17,6 +17,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/soup.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/core/vtk_messages.h"
 #include "reconstruct_internal.h"
@@ -168,14 +169,18 @@ class SurfaceReconstruction {
     read_geometry();
     check_ct();
     extract();
+    phase_done("surface extraction");
     verify_extracted();
     drop_small_components();
+    phase_done("topology check, small components");
     smooth_mesh();
+    phase_done("smoothing");
     mesh_ = to_openmesh(tris_);
     tris_ = TriangleList{};
     staircase_ = {};
     decimate();
     final_check();
+    phase_done("decimation and final check");
     st_.time_total_s = total_.seconds();
     if (stats_out) *stats_out = std::move(st_);
     return std::move(mesh_);

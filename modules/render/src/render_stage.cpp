@@ -5,6 +5,7 @@
 
 #include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/render/artifacts.h"
@@ -59,6 +60,7 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   const FlatMap& flat = bag.get<FlatMap>("flat");
   Stopwatch sw;
   RenderResult r = render_flat(flat, opts_);
+  phase_done("colon image and candidates");
   ctx.report["colon_image"] = {{"width", r.colon.width}, {"height", r.colon.height}, {"pixel_size_mm", r.colon.pixel_size}};
   ctx.report["candidates"] = r.candidates.size();
   if (r.candidates_json.contains("score_vs_known")) ctx.report["score_vs_known"] = r.candidates_json["score_vs_known"];
@@ -96,12 +98,14 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
       so.caption = "before denoising: genus " + (topo.genus ? std::to_string(*topo.genus) : std::string("?")) +
                    (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
       bag.put("snapshot_before", render_snapshot(to_triangle_list(m), loops, so));
+      phase_done("3D snapshot before denoising");
     }
     TriangleList after = bag.has("denoised") ? to_triangle_list(bag.get<Mesh>("denoised")) : flat_to_surface(flat);
     so.caption = std::string(bag.has("denoised") ? "after denoising" : "flattened surface") + ", " +
                  std::to_string(r.candidates.size()) + " polyp candidates" +
                  (loops ? ", cut loops highlighted" : std::string());
     bag.put("snapshot_after", render_snapshot(after, loops, so));
+    phase_done("3D snapshot after denoising");
     ctx.report["display"] = ensure_display();
   } catch (const Error& e) {
     ctx.report["snapshot_error"] = e.what();

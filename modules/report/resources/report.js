@@ -26,6 +26,8 @@
   const allFindings = () => (R.candidates || []).concat(R.known || []);
   const findingByKey = (key) => allFindings().find((f) => f.key === key);
 
+  // What the views show: the CT, or the lumen mask of a run without a CT.
+  const volumeName = () => (R.ct && R.ct.is_mask ? "Lumen mask (no CT)" : "CT");
   // CT voxel index (continuous) of an LPS point, and the text shown for it.
   function ctIndex(lps) {
     if (!R.ct) return null;
@@ -201,7 +203,7 @@
     const hit = lookup(p[0], p[1]);
     if (!hit) return;
     setPin(p[0], p[1]);
-    showCtAt(hit.lps, "CT at the clicked point: " + hoverText(hit));
+    showCtAt(hit.lps, volumeName() + " at the clicked point: " + hoverText(hit));
   }
 
   // Shows a finding: selects its card, centres the map on it (unless keepMap), CT planes there.
@@ -216,7 +218,7 @@
       if (!keepMap) centreOn(f.pixel[0], f.pixel[1], Math.max(view.scale, 1.5));
       setPin(f.pixel[0], f.pixel[1]);
     }
-    showCtAt(f.lps_mm, "CT at " + key + ": " + positionText(f) + " · LPS " + lpsText(f.lps_mm) + " mm · " + sliceText(f.lps_mm));
+    showCtAt(f.lps_mm, volumeName() + " at " + key + ": " + positionText(f) + " · LPS " + lpsText(f.lps_mm) + " mm · " + sliceText(f.lps_mm));
     if (scroll && card) card.scrollIntoView({ block: "start" });
   }
   window.colonflatFocus = focusFinding;
@@ -232,9 +234,11 @@
     const box = el("div", { class: "ct-views" });
     for (const plane of ["axial", "coronal", "sagittal"]) {
       const p = f.ct[plane];
-      const t = el("div", { class: "tile ct-tile", "data-plane": plane }, [
-        el("img", { src: p.lung, alt: plane + " lung window", class: "lung" }),
-        el("img", { src: p.soft, alt: plane + " soft-tissue window", class: "soft" })]);
+      // a run from a lumen mask has no CT: one mask view (lumen white) per plane
+      const imgs = p.mask ? [el("img", { src: p.mask, alt: plane + " lumen mask", class: "lung" })]
+        : [el("img", { src: p.lung, alt: plane + " lung window", class: "lung" }),
+           el("img", { src: p.soft, alt: plane + " soft-tissue window", class: "soft" })];
+      const t = el("div", { class: "tile ct-tile", "data-plane": plane }, imgs);
       crosshair(t);
       t.appendChild(el("span", { class: "lab", text: plane + " · FOV " + fix(f.fov_mm, 0) + " mm" }));
       box.appendChild(t);
@@ -277,7 +281,8 @@
       ring.style.width = ring.style.height = d + "px";
       body.appendChild(tile(f.flat_thumbnail, "colon map", "", [ring]));
     }
-    if (f.ct) body.appendChild(el("div", {}, [ctTiles(f), windowButtons(c)]));
+    const maskNote = () => el("p", { class: "dim", text: "lumen mask (the run had no CT): lumen white" });
+    if (f.ct) body.appendChild(el("div", {}, [ctTiles(f), R.ct && R.ct.is_mask ? maskNote() : windowButtons(c)]));
     if (f.endoluminal) {
       const t = tile(f.endoluminal, "endoluminal 3D", "endo");
       crosshair(t);
@@ -403,7 +408,7 @@
     buildFiles();
     const first = (R.candidates || [])[0] || (R.known || [])[0];
     if (first) focusFinding(first.key, false, true);
-    else $("ct-title").textContent = "CT: click the map";
+    else $("ct-title").textContent = volumeName() + ": click the map";
     document.body.setAttribute("data-ready", "1");
   }
   start();

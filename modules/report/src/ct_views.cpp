@@ -33,6 +33,11 @@ const CtWindow& soft_tissue_window() {
   return w;
 }
 
+const CtWindow& mask_window() {
+  static const CtWindow w{"mask", 0.5, 1};
+  return w;
+}
+
 PlaneAxes plane_axes(Plane p) {
   // LPS: +x left, +y posterior, +z superior. Screen right = patient left (+x) or posterior (+y,
   // sagittal); screen down = posterior (+y, axial) or inferior (-z).
@@ -43,30 +48,31 @@ PlaneAxes plane_axes(Plane p) {
   }
 }
 
-PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
+template <class Image>
+PlaneImage sample_plane(const Image* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
                         double pixel_mm) {
   if (!ct) throw Error("sample_plane: no CT volume");
   PlaneImage out;
   out.plane = plane;
   out.w = w, out.h = h, out.pixel_mm = pixel_mm, out.u0 = u0, out.v0 = v0, out.fixed = fixed;
   out.hu.assign(std::size_t(w) * h, -2000.0f);
-  using Interp = itk::LinearInterpolateImageFunction<CtImage, double>;
+  using Interp = itk::LinearInterpolateImageFunction<Image, double>;
   auto interp = Interp::New();
   interp->SetInputImage(ct);
   const PlaneAxes a = plane_axes(plane);
   // The index is affine in the pixel: per row, the start index and a per-column step.
   const auto index_of = [&](int r, int c) {
-    Interp::PointType p;
+    typename Interp::PointType p;
     p[a.fixed_axis] = fixed;
     p[a.v_axis] = a.v_sign * (v0 + r * pixel_mm);
     p[a.u_axis] = a.u_sign * (u0 + c * pixel_mm);
-    Interp::ContinuousIndexType idx;
+    typename Interp::ContinuousIndexType idx;
     ct->TransformPhysicalPointToContinuousIndex(p, idx);
     return idx;
   };
   for (int r = 0; r < h; ++r) {
     const auto start = index_of(r, 0), next = index_of(r, 1);
-    Interp::ContinuousIndexType idx;
+    typename Interp::ContinuousIndexType idx;
     for (int c = 0; c < w; ++c) {
       for (int k = 0; k < 3; ++k) idx[k] = start[k] + c * (next[k] - start[k]);
       if (interp->IsInsideBuffer(idx)) out.hu[std::size_t(r) * w + c] = float(interp->EvaluateAtContinuousIndex(idx));
@@ -75,7 +81,8 @@ PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0,
   return out;
 }
 
-PlaneImage sample_plane_around(const CtImage* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
+template <class Image>
+PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
                                int pixels) {
   const PlaneAxes a = plane_axes(plane);
   const double pix = fov_mm / pixels;
@@ -107,7 +114,8 @@ void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::pat
   });
 }
 
-nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::array<double, 3>& box_min,
+template <class Image>
+nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
                                  const std::array<double, 3>& box_max, const SliceStackOptions& o,
                                  const fs::path& dir, const std::string& rel_prefix) {
   const PlaneAxes a = plane_axes(plane);
@@ -128,14 +136,15 @@ nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::arra
     const double fixed = f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm;
     const PlaneImage im = sample_plane(ct, plane, fixed, ur[0], vr[0], w, h, o.pixel_mm);
     const std::string name = std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png";
-    write_windowed_png(im, lung_window(), dir / name);
+    write_windowed_png(im, o.window ? *o.window : lung_window(), dir / name);
     j["positions"].push_back(std::round(fixed * 100) / 100);
     j["files"].push_back(rel_prefix + name);
   }
   return j;
 }
 
-nlohmann::json ct_geometry_json(const CtImage* ct) {
+template <class Image>
+nlohmann::json ct_geometry_json(const Image* ct) {
   const auto region = ct->GetLargestPossibleRegion();
   const auto sp = ct->GetSpacing();
   const auto org = ct->GetOrigin();
@@ -154,5 +163,17 @@ nlohmann::json ct_geometry_json(const CtImage* ct) {
           {"direction", direction},
           {"lps_to_index", to_index}};
 }
+
+// The two volume kinds a report shows.
+#define CF_VIEW_VOLUME(Image)                                                                                     \
+  template PlaneImage sample_plane(const Image*, Plane, double, double, double, int, int, double);             \
+  template PlaneImage sample_plane_around(const Image*, Plane, const std::array<double, 3>&, double, int);       \
+  template nlohmann::json write_slice_stack(const Image*, Plane, const std::array<double, 3>&,                  \
+                                            const std::array<double, 3>&, const SliceStackOptions&,             \
+                                            const fs::path&, const std::string&);                               \
+  template nlohmann::json ct_geometry_json(const Image*);
+CF_VIEW_VOLUME(CtImage)
+CF_VIEW_VOLUME(MaskImage)
+#undef CF_VIEW_VOLUME
 
 }  // namespace cf

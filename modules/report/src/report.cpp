@@ -2,10 +2,8 @@
 
 #include <vtkImageData.h>
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <ctime>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -14,6 +12,7 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/tool.h"
 #include "colonflat/report/ct_views.h"
@@ -26,25 +25,6 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-// A folder that is removed unless release()d.
-class TempFolder {
- public:
-  explicit TempFolder(fs::path p) : path_(std::move(p)) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    if (!released_) fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  void release() { released_ = true; }
-
- private:
-  fs::path path_;
-  bool released_ = false;
-};
-
 struct Builder {
   Builder(const ReportOptions& o, std::ostream* l, RunData r) : opts(o), log(l), run(std::move(r)) {}
   const ReportOptions& opts;
@@ -56,18 +36,15 @@ struct Builder {
   ImagePtr colon;
   ReportResult result;
 
-  void progress(const std::string& line) const {
-    if (log) *log << "report: " << line << "\n";
-  }
-
   // colon.png, its layout check and the hover/click lookup grid.
   void add_image() {
     const fs::path png = run.dir / "colon.png";
-    if (!run.flat || !fs::exists(png)) {
-      if (!fs::exists(png)) run.warnings.push_back("no colon.png in the run folder: no colon image");
+    const bool have_png = run.colon_image || run_has_file(run, "colon.png");
+    if (!run.flat || !have_png) {
+      if (!have_png) run.warnings.push_back("no colon.png in the run folder: no colon image");
       return;
     }
-    colon = read_png(png);
+    colon = run.colon_image ? run.colon_image : read_png(png);
     int dims[3];
     colon->GetDimensions(dims);
     layout.emplace(*run.flat, colon_image_pixel_size(run), std::numeric_limits<int>::max());
@@ -87,9 +64,10 @@ struct Builder {
 
   // The CT geometry and the stacks of planes a click on the map shows.
   void add_ct() {
-    if (!run.ct) return;
-    data["ct"] = ct_geometry_json(run.ct);
+    if (!run.ct && !run.mask) return;
+    data["ct"] = run.ct ? ct_geometry_json(run.ct.GetPointer()) : ct_geometry_json(run.mask.GetPointer());
     data["ct"]["file"] = run.ct_path.string();
+    data["ct"]["is_mask"] = run.volume_is_mask;
     std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
     const auto grow = [&](const std::array<double, 3>& p) {
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
@@ -101,8 +79,10 @@ struct Builder {
     SliceStackOptions so;
     so.step_mm = opts.stack_step_mm;
     so.pixel_mm = opts.stack_pixel_mm;
+    if (run.volume_is_mask) so.window = &mask_window();
     for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-      data["stacks"][plane_name(p)] = write_slice_stack(run.ct, p, lo, hi, so, files_dir, "report_files/");
+      data["stacks"][plane_name(p)] = run.ct ? write_slice_stack(run.ct.GetPointer(), p, lo, hi, so, files_dir, "report_files/")
+                                             : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
       result.images += int(data["stacks"][plane_name(p)]["files"].size());
     }
   }
@@ -156,8 +136,9 @@ struct Builder {
         {"polyps.json", "candidates (JSON, older name)"},
         {"ct.nrrd", "CT volume (HU)"}};
     for (const auto& [name, what] : outputs)
-      if (fs::exists(run.dir / name)) add(name, what);
-    if (!run.ct_path.empty() && !fs::exists(run.dir / "ct.nrrd")) add(run.ct_path.string(), "CT volume the run read (HU)");
+      if (run_has_file(run, name)) add(name, what);
+    if (!run.ct_path.empty() && !run_has_file(run, "ct.nrrd"))
+      add(run.ct_path.string(), run.volume_is_mask ? "lumen mask the run read (no CT)" : "CT volume the run read (HU)");
     data["files"] = files;
   }
 };
@@ -196,53 +177,60 @@ std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
   return points;
 }
 
+// Test-only fault injection (docs/pipeline.md): COLONFLAT_TEST_FAIL=report makes the report fail
+// after writing its images, to prove that a failing report leaves no run output.
+void maybe_inject_fault() {
+  const char* fail = std::getenv("COLONFLAT_TEST_FAIL");
+  if (fail && std::string(fail) == "report") throw Error("report: failure injected by COLONFLAT_TEST_FAIL=report (test only)");
+}
+
 }  // namespace
 
-ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& opts, std::ostream* log) {
-  Stopwatch clock, phase;
-  std::vector<std::pair<std::string, double>> phases;
-  std::clock_t cpu = std::clock();
-  const auto lap = [&](const char* name) {
-    phases.emplace_back(name, phase.seconds());
-    phases.emplace_back(std::string(name) + "_cpu", double(std::clock() - cpu) / CLOCKS_PER_SEC);
-    phase.restart();
-    cpu = std::clock();
-  };
-  Builder b(opts, log, load_run(run_dir, {opts.ct, opts.truth}));
-  lap("load");
-  TempFolder files(run_dir / (".report_files.tmp-" + std::to_string(::getpid())));
-  b.files_dir = files.path();
+ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputTransaction& tx, std::ostream* log) {
+  Stopwatch clock;
+  ProgressScope scope(log, "report");
+  const fs::path dir = run.dir;
+  Builder b(opts, log, std::move(run));
+  b.files_dir = tx.stage(dir / "report_files");
+  fs::create_directories(b.files_dir);
   b.data["title"] = "ColonFlat review report";
   b.data["version"] = colonflat_version();
-  b.data["run_dir"] = fs::absolute(run_dir).lexically_normal().string();
+  b.data["run_dir"] = fs::absolute(dir).lexically_normal().string();
   b.data["candidates_file"] = b.run.candidates_file;
   b.add_image();
-  lap("image");
+  phase_done("colon image and lookup grid");
   b.add_ct();
-  lap("ct");
-  b.progress("CT planes written");
+  phase_done(std::string(b.run.volume_is_mask ? "mask" : "CT") + " planes (" + std::to_string(b.result.images) + " images)");
   b.add_findings();
-  lap("cards");
-  b.progress(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
+  phase_done(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
              " known-polyp cards");
+  maybe_inject_fault();
   b.add_files();
   b.data["summary"] = summary_json(b.run);
-  OutputTransaction tx;
-  std::ofstream(tx.stage(run_dir / "report.html")) << page_html(b.data);
-  std::ofstream(tx.stage(run_dir / "polyps.mrk.json"))
+  std::ofstream(tx.stage(dir / "report.html")) << page_html(b.data);
+  std::ofstream(tx.stage(dir / "polyps.mrk.json"))
       << slicer_point_list("ColonFlat candidates", markup_points(b.data["candidates"]), {1.0, 0.85, 0.0}).dump(2) << "\n";
   if (!b.run.known.empty())
-    std::ofstream(tx.stage(run_dir / "known_polyps.mrk.json"))
+    std::ofstream(tx.stage(dir / "known_polyps.mrk.json"))
         << slicer_point_list("Known polyps", markup_points(b.data["known"]), {0.25, 0.9, 0.4}).dump(2) << "\n";
-  fs::remove_all(run_dir / "report_files");
-  fs::rename(files.path(), run_dir / "report_files");
-  files.release();
-  tx.commit();
-  lap("page");
-  b.result.phases = phases;
+  phase_done("page and Slicer files");
+  for (const auto& p : scope.phases()) b.result.phases.emplace_back(p["phase"].get<std::string>(), p["time_s"].get<double>());
   b.result.warnings = b.run.warnings;
   b.result.seconds = clock.seconds();
   return b.result;
+}
+
+ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& opts, std::ostream* log) {
+  Stopwatch clock;
+  ProgressScope scope(log, "report");
+  RunData run = load_run(run_dir, {opts.ct, opts.truth});
+  phase_done("read the run folder");
+  OutputTransaction tx;
+  ReportResult r = build_review_report(std::move(run), opts, tx, log);
+  tx.commit();
+  r.phases.insert(r.phases.begin(), {"read the run folder", scope.phases()[0]["time_s"].get<double>()});
+  r.seconds = clock.seconds();
+  return r;
 }
 
 }  // namespace cf

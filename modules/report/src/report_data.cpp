@@ -113,15 +113,20 @@ int write_finding_images(const RunData& run, const ReportFinding& f, const Repor
                          vtkImageData* colon_image, EndoluminalRenderer* endo, nlohmann::json& fj) {
   int written = 0;
   const std::string rel = "report_files/";
-  if (run.ct) {
+  if (run.ct || run.mask) {
     const double fov = std::clamp(o.fov_per_size * f.size_mm, o.min_fov_mm, o.max_fov_mm);
     fj["fov_mm"] = std::round(fov * 10) / 10;
+    // A CT in the lung and soft-tissue windows; a mask (no CT) once, in the mask window.
+    std::vector<std::pair<const CtWindow*, std::string>> windows = {{&lung_window(), "lung"},
+                                                                    {&soft_tissue_window(), "soft"}};
+    if (run.volume_is_mask) windows = {{&mask_window(), "mask"}};
     for (Plane plane : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-      const PlaneImage im = sample_plane_around(run.ct, plane, f.lps_mm, fov, o.tile_pixels);
-      for (const CtWindow* w : {&lung_window(), &soft_tissue_window()}) {
-        const std::string name = f.key + "_" + plane_name(plane) + (w == &lung_window() ? "_lung" : "_soft") + ".png";
-        write_windowed_png(im, *w, dir / name);
-        fj["ct"][plane_name(plane)][w == &lung_window() ? "lung" : "soft"] = rel + name;
+      const PlaneImage im = run.ct ? sample_plane_around(run.ct.GetPointer(), plane, f.lps_mm, fov, o.tile_pixels)
+                                   : sample_plane_around(run.mask.GetPointer(), plane, f.lps_mm, fov, o.tile_pixels);
+      for (const auto& [window, key] : windows) {
+        const std::string name = f.key + "_" + plane_name(plane) + "_" + key + ".png";
+        write_windowed_png(im, *window, dir / name);
+        fj["ct"][plane_name(plane)][key] = rel + name;
         ++written;
       }
     }
@@ -153,7 +158,7 @@ nlohmann::json summary_json(const RunData& run) {
                       {"result", s.value("result", nlohmann::json::object())}});
   nlohmann::json snapshots = nlohmann::json::array();
   for (const char* name : {"snapshot_before.png", "snapshot_after.png"})
-    if (fs::exists(run.dir / name)) snapshots.push_back(name);
+    if (run_has_file(run, name)) snapshots.push_back(name);
   nlohmann::json j = {{"stages", stages},
                       {"total_time_s", run.run_report.value("total_time_s", 0.0)},
                       {"peak_memory_mib", run.run_report.value("peak_memory_mib", 0.0)},

@@ -4,6 +4,10 @@
 #include <iostream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
+#include "colonflat/core/run_finisher.h"
+#include "colonflat/core/run_stats.h"
+#include "colonflat/report/run_data.h"
 
 namespace cf {
 
@@ -31,7 +35,8 @@ const ParamTable<ReportOptions>& report_param_table() {
 
 namespace {
 
-class ReportTool : public Tool {
+// `colonflat report RUN_DIR` reads a run's files; as the run's finisher it gets the run's memory.
+class ReportTool : public Tool, public RunFinisher {
  public:
   std::string name() const override { return "report"; }
   std::string summary() const override {
@@ -53,18 +58,44 @@ class ReportTool : public Tool {
       report_param_table().validate(opts);
       if (opts.min_fov_mm > opts.max_fov_mm) throw UsageError("--min-fov must not exceed --max-fov");
       const ReportResult r = write_review_report(run_dir, opts, quiet ? nullptr : &err);
-      if (!quiet) {
+      if (!quiet)
         for (const auto& w : r.warnings) err << "colonflat report: warning: " << w << "\n";
-        err << "report: phases";
-        for (const auto& [phase, secs] : r.phases) err << " " << phase << " " << std::fixed << std::setprecision(2) << secs << " s";
-        err << "\n";
-      }
       out << "report: " << (std::filesystem::path(run_dir) / "report.html").string() << " (" << r.candidates
           << " candidates, " << r.known_polyps << " known polyps, " << r.images << " images, "
           << r.endoluminal_views << " endoluminal views) in " << std::fixed << std::setprecision(2) << r.seconds
           << " s\n";
       return kExitOk;
     });
+  }
+
+  // After render (the report needs the colon image and its candidates).
+  bool applies_to(const std::vector<std::string>& stages_run) const override {
+    return !stages_run.empty() && stages_run.back() == "render";
+  }
+  std::vector<std::filesystem::path> planned_outputs(const std::filesystem::path& dir) const override {
+    return {dir / "report.html", dir / "polyps.mrk.json", dir / "known_polyps.mrk.json"};
+  }
+  std::vector<std::filesystem::path> planned_folders(const std::filesystem::path& dir) const override {
+    return {dir / "report_files"};
+  }
+  nlohmann::json finish(FinishedRun& run, OutputTransaction& tx) override {
+    Stopwatch clock;
+    ProgressScope scope(run.log, "report");
+    // The meshes are written; free them before the report's views allocate.
+    for (const char* done : {"surface", "denoised", "loops"}) run.artifacts->erase(done);
+    phase_done("meshes released");
+    RunData data = run_from_artifacts(*run.artifacts, run.dir, *run.report, run.input);
+    for (const auto& target : tx.targets())
+      if (target.parent_path() == run.dir) data.staged_files.push_back(target.filename().string());
+    phase_done("run data from memory");
+    const ReportResult r = build_review_report(std::move(data), ReportOptions{}, tx, run.log);
+    for (const auto& w : r.warnings)
+      if (run.log) *run.log << "colonflat report: warning: " << w << "\n";
+    nlohmann::json phases = scope.phases();
+    for (const auto& [phase, secs] : r.phases) phases.push_back({{"phase", phase}, {"time_s", secs}});
+    return {{"step", "report"}, {"time_s", clock.seconds()}, {"phases", phases}, {"candidates", r.candidates},
+            {"known_polyps", r.known_polyps}, {"images", r.images}, {"endoluminal_views", r.endoluminal_views},
+            {"warnings", r.warnings}};
   }
 };
 

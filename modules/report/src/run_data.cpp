@@ -1,12 +1,14 @@
 #include "colonflat/report/run_data.h"
 
 #include <vtkDataArray.h>
+#include <vtkImageData.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
+
 
 #include <algorithm>
 #include <cmath>
@@ -44,6 +46,7 @@ void load_flat(RunData& run, const fs::path& path) {
     run.centreline_mm.resize(cl->GetNumberOfTuples());
     for (vtkIdType i = 0; i < cl->GetNumberOfTuples(); ++i) run.centreline_mm[i] = cl->GetTuple1(i);
   }
+  // FlatSegments as written (it may hold fields this build's FlatMap does not keep).
   if (auto* js = vtkStringArray::SafeDownCast(pd->GetFieldData()->GetAbstractArray("FlatSegments"))) {
     const auto j = nlohmann::json::parse(js->GetValue(0), nullptr, false);
     if (!j.is_discarded() && j.contains("segments")) run.flat_segments = j["segments"];
@@ -87,6 +90,18 @@ fs::path find_truth(const RunData& run, const RunLoadOptions& opts) {
   return {};
 }
 
+// A run that started from a lumen mask (its first stage is reconstruct): its input is no CT.
+bool run_started_from_mask(const nlohmann::json& run_report) {
+  const auto stages = run_report.value("stages", nlohmann::json::array());
+  return !stages.empty() && stages[0].value("stage", "") == "reconstruct";
+}
+
+void set_flat(RunData& run, FlatMap flat) {
+  if (flat.centreline_mm.size() == flat.uv.size()) run.centreline_mm = flat.centreline_mm;
+  run.flat_segments = flat_report(flat).value("segments", nlohmann::json::array());
+  run.flat = std::move(flat);
+}
+
 void load_candidates(RunData& run) {
   for (const char* name : {"candidates.json", "polyps.json"}) {
     if (!fs::exists(run.dir / name)) continue;
@@ -110,6 +125,18 @@ void load_truth(RunData& run, const RunLoadOptions& opts) {
     f.size_mm = k.diameter_mm;
     f.type = k.type;
     run.known.push_back(f);
+  }
+}
+
+// What both loaders share: the truth polyps, findings placed on the flat map, missing pieces.
+void complete_run(RunData& run, const RunLoadOptions& opts) {
+  if (!run.flat) run.warnings.push_back("no flat map: no colon map lookup, no positions along the colon");
+  if (!run.ct && !run.mask) run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
+  else if (run.volume_is_mask) run.warnings.push_back("the run started from a lumen mask: the views show the mask, not a CT");
+  load_truth(run, opts);
+  if (run.flat) {
+    attach_to_flat(*run.flat, run.candidates);
+    attach_to_flat(*run.flat, run.known);
   }
 }
 
@@ -149,16 +176,49 @@ RunData load_run(const fs::path& dir, const RunLoadOptions& opts) {
   if (!run.run_report.is_object()) throw InputError((dir / "run_report.json").string(), "not a JSON object");
   load_candidates(run);
   if (fs::exists(dir / "flat.vtp")) load_flat(run, dir / "flat.vtp");
-  else run.warnings.push_back("no flat.vtp in the run folder: no colon map lookup, no positions along the colon");
   run.ct_path = find_ct(run, opts);
-  if (!run.ct_path.empty()) run.ct = read_ct_volume(run.ct_path);
-  else run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
-  load_truth(run, opts);
-  if (run.flat) {
-    attach_to_flat(*run.flat, run.candidates);
-    attach_to_flat(*run.flat, run.known);
+  if (!run.ct_path.empty()) {
+    run.volume_is_mask = opts.ct.empty() && run_started_from_mask(run.run_report) &&
+                         fs::path(run.run_report.value("input", "")).filename() == run.ct_path.filename();
+    if (run.volume_is_mask) run.mask = read_mask(run.ct_path);
+    else run.ct = read_ct_volume(run.ct_path);
   }
+  complete_run(run, opts);
   return run;
+}
+
+RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann::json& run_report,
+                           const std::string& input, const RunLoadOptions& opts) {
+  RunData run;
+  run.dir = dir;
+  run.run_report = run_report;
+  if (bag.has("candidates")) {
+    run.candidates_file = "candidates.json";
+    run.candidates_doc = bag.get<nlohmann::json>("candidates");
+    run.candidates = candidates_from_json(run.candidates_doc, "candidates");
+  } else {
+    run.warnings.push_back("the run made no candidates: no candidate cards");
+  }
+  if (bag.has("flat")) set_flat(run, bag.take<FlatMap>("flat"));
+  if (bag.has("colon_image")) run.colon_image = bag.get<ImagePtr>("colon_image");
+  if (!opts.ct.empty()) {
+    run.ct_path = opts.ct;
+    run.ct = read_ct_volume(opts.ct);
+  } else if (bag.has("ct")) {
+    run.ct = bag.get<CtImage::Pointer>("ct");
+    run.ct_path = input;
+  } else if (bag.has("mask")) {
+    run.mask = bag.get<MaskImage::Pointer>("mask");
+    run.ct_path = input;
+    run.volume_is_mask = true;
+  }
+  complete_run(run, opts);
+  return run;
+}
+
+bool run_has_file(const RunData& run, const std::string& name) {
+  return std::find(run.staged_files.begin(), run.staged_files.end(), name) != run.staged_files.end() ||
+         fs::exists(run.dir / name);
 }
 
 ColonPosition colon_position(const RunData& run, int v) {

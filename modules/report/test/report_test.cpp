@@ -90,7 +90,7 @@ TEST(ReportCt, PlanesCentredOnPointInRadiologicalConvention) {
   const auto ct = testing::ball_ct({-20, -50, 0}, {40, 10, 60}, c);
   const int n = 61;  // 1 mm pixels, centre pixel 30
   for (Plane plane : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-    const PlaneImage im = sample_plane_around(ct, plane, c, 61.0, n);
+    const PlaneImage im = sample_plane_around(ct.GetPointer(), plane, c, 61.0, n);
     auto hu = [&](int col, int row) { return im.hu[std::size_t(row) * n + col]; };
     EXPECT_GT(hu(30, 30), 500) << plane_name(plane);
     EXPECT_LT(hu(2, 2), -900) << plane_name(plane);

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/progress.h"
 #include "colonflat/core/params.h"
 #include "segment_internal.h"
 
@@ -114,6 +115,7 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
 void ColonSegmenter::lap(const char* name) {
   timings_[name] = step_.seconds();
   step_.restart();
+  phase_done(name);
 }
 
 void ColonSegmenter::check_input() {

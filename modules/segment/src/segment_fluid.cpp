@@ -9,7 +9,7 @@
 
 namespace cf::segment_detail {
 namespace {
-constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4;
+constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExcluded = 5;
 }
 
 void ColonSegmenter::find_fluid_bodies() {
@@ -43,7 +43,8 @@ void ColonSegmenter::scan_contacts(int axis, std::vector<unsigned char>* contact
         if (!k) continue;
         if (last_kind && last_kind != k && p - last_pos - 1 <= wvox) {
           if (layer)
-            for (int r = last_pos + 1; r < p; ++r) lab_[base + std::size_t(r) * stride] = kLayer;
+            for (int r = last_pos + 1; r < p; ++r)
+              if (lab_[base + std::size_t(r) * stride] != kExcluded) lab_[base + std::size_t(r) * stride] = kLayer;
           if (contact) {
             if (k == 2) (*contact)[q] = 1;  // gas at lower index, fluid here
             else (*contact)[base + std::size_t(last_pos) * stride] = 2;

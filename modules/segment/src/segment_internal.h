@@ -3,9 +3,13 @@
 // the ColonSegmenter holding the state of one segmentation with one method per step.
 #include <itkImage.h>
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +20,9 @@
 
 namespace cf::segment_detail {
 
+class LinkGrid;
+struct Contact;
+struct LocalShape;
 using LabelImage = itk::Image<std::uint32_t, 3>;
 
 struct Dims {
@@ -77,7 +84,8 @@ struct BodyStats {
 
 class ColonSegmenter {
  public:
-  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts) : ct_(ct), opts_(opts) {}
+  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts);
+  ~ColonSegmenter();
   MaskImage::Pointer run(SegmentStats* stats);
 
  private:
@@ -85,10 +93,15 @@ class ColonSegmenter {
   void check_input();
   void gravity_from_metadata();
   void find_gas_bodies();
-  void trim_rectal_tube(const std::uint32_t* labels, std::uint32_t count, std::vector<unsigned char>& drop,
-                        unsigned char* gas);
-  std::size_t follow_tube_lumen(const std::uint32_t* labels, std::uint32_t label, std::size_t first_slice,
-                                unsigned char* gas, double sum[3]);
+  // Rectal tube (segment_tube.cpp).
+  void trim_rectal_tube(const std::uint32_t* labels, const std::vector<unsigned char>& drop, unsigned char* gas);
+  std::size_t track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]);
+  std::size_t slice_index(std::size_t s, long a, long b) const;
+  std::vector<std::pair<long, long>> slice_component(std::size_t s, const std::vector<std::pair<long, long>>& seeds,
+                                                     const unsigned char* gas, std::size_t limit) const;
+  std::vector<std::pair<long, long>> gas_in_disc(std::size_t s, double ca, double cb, double r_px, const unsigned char* gas) const;
+  void exclude_disc(std::size_t s, double ca, double cb, double r_px);
+  double ring_mean_hu(std::size_t s, double ca, double cb, double r0_px, double r1_px) const;
   void crop_to_gas(const unsigned char* gas);
   void class_means();
   void refine_boundary();
@@ -103,14 +116,14 @@ class ColonSegmenter {
   void mark_layer();
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
+  void check_colon_found(const std::vector<double>& vols) const;
+  std::vector<BodyStats> body_stats(const std::uint32_t* labels, std::uint32_t n, const std::function<bool(std::size_t)>& gas) const;
   void link_tagged_stretches();
-  std::size_t link_pass(bool last);
-  void nearest_colon(const std::vector<BodyStats>& bodies, std::vector<std::size_t>& from, std::vector<std::size_t>& to,
-                     std::vector<double>& gap) const;
-  std::size_t local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
-                          std::array<double, 3>& centroid, std::array<double, 3>& axis) const;
-  bool continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const;
-  bool continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius, std::string& why) const;
+  std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
+  bool continues_colon(const Contact& c, std::string& why) const;
+  bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
+  void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
+  void report_candidate(const BodyStats& b, double kept_gap, const std::string& why);
   // Helpers.
   std::array<double, 3> lps_of(const double crop_voxel[3]) const;
   void decide(const std::string& what, double ml, const double centroid_crop[3], bool kept, const std::string& reason);
@@ -131,13 +144,13 @@ class ColonSegmenter {
   std::string gravity_source_;
   std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
   std::vector<float> hu_;              // CT in the crop
-  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate
+  std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
+  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
   std::vector<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
-  std::vector<std::uint32_t> cand_label_;  // fully tagged candidates (during link_tagged_stretches)
-  std::vector<std::uint32_t> seg_label_;   // kept colon segments (until the stretches are linked)
-  int linked_ = 0;                         // candidates linked so far
+  std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
+  std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   std::vector<unsigned char> state_;   // crop: final 0/1 (after the graph cut)
   std::vector<unsigned char> lumen0_;  // crop: initial lumen
   std::vector<Decision> decisions_;

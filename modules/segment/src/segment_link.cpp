@@ -1,23 +1,32 @@
 // Colon segments and fully tagged stretches: components of gas + pools + layer are colon segments
 // when they hold enough gas; fluid bodies without gas above them (and fluid-dominated bodies with a
 // little gas: small bowel) are kept only as fully tagged colon stretches: they continue the path of
-// a colon segment from its end across a short gap (a collapsed or fluid-filled neck).
-#include <Eigen/Dense>
-
+// a colon segment from its end across a short gap (a collapsed or fluid-filled neck). The linking
+// runs on the coarse cells of a LinkGrid (segment_linkgrid.h).
 #include <algorithm>
 #include <cmath>
-#include <deque>
+#include <cstdio>
+#include <cstdlib>
 #include <iomanip>
+#include <map>
 #include <numeric>
 #include <sstream>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/params.h"
 #include "segment_internal.h"
+#include "segment_linkgrid.h"
 
 namespace cf::segment_detail {
 namespace {
 constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4;
+constexpr double kLinkCellMm = 2.5;     // coarse cell of the linking step
+constexpr double kShapeRadiusMm = 75;   // path length inside a body over which its end is judged (fronts at 25, 50, 75 mm)
+constexpr double kMinChord = 0.7;       // last front's distance from the contact / its path length
+constexpr double kSameEndMm = 30;       // a used end within this path length of a new contact: the same end
+constexpr double kMinCalibreRatio = 0.3; // cross-sections (front sizes) of the two bodies within this ratio
+constexpr std::size_t kContactsPerPair = 3;
+constexpr double kContactSeparationMm = 20;
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
   std::ostringstream s;
@@ -26,25 +35,22 @@ std::string fixed1(double v) {
 }
 }  // namespace
 
+ColonSegmenter::ColonSegmenter(const CtImage* ct, const SegmentOptions& opts) : ct_(ct), opts_(opts) {}
+ColonSegmenter::~ColonSegmenter() = default;
+
 // Components of gas + pools + layer, largest first: kept while they hold >= min-segment-volume of
 // gas, reach min-segment-fraction of the largest and max-segments is not reached. Rejected bodies
-// with enough fluid become candidates for fully tagged stretches (lab 4).
+// with enough fluid become candidates for fully tagged stretches (lab 4). Kept segments are marked
+// on the link grid.
 void ColonSegmenter::select_segments() {
   MaskImage::Pointer work = mask_of_size(d_.n);
   unsigned char* w = work->GetBufferPointer();
   for (std::size_t q = 0; q < d_.total; ++q) w[q] = colon_kind(lab_[q]);
   std::uint32_t n = 0;
   LabelImage::Pointer cl = components(work, n);
+  work = nullptr;
   const std::uint32_t* clb = cl->GetBufferPointer();
-  std::vector<BodyStats> bodies(n + 1);
-  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
-    for (std::size_t j = 0; j < d_.n[1]; ++j)
-      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
-        BodyStats& b = bodies[clb[q]];
-        ++b.voxels;
-        b.gas += lab_[q] == kGas;
-        b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
-      }
+  const std::vector<BodyStats> bodies = body_stats(clb, n, [&](std::size_t q) { return lab_[q] == kGas; });
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 1u);
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return bodies[a].voxels > bodies[b].voxels; });
@@ -69,11 +75,19 @@ void ColonSegmenter::select_segments() {
       decide(b.gas == b.voxels ? "gas body" : "segment", ml, c, false, reason);
     }
   }
-  seg_label_.assign(d_.total, 0);
-  for (std::size_t q = 0; q < d_.total; ++q) {
-    if (colon_kind(lab_[q]) && fate[clb[q]] != 1) lab_[q] = fate[clb[q]] == 2 ? kCandidate : 0;
-    if (fate[clb[q]] == 1) seg_label_[q] = clb[q];
-  }
+  grid_ = std::make_unique<LinkGrid>(d_, kLinkCellMm);
+  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
+    for (std::size_t j = 0; j < d_.n[1]; ++j)
+      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
+        if (!clb[q]) continue;
+        const unsigned char f = fate[clb[q]];
+        if (f == 1) grid_->mark(i, j, k, clb[q], 0);
+        else lab_[q] = f == 2 ? kCandidate : 0;
+      }
+  check_colon_found(vols);
+}
+
+void ColonSegmenter::check_colon_found(const std::vector<double>& vols) const {
   if (vols.empty())
     throw PreconditionError("no colon found: no gas/fluid body inside the body of at least " +
                             format_number(opts_.min_segment_volume) + " mL");
@@ -84,171 +98,161 @@ void ColonSegmenter::select_segments() {
                             " mL (an insufflated colon holds several hundred mL)");
 }
 
-// Candidates (lab 4): kept when they continue a colon segment's end within link-gap, in passes
-// (a stretch kept in one pass is colon for the next: chains of stretches and small gas pieces
-// between them); the last pass rejects every other candidate with its reason.
-void ColonSegmenter::link_tagged_stretches() {
-  for (int pass = 0; pass < 6; ++pass)
-    if (link_pass(false) == 0) break;
-  link_pass(true);
-  std::vector<std::uint32_t>().swap(cand_label_);
-  std::vector<std::uint32_t>().swap(seg_label_);
+// Per-label voxel count, `gas` count, coordinate sums and whether the body touches the crop's faces.
+std::vector<BodyStats> ColonSegmenter::body_stats(const std::uint32_t* labels, std::uint32_t n,
+                                                  const std::function<bool(std::size_t)>& gas) const {
+  std::vector<BodyStats> bodies(n + 1);
+  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
+    for (std::size_t j = 0; j < d_.n[1]; ++j) {
+      const bool face_row = j == 0 || k == 0 || j + 1 == d_.n[1] || k + 1 == d_.n[2];
+      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
+        if (!labels[q]) continue;
+        BodyStats& b = bodies[labels[q]];
+        ++b.voxels;
+        b.gas += gas(q);
+        b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
+        b.touches_face = b.touches_face || face_row || i == 0 || i + 1 == d_.n[0];
+      }
+    }
+  return bodies;
 }
 
-std::size_t ColonSegmenter::link_pass(bool last) {
+// Candidates (lab 4): kept when they continue a colon segment's end within link-gap, in passes (a
+// body kept in one pass is colon for the next: chains of stretches and small gas pieces between
+// them); then every other candidate is rejected with its reason.
+void ColonSegmenter::link_tagged_stretches() {
   MaskImage::Pointer work = mask_of_size(d_.n);
   unsigned char* w = work->GetBufferPointer();
   for (std::size_t q = 0; q < d_.total; ++q) w[q] = lab_[q] == kCandidate;
   std::uint32_t n = 0;
   LabelImage::Pointer cl = components(work, n);
-  cand_label_.assign(cl->GetBufferPointer(), cl->GetBufferPointer() + d_.total);
-  cl = nullptr;
   work = nullptr;
-  std::vector<BodyStats> bodies(n + 1);
+  const std::uint32_t* clb = cl->GetBufferPointer();
+  const std::vector<BodyStats> bodies = body_stats(clb, n, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
   for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
     for (std::size_t j = 0; j < d_.n[1]; ++j)
-      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
-        BodyStats& b = bodies[cand_label_[q]];
-        ++b.voxels;
-        b.gas += hu_[q] < opts_.air_threshold;
-        b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
-        b.touches_face = b.touches_face || i == 0 || j == 0 || k == 0 || i + 1 == d_.n[0] || j + 1 == d_.n[1] || k + 1 == d_.n[2];
-      }
-  std::vector<std::size_t> from(n + 1, SIZE_MAX), to(n + 1, SIZE_MAX);
-  std::vector<double> gap(n + 1, 1e9);
-  if (n > 0) nearest_colon(bodies, from, to, gap);
-  std::vector<std::uint32_t> keep(n + 1, 0);  // new segment label of a kept candidate
-  std::size_t kept = 0;
+      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q)
+        if (clb[q]) grid_->mark(i, j, k, 0, clb[q]);
+  std::vector<unsigned char> eligible(n + 1, 0);
+  std::vector<std::string> why(n + 1);
   for (std::uint32_t l = 1; l <= n; ++l) {
-    const BodyStats& b = bodies[l];
-    const double ml = double(b.voxels) * voxel_ml_;
-    const double c[3] = {b.sum[0] / double(b.voxels), b.sum[1] / double(b.voxels), b.sum[2] / double(b.voxels)};
-    const std::string what = 2 * b.gas > b.voxels ? "gas body" : (b.gas > 0 ? "fluid body with gas" : "fluid body");
-    std::string why;
-    if (ml < opts_.min_tagged_volume) why = "smaller than --min-tagged-volume";
-    else if (b.touches_face) why = "reaches beyond the colon's region (bone, vessel, bladder)";
-    else if (from[l] == SIZE_MAX) why = "no colon segment end within --link-gap";
-    else if (continues_colon(l, from[l], to[l], why)) {
-      keep[l] = 0x80000000u + std::uint32_t(++linked_);
+    if (double(bodies[l].voxels) * voxel_ml_ < opts_.min_tagged_volume) why[l] = "smaller than --min-tagged-volume";
+    else if (bodies[l].touches_face) why[l] = "reaches beyond the colon's region (bone, vessel, bladder)";
+    else eligible[l] = 1, why[l] = "no colon segment end within --link-gap";
+  }
+  std::vector<double> kept_gap(n + 1, -1);
+  ends_.clear();
+  for (int pass = 0; pass < 7; ++pass)
+    if (link_pass(eligible, why, kept_gap) == 0) break;
+  std::vector<unsigned char> keep(n + 1, 0);
+  for (std::uint32_t l = 1; l <= n; ++l) {
+    keep[l] = kept_gap[l] >= 0;
+    if (std::getenv("COLONFLAT_SEGMENT_DEBUG") && bodies[l].voxels * voxel_ml_ > 3) {
+      const double c[3] = {bodies[l].sum[0] / double(bodies[l].voxels), bodies[l].sum[1] / double(bodies[l].voxels), bodies[l].sum[2] / double(bodies[l].voxels)};
+      const auto p = lps_of(c);
+      std::fprintf(stderr, "cand %u %.1f mL at LPS (%.0f %.0f %.0f) %s %s\n", l, bodies[l].voxels * voxel_ml_, p[0], p[1], p[2], keep[l] ? "KEPT" : "rejected", why[l].c_str());
+    }
+    report_candidate(bodies[l], kept_gap[l], why[l]);
+  }
+  for (std::size_t q = 0; q < d_.total; ++q)
+    if (lab_[q] == kCandidate) lab_[q] = keep[clb[q]] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
+  grid_.reset();
+}
+
+// One pass over the contacts, nearest first: a candidate whose contact passes continues_colon at a
+// free end of the segment is kept and becomes colon. Returns the number kept.
+std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why,
+                                      std::vector<double>& kept_gap) {
+  std::vector<Contact> contacts = grid_->contacts(eligible, opts_.link_gap, kContactsPerPair, kContactSeparationMm);
+  std::stable_sort(contacts.begin(), contacts.end(), [](const Contact& a, const Contact& b) { return a.gap_mm < b.gap_mm; });
+  std::vector<unsigned char> tried(eligible.size(), 0);
+  std::size_t kept = 0;
+  for (const Contact& c : contacts) {
+    const std::uint32_t l = c.candidate;
+    if (!eligible[l]) continue;  // kept earlier in this pass
+    std::string reason;
+    if (continues_colon(c, reason)) {
+      kept_gap[l] = c.gap_mm;
+      eligible[l] = 0;
+      const std::uint32_t id = 0x80000000u + l;
+      grid_->absorb(l, id);
+      ends_[c.segment].push_back(c.to);
+      ends_[id].push_back(c.from);
       ++kept;
-      if (what != "gas body") ++st_.tagged_stretches, st_.tagged_stretch_volume_ml += ml;
-      decide(what, ml, c, true,
-             (what == "gas body" ? "colon segment continuing a segment's end (gap " : "fully tagged colon stretch continuing a segment's end (gap ") +
-                 fixed1(gap[l]) + " mm)");
       continue;
     }
-    if (!last) continue;
-    ++st_.rejected_fluid_components;
-    decide(what, ml, c, false, why);
-  }
-  for (std::size_t q = 0; q < d_.total; ++q) {
-    if (lab_[q] != kCandidate) continue;
-    const std::uint32_t l = cand_label_[q];
-    if (keep[l]) lab_[q] = hu_[q] < opts_.air_threshold ? kGas : kPool, seg_label_[q] = keep[l];
-    else if (last) lab_[q] = 0;
+    if (!tried[l]) why[l] = reason, tried[l] = 1;  // the nearest contact's reason is reported
   }
   return kept;
 }
 
-// Breadth-first growth from the colon segments through everything else, up to link-gap: per
-// candidate the voxel reached first (`from`), the colon voxel it was reached from (`to`), the gap.
-void ColonSegmenter::nearest_colon(const std::vector<BodyStats>& bodies, std::vector<std::size_t>& from,
-                                   std::vector<std::size_t>& to, std::vector<double>& gap) const {
-  const double hmin = std::min({d_.sp[0], d_.sp[1], d_.sp[2]});
-  const int max_steps = int(std::ceil(opts_.link_gap / hmin)) + 1;
-  std::vector<std::uint32_t> source(d_.total, UINT32_MAX);
-  std::vector<std::size_t> front, next;
-  for (std::size_t q = 0; q < d_.total; ++q)
-    if (colon_kind(lab_[q])) source[q] = std::uint32_t(q), front.push_back(q);
-  for (int step = 1; step <= max_steps && !front.empty(); ++step) {
-    next.clear();
-    for (std::size_t q : front) {
-      std::size_t c[3];
-      d_.coords(q, c[0], c[1], c[2]);
-      for (int a = 0; a < 3; ++a)
-        for (int dir = -1; dir <= 1; dir += 2) {
-          if ((dir < 0 && c[a] == 0) || (dir > 0 && c[a] + 1 == d_.n[a])) continue;
-          const std::size_t r = dir < 0 ? q - d_.stride[a] : q + d_.stride[a];
-          if (source[r] != UINT32_MAX) continue;
-          source[r] = source[q];
-          const std::uint32_t l = cand_label_[r];
-          if (l && from[l] == SIZE_MAX) {
-            std::size_t s[3];
-            d_.coords(source[r], s[0], s[1], s[2]);
-            double g2 = 0;
-            for (int b = 0; b < 3; ++b) g2 += std::pow((double(c[b]) - double(s[b])) * d_.sp[b], 2);
-            if (std::sqrt(g2) <= opts_.link_gap + hmin) from[l] = r, to[l] = source[r], gap[l] = std::sqrt(g2);
-          }
-          if (!l) next.push_back(r);  // grow through the gap, not through other candidates
-        }
-    }
-    front.swap(next);
-  }
-  (void)bodies;
-}
-
-// Centroid and principal axis (mm, crop frame) of the voxels with `pred` within radius_mm of centre.
-std::size_t ColonSegmenter::local_shape(const std::function<bool(std::size_t)>& pred, std::size_t centre, double radius_mm,
-                                        std::array<double, 3>& centroid, std::array<double, 3>& axis) const {
-  std::size_t c[3];
-  d_.coords(centre, c[0], c[1], c[2]);
-  std::size_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    const std::size_t r = std::size_t(std::ceil(radius_mm / d_.sp[a]));
-    lo[a] = c[a] > r ? c[a] - r : 0;
-    hi[a] = std::min(d_.n[a] - 1, c[a] + r);
-  }
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d sq = Eigen::Matrix3d::Zero();
-  std::size_t count = 0;
-  for (std::size_t k = lo[2]; k <= hi[2]; ++k)
-    for (std::size_t j = lo[1]; j <= hi[1]; ++j)
-      for (std::size_t i = lo[0]; i <= hi[0]; ++i) {
-        const Eigen::Vector3d p((double(i) - double(c[0])) * d_.sp[0], (double(j) - double(c[1])) * d_.sp[1],
-                                (double(k) - double(c[2])) * d_.sp[2]);
-        if (p.squaredNorm() > radius_mm * radius_mm || !pred(d_.idx(i, j, k))) continue;
-        sum += p;
-        sq += p * p.transpose();
-        ++count;
-      }
-  if (count < 4) return count;
-  const Eigen::Vector3d mean = sum / double(count);
-  const Eigen::Matrix3d cov = sq / double(count) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  const Eigen::Vector3d ax = es.eigenvectors().col(2);
-  for (int a = 0; a < 3; ++a) centroid[a] = mean[a], axis[a] = ax[a];
-  return count;
-}
-
-// The candidate continues the colon: at the link, both bodies end (their local mass lies behind
-// the link point along their own axis) and point at each other.
-bool ColonSegmenter::continues_colon(std::uint32_t cand, std::size_t from, std::size_t to, std::string& why) const {
-  // Two ball radii: 45 mm (a tube piece longer than the colon is wide) and 30 mm (a bending sigmoid).
-  for (double radius : {std::max(45.0, 1.5 * opts_.link_gap), 30.0})
-    if (continues_colon_at(cand, from, to, radius, why)) return true;
-  return false;
-}
-
-bool ColonSegmenter::continues_colon_at(std::uint32_t cand, std::size_t from, std::size_t to, double radius,
-                                        std::string& why) const {
-  std::array<double, 3> cg{}, ag{}, cf{}, af{};
-  const std::uint32_t segment = seg_label_[to];
-  const std::size_t ng = local_shape([&](std::size_t q) { return seg_label_[q] == segment; }, to, radius, cg, ag);
-  const std::size_t nf = local_shape([&](std::size_t q) { return cand_label_[q] == cand; }, from, radius, cf, af);
-  if (ng < 4 || nf < 4) return why = "too small near the link", false;
-  std::size_t a[3], b[3];
-  d_.coords(to, a[0], a[1], a[2]);
-  d_.coords(from, b[0], b[1], b[2]);
-  Eigen::Vector3d link, axg(ag[0], ag[1], ag[2]), axf(af[0], af[1], af[2]);
-  for (int k = 0; k < 3; ++k) link[k] = (double(b[k]) - double(a[k])) * d_.sp[k];
-  const Eigen::Vector3d ug = -Eigen::Vector3d(cg[0], cg[1], cg[2]);  // colon end -> out of the colon
-  const Eigen::Vector3d uf(cf[0], cf[1], cf[2]);                      // candidate end -> into the candidate
-  if (ug.norm() < 0.15 * radius || uf.norm() < 0.15 * radius) return why = "touches the colon's side, not an end", false;
-  if (std::abs(ug.normalized().dot(axg)) < 0.6) return why = "lies beside a colon segment, not at its end", false;
-  if (std::abs(uf.normalized().dot(axf)) < 0.6) return why = "meets the colon with its side (not tube-shaped there)", false;
-  if (ug.normalized().dot(uf.normalized()) < 0.5) return why = "does not continue the colon's direction", false;
-  if (link.norm() > 1e-9 && ug.normalized().dot(link.normalized()) < 0.3) return why = "does not continue the colon's direction", false;
+// A body continues at most two others (a tube has two ends), and not twice at the same end: no
+// end already used lies within kSameEndMm of path from the new contact (`near`).
+bool ColonSegmenter::end_is_free(std::uint32_t segment, const LocalShape& near) const {
+  auto it = ends_.find(segment);
+  if (it == ends_.end()) return true;
+  if (it->second.size() >= 2) return false;
+  for (std::size_t cell : it->second)
+    if (near.within(cell, kSameEndMm)) return false;
   return true;
+}
+
+// The candidate continues the colon at this contact: seen along paths inside each body, both end
+// there (no front splits into two pieces, as it does on a tube's side, and the farthest front lies a
+// chord of at least 0.7 of its path length away: the body runs away from the contact), they point
+// the same way, their cross-sections (front sizes at the same path length) agree within a factor
+// of 1 / kMinCalibreRatio, and the candidate lies beyond the segment's end, not beside it.
+bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
+  const LocalShape sg = grid_->segment_shape(c.segment, c.to, kShapeRadiusMm);
+  const LocalShape sf = grid_->candidate_shape(c.candidate, c.from, kShapeRadiusMm);
+  const Eigen::Vector3d link = grid_->mm(c.from) - grid_->mm(c.to);
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_link(c, sg, sf);
+  if (sg.fronts.empty() || sf.fronts.empty()) return why = "too small near the link", false;
+  if (!end_is_free(c.segment, sg)) return why = "the colon end it meets already continues into another body", false;
+  for (const Front& f : sg.fronts)
+    if (f.pieces >= 2) return why = "lies beside a colon segment, not at its end", false;
+  for (const Front& f : sf.fronts)
+    if (f.pieces >= 2) return why = "meets the colon with its side (not tube-shaped there)", false;
+  const Front &fg = sg.fronts.front(), &ff = sf.fronts.front();
+  const Front &lg = sg.fronts.back(), &lf = sf.fronts.back();
+  if (lg.centroid.norm() < kMinChord * lg.radius_mm) return why = "touches the colon's side, not an end", false;
+  if (lf.centroid.norm() < kMinChord * lf.radius_mm) return why = "meets the colon with its side (not tube-shaped there)", false;
+  const std::size_t common = std::min(sg.fronts.size(), sf.fronts.size()) - 1;  // the farthest front both reach
+  const double cg = double(sg.fronts[common].cells), cf = double(sf.fronts[common].cells);
+  if (std::min(cg, cf) < kMinCalibreRatio * std::max(cg, cf)) return why = "not at the colon's calibre there", false;
+  const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
+  if (ug.dot(uf) < 0.3) return why = "does not continue the colon's direction", false;
+  const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});
+  if (link.norm() > 1.5 * cell && ug.dot(link.normalized()) < 0.3) return why = "does not continue the colon's direction", false;
+  return true;
+}
+
+void ColonSegmenter::debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const {
+  const Eigen::Vector3d a = grid_->mm(c.to);
+  std::fprintf(stderr, "link cand %u seg %x at (%.0f %.0f %.0f) gap %.1f |", c.candidate, c.segment, a[0], a[1], a[2], c.gap_mm);
+  for (const LocalShape* s : {&sg, &sf}) {
+    std::fprintf(stderr, " reach %.0f:", s->reach_mm);
+    for (const Front& f : s->fronts)
+      std::fprintf(stderr, " r%.0f n%zu p%d chord %.2f", f.radius_mm, f.cells, f.pieces, f.centroid.norm() / f.radius_mm);
+    std::fprintf(stderr, " |");
+  }
+  if (!sg.fronts.empty() && !sf.fronts.empty())
+    std::fprintf(stderr, " dir %.2f", -sg.fronts[0].centroid.normalized().dot(sf.fronts[0].centroid.normalized()));
+  std::fprintf(stderr, "\n");
+}
+
+void ColonSegmenter::report_candidate(const BodyStats& b, double kept_gap, const std::string& why) {
+  const double ml = double(b.voxels) * voxel_ml_;
+  const double c[3] = {b.sum[0] / double(b.voxels), b.sum[1] / double(b.voxels), b.sum[2] / double(b.voxels)};
+  const std::string what = 2 * b.gas > b.voxels ? "gas body" : (b.gas > 0 ? "fluid body with gas" : "fluid body");
+  if (kept_gap < 0) {
+    ++st_.rejected_fluid_components;
+    return decide(what, ml, c, false, why);
+  }
+  if (what != "gas body") ++st_.tagged_stretches, st_.tagged_stretch_volume_ml += ml;
+  decide(what, ml, c, true,
+         (what == "gas body" ? "colon segment continuing a segment's end (gap " : "fully tagged colon stretch continuing a segment's end (gap ") +
+             fixed1(kept_gap) + " mm)");
 }
 
 }  // namespace cf::segment_detail

@@ -8,6 +8,9 @@
 #include "segment_internal.h"
 
 namespace cf::segment_detail {
+namespace {
+constexpr unsigned char kExcluded = 5;  // rectal tube channel and wall
+}
 
 // Gas (kept gas below -800 HU), tissue (0-2.5 mm outside the lumen, -150..150 HU), fluid (pools).
 void ColonSegmenter::class_means() {
@@ -15,7 +18,7 @@ void ColonSegmenter::class_means() {
   std::size_t an = 0, fn = 0;
   lumen0_.assign(d_.total, 0);
   for (std::size_t q = 0; q < d_.total; ++q) {
-    lumen0_[q] = lab_[q] != 0;
+    lumen0_[q] = lab_[q] != 0 && lab_[q] != kExcluded;
     if (lab_[q] == 1 && hu_[q] < -800) as += hu_[q], ++an;
     if (lab_[q] == 2 && hu_[q] >= opts_.fluid_threshold) fs += hu_[q], ++fn;
   }
@@ -48,7 +51,8 @@ void ColonSegmenter::refine_boundary() {
     std::vector<unsigned char> outer = lumen0_, inner = lumen0_;
     dilate_box(outer, d_, rb);
     erode_box(inner, d_, rb);
-    for (std::size_t q = 0; q < d_.total; ++q) state_[q] = inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0);
+    for (std::size_t q = 0; q < d_.total; ++q)
+      state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0));
   }
   std::vector<unsigned char> near_fluid(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) near_fluid[q] = lab_[q] == 2;

@@ -125,6 +125,50 @@ TEST(SegmentRules, RectalTubeTrimmedRectumKept) {
   EXPECT_TRUE(at(kept, 40, 40, 5));
 }
 
+// A contrast-filled tube 4 mm in radius continues a 9 mm colon end across a 7 mm neck, in line
+// with it: a tube of a third of the colon's calibre is not the colon continuing (small bowel at the
+// caecum); the same tube at the colon's calibre is kept.
+TEST(SegmentRules, ThinTubeAtColonEndRejectedByCalibre) {
+  for (double radius : {4.0, 8.0}) {
+    SCOPED_TRACE(radius);
+    auto ct = make_volume(100, [&](double x, double y, double z) {
+      const double d = tube_dist(y, z, 50, 50);
+      if (x >= 8 && x <= 40 && d < 9) return -1000.0;
+      if (x >= 47 && x <= 80 && d < radius) return 500.0;
+      return kKeep;
+    }, 0.6, 10);
+    SegmentOptions o = small_volume_options();
+    o.min_tagged_volume = 1;
+    SegmentStats st;
+    auto m = segment_colon(ct, o, &st);
+    EXPECT_EQ(st.tagged_stretches, radius > 5 ? 1 : 0) << st.to_json()["decisions"].dump(1);
+    EXPECT_EQ(at(m, 70, 50, 50), radius > 5);
+    if (radius < 5) EXPECT_TRUE(has_decision(st, "rejected", "calibre")) << st.to_json()["decisions"].dump(1);
+  }
+}
+
+// A catheter (air channel 2 mm, plastic wall to 3.5 mm at 150 HU) enters from the inferior face
+// and runs 20 mm up inside the rectal gas with an open tip: neither its channel nor its wall is
+// lumen, the rectal gas beside it is.
+TEST(SegmentRules, CatheterInsideRectumExcluded) {
+  auto ct = make_volume(80, [&](double x, double y, double z) {
+    const double d = tube_dist(x, y, 40, 40);
+    if (z <= 35) {  // the catheter up to its open tip
+      if (d < 2) return -1000.0;
+      if (d < 3.5) return 150.0;
+    }
+    if (z >= 15 && z <= 65 && d < 16) return -1000.0;  // rectum
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_colon(ct, small_volume_options(), &st);
+  for (int z = 0; z <= 32; ++z) EXPECT_FALSE(at(m, 40, 40, z)) << "channel kept at z " << z;
+  for (int z = 18; z <= 32; ++z) EXPECT_FALSE(at(m, 43, 40, z)) << "wall kept at z " << z;
+  EXPECT_TRUE(at(m, 50, 40, 25));  // rectal gas beside the catheter
+  EXPECT_TRUE(at(m, 40, 40, 50));  // above the tip
+  EXPECT_GT(st.rectal_tube_trimmed_ml, 0.0);
+}
+
 // New options are checked.
 TEST(SegmentRules, InvalidNewOptionsRejected) {
   SegmentOptions o;

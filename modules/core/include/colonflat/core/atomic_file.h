@@ -18,28 +18,38 @@ std::filesystem::path temp_sibling(const std::filesystem::path& target);
 void write_atomically(const std::filesystem::path& target,
                       const std::function<void(const std::filesystem::path& tmp)>& write);
 
-// Several outputs that must appear together or not at all: stage() returns a temp path for
+// Several outputs that must appear together or not at all: stage() returns a temporary path for
 // each target; commit() renames them all; the destructor removes any that were not committed.
-// With a staging folder root R, targets directly inside R are written into the hidden folder
-// "R/.colonflat-staging-<pid>/" (removed at the end, on failure and on interruption); other
-// targets get temporary siblings. commit() checks every temporary first, then renames; if a
-// rename fails, the targets already renamed are restored to their previous content.
+// Every folder that receives a target gets one hidden staging folder,
+// "<folder>/.colonflat-staging-<pid>-<n>/", holding the target's temporary under the target's
+// own name (so format detection by extension still works); staging folders are removed at the
+// end, on failure and on interruption. A target may be a folder: the caller creates the folder
+// at the staged path and fills it; an existing folder of that name is replaced on commit.
+// commit() checks every temporary first, then renames; if a rename fails, the targets already
+// renamed are restored to their previous content.
 class OutputTransaction {
  public:
-  explicit OutputTransaction(std::filesystem::path staging_root = {});
+  OutputTransaction() = default;
+  // The older form with a staging root: no longer needed (every output folder gets its staging
+  // folder); kept so that callers written against it still build.
+  explicit OutputTransaction(const std::filesystem::path& /*staging_root*/) {}
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
   ~OutputTransaction();
   std::filesystem::path stage(const std::filesystem::path& target);
   void commit();
-  const std::filesystem::path& staging_folder() const { return staging_; }
+  // The targets staged so far (in staging order).
+  std::vector<std::filesystem::path> targets() const;
+  // The staging folder of `folder` ("" when nothing was staged there).
+  std::filesystem::path staging_folder(const std::filesystem::path& folder) const;
 
  private:
+  std::filesystem::path staging_for(const std::filesystem::path& folder, const std::filesystem::path& target);
   void rollback(std::size_t renamed);
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, target
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> backups_; // backup, target
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staging_; // folder, its staging folder
   std::vector<std::filesystem::path> created_dirs_;
-  std::filesystem::path root_, staging_;
   bool committed_ = false;
 };
 

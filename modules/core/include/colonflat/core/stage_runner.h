@@ -5,7 +5,8 @@
 // Stage record (the "stages" entries of run_report.json, and the whole --report of a stand-alone
 // stage, which adds "version", "inputs" and "total_time_s"):
 //   {"stage": "denoise", "parameters": {...}, "result": {...stage counts...},
-//    "time_s": 1.23, "peak_memory_mib": 456, "outputs": {"denoised": "denoised.vtp", ...}}
+//    "time_s": 1.23, "phases": [{"phase": "loop search", "time_s": 0.8}, ...],
+//    "peak_memory_mib": 456, "outputs": {"denoised": "denoised.vtp", ...}}
 #include <filesystem>
 #include <map>
 #include <string>
@@ -19,7 +20,9 @@
 namespace cf {
 
 // Runs `stage` on `bag` and returns its record (without "outputs"). While the stage runs, a line
-// "    <stage>: still running (N s)" goes to ctx.log every `heartbeat_s` seconds without other output.
+// "    <stage>: still running (N s)" goes to ctx.log every `heartbeat_s` seconds, and a line
+// "<stage>: <phase> N s" at every phase_done() (core/progress.h) of the stage's code; "phases"
+// records those times.
 nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ctx, double heartbeat_s = 10.0);
 
 // Writes the outputs of `stage` found in `targets` (port -> file) through `tx`; a missing

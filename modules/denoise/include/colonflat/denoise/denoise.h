@@ -55,6 +55,10 @@ struct LoopRecord {
   std::string type;             // "handle" | "tunnel"
   bool separating = false;      // only "paper" can cut separating loops
   std::size_t cap_intersections = 0;  // triangle pairs its caps still intersect (0 unless no placement worked)
+  // Set when this loop replaces the shortest one, whose caps intersected the surface in every
+  // placement: another loop of the same class (modulo the classes cut before), away from it.
+  double replaced_length = 0;               // mm: length of the shortest loop it replaces (0: none)
+  std::size_t replaced_intersections = 0;   // triangle pairs that loop's caps intersected
   // Where it is and what it cuts (describe_cross_section):
   Vec3 centroid{0, 0, 0};              // mean of its points (LPS mm)
   double diameter_mm = 0;              // largest distance between two of its points

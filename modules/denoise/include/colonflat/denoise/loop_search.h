@@ -41,6 +41,14 @@ class FundamentalCycleSearch {
   // `accept` approves, when given). The search state is kept for extract().
   // With `frontier`, a truncated search without a loop also computes frontier_bound.
   CycleCandidate run(Mesh::VertexHandle s, double limit, const Accept* accept = nullptr, bool frontier = false);
+  // Cochain mode: with an edge cochain x (one flag per edge id), run() looks for cycles whose
+  // edges have an odd sum of x instead of a class outside the span. That family also satisfies
+  // the 3-path condition (the sum is additive), so the same fundamental-cycle argument holds.
+  // nullptr: span mode. The cochain must outlive the runs.
+  void set_cochain(const std::vector<std::uint8_t>* cochain);
+  // Vertices flagged in `avoid` (per vertex id) are never entered (the source excepted);
+  // nullptr: none. Must outlive the runs.
+  void set_avoid(const std::vector<std::uint8_t>* avoid) { avoid_ = avoid; }
   // The simple cycle of a candidate from the last run() (the common stem from s is dropped).
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
@@ -58,10 +66,17 @@ class FundamentalCycleSearch {
   void settle(int v);
   void try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept, CycleCandidate& best);
   double frontier_bound();
+  bool wanted(std::uint64_t* cls) const;  // in the searched family (cls may be modified)
+  const std::uint64_t* edge_bits(Mesh::EdgeHandle e) const {
+    return cochain_ ? &kBit[(*cochain_)[e.idx()] & 1] : hom_.edge_class(e);
+  }
+  static constexpr std::uint64_t kBit[2] = {0, 1};
   bool settled(int v) const { return stamp_[v] == run_id_ && settled_flag_[v]; }
   const Mesh& mesh_;
   const HomologyBasis& hom_;
   const Z2Span& span_;
+  const std::vector<std::uint8_t>* cochain_ = nullptr;
+  const std::vector<std::uint8_t>* avoid_ = nullptr;
   int W_;
   std::uint32_t run_id_ = 0;
   std::vector<std::uint8_t> blocked_;  // boundary vertices (never on a loop)
@@ -79,6 +94,13 @@ class FundamentalCycleSearch {
   using Item = std::pair<double, int>;
   std::vector<Item> heap_;  // binary min-heap (std::push_heap / pop_heap with std::greater)
 };
+
+// Edge cochain whose sum over any edge cycle C is the Z2 intersection number of C with `loop`:
+// the edges leaving the loop's vertices on its left side, toggled (the loop pushed off into its
+// left faces crosses exactly these; a chord on that side is crossed twice). Shape: one flag per
+// edge id. Precondition: `loop` is a simple edge cycle through interior vertices of an oriented
+// manifold mesh.
+std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);
 
 // Euclidean length of a closed loop.
 double loop_length(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);

@@ -10,7 +10,9 @@
 // guard, caps are first minimum-area triangulations of the pulled rings, restricted when needed
 // to triangles that intersect nothing (cap_triangulation.h, face_grid.h; surgery.cpp, step 7a). Nothing is deleted: the input's
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
+#include <array>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
@@ -28,10 +30,22 @@ struct SurgeryOptions {
                               // nothing (see SurgeryResult::intersections), and update the grid
 };
 
+// What undo_surgery() needs to put the mesh back as it was before cut_and_cap(): the element
+// counts (everything the surgery created comes after them), the connectivity it rewired and the
+// positions it moved.
+struct SurgeryUndo {
+  std::size_t vertices = 0, edges = 0, faces = 0;
+  std::vector<std::pair<Mesh::HalfedgeHandle, Mesh::VertexHandle>> targets;  // fan halfedges' old to-vertex
+  std::vector<std::pair<Mesh::FaceHandle, std::array<Mesh::HalfedgeHandle, 3>>> face_cycles;
+  std::vector<std::pair<Mesh::VertexHandle, Mesh::HalfedgeHandle>> vertex_halfedges;
+  std::vector<std::pair<Mesh::VertexHandle, Vec3>> positions;
+};
+
 struct SurgeryResult {
   std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
   Mesh::VertexHandle left_cap, right_cap;                 // cap centres
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
+  SurgeryUndo undo;
 };
 
 // Preconditions (checked, PreconditionError otherwise): `loop` is a simple cycle of >= 3
@@ -39,6 +53,11 @@ struct SurgeryResult {
 // When `homology` is given, new edges get classes consistent with it modulo the loop's class.
 SurgeryResult cut_and_cap(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts,
                           HomologyBasis* homology = nullptr);
+
+// Puts the mesh back as it was before the cut_and_cap() that returned `undo`, which must be the
+// last change to the mesh. A FaceGrid guard that saw the surgery holds stale faces afterwards:
+// rebuild it. Edge classes set by the surgery are left (those ids are reused by the next one).
+void undo_surgery(Mesh& mesh, const SurgeryUndo& undo);
 
 // True when a and b are connected in the mesh graph (bidirectional breadth-first search, which
 // stops early when both sides meet: cheap for the small handles of denoising).

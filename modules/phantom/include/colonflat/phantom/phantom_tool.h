@@ -1,5 +1,5 @@
 #pragma once
-// `colonflat phantom -o DIR [--seed N] [--size small|full] [--format nrrd|dicom] ...`
+// `colonflat phantom -o DIR [--seed N] [--size small|medium|full] [--format nrrd|dicom] ...`
 #include <memory>
 
 #include "colonflat/core/tool.h"

@@ -24,6 +24,7 @@ struct CtWindow {
 };
 const CtWindow& lung_window();         // L -200 / W 1500 (CT colonography 2D reading)
 const CtWindow& soft_tissue_window();  // L 40 / W 400
+const CtWindow& mask_window();         // L 0.5 / W 1: a 0/1 lumen mask, lumen white
 
 // On-screen axes of a plane: LPS axis index and sign of the screen's right (u) and down (v)
 // directions, and the LPS axis fixed by the plane (its normal).
@@ -41,10 +42,12 @@ struct PlaneImage {
   double pixel_mm = 1, u0 = 0, v0 = 0, fixed = 0;
   std::vector<float> hu;
 };
-PlaneImage sample_plane(const CtImage* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
+template <class Image>  // CtImage (HU) or MaskImage (0/1, a run without a CT)
+PlaneImage sample_plane(const Image* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
                         double pixel_mm);
 // A square plane of side `fov_mm` centred on `lps`.
-PlaneImage sample_plane_around(const CtImage* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
+template <class Image>
+PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
                                int pixels);
 
 // Writes `image` through `window` as an 8-bit grey PNG (atomic).
@@ -57,13 +60,16 @@ struct SliceStackOptions {
   double step_mm = 5;      // between planes
   double pixel_mm = 1;     // in-plane pixel size
   double margin_mm = 25;   // added around the box
+  const CtWindow* window = nullptr;  // null: lung window
 };
-nlohmann::json write_slice_stack(const CtImage* ct, Plane plane, const std::array<double, 3>& box_min,
+template <class Image>
+nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
                                  const std::array<double, 3>& box_max, const SliceStackOptions& opts,
                                  const std::filesystem::path& dir, const std::string& rel_prefix);
 
 // The volume's geometry for the page: size, spacing, origin, direction and the 3x3 matrix taking
 // (LPS - origin) to continuous voxel indices.
-nlohmann::json ct_geometry_json(const CtImage* ct);
+template <class Image>
+nlohmann::json ct_geometry_json(const Image* ct);
 
 }  // namespace cf

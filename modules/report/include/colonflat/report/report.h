@@ -15,6 +15,9 @@
 
 namespace cf {
 
+struct RunData;
+class OutputTransaction;
+
 struct ReportOptions {
   std::string ct;                  // CT volume (empty: ct.nrrd in the run folder, else the run's input)
   std::string truth;               // known polyps JSON (empty: polyps.json beside a phantom CT)
@@ -35,12 +38,19 @@ struct ReportResult {
   int images = 0;               // PNGs written under report_files/
   int endoluminal_views = 0;
   double seconds = 0;
-  std::vector<std::pair<std::string, double>> phases;  // (phase, wall s) and (phase_cpu, CPU s): load, image, ct, cards, page
+  std::vector<std::pair<std::string, double>> phases;  // (phase, wall s), in order
   std::vector<std::string> warnings;  // also shown on the page
 };
 
-// Throws InputError (not a run folder, unreadable file), Error (cannot write).
+// Throws InputError (not a run folder, unreadable file), Error (cannot write). `log`: progress
+// lines "report: <phase> N s".
 ReportResult write_review_report(const std::filesystem::path& run_dir, const ReportOptions& opts = {},
+                                 std::ostream* log = nullptr);
+
+// The report of a loaded run (load_run() from files, or run_from_artifacts() from the memory of
+// `colonflat run`): report.html, polyps.mrk.json, known_polyps.mrk.json (with truth) and the
+// folder report_files/ in run.dir, staged through `tx`; nothing appears until the caller commits.
+ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputTransaction& tx,
                                  std::ostream* log = nullptr);
 
 }  // namespace cf

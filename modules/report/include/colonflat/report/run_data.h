@@ -11,7 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/stage.h"
 #include "colonflat/flatten/flatten.h"
+#include "colonflat/render/artifacts.h"
 #include "colonflat/volume/volume_io.h"
 
 namespace cf {
@@ -45,13 +47,27 @@ struct RunData {
   std::vector<double> centreline_mm;           // per flat vertex (contract 1); empty when absent
   nlohmann::json flat_segments = nlohmann::json::array();  // FlatSegments "segments" (as written)
   CtImage::Pointer ct;                         // null when no CT was found
+  MaskImage::Pointer mask;                     // without a CT: the lumen mask the run started from
+  bool volume_is_mask = false;                 // the views show `mask` (0/1), not a CT
+  ImagePtr colon_image;                        // colon.png in memory; null: read from the run folder
   std::filesystem::path ct_path, truth_path;
   std::vector<std::string> warnings;           // what is missing or inconsistent, for the page
+  std::vector<std::string> staged_files;       // run-folder files of the same (uncommitted) transaction
 };
+
+// Whether the run folder has (or, once committed, will have) the file `name`.
+bool run_has_file(const RunData& run, const std::string& name);
 
 // Loads a run folder. Throws InputError when `dir` is not a run folder (no run_report.json) or a
 // file that is there cannot be read.
 RunData load_run(const std::filesystem::path& dir, const RunLoadOptions& opts = {});
+
+// The same from the artifacts `colonflat run` still holds after its last stage (no file is read
+// but the truth polyps.json): "flat" is moved out of `bag`; the view volume is "ct", else the
+// lumen mask "mask" (volume_is_mask); "colon_image" and "candidates" are shared.
+// `run_report` is the run's report so far; `input` the run's input (shown as the CT's file).
+RunData run_from_artifacts(ArtifactBag& bag, const std::filesystem::path& dir, const nlohmann::json& run_report,
+                           const std::string& input, const RunLoadOptions& opts = {});
 
 // The candidates of a candidates.json / polyps.json document (render stage format; LPS under
 // "position_lps_mm" or "center_lps_mm"), sorted by decreasing score. Throws InputError.

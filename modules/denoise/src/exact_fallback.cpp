@@ -1,0 +1,104 @@
+// The exact method's fallback for loops that cannot be capped cleanly (exact_greedy.h): the
+// surgery is undone and another loop of the same class, away from the first, is cut instead.
+#include <algorithm>
+
+#include "colonflat/core/error.h"
+#include "colonflat/core/geodesic_ball.h"
+#include "colonflat/core/run_stats.h"
+#include "exact_greedy.h"
+
+namespace cf::detail {
+
+// Cuts `loop`; when every placement of its caps intersects the surface (with --check-caps), the
+// surgery is undone and the shortest loop of the same class (modulo the classes cut before)
+// outside a tube of radius delta around it is cut instead, for two tube radii; the first one
+// capped cleanly is kept and records the loop it replaces. If none is, `loop` is cut again and
+// its intersections are reported as before. Precondition: `reduced` = loop's class reduced
+// modulo the span (nonzero). Throws when a cut separates.
+SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& loop,
+                                       const std::vector<std::uint64_t>& reduced, int iteration) {
+  SurgeryResult sr = cut_recorded(loop, iteration);
+  if (sr.intersections == 0 || !opts_.check_caps) return sr;
+  const double length = st_.loops.back().length;
+  const std::size_t intersections = sr.intersections;
+  const double delta = std::max(5.0 * st_.mean_edge, length / 8.0);
+  for (double tube : {delta, 2.0 * delta}) {
+    revert_cut(sr);
+    const std::vector<Mesh::VertexHandle> other = same_class_loop(loop, reduced, tube);
+    if (other.empty()) {
+      sr = cut_recorded(loop, iteration);
+      return sr;
+    }
+    sr = cut_recorded(other, iteration);
+    if (sr.intersections == 0) {
+      st_.loops.back().replaced_length = length;
+      st_.loops.back().replaced_intersections = intersections;
+      ++alternatives_;
+      return sr;
+    }
+  }
+  revert_cut(sr);
+  return cut_recorded(loop, iteration);
+}
+
+// Records and cuts one loop; throws when the two sides of the cut are no longer connected.
+SurgeryResult ExactGreedy::cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration) {
+  const int comp = st_.component[loop.front().idx()];
+  st_.record(loop, iteration, false);
+  SurgeryResult sr;
+  if (!cut_loop(st_, loop, opts_, &homology_, &sr))
+    throw Error("denoise: surgery along loop " + std::to_string(iteration - 1) + " (length " +
+                format_number(st_.loops.back().length) + " mm) split component " + std::to_string(comp) +
+                " - the loop was separating; refusing to continue");
+  return sr;
+}
+
+// Undoes the last cut_recorded() (mesh, bookkeeping; the face grid guard is rebuilt later).
+void ExactGreedy::revert_cut(const SurgeryResult& sr) {
+  Stopwatch sw;
+  undo_surgery(st_.mesh, sr.undo);
+  st_.guard.reset();
+  st_.cap_rings.resize(st_.cap_rings.size() - 2);
+  st_.origin.resize(st_.mesh.n_vertices());
+  st_.component.resize(st_.mesh.n_vertices());
+  st_.loops.pop_back();
+  st_.t.surgery += sw.seconds();
+}
+
+// The shortest loop whose class equals `reduced` modulo the span, avoiding every vertex closer
+// than `tube` to `loop`, among fundamental cycles from up to kFallbackSources vertices spread
+// over the tube's rim (a loop of that class parallel to `loop` passes near the rim). Empty when
+// none is found within three times the loop's length.
+std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<Mesh::VertexHandle>& loop,
+                                                             const std::vector<std::uint64_t>& reduced, double tube) {
+  Stopwatch sw;
+  std::vector<double> dist;
+  const std::vector<int> near = vertices_within(st_.mesh, loop, tube + 3.0 * st_.mean_edge, &dist);
+  std::vector<std::uint8_t> avoid(st_.mesh.n_vertices(), 0);
+  std::vector<int> rim;
+  for (std::size_t i = 0; i < near.size(); ++i) (dist[i] < tube ? avoid[near[i]] = 1 : (rim.push_back(near[i]), 0));
+  FundamentalCycleSearch::Accept same_class = [&](const std::vector<Mesh::VertexHandle>& cycle) {
+    std::vector<std::uint64_t> cls = search_->cycle_class(cycle);
+    span_.reduce(cls.data());
+    return cls == reduced;
+  };
+  search_->set_cochain(nullptr);
+  search_->set_avoid(&avoid);
+  double best = 3.0 * loop_length(st_.mesh, loop) + 4.0 * tube;
+  std::vector<Mesh::VertexHandle> found;
+  const std::size_t stride = std::max<std::size_t>(1, rim.size() / kFallbackSources);
+  for (std::size_t i = 0; i < rim.size(); i += stride) {
+    const CycleCandidate c = search_->run(Mesh::VertexHandle(rim[i]), best, &same_class);
+    ++searches_;
+    settled_ += static_cast<long long>(search_->last_settled());
+    if (c.found && c.value < best) {
+      best = c.value;
+      found = search_->extract(c);
+    }
+  }
+  search_->set_avoid(nullptr);
+  st_.t.search += sw.seconds();
+  return found;
+}
+
+}  // namespace cf::detail

@@ -1,0 +1,133 @@
+#pragma once
+// Internal to the denoise module: the greedy loop of the exact method (docs/denoise.md, "How it
+// is fast"). Implemented in exact_method.cpp (the greedy steps) and exact_sources.cpp (sources,
+// families and bounds).
+#include <cstdint>
+#include <memory>
+#include <queue>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/denoise/loop_search.h"
+#include "denoise_internal.h"
+
+namespace cf::detail {
+
+// What is known of F(s) for one source slot (a vertex in one family): the shortest closed walk
+// through the vertex in the family's cycles (the shortest fundamental cycle of its
+// shortest-path tree in the family). exact: F == value, else F >= value.
+struct SourceBound {
+  double value = 0;
+  bool exact = false;
+  int centre = -1;  // vertex whose search gave it (-1: none, or lowered after a surgery)
+  std::uint32_t version = 0;
+};
+
+struct QueueEntry {
+  double key;
+  int slot;
+  std::uint32_t version;
+  bool exact;
+  // Min-heap order: smaller key first; at equal keys exact values before lower bounds.
+  bool operator>(const QueueEntry& e) const { return key != e.key ? key > e.key : (!exact && e.exact); }
+};
+
+// A family of cycles searched from its own source set, which every cycle of the family meets.
+//  - Span family (index 0, no cochain): classes outside the span of the cut classes; sources =
+//    the pruned cut graph plus every ring and cap since.
+//  - Crossing families (closed surface with total genus 1 left, policy shortest): once a loop A
+//    is known, the cycles crossing A an odd number of times (sources: A's vertices), and, once
+//    the first of those, Z, is found, the cycles crossing Z oddly (sources: Z's vertices). On a
+//    genus-1 surface the classes are a = [A], z = [Z] and a + z, with a.z = 1: each crosses A
+//    or Z oddly, so the minimum over both families is the shortest non-separating cycle. The
+//    point: a long handle's loop is short only in Z's family, whose sources cross it, and A's
+//    family holds the cycles through the handle, which are long, so one search certifies a
+//    long stretch of A; the pruned cut graph may instead run along the long loop, where every
+//    source needs its own search to the loop's length.
+struct Family {
+  std::vector<std::uint8_t> cochain;  // crossing_cochain() of the family's loop; empty: span family
+  std::vector<int> slot_of;           // vertex -> slot, -1 if not a source of this family
+};
+
+struct Slot {
+  int vertex = -1;
+  int family = 0;
+  bool active = false;
+  SourceBound bound;
+  double own_limit = 0;  // limit of its last own search (the next one at least doubles it)
+};
+
+class ExactGreedy {
+ public:
+  ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge);
+  std::string run(int needed, const DenoiseProgress& progress);
+  void write_stats(nlohmann::json& stats) const;
+
+ private:
+  // exact_sources.cpp
+  void build_homology();
+  void deactivate_all_slots();
+  void maybe_rebuild(int cuts, int total_genus);
+  void enter_crossing_mode();
+  void add_crossing_family(const std::vector<Mesh::VertexHandle>& loop);
+  void add_transversal_family(const CycleCandidate& shortest);
+  void leave_crossing_mode();
+  void add_source(int family, int v);
+  void set_bound(int slot, const SourceBound& b);
+  double best_exact_value();
+  int farthest_pending(double best);
+  void spread_bounds(int centre_slot, double bound);
+  void add_surgery_sources(const SurgeryResult& sr);
+  void lower_bounds_near(const SurgeryResult& sr);
+  // exact_fallback.cpp
+  SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
+                            int iteration);
+  SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration);
+  void revert_cut(const SurgeryResult& sr);
+  std::vector<Mesh::VertexHandle> same_class_loop(const std::vector<Mesh::VertexHandle>& loop,
+                                                  const std::vector<std::uint64_t>& reduced, double tube);
+  static constexpr std::size_t kFallbackSources = 24;
+  static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
+  // exact_method.cpp
+  double search_limit(int slot);
+  CycleCandidate search_from(int slot, double limit);
+  bool stop_before(const QueueEntry& top, std::string* reason) const;
+  void cut(int slot, const CycleCandidate& c, int iteration);
+  int total_genus_left() const;
+  void update_crossing_wanted();
+
+  DenoiseState& st_;
+  const DenoiseOptions& opts_;
+  const double first_radius_;  // mm: limit of a source's first search
+  bool want_type_ = false;
+  LoopType wanted_ = LoopType::kHandle;
+  FundamentalCycleSearch::Accept accept_;
+  HomologyBasis homology_;
+  Z2Span span_;
+  std::unique_ptr<FundamentalCycleSearch> search_;
+  bool crossing_wanted_ = false;  // closed, total genus 1, policy shortest: use crossing families
+  int closed_ = 0;               // mesh without boundary: 1, with: -1, unknown: 0
+  bool crossing_ = false;         // crossing families in use (span family inactive)
+  std::vector<Mesh::VertexHandle> loop_a_;  // A
+  double loop_a_value_ = 0;
+  std::vector<double> carried_;   // per vertex: lower bound of F(v) when the span family was left
+  std::vector<Family> families_;
+  std::vector<Slot> slots_;
+  std::vector<int> active_;  // active slots (may hold deactivated ones until the next build)
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> queue_;
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
+  long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
+  int builds_ = 0, crossing_modes_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
+  // Sources to certify against the best known loop, farthest from its source first.
+  int far_anchor_ = -1;
+  double far_value_ = 0;
+  std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
+  long long far_searches_ = 0;
+  int alternatives_ = 0;  // loops replaced by another of the same class (caps)
+  double build_time_ = 0, search_time_at_build_ = 0;
+  double largest_limit_ = 0;
+};
+
+}  // namespace cf::detail

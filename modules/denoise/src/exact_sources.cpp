@@ -1,0 +1,245 @@
+// The exact method's source sets, search families and per-source bounds (exact_greedy.h).
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "colonflat/core/geodesic_ball.h"
+#include "colonflat/core/run_stats.h"
+#include "exact_greedy.h"
+
+namespace cf::detail {
+
+// Homology of the current mesh and its pruned cut graph as the span family's sources (every
+// non-separating cycle meets it). Bounds of sources that stay are kept: F(s) is the same
+// quantity whatever the annotations.
+void ExactGreedy::build_homology() {
+  Stopwatch sw;
+  std::vector<SourceBound> kept(st_.mesh.n_vertices());
+  for (int s : active_)
+    if (slots_[s].active && slots_[s].family == 0) kept[slots_[s].vertex] = slots_[s].bound;
+  homology_.build(st_.mesh);
+  span_.reset(homology_.words());
+  search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  deactivate_all_slots();
+  queue_ = {};
+  exact_queue_ = {};
+  far_anchor_ = -1;
+  families_.resize(1);
+  for (int v : homology_.pruned_cut_graph_vertices()) add_source(0, v);
+  for (int s : active_) set_bound(s, kept[slots_[s].vertex]);
+  build_time_ = sw.seconds();
+  st_.t.homology += build_time_;
+  search_time_at_build_ = st_.t.search;
+  ++builds_;
+}
+
+// Every slot leaves the source set; those not added again lose their bound (it would no
+// longer be maintained across surgeries).
+void ExactGreedy::deactivate_all_slots() {
+  for (int s : active_) slots_[s].active = false;
+  for (Slot& slot : slots_) {
+    slot.bound = SourceBound{0, false, -1, slot.bound.version + 1};
+    slot.own_limit = 0;
+  }
+  active_.clear();
+}
+
+// A fresh cut graph of the lower-genus mesh is much smaller than the old one plus every ring,
+// and searches start only from it; rebuilt once half the genus is gone, if searching has cost
+// more than two builds since the last one.
+void ExactGreedy::maybe_rebuild(int cuts, int total_genus) {
+  if (total_genus < 1 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
+  if (st_.t.search - search_time_at_build_ < 2 * build_time_) return;
+  build_homology();
+  cuts_at_build_ = cuts;
+  genus_at_build_ = total_genus;
+}
+
+// Switches from the span family to the crossing families once a loop A is known (the best exact
+// entry, re-searched to extract it), and again whenever a shorter loop turns up (a shorter A
+// has fewer sources whose cycles can be as short as the loop to cut). The span family's bounds
+// carry over: a crossing family's cycles are non-separating, so its F(v) >= the span family's.
+void ExactGreedy::enter_crossing_mode() {
+  const int anchor = exact_queue_.top().slot;
+  const double value = exact_queue_.top().key;
+  const CycleCandidate c = search_from(anchor, value * (1 + 1e-12) + 1e-12);
+  if (!c.found) return;  // re-queued with its new bound; tried again with the next best
+  const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
+  if (!crossing_) {
+    carried_.assign(st_.mesh.n_vertices(), 0);
+    for (int s : active_)
+      if (slots_[s].active) carried_[slots_[s].vertex] = slots_[s].bound.value;
+  }
+  deactivate_all_slots();
+  queue_ = {};
+  exact_queue_ = {};
+  far_anchor_ = -1;
+  families_.resize(1);
+  crossing_ = true;
+  ++crossing_modes_;
+  loop_a_ = loop;
+  loop_a_value_ = c.value;
+  add_crossing_family(loop);
+}
+
+// Z from the shortest cycle crossing A (source s on A), rerouted to stay at least delta away from
+// A except within 2 delta of s: Z's sources near A (where the bounds are tight, each needing its
+// own search) are then only the few near s, not a stretch along A. Falls back to the shortest
+// crossing cycle itself when no such route exists.
+void ExactGreedy::add_transversal_family(const CycleCandidate& shortest) {
+  std::vector<Mesh::VertexHandle> z = search_->extract(shortest);
+  const double delta = std::max(5.0 * st_.mean_edge, loop_a_value_ / 16.0);
+  std::vector<std::uint8_t> avoid(st_.mesh.n_vertices(), 0);
+  for (int v : vertices_within(st_.mesh, loop_a_, delta)) avoid[v] = 1;
+  for (int v : vertices_within(st_.mesh, {shortest.source}, 2.0 * delta)) avoid[v] = 0;
+  search_->set_avoid(&avoid);
+  const CycleCandidate rerouted = search_->run(shortest.source, 4.0 * shortest.value + 4.0 * delta);
+  ++searches_;
+  settled_ += static_cast<long long>(search_->last_settled());
+  if (rerouted.found) z = search_->extract(rerouted);
+  search_->set_avoid(nullptr);
+  add_crossing_family(z);
+}
+
+// A family of the cycles crossing `loop` oddly, with the loop's vertices as sources.
+void ExactGreedy::add_crossing_family(const std::vector<Mesh::VertexHandle>& loop) {
+  const int family = static_cast<int>(families_.size());
+  families_.emplace_back();
+  families_.back().cochain = crossing_cochain(st_.mesh, loop);
+  for (auto v : loop) {
+    add_source(family, v.idx());
+    const int s = families_[family].slot_of[v.idx()];
+    if (s >= 0 && carried_[v.idx()] > slots_[s].bound.value) set_bound(s, SourceBound{carried_[v.idx()], false, -1, 0});
+  }
+}
+
+// Back to the span family on a fresh homology (after a cut, or if no crossing cycle exists).
+void ExactGreedy::leave_crossing_mode() {
+  crossing_ = false;
+  search_->set_cochain(nullptr);
+  deactivate_all_slots();
+  families_.resize(1);
+  build_homology();
+}
+
+void ExactGreedy::add_source(int family, int v) {
+  Family& fam = families_[family];
+  if (fam.slot_of.size() < st_.mesh.n_vertices()) fam.slot_of.resize(st_.mesh.n_vertices(), -1);
+  if (st_.mesh.is_boundary(Mesh::VertexHandle(v))) return;
+  int& s = fam.slot_of[v];
+  if (s < 0) {
+    s = static_cast<int>(slots_.size());
+    slots_.emplace_back();
+    slots_.back().vertex = v;
+    slots_.back().family = family;
+  }
+  Slot& slot = slots_[s];
+  if (slot.active) return;
+  slot.active = true;
+  active_.push_back(s);
+  set_bound(s, slot.bound);
+}
+
+void ExactGreedy::set_bound(int s, const SourceBound& b) {
+  Slot& slot = slots_[s];
+  const std::uint32_t version = slot.bound.version + 1;
+  slot.bound = b;
+  slot.bound.version = version;
+  if (!slot.active || !std::isfinite(b.value)) return;  // inf: no cycle of the family through it
+  queue_.push({b.value, s, version, b.exact});
+  if (b.exact) exact_queue_.push({b.value, s, version, true});
+}
+
+// The smallest exact value still queued (an upper bound of the shortest loop), or inf.
+double ExactGreedy::best_exact_value() {
+  while (!exact_queue_.empty()) {
+    const QueueEntry& e = exact_queue_.top();
+    const Slot& slot = slots_[e.slot];
+    if (slot.active && e.version == slot.bound.version) return e.key;
+    exact_queue_.pop();
+  }
+  return kInf;
+}
+
+// While sources with a bound below the best known loop (value U, source u) remain, any order of
+// searching them keeps the result exact. Farthest from u first: a source at distance D from the
+// loop finds a walk of about U + 2D and then covers every source within D of it, so far sources
+// certify the near ones, which could otherwise only search to U each. Returns -1 when the plain
+// smallest-bound order should be used.
+int ExactGreedy::farthest_pending(double best) {
+  if (!std::isfinite(best)) return -1;
+  const int anchor = exact_queue_.top().slot;  // best_exact_value() left a valid top
+  if (anchor != far_anchor_ || best != far_value_) {
+    far_anchor_ = anchor;
+    far_value_ = best;
+    std::vector<double> dist;
+    const std::vector<int> near = vertices_within(st_.mesh, {Mesh::VertexHandle(slots_[anchor].vertex)}, best, &dist);
+    std::vector<double> from_anchor(st_.mesh.n_vertices(), kInf);
+    for (std::size_t i = 0; i < near.size(); ++i) from_anchor[near[i]] = dist[i];
+    far_order_.clear();
+    for (int s : active_) {
+      const Slot& slot = slots_[s];
+      if (slot.active && slot.bound.value < best && !slot.bound.exact) far_order_.push_back({from_anchor[slot.vertex], s});
+    }
+    std::make_heap(far_order_.begin(), far_order_.end());
+  }
+  while (!far_order_.empty()) {
+    std::pop_heap(far_order_.begin(), far_order_.end());
+    const int s = far_order_.back().second;
+    far_order_.pop_back();
+    const Slot& slot = slots_[s];
+    if (!slot.active || slot.bound.exact || !(slot.bound.value < best)) continue;  // done meanwhile
+    ++far_searches_;
+    return s;
+  }
+  return -1;
+}
+
+// F(t) >= F(c) - 2 d(c, t) for every source t of c's family that the search from c settled.
+void ExactGreedy::spread_bounds(int centre_slot, double bound) {
+  const int centre = slots_[centre_slot].vertex;
+  const Family& fam = families_[slots_[centre_slot].family];
+  for (int t : search_->last_settled_vertices()) {
+    if (t == centre || t >= static_cast<int>(fam.slot_of.size()) || fam.slot_of[t] < 0) continue;
+    const int s = fam.slot_of[t];
+    if (!slots_[s].active) continue;
+    const double lower = bound - 2.0 * search_->distance(t);
+    if (!(lower > slots_[s].bound.value)) continue;  // also keeps dropped sources (inf) dropped
+    set_bound(s, SourceBound{lower, false, centre, 0});
+    ++bounds_spread_;
+  }
+}
+
+// Span mode: every non-separating cycle of the new mesh meets the old sources or the new rings
+// and caps.
+void ExactGreedy::add_surgery_sources(const SurgeryResult& sr) {
+  for (auto v : sr.left_ring) add_source(0, v.idx());
+  for (auto v : sr.right_ring) add_source(0, v.idx());
+  add_source(0, sr.left_cap.idx());
+  add_source(0, sr.right_cap.idx());
+}
+
+// After a surgery (span mode): a closed walk through t shorter than twice t's distance to the
+// new rings never reaches them, so it is a walk of the old mesh with the same class (only the
+// span grew): F_new(t) >= min(F_old bound, 2 d(t, rings)). Bounds are lowered to that, nothing
+// more; sources farther than half their bound from the rings keep it.
+void ExactGreedy::lower_bounds_near(const SurgeryResult& sr) {
+  std::vector<Mesh::VertexHandle> seeds = sr.left_ring;
+  seeds.insert(seeds.end(), sr.right_ring.begin(), sr.right_ring.end());
+  double reach = 0;
+  for (int s : active_)
+    if (slots_[s].active && std::isfinite(slots_[s].bound.value)) reach = std::max(reach, 0.5 * slots_[s].bound.value);
+  std::vector<double> dist;
+  const std::vector<int> near = vertices_within(st_.mesh, seeds, reach, &dist);
+  const std::vector<int>& slot_of = families_[0].slot_of;
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const int t = near[i];
+    if (t >= static_cast<int>(slot_of.size()) || slot_of[t] < 0 || !slots_[slot_of[t]].active) continue;
+    const double cap = 2.0 * dist[i];
+    if (!(cap < slots_[slot_of[t]].bound.value)) continue;
+    set_bound(slot_of[t], SourceBound{cap, false, -1, 0});
+    ++bounds_reset_;
+  }
+}
+
+}  // namespace cf::detail
