@@ -1,5 +1,5 @@
 #pragma once
-// A synthetic colon for tests and benchmarks: a tube of radius `radius` along a bent 3D
+// A synthetic colon for tests and benchmarks (test-support library colonflat_testdata): a tube of radius `radius` along a bent 3D
 // centreline, with haustral folds (ridges across the tube, height varying around it) and polyps
 // (hemispheres of known diameter, protruding into the lumen), closed by hemispherical caps or
 // left open. Triangle size ~`spacing` mm. Genus 0; outward normals (out of the lumen).
