@@ -25,7 +25,7 @@ void run_tool(std::unique_ptr<Stage> (*make)(), const std::vector<std::string>& 
   ASSERT_EQ(tool->run(args, out, err), 0) << err.str();
 }
 
-// What the area-balanced map achieves on real colons today: no flipped triangle, band length =
+// What the area-balanced map achieves on real colons today: no flipped triangle, colon band length =
 // centreline length, area ratio of the mapped wall within [0.2, 5] for 90 % of it, coverage
 // measured and consistent, ends labelled.
 void expect_achieved(const FlatMap& f) {
@@ -35,7 +35,9 @@ void expect_achieved(const FlatMap& f) {
   const Coverage& c = f.coverage;
   EXPECT_NEAR(c.shown_area_mm2 + c.compressed_area_mm2 + c.missing_area_mm2, c.wall_area_mm2, 1e-6 * c.wall_area_mm2);
   for (const auto& s : f.segments) {
-    EXPECT_NEAR(s.length, s.centreline_length, 0.1 * s.centreline_length);
+    // colon bands: length = centreline length within 10 %; a side branch's band takes its conformal
+    // length (docs/flatten.md), its ticks still in centreline mm from the neck
+    if (s.kind == "colon") EXPECT_NEAR(s.length, s.centreline_length, 0.1 * s.centreline_length);
     EXPECT_FALSE(s.x0_end.empty());
   }
 }
