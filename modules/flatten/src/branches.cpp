@@ -10,7 +10,8 @@
 //     pouch, and its rim a closed curve on the surface;
 //  3. the neck: the radius r >= the cluster's extent whose rim is shortest in 3D (inside the pouch
 //     the rim runs around its body, beyond the neck it grows with the tube wall);
-//  4. the branch: faces with d < r connected to the cluster, with any enclosed island added.
+//  4. the branch: faces with d < r connected to the cluster, with any enclosed island added; kept
+//     when it is a disk holding lumen (a polyp on a stalk, tissue, stays on the colon band).
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -30,8 +31,8 @@ struct Cluster {
 
 class BranchFinder {
  public:
-  BranchFinder(const Surface& s, const Edges& E, const Embedding& emb, double length)
-      : s_(s), E_(E), emb_(emb), length_(length), area3_(s.t.size()), taken_(s.t.size(), 0) {
+  BranchFinder(const Surface& s, const Edges& E, const Embedding& emb, double length, double lumen_sign)
+      : s_(s), E_(E), emb_(emb), length_(length), lumen_sign_(lumen_sign), area3_(s.t.size()), taken_(s.t.size(), 0) {
     for (std::size_t f = 0; f < s.t.size(); ++f) area3_[f] = face_area_3d(s, int(f));
   }
 
@@ -205,13 +206,34 @@ class BranchFinder {
     return V - Ed + F == 1 && boundary >= 3;
   }
 
+  // Lumen (a pouch of the lumen: diverticulum, blind loop) or tissue (a polyp on a stalk)? The
+  // region closed by a cone over its neck encloses a positive volume, counted with the normals out
+  // of the lumen, when it holds lumen.
+  bool holds_lumen(const std::vector<char>& in) const {
+    V3 apex = V3::Zero();
+    std::size_t n = 0;
+    for (std::size_t e = 0; e < E_.ev.size(); ++e) {
+      const int f0 = E_.ef[e][0], f1 = E_.ef[e][1];
+      if ((f0 >= 0 && in[f0]) != (f1 >= 0 && in[f1])) apex += s_.p[E_.ev[e][0]] + s_.p[E_.ev[e][1]], n += 2;
+    }
+    if (n == 0) return false;
+    apex /= double(n);
+    double vol = 0;
+    for (std::size_t f = 0; f < s_.t.size(); ++f)
+      if (in[f]) {
+        const Tri& t = s_.t[f];
+        vol += (s_.p[t[0]] - apex).dot((s_.p[t[1]] - apex).cross(s_.p[t[2]] - apex));
+      }
+    return vol * lumen_sign_ > 0;
+  }
+
   bool cut_branch(const Cluster& c, BranchCut& b) const {
     b.centre = centre_of(c);
     const std::vector<double> d = flat_distance(b.centre);
     const double r = neck_radius(c, d, b.neck_mm);
     if (!(r > 0)) return false;
     const std::vector<char> in = inside(c, d, r);
-    if (!is_disk(in)) return false;
+    if (!is_disk(in) || !holds_lumen(in)) return false;
     for (std::size_t f = 0; f < s_.t.size(); ++f)
       if (in[f]) b.faces.push_back(int(f)), b.area_mm2 += area3_[f];
     return !b.faces.empty();
@@ -221,6 +243,7 @@ class BranchFinder {
   const Edges& E_;
   const Embedding& emb_;
   double length_;
+  double lumen_sign_;
   std::vector<double> area3_;
   std::vector<char> taken_;
 };
@@ -228,8 +251,8 @@ class BranchFinder {
 }  // namespace
 
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
-                                     double min_area_mm2) {
-  return BranchFinder(s, E, emb, length).run(min_area_mm2);
+                                     double lumen_sign, double min_area_mm2) {
+  return BranchFinder(s, E, emb, length, lumen_sign).run(min_area_mm2);
 }
 
 }  // namespace cf::flat_detail

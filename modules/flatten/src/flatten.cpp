@@ -214,7 +214,7 @@ void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out)
 // then re-solves the conformal map of what remains. Returns the branches' works.
 std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
-  const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, o.branch_min_area);
+  const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
   if (cuts.empty()) return {};
   const std::size_t nf = w.ann.t.size();
   std::vector<char> keep(nf, 1);

@@ -102,9 +102,11 @@ struct BranchCut {
   V2 centre;            // flat position of the collapse in the conformal embedding (mm)
 };
 // Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; largest first,
-// disjoint. `emb`: conformal embedding at the area-preserving scale, band [0, length] in x.
+// disjoint; pouches of the lumen only (face normals x `lumen_sign` point out of the lumen), not
+// tissue protrusions (a polyp on a stalk). `emb`: conformal embedding at the area-preserving
+// scale, band [0, length] in x.
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
-                                     double min_area_mm2);
+                                     double lumen_sign, double min_area_mm2);
 
 // Vertex -> incident faces.
 std::vector<std::vector<int>> vertex_faces(const Surface& s);

@@ -65,6 +65,18 @@ TEST(FlattenBranches, WithoutBranchesThePouchIsNotShownAndLocated) {
   EXPECT_GT(f.coverage.not_shown[0].centroid_lps_mm[1], 30.0);
 }
 
+// A polyp on a thin stalk is collapsed like a pouch but is tissue, not lumen: it stays on the
+// colon band (no side branch), where the image and the polyp detection look for it.
+TEST(FlattenBranches, PolypOnAStalkStaysOnTheColonBand) {
+  const FlatMap f = flatten_colon(test_shapes::stalked_polyp());
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_EQ(f.segments[0].kind, "colon");
+  bool head_on_band = false;  // a flat vertex on top of the head (z > 2 mm, near x = 100)
+  for (std::size_t i = 0; i < f.position.size(); ++i)
+    head_on_band = head_on_band || (std::abs(f.position[i][0] - 100) < 4 && f.position[i][2] > 2);
+  EXPECT_TRUE(head_on_band);
+}
+
 // A plain folded colon tube has no side branch (no false cut) and keeps its whole wall.
 TEST(FlattenBranches, PlainFoldedTubeHasNoBranch) {
   synthetic::ColonOptions o;

@@ -86,4 +86,17 @@ inline TriangleList pouch_behind_neck(double neck) {
       {-15, -15, -25}, {215, 75, 25}, 1.0);
 }
 
+// Closed tube along x (radius 15 mm, 0..200 mm) with a pedunculated polyp: a head of radius 6 mm
+// on a stalk of radius 1.6 mm rising 8 mm from the wall at x = 100 into the lumen (tissue).
+inline TriangleList stalked_polyp() {
+  return surface_of(
+      [](const Eigen::Vector3d& p) {
+        const double tube = capsule(p, {0, 0, 0}, {200, 0, 0}, 15);
+        const double stalk = capsule(p, {100, 0, -16}, {100, 0, -6}, 1.6);
+        const double head = (p - Eigen::Vector3d(100, 0, -2)).norm() - 6;
+        return std::max(tube, -std::min(stalk, head));  // lumen = tube minus the polyp's tissue
+      },
+      {-18, -18, -18}, {218, 18, 18}, 0.8);
+}
+
 }  // namespace cf::test_shapes
