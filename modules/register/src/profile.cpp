@@ -1,6 +1,7 @@
 #include "colonflat/register/profile.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <limits>
 
@@ -105,6 +106,26 @@ std::vector<double> axial_from_flat_x(const ColonScan& scan, const ProfileOption
   return s;
 }
 
+// A side branch's vertices (a pouch flattened as a band of its own, flatten's FlatSegments
+// kind "branch") carry centreline mm along the pouch; along the colon they sit at the neck of the
+// branch chain on its colon band (attach_mm).
+void place_branches_at_their_neck(const ColonScan& scan, std::vector<double>& s) {
+  std::map<int, std::pair<int, double>> branch;  // id -> (parent, attach_mm)
+  for (const auto& seg : scan.segments)
+    if (seg.value("kind", std::string("colon")) == "branch")
+      branch[seg.value("id", -1)] = {seg.value("parent", -1), seg.value("attach_mm", 0.0)};
+  if (branch.empty()) return;
+  std::map<int, double> at;  // branch id -> centreline mm of its chain's neck on the colon band
+  for (const auto& [id, pa] : branch) {
+    int cur = id;
+    double attach = pa.second;
+    for (int guard = 0; guard < 16 && branch.count(cur); ++guard) attach = branch[cur].second, cur = branch[cur].first;
+    at[id] = attach;
+  }
+  for (size_t v = 0; v < s.size() && v < scan.segment.size(); ++v)
+    if (auto it = at.find(scan.segment[v]); it != at.end()) s[v] = it->second;
+}
+
 std::vector<double> axial_coordinate(const ColonScan& scan, const ProfileOptions& o, ScanCoordinates& c) {
   if (scan.centreline_mm.empty()) return axial_from_flat_x(scan, o, c);
   c.axial_source = "centreline_mm";
@@ -115,6 +136,7 @@ std::vector<double> axial_coordinate(const ColonScan& scan, const ProfileOptions
   std::vector<double> s = scan.centreline_mm;
   for (double& x : s)
     if (!std::isfinite(x) || x < 0) x = kNaN;
+  place_branches_at_their_neck(scan, s);
   return s;
 }
 

@@ -190,3 +190,37 @@ TEST(RegisterScan, CandidateJsonForms) {
 
 }  // namespace
 }  // namespace cf
+
+namespace cf {
+namespace {
+
+// A tube of 300 mm (segment 0, centreline_mm = x) with a side-branch band (segment 1, a pouch at
+// x = 150 whose own centreline_mm runs 0..20 mm): the pouch's vertices are placed at its neck
+// (attach_mm = 150) along the colon, not at the rectal end.
+TEST(RegisterProfile, SideBranchVerticesSitAtTheirNeck) {
+  ColonScan scan;
+  scan.name = "synthetic";
+  for (int i = 0; i <= 300; ++i)
+    for (int k = 0; k < 16; ++k) {
+      const double a = 2 * M_PI * k / 16;
+      scan.lps.emplace_back(double(i), 10 * std::cos(a), 10 * std::sin(a));
+      scan.uv.emplace_back(double(i), 10 * a);
+      scan.segment.push_back(0);
+      scan.centreline_mm.push_back(double(i));
+    }
+  for (int j = 0; j <= 20; ++j) {
+    scan.lps.emplace_back(150.0, 10.0 + j, 0.0);
+    scan.uv.emplace_back(double(j), 400.0);
+    scan.segment.push_back(1);
+    scan.centreline_mm.push_back(double(j));
+  }
+  scan.normal.assign(scan.lps.size(), Eigen::Vector3d::Zero());
+  scan.segments = nlohmann::json::array({{{"id", 0}, {"kind", "colon"}, {"x0_end", "rectum"}, {"x1_end", "cecum"}},
+                                         {{"id", 1}, {"kind", "branch"}, {"parent", 0}, {"attach_mm", 150.0}}});
+  const ScanCoordinates c = colon_coordinates(scan, ProfileOptions{});
+  for (std::size_t v = scan.lps.size() - 21; v < scan.lps.size(); ++v) EXPECT_NEAR(c.s[v], 150.0, 1e-9) << v;
+  EXPECT_NEAR(c.s[16 * 100], 100.0, 1e-9);  // a colon vertex keeps its centreline mm
+}
+
+}  // namespace
+}  // namespace cf
