@@ -158,32 +158,9 @@ class BranchFinder {
     // The outside must be one piece holding the annulus' own boundary: other pieces are islands.
     std::vector<char> out(s_.t.size());
     for (std::size_t f = 0; f < s_.t.size(); ++f) out[f] = !in[f];
-    keep_largest_component(out);
+    keep_largest_component(E_, out);
     for (std::size_t f = 0; f < s_.t.size(); ++f) in[f] = !out[f];
     return in;
-  }
-
-  void keep_largest_component(std::vector<char>& keep) const {
-    std::vector<int> comp(s_.t.size(), -1), stack;
-    int best = -1;
-    std::size_t best_size = 0;
-    for (std::size_t f0 = 0, n = 0; f0 < s_.t.size(); ++f0) {
-      if (!keep[f0] || comp[f0] >= 0) continue;
-      std::size_t size = 0;
-      comp[f0] = int(n);
-      stack.push_back(int(f0));
-      while (!stack.empty()) {
-        const int f = stack.back();
-        stack.pop_back();
-        ++size;
-        for (int e : E_.fe[f])
-          for (int g : E_.ef[e])
-            if (g >= 0 && keep[g] && comp[g] < 0) comp[g] = int(n), stack.push_back(g);
-      }
-      if (size > best_size) best_size = size, best = int(n);
-      ++n;
-    }
-    for (std::size_t f = 0; f < s_.t.size(); ++f) keep[f] = keep[f] && comp[f] == best;
   }
 
   // A disk: one boundary loop and Euler characteristic 1.

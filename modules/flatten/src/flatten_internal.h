@@ -51,6 +51,8 @@ struct Opened {
   std::size_t removed = 0;
 };
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
+// Keeps the largest edge-connected set of faces among `keep`.
+void keep_largest_component(const Edges& E, std::vector<char>& keep);
 // The kept faces (`keep[f]`), reindexed; src carried over; `new_of_old` (optional): new vertex id
 // of each old one, -1 when dropped.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old = nullptr);

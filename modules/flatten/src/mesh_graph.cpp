@@ -78,8 +78,6 @@ int argmax_finite(const std::vector<double>& d) {
   return best;
 }
 
-namespace {
-
 // Keeps the largest edge-connected set of faces among `keep`.
 void keep_largest_component(const Edges& E, std::vector<char>& keep) {
   const std::size_t nf = keep.size();
@@ -106,8 +104,6 @@ void keep_largest_component(const Edges& E, std::vector<char>& keep) {
   }
   for (std::size_t f = 0; f < nf; ++f) keep[f] = keep[f] && comp[f] == best;
 }
-
-}  // namespace
 
 // Surface made of the kept faces, reindexed.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old) {
