@@ -6,6 +6,7 @@
 #include <vtkNew.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -61,22 +62,27 @@ struct NotShownMark {
   double x = 0, y = 0;  // flat layout position (mm)
   double area_mm2 = 0;
 };
+// The flat layout position of segment `segment`'s vertex nearest to `lps` (false: none in it).
+bool nearest_flat_position(const FlatMap& f, int segment, const std::array<double, 3>& lps, double& x, double& y) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t v = 0; v < f.position.size(); ++v) {
+    if (f.segment[v] != segment) continue;
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d += (f.position[v][k] - lps[k]) * (f.position[v][k] - lps[k]);
+    if (d < best) best = d, x = f.uv[v][0], y = f.uv[v][1];
+  }
+  return best < std::numeric_limits<double>::infinity();
+}
+
 std::vector<NotShownMark> not_shown_marks(const FlatMap& f) {
   std::vector<NotShownMark> marks;
   for (const FlatSegment& s : f.segments)
     for (const auto& cl : s.coverage.not_shown) {
       if (cl.area_mm2 < kNotShownMinArea) continue;
-      double best = std::numeric_limits<double>::infinity();
       NotShownMark m;
       m.segment = s.id;
       m.area_mm2 = cl.area_mm2;
-      for (std::size_t v = 0; v < f.position.size(); ++v) {
-        if (f.segment[v] != s.id) continue;
-        double d = 0;
-        for (int k = 0; k < 3; ++k) d += (f.position[v][k] - cl.centroid_lps_mm[k]) * (f.position[v][k] - cl.centroid_lps_mm[k]);
-        if (d < best) best = d, m.x = f.uv[v][0], m.y = f.uv[v][1];
-      }
-      if (best < std::numeric_limits<double>::infinity()) marks.push_back(m);
+      if (nearest_flat_position(f, s.id, cl.centroid_lps_mm, m.x, m.y)) marks.push_back(m);
     }
   return marks;
 }
@@ -90,16 +96,9 @@ struct NeckMark {
 std::vector<NeckMark> neck_marks(const FlatMap& f) {
   std::vector<NeckMark> marks;
   for (const FlatSegment& b : f.segments) {
-    if (b.kind != "branch" || b.parent < 0) continue;
     NeckMark m{b.parent, b.id, 0, 0};
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t v = 0; v < f.position.size(); ++v) {
-      if (f.segment[v] != b.parent) continue;
-      double d = 0;
-      for (int k = 0; k < 3; ++k) d += (f.position[v][k] - b.attach_lps[k]) * (f.position[v][k] - b.attach_lps[k]);
-      if (d < best) best = d, m.x = f.uv[v][0], m.y = f.uv[v][1];
-    }
-    if (best < std::numeric_limits<double>::infinity()) marks.push_back(m);
+    if (b.kind == "branch" && b.parent >= 0 && nearest_flat_position(f, b.parent, b.attach_lps, m.x, m.y))
+      marks.push_back(m);
   }
   return marks;
 }
