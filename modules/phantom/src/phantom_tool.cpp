@@ -32,7 +32,7 @@ class PhantomTool : public Tool {
     app.add_option("--seed", o.seed, "random seed (default 1)")->type_name("N")->check(
         CLI::Validator([](std::string& v) { return v.rfind('-', 0) == 0 ? "must be >= 0 (got " + v + ")" : std::string(); }, ""));
     app.add_option("--size", o.size, "small: 128^3 at 2.8 x 2.8 x 3.125 mm (seconds); medium: 256 x 256 x 200 at "
-                                     "1.4 x 1.4 x 2 mm; full: 512 x 512 x 400 at 0.7 x 0.7 x 1 mm (default small)")
+                                     "1.4 x 1.4 x 2 mm; full: 512 x 512 x 400 at 0.7 x 0.7 x 1 mm (default " + o.size + ")")
         ->type_name("small|medium|full");
     app.add_option("--format", format, "volume format: nrrd (DIR/ct.nrrd) or dicom (DIR/dicom/, one file per slice) "
                                        "(default nrrd)")

@@ -19,6 +19,7 @@ namespace {
 
 Phantom make(const std::string& position, int tagged = 0, bool extras = false, std::uint64_t seed = 1) {
   PhantomOptions o;
+  o.size = "small";
   o.seed = seed;
   o.position = position;
   o.fully_tagged_segments = tagged;

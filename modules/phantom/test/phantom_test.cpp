@@ -50,6 +50,7 @@ bool lumen_at(const Phantom& p, const std::array<double, 3>& x) {
 // The same seed gives the same volume and ground truth; another seed gives another case.
 TEST(PhantomGenerate, DeterministicPerSeed) {
   PhantomOptions o;
+  o.size = "small";
   o.seed = 1;
   const Phantom a = generate_phantom(o);
   const Phantom& b = small(1);
@@ -167,6 +168,7 @@ TEST(PhantomGenerate, NoiseSitesRecorded) {
   for (const auto& s : p.noise_sites)
     if (s.type == "strand") EXPECT_FALSE(lumen_at(p, s.center_lps_mm));
   PhantomOptions o;
+  o.size = "small";
   o.topological_noise = false;
   EXPECT_TRUE(generate_phantom(o).noise_sites.empty());
 }
@@ -216,7 +218,7 @@ Run run_tool(const std::vector<std::string>& args) {
 // `colonflat phantom` writes the volume and every ground-truth file; they match the in-memory phantom.
 TEST(PhantomTool, WritesVolumeAndGroundTruth) {
   testing::TempDir tmp;
-  const auto r = run_tool({"-o", tmp.str("case"), "--seed", "1", "-q"});
+  const auto r = run_tool({"-o", tmp.str("case"), "--seed", "1", "--size", "small", "-q"});
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"ct.nrrd", "lumen_mask.nrrd", "polyps.json", "centerline.json", "noise_sites.json", "phantom.json"})
     EXPECT_TRUE(fs::exists(tmp / "case" / f)) << f;
@@ -244,7 +246,7 @@ TEST(PhantomTool, WritesVolumeAndGroundTruth) {
 // --format dicom writes a DICOM series that reads back to the same HU volume and geometry.
 TEST(PhantomTool, DicomFormatMatchesNrrd) {
   testing::TempDir tmp;
-  ASSERT_EQ(run_tool({"-o", tmp.str("d"), "--format", "dicom", "-q"}).code, 0);
+  ASSERT_EQ(run_tool({"-o", tmp.str("d"), "--size", "small", "--format", "dicom", "-q"}).code, 0);
   EXPECT_FALSE(fs::exists(tmp / "d" / "ct.nrrd"));
   std::size_t files = 0;
   for (const auto& e : fs::directory_iterator(tmp / "d" / "dicom")) files += e.path().extension() == ".dcm";

@@ -22,7 +22,7 @@ namespace cf {
 
 struct PhantomOptions {
   std::uint64_t seed = 1;
-  std::string size = "small";     // "small" (128 x 128 x 128, 2.8 x 2.8 x 3.125 mm), "medium" (256 x 256 x 200,
+  std::string size = "full";      // "small" (128 x 128 x 128, 2.8 x 2.8 x 3.125 mm), "medium" (256 x 256 x 200,
                                   // 1.4 x 1.4 x 2 mm) or "full" (512 x 512 x 400, 0.7 x 0.7 x 1 mm)
   bool collapsed_segment = false; // a collapsed stretch of descending colon (the lumen splits in two)
   bool tagged_fluid = true;       // pools of tagged fluid in the dependent (posterior) parts

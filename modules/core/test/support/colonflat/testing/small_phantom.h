@@ -15,6 +15,7 @@ inline const Phantom& small_phantom(std::uint64_t seed = 1, bool collapsed = fal
   auto it = cache.find(key);
   if (it == cache.end()) {
     PhantomOptions o;
+    o.size = "small";
     o.seed = seed;
     o.collapsed_segment = collapsed;
     it = cache.emplace(key, generate_phantom(o)).first;
