@@ -47,6 +47,23 @@ nlohmann::json loops_info(vtkPolyData* pd) {
           {"coordinate_system", field_string(pd, "CoordinateSystem")}};
 }
 
+// FlatSegments is {"segments": [...], "coverage": {...}, ...} (flatten's flat_io); files from before
+// issue 11 hold the bare segment array.
+nlohmann::json flat_info(const nlohmann::json& flat) {
+  const nlohmann::json& segs = flat.is_object() && flat.contains("segments") ? flat["segments"] : flat;
+  nlohmann::json rows = nlohmann::json::array();
+  if (segs.is_array())
+    for (const auto& s : segs)
+      rows.push_back({{"id", s.value("id", -1)}, {"kind", s.value("kind", "colon")},
+                      {"length_mm", s.contains("rectangle_mm") ? s["rectangle_mm"].value("length", 0.0) : 0.0},
+                      {"around_mm", s.contains("rectangle_mm") ? s["rectangle_mm"].value("period", 0.0) : 0.0},
+                      {"x0_end", s.value("x0_end", "")}, {"x1_end", s.value("x1_end", "")}});
+  nlohmann::json info = {{"kind", "flat map"}, {"segments", rows.size()}, {"segment_list", rows}};
+  if (flat.is_object() && flat.contains("coverage") && flat["coverage"].contains("fraction_shown"))
+    info["fraction_shown"] = flat["coverage"]["fraction_shown"];
+  return info;
+}
+
 }  // namespace
 
 OwnOutput inspect_own_output(const std::string& file) {
@@ -64,11 +81,9 @@ OwnOutput inspect_own_output(const std::string& file) {
     out.info = loops_info(pd);
   } else if (!field_string(pd, "FlatSegments").empty()) {
     out.kind = OwnKind::kFlat;
-    const auto segs = nlohmann::json::parse(field_string(pd, "FlatSegments"), nullptr, false);
-    out.info = {{"kind", "flat map"},
-                {"segments", segs.is_array() ? segs.size() : 0},
-                {"units", field_string(pd, "Units")},
-                {"coordinate_system", field_string(pd, "CoordinateSystem")}};
+    out.info = flat_info(nlohmann::json::parse(field_string(pd, "FlatSegments"), nullptr, false));
+    out.info["units"] = field_string(pd, "Units");
+    out.info["coordinate_system"] = field_string(pd, "CoordinateSystem");
   }
   return out;
 }
@@ -90,6 +105,16 @@ std::string own_output_text(const OwnOutput& o) {
   } else if (o.kind == OwnKind::kFlat) {
     s << "ColonFlat flat map: " << o.info["segments"] << " segment(s); x, y in mm (an open surface: boundary "
       << "loops are expected)\n";
+    if (o.info.contains("fraction_shown"))
+      s << "  wall shown: " << 100.0 * o.info["fraction_shown"].get<double>() << " %\n";
+    for (const auto& r : o.info["segment_list"]) {
+      s << "  segment " << r["id"] << " (" << r["kind"].get<std::string>() << ")";
+      if (r["length_mm"].get<double>() > 0)
+        s << ": " << r["length_mm"].get<double>() << " x " << r["around_mm"].get<double>() << " mm";
+      if (!r["x0_end"].get<std::string>().empty())
+        s << ", " << r["x0_end"].get<std::string>() << " -> " << r["x1_end"].get<std::string>();
+      s << "\n";
+    }
   }
   return s.str();
 }
