@@ -19,8 +19,10 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
     fd.back().degenerate = degenerate[f];
   }
   const DistortionStats st = stats_of(fd);
-  std::fprintf(stderr, "flatten debug %s: flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
-               step, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
+  std::size_t crowded = 0;
+  for (const FaceDistortion& d : fd) crowded += !d.degenerate && too_small_in_map(d.area2, d.area3);
+  std::fprintf(stderr, "flatten debug %s: crowded %zu, flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
+               step, crowded, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
 }
 
 

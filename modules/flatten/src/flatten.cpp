@@ -94,7 +94,7 @@ V3 loop_centre(const Surface& s, const std::vector<int>& l) {
 std::size_t count_bad(const Surface& s, const Embedding& emb, const std::vector<char>& degenerate) {
   std::size_t n = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f] && emb.area2(s, int(f)) <= 1e-7 * face_area_3d(s, int(f))) ++n;
+    if (!degenerate[f] && too_small_in_map(emb.area2(s, int(f)), face_area_3d(s, int(f)))) ++n;
   return n;
 }
 
@@ -144,7 +144,7 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   kept.reserve(fd.size());
   double a2 = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!degenerate[f] && fd[f].area2 <= 1e-7 * fd[f].area3) w.in_map[f] = 0, ++w.seg.crowded_faces;
+    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) w.in_map[f] = 0, ++w.seg.crowded_faces;
     else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
   }
   w.seg.stats = stats_of(kept);

@@ -88,6 +88,10 @@ struct Embedding {
     return 0.5 * (a.x() * b.y() - a.y() * b.x());
   }
 };
+// A face whose 2D area is at most this fraction of its 3D area is not in the map ("crowded": a
+// sliver or fold-over). untangle() repairs exactly these; measure() counts what is left.
+constexpr double kMinInMapAreaRatio = 1e-7;
+inline bool too_small_in_map(double area2, double area3) { return area2 <= kMinInMapAreaRatio * area3; }
 // (u, sign * v * period) * scale, corners lifted so that each face's centroid y lies in [0, P).
 Embedding embed_conformal(const Surface& s, const Edges& E, const Harmonic& h, double sign, double scale);
 // Re-places each corner offset so that every face's centroid y lies in [0, period).

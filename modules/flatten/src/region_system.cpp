@@ -84,7 +84,7 @@ std::size_t untangle(const Surface& s, const std::vector<std::vector<int>>& vf, 
   std::vector<char> in(nv, 0);
   std::vector<int> region;
   for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f] && emb.area2(s, int(f)) <= 0)
+    if (!degenerate[f] && too_small_in_map(emb.area2(s, int(f)), face_area_3d(s, int(f))))
       for (int v : s.t[f])
         if (!in[v]) in[v] = 1, region.push_back(v);
   if (region.empty()) return 0;
@@ -109,7 +109,7 @@ std::size_t untangle(const Surface& s, const std::vector<std::vector<int>>& vf, 
     emb.pos = sys.solve(s, emb, std::vector<std::array<V2, 3>>(faces.size(), {V2::Zero(), V2::Zero(), V2::Zero()}));
     bool any = false;
     for (int f : faces)
-      if (!degenerate[f] && emb.area2(s, f) <= 0) any = true;
+      if (!degenerate[f] && too_small_in_map(emb.area2(s, f), face_area_3d(s, f))) any = true;
     if (!any) break;
   }
   return region.size();
