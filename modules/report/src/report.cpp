@@ -26,10 +26,11 @@ namespace cf {
 namespace {
 
 struct Builder {
-  Builder(const ReportOptions& o, std::ostream* l, RunData r) : opts(o), log(l), run(std::move(r)) {}
+  Builder(const ReportOptions& o, std::ostream* l, const RunData& r) : opts(o), log(l), run(r), warnings(r.warnings) {}
   const ReportOptions& opts;
   std::ostream* log;
-  RunData run;
+  const RunData& run;
+  std::vector<std::string> warnings;  // the run's, and the report's own
   fs::path files_dir;
   nlohmann::json data = nlohmann::json::object();
   std::optional<ColonImageLayout> layout;
@@ -41,7 +42,7 @@ struct Builder {
     const fs::path png = run.dir / "colon.png";
     const bool have_png = run.colon_image || run_has_file(run, "colon.png");
     if (!run.flat || !have_png) {
-      if (!have_png) run.warnings.push_back("no colon.png in the run folder: no colon image");
+      if (!have_png) warnings.push_back("no colon.png in the run folder: no colon image");
       return;
     }
     colon = run.colon_image ? run.colon_image : read_png(png);
@@ -54,7 +55,7 @@ struct Builder {
     data["image"] = {{"file", "colon.png"}, {"width", dims[0]}, {"height", dims[1]},
                      {"pixel_size_mm", layout->pixel_size()}};
     if (!problem.empty()) {
-      run.warnings.push_back("colon image layout does not match the flat map (" + problem +
+      warnings.push_back("colon image layout does not match the flat map (" + problem +
                              "): hover read-out and click-to-CT on the image are off");
       layout.reset();
       return;
@@ -98,7 +99,7 @@ struct Builder {
       eo.size = opts.endoluminal_pixels;
       return std::make_unique<EndoluminalRenderer>(surface, normals, eo);
     } catch (const Error& e) {
-      run.warnings.push_back(std::string("no endoluminal views: ") + e.what());
+      warnings.push_back(std::string("no endoluminal views: ") + e.what());
       return nullptr;
     }
   }
@@ -149,14 +150,6 @@ std::string replace_once(std::string text, const std::string& marker, const std:
   return text.replace(at, marker.size(), with);
 }
 
-std::string page_html(const nlohmann::json& data) {
-  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
-  std::string html = replace_once(report_resources::kHtml, "/*@CSS@*/", report_resources::kCss);
-  html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
-  return replace_once(html, "/*@JS@*/", report_resources::kJs);
-}
-
 std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
   std::vector<MarkupPoint> points;
   for (const auto& f : list) {
@@ -186,11 +179,21 @@ void maybe_inject_fault() {
 
 }  // namespace
 
-ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputTransaction& tx, std::ostream* log) {
+std::string report_page_html(const std::string& html_template, const nlohmann::json& data, const std::string& page_css,
+                             const std::string& page_js) {
+  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
+  std::string html = replace_once(html_template, "/*@CSS@*/", std::string(report_resources::kCss) + page_css);
+  html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
+  return replace_once(html, "/*@JS@*/", std::string(report_resources::kCardsJs) + "\n" + page_js);
+}
+
+ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
+                                 std::ostream* log) {
   Stopwatch clock;
   ProgressScope scope(log, "report");
   const fs::path dir = run.dir;
-  Builder b(opts, log, std::move(run));
+  Builder b(opts, log, run);
   b.files_dir = tx.stage(dir / "report_files");
   fs::create_directories(b.files_dir);
   b.data["title"] = "ColonFlat review report";
@@ -207,7 +210,8 @@ ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputT
   maybe_inject_fault();
   b.add_files();
   b.data["summary"] = summary_json(b.run);
-  std::ofstream(tx.stage(dir / "report.html")) << page_html(b.data);
+  b.data["summary"]["warnings"] = b.warnings;
+  std::ofstream(tx.stage(dir / "report.html")) << report_page_html(report_resources::kHtml, b.data, "", report_resources::kJs);
   std::ofstream(tx.stage(dir / "polyps.mrk.json"))
       << slicer_point_list("ColonFlat candidates", markup_points(b.data["candidates"]), {1.0, 0.85, 0.0}).dump(2) << "\n";
   if (!b.run.known.empty())
@@ -215,7 +219,7 @@ ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputT
         << slicer_point_list("Known polyps", markup_points(b.data["known"]), {0.25, 0.9, 0.4}).dump(2) << "\n";
   phase_done("page and Slicer files");
   for (const auto& p : scope.phases()) b.result.phases.emplace_back(p["phase"].get<std::string>(), p["time_s"].get<double>());
-  b.result.warnings = b.run.warnings;
+  b.result.warnings = b.warnings;
   b.result.seconds = clock.seconds();
   return b.result;
 }
@@ -226,7 +230,7 @@ ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& o
   RunData run = load_run(run_dir, {opts.ct, opts.truth});
   phase_done("read the run folder");
   OutputTransaction tx;
-  ReportResult r = build_review_report(std::move(run), opts, tx, log);
+  ReportResult r = build_review_report(run, opts, tx, log);
   tx.commit();
   r.phases.insert(r.phases.begin(), {"read the run folder", scope.phases()[0]["time_s"].get<double>()});
   r.seconds = clock.seconds();
