@@ -94,11 +94,11 @@ window.colonflatCards = function (R, opts) {
     const cell = (v) => el("td", typeof v === "string" ? { text: v } : {}, typeof v === "string" ? [] : [v]);
     return el("table", { class: "facts" }, rows.concat(extraRows || []).map(([k, v]) => el("tr", {}, [el("td", { text: k }), cell(v)])));
   }
-  // A finding's card. extra (optional): {head: [elements] replacing the size/score/badge part,
+  // A finding's card. extra (optional): {title: shown instead of the key, head: [elements] replacing the size/score/badge part,
   // facts: [[label, text or element]] added to the facts, cls: added class}.
   function card(f, extra) {
     extra = extra || {};
-    const head = el("div", { class: "card-head" }, [el("span", { class: "key", text: f.key })].concat(extra.head || [
+    const head = el("div", { class: "card-head" }, [el("span", { class: "key", text: extra.title || f.key })].concat(extra.head || [
       el("span", { text: fix(f.size_mm) + " mm" }),
       f.known ? null : el("span", { text: "score " + fix(f.score, 2) }),
       matchBadge(f)]).concat([

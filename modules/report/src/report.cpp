@@ -39,27 +39,24 @@ struct Builder {
 
   // colon.png, its layout check and the hover/click lookup grid.
   void add_image() {
-    const fs::path png = run.dir / "colon.png";
     const bool have_png = run.colon_image || run_has_file(run, "colon.png");
     if (!run.flat || !have_png) {
       if (!have_png) warnings.push_back("no colon.png in the run folder: no colon image");
       return;
     }
-    colon = run.colon_image ? run.colon_image : read_png(png);
+    colon = colon_image_of(run);
     int dims[3];
     colon->GetDimensions(dims);
-    layout.emplace(*run.flat, colon_image_pixel_size(run), std::numeric_limits<int>::max());
-    const nlohmann::json cands = run.candidates_doc.value("candidates", nlohmann::json::array());
-    layout->set_rolls_from_candidates(cands);
-    const std::string problem = layout->check(dims[0], dims[1], cands);
     data["image"] = {{"file", "colon.png"}, {"width", dims[0]}, {"height", dims[1]},
-                     {"pixel_size_mm", layout->pixel_size()}};
-    if (!problem.empty()) {
+                     {"pixel_size_mm", colon_image_pixel_size(run)}};
+    std::string problem;
+    const auto made = colon_image_layout(run, colon, &problem);
+    if (!made) {
       warnings.push_back("colon image layout does not match the flat map (" + problem +
-                             "): hover read-out and click-to-CT on the image are off");
-      layout.reset();
+                         "): hover read-out and click-to-CT on the image are off");
       return;
     }
+    layout.emplace(*made);
     data["lookup"] = lookup_json(run, build_lookup_grid(*run.flat, *layout, opts.lookup_step_px));
   }
 
@@ -88,24 +85,8 @@ struct Builder {
     }
   }
 
-  std::unique_ptr<EndoluminalRenderer> make_endoluminal() {
-    if (!opts.endoluminal || !run.flat) return nullptr;
-    try {
-      std::vector<int> flat_to_3d;
-      const TriangleList surface = flat_to_surface(*run.flat, &flat_to_3d);
-      std::vector<std::array<double, 3>> normals(surface.points.size());
-      for (std::size_t i = 0; i < flat_to_3d.size(); ++i) normals[flat_to_3d[i]] = run.flat->normal[i];
-      EndoluminalOptions eo;
-      eo.size = opts.endoluminal_pixels;
-      return std::make_unique<EndoluminalRenderer>(surface, normals, eo);
-    } catch (const Error& e) {
-      warnings.push_back(std::string("no endoluminal views: ") + e.what());
-      return nullptr;
-    }
-  }
-
   void add_findings() {
-    auto endo = make_endoluminal();
+    auto endo = opts.endoluminal ? make_endoluminal_renderer(run, opts.endoluminal_pixels, warnings) : nullptr;
     for (const bool known : {false, true}) {
       nlohmann::json list = nlohmann::json::array();
       for (const ReportFinding& f : known ? run.known : run.candidates) {
