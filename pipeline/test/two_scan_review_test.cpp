@@ -19,6 +19,7 @@
 #include "colonflat/register/register.h"
 #include "colonflat/register/scan.h"
 #include "colonflat/render/artifacts.h"
+#include "colonflat/report/report.h"
 #include "colonflat/testing/command.h"
 #include "colonflat/testing/temp_dir.h"
 
@@ -30,16 +31,6 @@ namespace {
 std::string read_text(const fs::path& p) {
   std::ifstream in(p);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-// window.REPORT of a page.
-nlohmann::json page_data(const fs::path& html) {
-  const std::string text = read_text(html);
-  const std::string marker = "window.REPORT = ";
-  const auto at = text.find(marker);
-  const auto end = text.find(";</script>", at);
-  if (at == std::string::npos || end == std::string::npos) return nullptr;
-  return nlohmann::json::parse(text.substr(at + marker.size(), end - at - marker.size()));
 }
 
 // The side (px) of a PNG under `dir`, 0 when it is missing or does not decode.
@@ -79,7 +70,7 @@ Eigen::Vector3d candidate_lps(const ColonScan& scan, int id) {
 // Every pair and single of registration.json is on the page in `dir`, with the views of both
 // scans (pairs) or the other scan's views at register's mapping of the candidate (singles).
 void expect_review(const fs::path& dir, const ColonRegistration& reg) {
-  const nlohmann::json page = page_data(dir / "report.html");
+  const nlohmann::json page = report_page_data(dir / "report.html");
   ASSERT_TRUE(page.is_object()) << "no window.REPORT in " << dir / "report.html";
   const nlohmann::json cands = read_json_file(dir / "registration.json")["candidates"];
   ASSERT_EQ(page["pairs"].size(), cands["pairs"].size());
@@ -165,7 +156,7 @@ TEST_F(TwoScanReview, PairsShowBothScansAndSinglesTheOtherScanAtTheMappedPoint) 
   const auto f = testing::run_colonflat({"register", dir_.str("out/supine"), dir_.str("out/prone"), "-o", dir_.str("files"), "-q"});
   ASSERT_EQ(f.code, 0) << f.err;
   expect_review(dir_ / "files", reg);
-  const nlohmann::json page = page_data(dir_ / "files" / "report.html");
+  const nlohmann::json page = report_page_data(dir_ / "files" / "report.html");
   EXPECT_TRUE(fs::exists(dir_ / "files" / page["scans"]["supine"]["report"].get<std::string>()));  // link to the run's page
   expect_browser_page(dir_ / "files", dir_.path(), int(reg.matching().pairs.size()),
                       int(reg.matching().supine_only.size() + reg.matching().prone_only.size()));

@@ -169,6 +169,16 @@ std::string report_page_html(const std::string& html_template, const nlohmann::j
   return replace_once(html, "/*@JS@*/", std::string(report_resources::kCardsJs) + "\n" + page_js);
 }
 
+nlohmann::json report_page_data(const fs::path& html) {
+  std::ifstream in(html);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string marker = "window.REPORT = ";
+  const auto at = text.find(marker);
+  const auto end = text.find(";</script>", at);
+  if (at == std::string::npos || end == std::string::npos) return nullptr;
+  return nlohmann::json::parse(text.substr(at + marker.size(), end - at - marker.size()), nullptr, false);
+}
+
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
                                  std::ostream* log) {
   Stopwatch clock;

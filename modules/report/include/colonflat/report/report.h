@@ -61,5 +61,7 @@ ReportResult build_review_report(const RunData& run, const ReportOptions& opts, 
 // supine-prone review are both built with it.
 std::string report_page_html(const std::string& html_template, const nlohmann::json& data, const std::string& page_css,
                              const std::string& page_js);
+// The data embedded in such a page (window.REPORT); null when the file holds none.
+nlohmann::json report_page_data(const std::filesystem::path& html);
 
 }  // namespace cf
