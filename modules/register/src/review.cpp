@@ -122,8 +122,8 @@ class ReviewBuilder {
 
   void write_page() {
     data_["warnings"] = result.warnings;
-    const std::string html = report_page_html(register_resources::kReviewHtml, data_, register_resources::kReviewCss,
-                                              register_resources::kReviewJs);
+    const std::string html = report_page_html("ColonFlat supine-prone review", register_resources::kReviewHtml, data_,
+                                              register_resources::kReviewCss, register_resources::kReviewJs);
     std::ofstream(tx_.stage(dir_ / "report.html")) << html;
   }
 

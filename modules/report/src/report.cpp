@@ -160,11 +160,13 @@ void maybe_inject_fault() {
 
 }  // namespace
 
-std::string report_page_html(const std::string& html_template, const nlohmann::json& data, const std::string& page_css,
-                             const std::string& page_js) {
+std::string report_page_html(const std::string& title, const std::string& body_html, const nlohmann::json& data,
+                             const std::string& page_css, const std::string& page_js) {
   std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
-  std::string html = replace_once(html_template, "/*@CSS@*/", std::string(report_resources::kCss) + page_css);
+  std::string html = replace_once(report_resources::kPageHtml, "/*@TITLE@*/", title);
+  html = replace_once(html, "/*@BODY@*/", body_html);
+  html = replace_once(html, "/*@CSS@*/", std::string(report_resources::kCss) + page_css);
   html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
   return replace_once(html, "/*@JS@*/", std::string(report_resources::kCardsJs) + "\n" + page_js);
 }
@@ -202,7 +204,7 @@ ReportResult build_review_report(const RunData& run, const ReportOptions& opts, 
   b.add_files();
   b.data["summary"] = summary_json(b.run);
   b.data["summary"]["warnings"] = b.warnings;
-  std::ofstream(tx.stage(dir / "report.html")) << report_page_html(report_resources::kHtml, b.data, "", report_resources::kJs);
+  std::ofstream(tx.stage(dir / "report.html")) << report_page_html("ColonFlat review report", report_resources::kHtml, b.data, "", report_resources::kJs);
   std::ofstream(tx.stage(dir / "polyps.mrk.json"))
       << slicer_point_list("ColonFlat candidates", markup_points(b.data["candidates"]), {1.0, 0.85, 0.0}).dump(2) << "\n";
   if (!b.run.known.empty())

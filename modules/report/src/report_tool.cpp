@@ -90,7 +90,9 @@ class ReportTool : public Tool, public RunFinisher {
       if (target.parent_path() == run.dir) data->staged_files.push_back(target.filename().string());
     phase_done("run data from memory");
     const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log);
-    // Left for what follows on the same memory (`colonflat run --prone`: the supine-prone review).
+    // Left for what follows on the same memory (`colonflat run --prone`: the supine-prone review);
+    // the lumen mask is not needed any more when the views show the CT.
+    if (!data->volume_is_mask) run.artifacts->erase("mask");
     run.artifacts->put(kRunDataArtifact, std::shared_ptr<const RunData>(data));
     for (const auto& w : r.warnings)
       if (run.log) *run.log << "colonflat report: warning: " << w << "\n";

@@ -55,12 +55,12 @@ ReportResult write_review_report(const std::filesystem::path& run_dir, const Rep
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
                                  std::ostream* log = nullptr);
 
-// A report page: `html_template` (markers /*@CSS@*/, /*@DATA@*/, /*@JS@*/) with the report's
-// style sheet followed by `page_css`, `window.REPORT = data`, and the shared card script
-// (colonflatCards, resources/cards.js) followed by `page_js`. The run report and register's
-// supine-prone review are both built with it.
-std::string report_page_html(const std::string& html_template, const nlohmann::json& data, const std::string& page_css,
-                             const std::string& page_js);
+// A report page: the shared skeleton (resources/page.html: head, footer, scripts) titled `title`
+// around `body_html`, with the report's style sheet followed by `page_css`, `window.REPORT = data`,
+// and the shared card script (colonflatCards, resources/cards.js) followed by `page_js`. The run
+// report and register's supine-prone review are both built with it.
+std::string report_page_html(const std::string& title, const std::string& body_html, const nlohmann::json& data,
+                             const std::string& page_css, const std::string& page_js);
 // The data embedded in such a page (window.REPORT); null when the file holds none.
 nlohmann::json report_page_data(const std::filesystem::path& html);
 
