@@ -121,8 +121,10 @@ class RunTool : public Tool {
       out << run_summary_text(sup_report, sup.outdir) << run_summary_text(pro_report, pro.outdir)
           << "registration: " << record["pairs"] << " candidate pairs, " << record["supine_only"] << " supine-only, "
           << record["prone_only"] << " prone-only in " << std::fixed << std::setprecision(1)
-          << record["time_s"].get<double>() << " s (review page " << std::setprecision(1)
-          << record["timing_s"].value("review", 0.0) << " s) -> " << (regdir / "report.html").string() << "\n";
+          << record["time_s"].get<double>() << " s (scans from memory " << record["timing_s"].value("scans_from_memory", 0.0)
+          << ", register " << record["timing_s"].value("register", 0.0) << ", image and files "
+          << record["timing_s"].value("image_and_files", 0.0) << ", review page " << record["timing_s"].value("review", 0.0)
+          << " s) -> " << (regdir / "report.html").string() << "\n";
     }
     return kExitOk;
   }

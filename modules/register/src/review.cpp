@@ -165,11 +165,12 @@ class ReviewBuilder {
   }
 
   // A finding's card data with its images (file names prefixed by the scan).
-  nlohmann::json card_with_images(ReviewScan& s, ReportFinding f, const std::string& file_key) {
+  nlohmann::json card_with_images(ReviewScan& s, ReportFinding f, const std::string& file_key,
+                                  const ReportOptions& views) {
     const std::string key = f.key;
     f.key = file_key;
     nlohmann::json fj = finding_json(*s.run, f, s.layout ? &*s.layout : nullptr);
-    result.images += write_finding_images(*s.run, f, opts_.views, files_dir_, s.colon, s.endo.get(), fj);
+    result.images += write_finding_images(*s.run, f, views, files_dir_, s.colon, s.endo.get(), fj);
     if (fj.contains("endoluminal")) ++result.endoluminal_views;
     fj["key"] = key;
     fj["scan"] = s.name;
@@ -177,7 +178,7 @@ class ReviewBuilder {
   }
 
   nlohmann::json own_card(ReviewScan& s, const ReportFinding& f) {
-    nlohmann::json fj = card_with_images(s, f, s.name + "_" + f.key);
+    nlohmann::json fj = card_with_images(s, f, s.name + "_" + f.key, opts_.views);
     fj["registered"] = registered(s, f.lps_mm);
     return fj;
   }
@@ -193,7 +194,11 @@ class ReviewBuilder {
     const Eigen::Vector3d& p = other.scan->lps[size_t(v)];
     probe.lps_mm = {p.x(), p.y(), p.z()};
     probe.flat_vertex = run_vertex(other, v);
-    nlohmann::json pj = card_with_images(other, probe, other.name + "_at_" + own.name + "_" + f.key);
+    // A wider field of view than the finding's own: the registration is off by up to ~10 mm / 20 deg.
+    ReportOptions views = opts_.views;
+    views.min_fov_mm = std::max(views.min_fov_mm, opts_.check_min_fov_mm);
+    views.max_fov_mm = std::max(views.max_fov_mm, views.min_fov_mm);
+    nlohmann::json pj = card_with_images(other, probe, other.name + "_at_" + own.name + "_" + f.key, views);
     pj.erase("score");
     pj["probe_of"] = {{"scan", own.name}, {"key", f.key}};
     pj["registered"] = registered(other, probe.lps_mm);

@@ -31,6 +31,8 @@ struct ReviewOptions {
   ReportOptions views;                 // view sizes, fields of view, endoluminal on/off (report's defaults)
   SideBySideOptions image;             // as given to the side-by-side image (for the marks)
   std::string side_by_side_file = "supine_prone.png";  // the image, relative to the output folder
+  double check_min_fov_mm = 60;        // mm, smallest field of view of the "check here" CT views (the
+                                       // registration's error, ~10 mm along / 20 deg around, stays in view)
 };
 
 struct ReviewResult {
