@@ -1,5 +1,6 @@
 // `colonflat run [INPUT] -o OUTDIR`: chains the stages in memory (pipeline_stage_order()), then
-// the finishers (the review report) on the artifacts still in memory. Everything is checked
+// the finishers (the review report) on the artifacts still in memory. With `--prone PRONE`: both
+// scans, then the register tool's pair step (registration, supine-prone review) on their memory. Everything is checked
 // first (run_plan.cpp); outputs go to OUTDIR/.colonflat-staging-<pid>-<n>/ and are renamed into
 // OUTDIR only when every stage and finisher succeeded.
 #include <fstream>
@@ -9,6 +10,7 @@
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/output_check.h"
+#include "colonflat/core/pair_finisher.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/stage_runner.h"
 #include "colonflat/pipeline/registry.h"
@@ -38,7 +40,10 @@ class RunTool : public Tool {
       RunPlan plan = plan_run(o);
       std::ostream* log = o.quiet ? nullptr : &err;
       if (plan.generate_input) o.input = generate_default_input(o.outdir, err, log);
-      const nlohmann::json report = execute(plan, o, log);
+      ArtifactBag bag;
+      OutputTransaction tx;
+      const nlohmann::json report = execute(plan, o, log, bag, tx);
+      tx.commit();
       if (!o.quiet) out << run_summary_text(report, o.outdir);
       return kExitOk;
     });
@@ -67,16 +72,17 @@ class RunTool : public Tool {
     app.add_flag("-q,--quiet", o.quiet, "print nothing but errors");
   }
 
-  // `--prone PRONE`: both scans planned (every check) before any work, each run into its folder
-  // and committed when done, then `colonflat register` of the two run folders.
+  // `--prone PRONE`: both scans planned (every check) before any work, each run in memory, then
+  // the register tool's pair step (registration and review page) on both runs' memory; the
+  // outputs of all three go through one transaction (nothing appears unless everything succeeded).
   static int run_two_scans(const RunOptions& o, std::ostream& out, std::ostream& err) {
-    Tool* reg = nullptr;
     auto tools = registered_module_tools();
+    PairFinisher* pair = nullptr;
     for (auto& t : tools)
-      if (t->name() == "register") reg = t.get();
-    if (!reg) throw UsageError("--prone needs the register command, which this build lacks");
+      if (t->name() == "register") pair = dynamic_cast<PairFinisher*>(t.get());
+    if (!pair) throw UsageError("--prone needs the register command, which this build lacks");
     if (o.input.empty()) throw UsageError("--prone needs INPUT, the supine scan");
-    const fs::path outdir(o.outdir);
+    const fs::path outdir(o.outdir), regdir = outdir / "registration";
     RunOptions sup = o, pro = o;
     sup.prone = pro.prone = "";
     sup.outdir = (outdir / "supine").string();
@@ -93,31 +99,46 @@ class RunTool : public Tool {
     PathPlan paths;
     paths.input(o.input);
     paths.input(o.prone);
-    paths.output_folder(outdir / "registration", "-o (registration)");
+    for (const auto& f : pair->pair_outputs(regdir)) paths.output(f, "-o (registration)");
+    for (const auto& d : pair->pair_folders(regdir)) paths.output_folder(d, "-o (registration)");
     paths.check();
     if (same_file(o.input, o.prone)) throw UsageError(o.prone + ": --prone is the same file as INPUT");
     std::ostream* log = o.quiet ? nullptr : &err;
+    OutputTransaction tx;
+    ArtifactBag sup_bag, pro_bag;
     if (log) *log << "colonflat run: supine scan " << o.input << " -> " << sup.outdir << "\n";
-    const nlohmann::json sup_report = execute(sup_plan, sup, log);
+    const nlohmann::json sup_report = execute(sup_plan, sup, log, sup_bag, tx);
     if (log) *log << "colonflat run: prone scan " << o.prone << " -> " << pro.outdir << "\n";
-    const nlohmann::json pro_report = execute(pro_plan, pro, log);
-    std::vector<std::string> reg_args = {sup.outdir, pro.outdir, "-o", (outdir / "registration").string()};
-    if (o.quiet) reg_args.push_back("-q");
-    const int rc = reg->run(reg_args, out, err);
-    if (rc != kExitOk) return rc;
-    if (!o.quiet) out << run_summary_text(sup_report, sup.outdir) << run_summary_text(pro_report, pro.outdir);
+    const nlohmann::json pro_report = execute(pro_plan, pro, log, pro_bag, tx);
+    if (log) *log << "[after both scans] register: registration and review page -> " << regdir.string() << "\n";
+    FinishedRun sup_run{sup.outdir, sup.input, {}, &sup_report, &sup_bag, log};
+    FinishedRun pro_run{pro.outdir, pro.input, {}, &pro_report, &pro_bag, log};
+    const nlohmann::json record = pair->finish_pair(sup_run, pro_run, regdir, tx);
+    tx.commit();
+    if (!o.quiet) {
+      for (const auto& w : record.value("warnings", nlohmann::json::array()))
+        err << "colonflat register: warning: " << w.get<std::string>() << "\n";
+      out << run_summary_text(sup_report, sup.outdir) << run_summary_text(pro_report, pro.outdir)
+          << "registration: " << record["pairs"] << " candidate pairs, " << record["supine_only"] << " supine-only, "
+          << record["prone_only"] << " prone-only in " << std::fixed << std::setprecision(1)
+          << record["time_s"].get<double>() << " s (scans from memory " << record["timing_s"].value("scans_from_memory", 0.0)
+          << ", register " << record["timing_s"].value("register", 0.0) << ", image and files "
+          << record["timing_s"].value("image_and_files", 0.0) << ", review page " << record["timing_s"].value("review", 0.0)
+          << " s) -> " << (regdir / "report.html").string() << "\n";
+    }
     return kExitOk;
   }
 
-  static nlohmann::json execute(RunPlan& plan, const RunOptions& o, std::ostream* log) {
-    ArtifactBag bag;
+  // The stages and finishers of one run; every output (run_report.json too) staged in `tx`, the
+  // artifacts left in `bag`. The caller commits.
+  static nlohmann::json execute(RunPlan& plan, const RunOptions& o, std::ostream* log, ArtifactBag& bag,
+                                OutputTransaction& tx) {
     const Port& in_port = plan.stages.front()->spec().inputs.at(0);
     if (log) *log << "colonflat run: reading " << o.input << " as " << in_port.type->name << "\n";
     bag.put(in_port.name, in_port.type->read(o.input));
     nlohmann::json report = {{"version", colonflat_version()}, {"input", o.input},           {"units", "mm"},
                              {"coordinate_system", "LPS"},     {"stages", nlohmann::json::array()}};
     Stopwatch total;
-    OutputTransaction tx;
     const nlohmann::json params = run_stages(plan, o, bag, tx, report, log);
     std::string rest;
     for (const auto& s : plan.not_run) rest += (rest.empty() ? "" : ", ") + s;
@@ -131,7 +152,6 @@ class RunTool : public Tool {
     std::ofstream(tx.stage(outdir / "run_report.json")) << report.dump(2) << "\n";
     std::ofstream(tx.stage(outdir / "run_report.txt")) << run_report_text(report);
     if (!o.params_out.empty()) std::ofstream(tx.stage(o.params_out)) << params.dump(2) << "\n";
-    tx.commit();
     return report;
   }
 

@@ -86,8 +86,8 @@ vtkSmartPointer<vtkPolyData> correspondence_polydata(const ColonRegistration& re
   return pd;
 }
 
-void write_registration(const ColonRegistration& reg, const fs::path& dir, const SideBySideOptions& image,
-                        const nlohmann::json& params) {
+void stage_registration(const ColonRegistration& reg, const fs::path& dir, const SideBySideOptions& image,
+                        const nlohmann::json& params, OutputTransaction& tx) {
   nlohmann::json j = reg.summary();
   j["parameters"] = params;
   j["files"] = {{"supine_to_prone", "supine_to_prone.vtp"}, {"prone_to_supine", "prone_to_supine.vtp"},
@@ -97,18 +97,22 @@ void write_registration(const ColonRegistration& reg, const fs::path& dir, const
   j["timing_s"]["image_s"] = clock.seconds();
   auto forward = correspondence_polydata(reg, Direction::kSupineToProne);
   auto backward = correspondence_polydata(reg, Direction::kProneToSupine);
+  write_vtp(forward, tx.stage(dir / "supine_to_prone.vtp"), dir / "supine_to_prone.vtp");
+  write_vtp(backward, tx.stage(dir / "prone_to_supine.vtp"), dir / "prone_to_supine.vtp");
+  png_image_artifact().write(std::any(ImagePtr(png)), tx.stage(dir / "supine_prone.png"), dir / "supine_prone.png");
+  j["timing_s"]["image_and_files_s"] = clock.seconds();
+  std::ofstream(tx.stage(dir / "registration.json")) << j.dump(1) << "\n";
+}
+
+void write_registration(const ColonRegistration& reg, const fs::path& dir, const SideBySideOptions& image,
+                        const nlohmann::json& params) {
   std::error_code ec;
   const bool created = !fs::exists(dir);
   fs::create_directories(dir, ec);
   if (ec) throw Error(dir.string() + ": cannot create folder: " + ec.message());
   try {
     OutputTransaction tx;
-    write_vtp(forward, tx.stage(dir / "supine_to_prone.vtp"), dir / "supine_to_prone.vtp");
-    write_vtp(backward, tx.stage(dir / "prone_to_supine.vtp"), dir / "prone_to_supine.vtp");
-    png_image_artifact().write(std::any(ImagePtr(png)), tx.stage(dir / "supine_prone.png"), dir / "supine_prone.png");
-    j["timing_s"]["image_and_files_s"] = clock.seconds();
-    const fs::path json_tmp = tx.stage(dir / "registration.json");
-    std::ofstream(json_tmp) << j.dump(1) << "\n";
+    stage_registration(reg, dir, image, params, tx);
     tx.commit();
   } catch (...) {
     if (created) fs::remove_all(dir, ec);

@@ -148,6 +148,13 @@ void write_text(vtkImageData* out, const ColonRegistration& reg, const Layout& l
 
 }  // namespace
 
+SideBySideMarks side_by_side_marks(const ColonRegistration& reg, const SideBySideOptions& opts) {
+  const Layout l = make_layout(reg, opts);
+  SideBySideMarks out{l.width, l.height, {}};
+  for (const Marker& m : place_markers(reg, l)) out.marks.push_back({m.id, m.supine, m.x, m.row, m.radius});
+  return out;
+}
+
 vtkSmartPointer<vtkImageData> render_side_by_side(const ColonRegistration& reg, const SideBySideOptions& o) {
   const Layout l = make_layout(reg, o);
   vtkNew<vtkImageData> bands;

@@ -13,7 +13,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "colonflat/core/stage.h"
+#include "colonflat/register/register.h"
 #include "colonflat/register/register_tool.h"
+#include "colonflat/register/scan.h"
+#include "colonflat/report/report.h"
 #include "colonflat/testdata/synthetic_pair.h"
 #include "colonflat/testing/temp_dir.h"
 
@@ -139,6 +143,60 @@ TEST(RegisterCli, InvalidParametersAreUsageErrors) {
       run_register({tmp.str("supine"), tmp.str("prone"), "-o", tmp.str("out"), "--orientation", "sideways"}), 2,
       "--orientation");
   expect_one_error_line(run_register({tmp.str("supine"), "-o", tmp.str("out")}), 2, "PRONE_RUN_DIR");
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+}
+
+}  // namespace
+}  // namespace cf
+
+namespace cf {
+namespace {
+
+// The review page of a synthetic pair (no CT, no colon image): one row per pair of the JSON with
+// both candidates' ids, and for every one-scan-only candidate the other scan's panel recorded at
+// register's mapping of its point (within 1 mm); --no-review writes no page.
+TEST(RegisterReview, SyntheticPairPageListsPairsAndCheckHerePanels) {
+  testing::TempDir tmp;
+  write_pair(tmp.path());
+  const Result r = run_register({tmp.str("supine"), tmp.str("prone"), "-o", tmp.str("out"), "-q"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json page = report_page_data(tmp / "out/report.html");
+  ASSERT_TRUE(page.is_object());
+  const nlohmann::json cands = read_json_file(tmp / "out/registration.json")["candidates"];
+  ASSERT_EQ(page["pairs"].size(), cands["pairs"].size());
+  for (std::size_t i = 0; i < cands["pairs"].size(); ++i) {
+    EXPECT_EQ(page["pairs"][i]["supine"]["key"], "P" + std::to_string(cands["pairs"][i]["supine_id"].get<int>()));
+    EXPECT_EQ(page["pairs"][i]["prone"]["key"], "P" + std::to_string(cands["pairs"][i]["prone_id"].get<int>()));
+  }
+  const ColonScan sup = read_run_dir(tmp / "supine"), pro = read_run_dir(tmp / "prone");
+  ColonRegistration reg(sup, pro);
+  reg.run();
+  ASSERT_EQ(page["singles"].size(), reg.matching().supine_only.size() + reg.matching().prone_only.size());
+  ASSERT_GE(page["singles"].size(), 1u);
+  for (const auto& single : page["singles"]) {
+    const bool supine = single["scan"] == "supine";
+    const int id = std::stoi(single["finding"]["key"].get<std::string>().substr(1));
+    Eigen::Vector3d p = Eigen::Vector3d::Constant(1e9);
+    for (const auto& c : (supine ? sup : pro).candidates)
+      if (c.id == id) p = c.lps;
+    const Eigen::Vector3d want = reg.map_lps(p, supine ? Direction::kSupineToProne : Direction::kProneToSupine);
+    const auto got = single["probe"]["lps_mm"].get<std::array<double, 3>>();
+    EXPECT_LT((Eigen::Vector3d(got[0], got[1], got[2]) - want).norm(), 1.0) << single.dump();
+  }
+  const Result off = run_register({tmp.str("supine"), tmp.str("prone"), "-o", tmp.str("off"), "--no-review", "-q"});
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_TRUE(fs::exists(tmp / "off/registration.json"));
+  EXPECT_FALSE(fs::exists(tmp / "off/report.html"));
+}
+
+// A review that fails after writing its images leaves no output folder and one error line.
+TEST(RegisterReview, FailingReviewLeavesNoOutput) {
+  testing::TempDir tmp;
+  write_pair(tmp.path());
+  ::setenv("COLONFLAT_TEST_FAIL", "review", 1);
+  const Result r = run_register({tmp.str("supine"), tmp.str("prone"), "-o", tmp.str("out"), "-q"});
+  ::unsetenv("COLONFLAT_TEST_FAIL");
+  expect_one_error_line(r, 1, "failure injected");
   EXPECT_FALSE(fs::exists(tmp / "out"));
 }
 

@@ -26,10 +26,11 @@ namespace cf {
 namespace {
 
 struct Builder {
-  Builder(const ReportOptions& o, std::ostream* l, RunData r) : opts(o), log(l), run(std::move(r)) {}
+  Builder(const ReportOptions& o, std::ostream* l, const RunData& r) : opts(o), log(l), run(r), warnings(r.warnings) {}
   const ReportOptions& opts;
   std::ostream* log;
-  RunData run;
+  const RunData& run;
+  std::vector<std::string> warnings;  // the run's, and the report's own
   fs::path files_dir;
   nlohmann::json data = nlohmann::json::object();
   std::optional<ColonImageLayout> layout;
@@ -38,27 +39,24 @@ struct Builder {
 
   // colon.png, its layout check and the hover/click lookup grid.
   void add_image() {
-    const fs::path png = run.dir / "colon.png";
     const bool have_png = run.colon_image || run_has_file(run, "colon.png");
     if (!run.flat || !have_png) {
-      if (!have_png) run.warnings.push_back("no colon.png in the run folder: no colon image");
+      if (!have_png) warnings.push_back("no colon.png in the run folder: no colon image");
       return;
     }
-    colon = run.colon_image ? run.colon_image : read_png(png);
+    colon = colon_image_of(run);
     int dims[3];
     colon->GetDimensions(dims);
-    layout.emplace(*run.flat, colon_image_pixel_size(run), std::numeric_limits<int>::max());
-    const nlohmann::json cands = run.candidates_doc.value("candidates", nlohmann::json::array());
-    layout->set_rolls_from_candidates(cands);
-    const std::string problem = layout->check(dims[0], dims[1], cands);
     data["image"] = {{"file", "colon.png"}, {"width", dims[0]}, {"height", dims[1]},
-                     {"pixel_size_mm", layout->pixel_size()}};
-    if (!problem.empty()) {
-      run.warnings.push_back("colon image layout does not match the flat map (" + problem +
-                             "): hover read-out and click-to-CT on the image are off");
-      layout.reset();
+                     {"pixel_size_mm", colon_image_pixel_size(run)}};
+    std::string problem;
+    const auto made = colon_image_layout(run, colon, &problem);
+    if (!made) {
+      warnings.push_back("colon image layout does not match the flat map (" + problem +
+                         "): hover read-out and click-to-CT on the image are off");
       return;
     }
+    layout.emplace(*made);
     data["lookup"] = lookup_json(run, build_lookup_grid(*run.flat, *layout, opts.lookup_step_px));
   }
 
@@ -87,24 +85,8 @@ struct Builder {
     }
   }
 
-  std::unique_ptr<EndoluminalRenderer> make_endoluminal() {
-    if (!opts.endoluminal || !run.flat) return nullptr;
-    try {
-      std::vector<int> flat_to_3d;
-      const TriangleList surface = flat_to_surface(*run.flat, &flat_to_3d);
-      std::vector<std::array<double, 3>> normals(surface.points.size());
-      for (std::size_t i = 0; i < flat_to_3d.size(); ++i) normals[flat_to_3d[i]] = run.flat->normal[i];
-      EndoluminalOptions eo;
-      eo.size = opts.endoluminal_pixels;
-      return std::make_unique<EndoluminalRenderer>(surface, normals, eo);
-    } catch (const Error& e) {
-      run.warnings.push_back(std::string("no endoluminal views: ") + e.what());
-      return nullptr;
-    }
-  }
-
   void add_findings() {
-    auto endo = make_endoluminal();
+    auto endo = opts.endoluminal ? make_endoluminal_renderer(run, opts.endoluminal_pixels, warnings) : nullptr;
     for (const bool known : {false, true}) {
       nlohmann::json list = nlohmann::json::array();
       for (const ReportFinding& f : known ? run.known : run.candidates) {
@@ -149,14 +131,6 @@ std::string replace_once(std::string text, const std::string& marker, const std:
   return text.replace(at, marker.size(), with);
 }
 
-std::string page_html(const nlohmann::json& data) {
-  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
-  std::string html = replace_once(report_resources::kHtml, "/*@CSS@*/", report_resources::kCss);
-  html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
-  return replace_once(html, "/*@JS@*/", report_resources::kJs);
-}
-
 std::vector<MarkupPoint> markup_points(const nlohmann::json& list) {
   std::vector<MarkupPoint> points;
   for (const auto& f : list) {
@@ -186,11 +160,33 @@ void maybe_inject_fault() {
 
 }  // namespace
 
-ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputTransaction& tx, std::ostream* log) {
+std::string report_page_html(const std::string& title, const std::string& body_html, const nlohmann::json& data,
+                             const std::string& page_css, const std::string& page_js) {
+  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3)) json.insert(at + 1, "\\");
+  std::string html = replace_once(report_resources::kPageHtml, "/*@TITLE@*/", title);
+  html = replace_once(html, "/*@BODY@*/", body_html);
+  html = replace_once(html, "/*@CSS@*/", std::string(report_resources::kCss) + page_css);
+  html = replace_once(html, "/*@DATA@*/", "window.REPORT = " + json + ";");
+  return replace_once(html, "/*@JS@*/", std::string(report_resources::kCardsJs) + "\n" + page_js);
+}
+
+nlohmann::json report_page_data(const fs::path& html) {
+  std::ifstream in(html);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string marker = "window.REPORT = ";
+  const auto at = text.find(marker);
+  const auto end = text.find(";</script>", at);
+  if (at == std::string::npos || end == std::string::npos) return nullptr;
+  return nlohmann::json::parse(text.substr(at + marker.size(), end - at - marker.size()), nullptr, false);
+}
+
+ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
+                                 std::ostream* log) {
   Stopwatch clock;
   ProgressScope scope(log, "report");
   const fs::path dir = run.dir;
-  Builder b(opts, log, std::move(run));
+  Builder b(opts, log, run);
   b.files_dir = tx.stage(dir / "report_files");
   fs::create_directories(b.files_dir);
   b.data["title"] = "ColonFlat review report";
@@ -207,7 +203,8 @@ ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputT
   maybe_inject_fault();
   b.add_files();
   b.data["summary"] = summary_json(b.run);
-  std::ofstream(tx.stage(dir / "report.html")) << page_html(b.data);
+  b.data["summary"]["warnings"] = b.warnings;
+  std::ofstream(tx.stage(dir / "report.html")) << report_page_html("ColonFlat review report", report_resources::kHtml, b.data, "", report_resources::kJs);
   std::ofstream(tx.stage(dir / "polyps.mrk.json"))
       << slicer_point_list("ColonFlat candidates", markup_points(b.data["candidates"]), {1.0, 0.85, 0.0}).dump(2) << "\n";
   if (!b.run.known.empty())
@@ -215,7 +212,7 @@ ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputT
         << slicer_point_list("Known polyps", markup_points(b.data["known"]), {0.25, 0.9, 0.4}).dump(2) << "\n";
   phase_done("page and Slicer files");
   for (const auto& p : scope.phases()) b.result.phases.emplace_back(p["phase"].get<std::string>(), p["time_s"].get<double>());
-  b.result.warnings = b.run.warnings;
+  b.result.warnings = b.warnings;
   b.result.seconds = clock.seconds();
   return b.result;
 }
@@ -226,7 +223,7 @@ ReportResult write_review_report(const fs::path& run_dir, const ReportOptions& o
   RunData run = load_run(run_dir, {opts.ct, opts.truth});
   phase_done("read the run folder");
   OutputTransaction tx;
-  ReportResult r = build_review_report(std::move(run), opts, tx, log);
+  ReportResult r = build_review_report(run, opts, tx, log);
   tx.commit();
   r.phases.insert(r.phases.begin(), {"read the run folder", scope.phases()[0]["time_s"].get<double>()});
   r.seconds = clock.seconds();

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "colonflat/core/error.h"
 
 #include "colonflat/report/ct_views.h"
 
@@ -147,6 +150,43 @@ int write_finding_images(const RunData& run, const ReportFinding& f, const Repor
     ++written;
   }
   return written;
+}
+
+ImagePtr colon_image_of(const RunData& run) {
+  if (run.colon_image) return run.colon_image;
+  if (!run_has_file(run, "colon.png")) return nullptr;
+  return read_png(run.dir / "colon.png");
+}
+
+std::optional<ColonImageLayout> colon_image_layout(const RunData& run, vtkImageData* colon, std::string* problem) {
+  if (!run.flat || !colon) return std::nullopt;
+  int dims[3];
+  colon->GetDimensions(dims);
+  std::optional<ColonImageLayout> layout;
+  layout.emplace(*run.flat, colon_image_pixel_size(run), std::numeric_limits<int>::max());
+  const nlohmann::json cands = run.candidates_doc.value("candidates", nlohmann::json::array());
+  layout->set_rolls_from_candidates(cands);
+  const std::string differs = layout->check(dims[0], dims[1], cands);
+  if (differs.empty()) return layout;
+  if (problem) *problem = differs;
+  return std::nullopt;
+}
+
+std::unique_ptr<EndoluminalRenderer> make_endoluminal_renderer(const RunData& run, int pixels,
+                                                               std::vector<std::string>& warnings) {
+  if (!run.flat) return nullptr;
+  try {
+    std::vector<int> flat_to_3d;
+    const TriangleList surface = flat_to_surface(*run.flat, &flat_to_3d);
+    std::vector<std::array<double, 3>> normals(surface.points.size());
+    for (std::size_t i = 0; i < flat_to_3d.size(); ++i) normals[flat_to_3d[i]] = run.flat->normal[i];
+    EndoluminalOptions eo;
+    eo.size = pixels;
+    return std::make_unique<EndoluminalRenderer>(surface, normals, eo);
+  } catch (const Error& e) {
+    warnings.push_back(std::string("no endoluminal views: ") + e.what());
+    return nullptr;
+  }
 }
 
 nlohmann::json summary_json(const RunData& run) {

@@ -2,6 +2,7 @@
 
 #include <iomanip>
 #include <iostream>
+#include <memory>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
@@ -84,11 +85,15 @@ class ReportTool : public Tool, public RunFinisher {
     // The meshes are written; free them before the report's views allocate.
     for (const char* done : {"surface", "denoised", "loops"}) run.artifacts->erase(done);
     phase_done("meshes released");
-    RunData data = run_from_artifacts(*run.artifacts, run.dir, *run.report, run.input);
+    auto data = std::make_shared<RunData>(run_from_artifacts(*run.artifacts, run.dir, *run.report, run.input));
     for (const auto& target : tx.targets())
-      if (target.parent_path() == run.dir) data.staged_files.push_back(target.filename().string());
+      if (target.parent_path() == run.dir) data->staged_files.push_back(target.filename().string());
     phase_done("run data from memory");
-    const ReportResult r = build_review_report(std::move(data), ReportOptions{}, tx, run.log);
+    const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log);
+    // Left for what follows on the same memory (`colonflat run --prone`: the supine-prone review);
+    // the lumen mask is not needed any more when the views show the CT.
+    if (!data->volume_is_mask) run.artifacts->erase("mask");
+    run.artifacts->put(kRunDataArtifact, std::shared_ptr<const RunData>(data));
     for (const auto& w : r.warnings)
       if (run.log) *run.log << "colonflat report: warning: " << w << "\n";
     nlohmann::json phases = scope.phases();

@@ -32,15 +32,18 @@ std::array<double, 3> lps_of(const nlohmann::json& c, const std::string& name) {
   throw InputError(name, "a candidate has no position_lps_mm [L, P, S]");
 }
 
-// flat.vtp with the optional contract-1 extras (centreline_mm, FlatSegments as written).
-void load_flat(RunData& run, const fs::path& path) {
-  VtkMessageCapture msgs;
+// flat.vtp (read here unless `pd` holds it already) with the optional contract-1 extras
+// (centreline_mm, FlatSegments as written).
+void load_flat(RunData& run, const fs::path& path, vtkPolyData* pd) {
   vtkNew<vtkXMLPolyDataReader> reader;
-  reader->SetFileName(path.c_str());
-  reader->Update();
-  if (!msgs.first_problem().empty() || reader->GetErrorCode() != 0)
-    throw InputError(path.string(), "cannot read VTK XML PolyData: " + msgs.first_problem());
-  vtkPolyData* pd = reader->GetOutput();
+  if (!pd) {
+    VtkMessageCapture msgs;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    if (!msgs.first_problem().empty() || reader->GetErrorCode() != 0)
+      throw InputError(path.string(), "cannot read VTK XML PolyData: " + msgs.first_problem());
+    pd = reader->GetOutput();
+  }
   run.flat = polydata_to_flat(pd, path.string());
   if (vtkDataArray* cl = pd->GetPointData()->GetArray("centreline_mm")) {
     run.centreline_mm.resize(cl->GetNumberOfTuples());
@@ -175,7 +178,7 @@ RunData load_run(const fs::path& dir, const RunLoadOptions& opts) {
   run.run_report = read_json_file(dir / "run_report.json");
   if (!run.run_report.is_object()) throw InputError((dir / "run_report.json").string(), "not a JSON object");
   load_candidates(run);
-  if (fs::exists(dir / "flat.vtp")) load_flat(run, dir / "flat.vtp");
+  if (opts.flat || fs::exists(dir / "flat.vtp")) load_flat(run, dir / "flat.vtp", opts.flat);
   run.ct_path = find_ct(run, opts);
   if (!run.ct_path.empty()) {
     run.volume_is_mask = opts.ct.empty() && run_started_from_mask(run.run_report) &&

@@ -15,10 +15,18 @@
 class vtkPolyData;
 
 namespace cf {
+class OutputTransaction;
+}
+
+namespace cf {
 
 // The source scan's flat map with point data "<other>_vertex" (int, -1 = none),
 // "<other>_flat_mm" (x, y, 0), "<other>_position_lps_mm", "register_s_mm", "register_angle_rad".
 vtkSmartPointer<vtkPolyData> correspondence_polydata(const ColonRegistration& reg, Direction d);
+
+// Stages the four files for `dir` in `tx` (the caller commits; `dir` must exist or be staged).
+void stage_registration(const ColonRegistration& reg, const std::filesystem::path& dir, const SideBySideOptions& image,
+                        const nlohmann::json& params, OutputTransaction& tx);
 
 // Writes the four files into `dir` (created if missing); all appear together or none.
 // `params` is recorded in registration.json.

@@ -23,6 +23,7 @@ struct RegisterParams {
   double match_around_deg = RegisterOptions{}.match_around_deg;
   double match_size_ratio = RegisterOptions{}.match_size_ratio;
   double pixel_mm = SideBySideOptions{}.pixel_mm;
+  bool review = true;  // the supine-prone review page OUT/report.html (+ report_files/)
 };
 
 const ParamTable<RegisterParams>& register_param_table();

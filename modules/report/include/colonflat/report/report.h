@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace cf {
 
 struct RunData;
@@ -50,7 +52,16 @@ ReportResult write_review_report(const std::filesystem::path& run_dir, const Rep
 // The report of a loaded run (load_run() from files, or run_from_artifacts() from the memory of
 // `colonflat run`): report.html, polyps.mrk.json, known_polyps.mrk.json (with truth) and the
 // folder report_files/ in run.dir, staged through `tx`; nothing appears until the caller commits.
-ReportResult build_review_report(RunData run, const ReportOptions& opts, OutputTransaction& tx,
+ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
                                  std::ostream* log = nullptr);
+
+// A report page: the shared skeleton (resources/page.html: head, footer, scripts) titled `title`
+// around `body_html`, with the report's style sheet followed by `page_css`, `window.REPORT = data`,
+// and the shared card script (colonflatCards, resources/cards.js) followed by `page_js`. The run
+// report and register's supine-prone review are both built with it.
+std::string report_page_html(const std::string& title, const std::string& body_html, const nlohmann::json& data,
+                             const std::string& page_css, const std::string& page_js);
+// The data embedded in such a page (window.REPORT); null when the file holds none.
+nlohmann::json report_page_data(const std::filesystem::path& html);
 
 }  // namespace cf

@@ -3,6 +3,8 @@
 // to. Used by write_review_report(); separate for tests.
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <vector>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -33,6 +35,19 @@ nlohmann::json finding_json(const RunData& run, const ReportFinding& f, const Co
 int write_finding_images(const RunData& run, const ReportFinding& f, const ReportOptions& opts,
                          const std::filesystem::path& files_dir, vtkImageData* colon_image,
                          EndoluminalRenderer* endo, nlohmann::json& fj);
+
+// The run's colon.png: from memory, else read from the run folder; null when there is none.
+ImagePtr colon_image_of(const RunData& run);
+
+// Where the flat map lies in `colon` (the run's colon.png), checked against the image size and the
+// candidates' pixels; nullopt (and `problem` says why) when it does not match or a piece is missing.
+// The layout refers to run.flat: the run must outlive it.
+std::optional<ColonImageLayout> colon_image_layout(const RunData& run, vtkImageData* colon, std::string* problem);
+
+// The endoluminal renderer of the run's wall (`pixels` square views); null, with a warning added,
+// when the run has no flat map or no display can be had.
+std::unique_ptr<EndoluminalRenderer> make_endoluminal_renderer(const RunData& run, int pixels,
+                                                               std::vector<std::string>& warnings);
 
 // Run summary for the page: stages (time, memory, result), totals, snapshots, warnings.
 nlohmann::json summary_json(const RunData& run);

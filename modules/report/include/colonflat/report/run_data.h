@@ -16,6 +16,8 @@
 #include "colonflat/render/artifacts.h"
 #include "colonflat/volume/volume_io.h"
 
+class vtkPolyData;
+
 namespace cf {
 
 // A polyp candidate of the run or a known (truth) polyp, with where it sits on the flat map.
@@ -34,6 +36,7 @@ struct ReportFinding {
 struct RunLoadOptions {
   std::filesystem::path ct;     // CT volume; empty: ct.nrrd in the run folder, else the run's input
   std::filesystem::path truth;  // known polyps JSON; empty: polyps.json beside a phantom CT
+  vtkPolyData* flat = nullptr;  // the run's flat.vtp when already read (not read again), else null
 };
 
 struct RunData {
@@ -54,6 +57,10 @@ struct RunData {
   std::vector<std::string> warnings;           // what is missing or inconsistent, for the page
   std::vector<std::string> staged_files;       // run-folder files of the same (uncommitted) transaction
 };
+
+// The bag name under which the report finisher of `colonflat run` leaves the run's RunData
+// (std::shared_ptr<const RunData>) for a later step on the same memory (the supine-prone review).
+inline constexpr const char* kRunDataArtifact = "report_run";
 
 // Whether the run folder has (or, once committed, will have) the file `name`.
 bool run_has_file(const RunData& run, const std::string& name);
