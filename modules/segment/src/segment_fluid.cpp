@@ -14,7 +14,7 @@ constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExclud
 
 void ColonSegmenter::find_fluid_bodies() {
   {
-    const std::vector<float> sm = box_mean3(hu_, d_);  // noise spikes in soft tissue are not fluid
+    const Buffer<float> sm = box_mean3(hu_, d_);  // noise spikes in soft tissue are not fluid
     for (std::size_t q = 0; q < d_.total; ++q)
       if (!lab_[q] && sm[q] >= opts_.fluid_threshold && sm[q] <= opts_.fluid_max) lab_[q] = kCandidate;
   }
@@ -29,7 +29,7 @@ void ColonSegmenter::find_fluid_bodies() {
 // Scans every line along `axis` for gas and fluid at most interface-width apart. contact: 1 where
 // a fluid voxel has gas on its lower-index side, 2 on its higher-index side (candidates). With
 // `layer`, the voxels between gas and kept pools become layer.
-void ColonSegmenter::scan_contacts(int axis, std::vector<unsigned char>* contact, bool layer) {
+void ColonSegmenter::scan_contacts(int axis, Bytes* contact, bool layer) {
   const int wvox = int(std::ceil(opts_.interface_width / d_.sp[axis]));
   const std::size_t stride = d_.stride[axis], len = d_.n[axis];
   const unsigned char fluid = layer ? kPool : kCandidate;
@@ -60,7 +60,7 @@ void ColonSegmenter::scan_contacts(int axis, std::vector<unsigned char>* contact
 // Per fluid body and side (0: gas at lower index, 1: at higher index) along `axis`: the number of
 // contact columns when they lie at one height (spread <= level-tolerance), else 0.
 std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis) {
-  std::vector<unsigned char> contact(d_.total, 0);
+  Bytes contact(d_.total, 0);
   scan_contacts(axis, &contact, false);
   std::vector<std::vector<float>> heights[2];
   heights[0].resize(fluid_count_ + 1);

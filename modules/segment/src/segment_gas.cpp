@@ -88,6 +88,8 @@ void ColonSegmenter::crop_to_gas(const unsigned char* gas) {
     cn[a] = bhi_[a] - blo_[a] + 1;
   }
   d_ = make_dims(cn, full_.sp);
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
+    std::fprintf(stderr, "crop %zu x %zu x %zu of %zu x %zu x %zu\n", cn[0], cn[1], cn[2], full_.n[0], full_.n[1], full_.n[2]);
   lab_.assign(d_.total, 0);
   hu_.resize(d_.total);
   const float* fhu = ct_->GetBufferPointer();

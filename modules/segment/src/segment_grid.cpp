@@ -4,11 +4,36 @@
 
 #include <algorithm>
 #include <cstring>
+#include <new>
 #include <thread>
+
+#include <sys/mman.h>
 
 #include "segment_internal.h"
 
 namespace cf::segment_detail {
+
+namespace {
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+constexpr std::size_t kHugeMin = std::size_t(4) << 20;  // smaller blocks: the ordinary heap
+}  // namespace
+
+void* huge_page_alloc(std::size_t bytes) {
+  if (bytes < kHugeMin) return ::operator new(bytes);
+  const std::size_t size = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+  ::madvise(p, size, MADV_HUGEPAGE);  // advice only: without transparent huge pages, 4 KiB pages
+#endif
+  return p;
+}
+
+void huge_page_free(void* p, std::size_t bytes) {
+  if (!p) return;
+  if (bytes < kHugeMin) return ::operator delete(p);
+  ::munmap(p, (bytes + kHugePage - 1) / kHugePage * kHugePage);
+}
 
 Dims make_dims(const std::size_t n[3], const double sp[3]) {
   Dims d;
@@ -52,8 +77,8 @@ MaskImage::Pointer mask_of_size(const std::size_t n[3]) {
   return m;
 }
 
-void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
-  std::vector<unsigned char> tmp(v.size());
+void dilate_box(Bytes& v, const Dims& d, const int r[3]) {
+  Bytes tmp(v.size());
   const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
   for (int ax = 0; ax < 3; ++ax) {
     if (r[ax] <= 0) continue;
@@ -89,14 +114,14 @@ void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
   }
 }
 
-void erode_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
+void erode_box(Bytes& v, const Dims& d, const int r[3]) {
   for (auto& x : v) x = !x;
   dilate_box(v, d, r);
   for (auto& x : v) x = !x;
 }
 
-std::vector<float> box_mean3(const std::vector<float>& in, const Dims& d) {
-  std::vector<float> sm(in), tmp(d.total);
+Buffer<float> box_mean3(const Buffer<float>& in, const Dims& d) {
+  Buffer<float> sm(in), tmp(d.total);
   const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
   for (int ax = 0; ax < 3; ++ax) {
     parallel_for(nz, [&](std::size_t k0, std::size_t k1) {

@@ -24,7 +24,7 @@ void ColonSegmenter::class_means() {
   }
   st_.air_hu = an ? as / double(an) : -1000.0;
   st_.fluid_hu = fn ? fs / double(fn) : 0.0;
-  std::vector<unsigned char> shell = lumen0_;
+  Bytes shell = lumen0_;
   const int r2[3] = {int(std::ceil(2.5 / d_.sp[0])), int(std::ceil(2.5 / d_.sp[1])), int(std::ceil(2.5 / d_.sp[2]))};
   dilate_box(shell, d_, r2);
   double ts = 0;
@@ -48,13 +48,13 @@ void ColonSegmenter::refine_boundary() {
                      std::max(1, int(std::round(opts_.band_width / d_.sp[1]))),
                      std::max(1, int(std::round(opts_.band_width / d_.sp[2])))};
   {
-    std::vector<unsigned char> outer = lumen0_, inner = lumen0_;
+    Bytes outer = lumen0_, inner = lumen0_;
     dilate_box(outer, d_, rb);
     erode_box(inner, d_, rb);
     for (std::size_t q = 0; q < d_.total; ++q)
       state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0));
   }
-  std::vector<unsigned char> near_fluid(d_.total);
+  Bytes near_fluid(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) near_fluid[q] = lab_[q] == 2;
   const int rf[3] = {rb[0] + 1, rb[1] + 1, rb[2] + 1};
   dilate_box(near_fluid, d_, rf);
@@ -106,7 +106,7 @@ void ColonSegmenter::final_segments() {
   st_.segment_volumes_ml = vols;
   st_.lumen_volume_ml = std::accumulate(vols.begin(), vols.end(), 0.0);
   st_.fluid_volume_ml = double(fluid) * voxel_ml_;
-  std::vector<unsigned char>().swap(lumen0_);
+  Bytes().swap(lumen0_);
 }
 
 MaskImage::Pointer ColonSegmenter::paste() const {
