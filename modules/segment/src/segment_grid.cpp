@@ -1,6 +1,9 @@
 // Voxel-grid helpers of the segmentation: dims, threads, connected components, box dilation and
 // erosion, the 3 x 3 x 3 mean, line enumeration.
+#include <itkBinaryImageToLabelMapFilter.h>
 #include <itkConnectedComponentImageFilter.h>
+#include <itkLabelMap.h>
+#include <itkLabelObject.h>
 
 #include <algorithm>
 #include <cstring>
@@ -66,6 +69,45 @@ LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count) {
   count = cc->GetObjectCount();
   LabelImage::Pointer out = cc->GetOutput();
   out->DisconnectPipeline();
+  return out;
+}
+
+RunLabels component_runs(const unsigned char* mask, const Dims& d) {
+  auto image = MaskImage::New();  // wraps `mask` without copying it
+  image->SetRegions(MaskImage::SizeType{{d.n[0], d.n[1], d.n[2]}});
+  auto container = MaskImage::PixelContainer::New();
+  container->SetImportPointer(const_cast<unsigned char*>(mask), d.total, false);
+  image->SetPixelContainer(container);
+  using Map = itk::LabelMap<itk::LabelObject<std::uint32_t, 3>>;
+  auto filter = itk::BinaryImageToLabelMapFilter<MaskImage, Map>::New();
+  filter->SetInput(image);
+  filter->SetFullyConnected(false);
+  filter->SetInputForegroundValue(1);
+  filter->SetOutputBackgroundValue(0);
+  filter->SetNumberOfWorkUnits(2);
+  filter->Update();
+  const Map* map = filter->GetOutput();
+  RunLabels out;
+  const std::uint32_t n = std::uint32_t(map->GetNumberOfLabelObjects());
+  out.first.reserve(n + 1);
+  for (std::uint32_t l = 1; l <= n; ++l) {
+    const auto* object = map->GetLabelObject(l);
+    for (std::size_t i = 0, lines = object->GetNumberOfLines(); i < lines; ++i) {
+      const auto& line = object->GetLine(i);
+      const auto& at = line.GetIndex();
+      out.runs.push_back({d.idx(std::size_t(at[0]), std::size_t(at[1]), std::size_t(at[2])), std::size_t(line.GetLength())});
+    }
+    out.first.push_back(out.runs.size());
+  }
+  return out;
+}
+
+std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<unsigned char>& keep) const {
+  std::vector<std::pair<Run, std::uint32_t>> out;
+  for (std::uint32_t l = 1; l <= count(); ++l)
+    if (keep[l])
+      for (const Run* r = begin(l); r != end(l); ++r) out.emplace_back(*r, l);
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first.start < b.first.start; });
   return out;
 }
 

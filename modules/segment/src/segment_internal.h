@@ -66,6 +66,25 @@ double process_cpu_seconds();
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
 // Face-connected components of a 0/1 image; labels 1..count (0 background).
 LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count);
+// A run of voxels along axis 0: linear index of its first voxel and its length.
+struct Run {
+  std::size_t start;
+  std::size_t length;
+};
+// Face-connected components of a 0/1 voxel array as runs along axis 0, without a dense label
+// image: runs of label l (1..count()) are runs[first[l - 1] .. first[l]), in raster order. Labels
+// are numbered as itk::ConnectedComponentImageFilter numbers them (the same scanline union-find of
+// itk::BinaryImageToLabelMapFilter, 2 work units).
+struct RunLabels {
+  std::vector<std::size_t> first{0};
+  std::vector<Run> runs;
+  std::uint32_t count() const { return std::uint32_t(first.size() - 1); }
+  const Run* begin(std::uint32_t l) const { return runs.data() + first[l - 1]; }
+  const Run* end(std::uint32_t l) const { return runs.data() + first[l]; }
+  // All runs of the labels with keep[l] != 0 as (run, label), in raster order (ascending start).
+  std::vector<std::pair<Run, std::uint32_t>> raster(const std::vector<unsigned char>& keep) const;
+};
+RunLabels component_runs(const unsigned char* mask, const Dims& d);
 MaskImage::Pointer mask_of_size(const std::size_t n[3]);
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
@@ -118,7 +137,9 @@ class ColonSegmenter {
   void gravity_from_metadata();
   void find_gas_bodies();
   // Rectal tube (segment_tube.cpp).
-  void trim_rectal_tube(const std::uint32_t* labels, const std::vector<unsigned char>& drop, unsigned char* gas);
+  std::vector<unsigned char> outside_gas(const RunLabels& gas_labels);
+  std::vector<unsigned char> inferior_face_dropped(const RunLabels& gas_labels, const std::vector<unsigned char>& drop) const;
+  void trim_rectal_tube(const std::vector<unsigned char>& face_dropped, unsigned char* gas);
   std::size_t track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]);
   std::size_t slice_index(std::size_t s, long a, long b) const;
   std::vector<std::pair<long, long>> slice_component(std::size_t s, const std::vector<std::pair<long, long>>& seeds,
