@@ -162,7 +162,8 @@ class ColonSegmenter {
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
   void check_colon_found(const std::vector<double>& vols) const;
-  std::vector<BodyStats> body_stats(const std::uint32_t* labels, std::uint32_t n, const std::function<bool(std::size_t)>& gas) const;
+  std::vector<BodyStats> body_stats(const RunLabels& labels, const std::function<bool(std::size_t)>& gas) const;
+  void mark_grid(const std::vector<std::pair<Run, std::uint32_t>>& runs, bool segment);
   void link_tagged_stretches();
   std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
   bool continues_colon(const Contact& c, std::string& why) const;
