@@ -13,16 +13,22 @@ constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExclud
 }
 
 void ColonSegmenter::find_fluid_bodies() {
+  RunLabels fl;
   {
-    const Buffer<float> sm = box_mean3(hu_, d_);  // noise spikes in soft tissue are not fluid
-    for (std::size_t q = 0; q < d_.total; ++q)
-      if (!lab_[q] && sm[q] >= opts_.fluid_threshold && sm[q] <= opts_.fluid_max) lab_[q] = kCandidate;
+    Bytes bright(d_.total);
+    const std::size_t plane = d_.n[0] * d_.n[1];
+    box_mean3_slices(hu_.data(), d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
+      for (std::size_t t = 0, q = k * plane; t < plane; ++t, ++q) {
+        bright[q] = !lab_[q] && mean[t] >= opts_.fluid_threshold && mean[t] <= opts_.fluid_max;
+        if (bright[q]) lab_[q] = kCandidate;
+      }
+    });
+    fl = component_runs(bright.data(), d_);
   }
-  MaskImage::Pointer work = mask_of_size(d_.n);
-  unsigned char* w = work->GetBufferPointer();
-  for (std::size_t q = 0; q < d_.total; ++q) w[q] = lab_[q] == kCandidate;
-  LabelImage::Pointer fl = components(work, fluid_count_);
-  fluid_label_.assign(fl->GetBufferPointer(), fl->GetBufferPointer() + d_.total);
+  fluid_count_ = fl.count();
+  fluid_label_.assign(d_.total, 0);
+  for (std::uint32_t l = 1; l <= fluid_count_; ++l)
+    for (const Run* r = fl.begin(l); r != fl.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, l);
   pool_.assign(fluid_count_ + 1, 0);
 }
 

@@ -1,5 +1,5 @@
 // Voxel-grid helpers of the segmentation: dims, threads, connected components, box dilation and
-// erosion, the 3 x 3 x 3 mean, line enumeration.
+// erosion, the 3 x 3 x 3 mean (slice by slice), line enumeration.
 #include <itkBinaryImageToLabelMapFilter.h>
 #include <itkConnectedComponentImageFilter.h>
 #include <itkLabelMap.h>
@@ -162,30 +162,41 @@ void erode_box(Bytes& v, const Dims& d, const int r[3]) {
   for (auto& x : v) x = !x;
 }
 
-Buffer<float> box_mean3(const Buffer<float>& in, const Dims& d) {
-  Buffer<float> sm(in), tmp(d.total);
-  const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
-  for (int ax = 0; ax < 3; ++ax) {
-    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
-      for (std::size_t k = k0; k < k1; ++k)
-        for (std::size_t j = 0; j < ny; ++j) {
-          float* out = tmp.data() + (k * ny + j) * nx;
-          const float* mid = sm.data() + (k * ny + j) * nx;
-          if (ax == 0) {
-            for (std::size_t i = 0; i < nx; ++i)
-              out[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
-            continue;
-          }
-          const std::size_t rs = ax == 1 ? nx : nx * ny;  // row stride along the axis
-          const std::size_t c = ax == 1 ? j : k, n = ax == 1 ? ny : nz;
-          const float* lo = c > 0 ? mid - rs : mid;
-          const float* hi = c + 1 < n ? mid + rs : mid;
-          for (std::size_t i = 0; i < nx; ++i) out[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
-        }
-    });
-    sm.swap(tmp);
+namespace {
+// The x-then-y 3 x 3 box mean of slice k (edges clamped) into `out`; `tmp` holds the x pass.
+void mean_xy(const float* in, const Dims& d, std::size_t k, float* tmp, float* out) {
+  const std::size_t nx = d.n[0], ny = d.n[1];
+  const float* plane = in + k * nx * ny;
+  for (std::size_t j = 0; j < ny; ++j) {
+    const float* mid = plane + j * nx;
+    float* row = tmp + j * nx;
+    for (std::size_t i = 0; i < nx; ++i) row[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
   }
-  return sm;
+  for (std::size_t j = 0; j < ny; ++j) {
+    const float* mid = tmp + j * nx;
+    const float* lo = j > 0 ? mid - nx : mid;
+    const float* hi = j + 1 < ny ? mid + nx : mid;
+    float* row = out + j * nx;
+    for (std::size_t i = 0; i < nx; ++i) row[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
+  }
+}
+}  // namespace
+
+void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+  const std::size_t plane = d.n[0] * d.n[1], nz = d.n[2];
+  parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+    if (k0 >= k1) return;
+    std::vector<float> tmp(plane), mean(plane), lo(plane), mid(plane), hi(plane);
+    mean_xy(in, d, k0 > 0 ? k0 - 1 : 0, tmp.data(), lo.data());
+    mean_xy(in, d, k0, tmp.data(), mid.data());
+    for (std::size_t k = k0; k < k1; ++k) {
+      mean_xy(in, d, std::min(k + 1, nz - 1), tmp.data(), hi.data());
+      for (std::size_t q = 0; q < plane; ++q) mean[q] = (lo[q] + mid[q] + hi[q]) * (1.0f / 3.0f);
+      slice(k, mean.data());
+      lo.swap(mid);
+      mid.swap(hi);
+    }
+  });
 }
 
 std::size_t line_base(const Dims& d, int ax, std::size_t l) {

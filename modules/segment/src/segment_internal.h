@@ -89,8 +89,10 @@ MaskImage::Pointer mask_of_size(const std::size_t n[3]);
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
-// 3 x 3 x 3 box mean (edges clamped).
-Buffer<float> box_mean3(const Buffer<float>& in, const Dims& d);
+// 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
+// slice(k, mean of slice k) for every k, from two workers (each slice once, slices of one worker
+// in order); only a few slices are held in memory.
+void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
 // Base index of line `l` along axis `ax` (lines enumerate the other two axes).
 std::size_t line_base(const Dims& d, int ax, std::size_t l);
 
