@@ -6,6 +6,7 @@
 #include <itkLabelObject.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <new>
 #include <thread>
@@ -119,39 +120,71 @@ MaskImage::Pointer mask_of_size(const std::size_t n[3]) {
   return m;
 }
 
+namespace {
+// Dilation of v along axis 0 (contiguous rows) into out, rows [row0, row1).
+void dilate_rows(const unsigned char* v, unsigned char* out, std::size_t nx, std::size_t row0, std::size_t row1, long radius) {
+  for (std::size_t row = row0; row < row1; ++row) {
+    const unsigned char* in = v + row * nx;
+    unsigned char* o = out + row * nx;
+    long last = -1000000;
+    for (long i = 0; i < long(nx); ++i) {
+      if (in[i]) last = i;
+      o[i] = (i - last <= radius) ? 1 : 0;
+    }
+    last = 1000000;
+    for (long i = long(nx) - 1; i >= 0; --i) {
+      if (in[i]) last = i;
+      if (last - i <= radius) o[i] = 1;
+    }
+  }
+}
+
+// Dilation along a line of `count` rows `step` bytes apart (rows of nx bytes) starting at `base`:
+// per x, the nearest set row before and after each row (two sweeps, O(1) per voxel).
+void dilate_across(const unsigned char* v, unsigned char* out, std::size_t nx, std::size_t base, std::size_t step,
+                   std::size_t count, long radius, std::vector<std::int32_t>& near) {
+  near.assign(nx, -1000000);
+  for (std::size_t t = 0; t < count; ++t) {
+    const unsigned char* in = v + base + t * step;
+    unsigned char* o = out + base + t * step;
+    const std::int32_t pos = std::int32_t(t);
+    for (std::size_t i = 0; i < nx; ++i) {
+      near[i] = in[i] ? pos : near[i];
+      o[i] = pos - near[i] <= radius;
+    }
+  }
+  near.assign(nx, 1000000);
+  for (std::size_t t = count; t-- > 0;) {
+    const unsigned char* in = v + base + t * step;
+    unsigned char* o = out + base + t * step;
+    const std::int32_t pos = std::int32_t(t);
+    for (std::size_t i = 0; i < nx; ++i) {
+      near[i] = in[i] ? pos : near[i];
+      o[i] |= near[i] - pos <= radius;
+    }
+  }
+}
+}  // namespace
+
 void dilate_box(Bytes& v, const Dims& d, const int r[3]) {
   Bytes tmp(v.size());
   const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
   for (int ax = 0; ax < 3; ++ax) {
     if (r[ax] <= 0) continue;
-    const long R = r[ax];
-    // Rows (x lines) are contiguous: along y and z whole rows are OR-ed (cache friendly).
-    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
-      for (std::size_t k = k0; k < k1; ++k)
-        for (std::size_t j = 0; j < ny; ++j) {
-          unsigned char* out = tmp.data() + (k * ny + j) * nx;
-          if (ax == 0) {
-            const unsigned char* in = v.data() + (k * ny + j) * nx;
-            long last = -1000000;
-            for (long i = 0; i < long(nx); ++i) {
-              if (in[i]) last = i;
-              out[i] = (i - last <= R) ? 1 : 0;
-            }
-            last = 1000000;
-            for (long i = long(nx) - 1; i >= 0; --i) {
-              if (in[i]) last = i;
-              if (last - i <= R) out[i] = 1;
-            }
-            continue;
-          }
-          std::memset(out, 0, nx);
-          const long c = ax == 1 ? long(j) : long(k), n = ax == 1 ? long(ny) : long(nz);
-          for (long o = std::max(0L, c - R); o <= std::min(n - 1, c + R); ++o) {
-            const unsigned char* in = v.data() + (ax == 1 ? (k * ny + std::size_t(o)) : (std::size_t(o) * ny + j)) * nx;
-            for (std::size_t i = 0; i < nx; ++i) out[i] |= in[i];
-          }
-        }
-    });
+    const long radius = r[ax];
+    if (ax == 0) {
+      parallel_for(ny * nz, [&](std::size_t r0, std::size_t r1) { dilate_rows(v.data(), tmp.data(), nx, r0, r1, radius); });
+    } else if (ax == 1) {  // lines along y: one per slice
+      parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+        std::vector<std::int32_t> near;
+        for (std::size_t k = k0; k < k1; ++k) dilate_across(v.data(), tmp.data(), nx, k * nx * ny, nx, ny, radius, near);
+      });
+    } else {  // lines along z: one per row index j
+      parallel_for(ny, [&](std::size_t j0, std::size_t j1) {
+        std::vector<std::int32_t> near;
+        for (std::size_t j = j0; j < j1; ++j) dilate_across(v.data(), tmp.data(), nx, j * nx, nx * ny, nz, radius, near);
+      });
+    }
     v.swap(tmp);
   }
 }
