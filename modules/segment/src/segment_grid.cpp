@@ -1,7 +1,6 @@
 // Voxel-grid helpers of the segmentation: dims, threads, connected components, box dilation and
 // erosion, the 3 x 3 x 3 mean (slice by slice), line enumeration.
 #include <itkBinaryImageToLabelMapFilter.h>
-#include <itkConnectedComponentImageFilter.h>
 #include <itkLabelMap.h>
 #include <itkLabelObject.h>
 
@@ -60,19 +59,6 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size
   for (auto& t : ts) t.join();
 }
 
-LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count) {
-  using CC = itk::ConnectedComponentImageFilter<MaskImage, LabelImage>;
-  auto cc = CC::New();
-  cc->SetInput(m);
-  cc->SetFullyConnected(false);
-  cc->SetNumberOfWorkUnits(2);
-  cc->Update();
-  count = cc->GetObjectCount();
-  LabelImage::Pointer out = cc->GetOutput();
-  out->DisconnectPipeline();
-  return out;
-}
-
 RunLabels component_runs(const unsigned char* mask, const Dims& d) {
   auto image = MaskImage::New();  // wraps `mask` without copying it
   image->SetRegions(MaskImage::SizeType{{d.n[0], d.n[1], d.n[2]}});
@@ -110,14 +96,6 @@ std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<u
       for (const Run* r = begin(l); r != end(l); ++r) out.emplace_back(*r, l);
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first.start < b.first.start; });
   return out;
-}
-
-MaskImage::Pointer mask_of_size(const std::size_t n[3]) {
-  auto m = MaskImage::New();
-  MaskImage::SizeType sz{{n[0], n[1], n[2]}};
-  m->SetRegions(sz);
-  m->Allocate();
-  return m;
 }
 
 namespace {

@@ -23,7 +23,6 @@ namespace cf::segment_detail {
 class LinkGrid;
 struct Contact;
 struct LocalShape;
-using LabelImage = itk::Image<std::uint32_t, 3>;
 
 // Large voxel buffers (crop-sized and more): blocks of at least 4 MiB are mapped directly and
 // advised for transparent huge pages, so a fresh buffer costs 1/512 of the page faults (on 2 loaded
@@ -64,8 +63,6 @@ Dims make_dims(const std::size_t n[3], const double sp[3]);
 // User + system CPU seconds of this process so far (all threads; getrusage).
 double process_cpu_seconds();
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
-// Face-connected components of a 0/1 image; labels 1..count (0 background).
-LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count);
 // A run of voxels along axis 0: linear index of its first voxel and its length.
 struct Run {
   std::size_t start;
@@ -85,7 +82,6 @@ struct RunLabels {
   std::vector<std::pair<Run, std::uint32_t>> raster(const std::vector<unsigned char>& keep) const;
 };
 RunLabels component_runs(const unsigned char* mask, const Dims& d);
-MaskImage::Pointer mask_of_size(const std::size_t n[3]);
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
