@@ -9,13 +9,16 @@
 //   segment_bench --realistic --seeds 1,2 [--size medium] [--pad-to 450] issue 13: supine and prone phantoms (full size unless --size) with 2 fully
 //                                     tagged stretches, oral contrast, bladder, aorta, rectal tube (written
 //                                     and read as NRRD, PatientPosition included); --pad-to N appends copies
-//                                     of the inferior slice so the scan has N slices (timing of 512x512xN).
+//                                     of the inferior slice (pelvic floor, thighs' soft tissue, the rectal
+//                                     tube's channel) below the volume so the scan has N slices (the 512 x 512
+//                                     x 450 case of issue 13: --pad-to 450); Dice on the original slices.
 // Peak memory: the process's peak resident set is reset (/proc/self/clear_refs) before each step,
 // so "peak" is the high-water mark of that step alone (segmentation: reading ct.nrrd included).
 #include <benchmark/benchmark.h>
 #include <itkConnectedComponentImageFilter.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -127,6 +130,14 @@ Quality evaluate(const cf::MaskImage* seg, const cf::Phantom& p) {
   }
   q.interface_kept = tot ? double(kept) / double(tot) : 1.0;
   return q;
+}
+
+// 1-minute load average of the machine (other processes share the 2 cores), -1 if unknown.
+double load_average() {
+  std::ifstream f("/proc/loadavg");
+  double load = -1;
+  f >> load;
+  return load;
 }
 
 // The CT with copies of its inferior slice appended below, up to `slices` slices (timing only).
@@ -261,8 +272,8 @@ void realistic_table(const std::string& size, const std::vector<int>& seeds, int
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_r" + std::to_string(::getpid()));
   std::printf("segment_bench --realistic: %s phantoms, 2 fully tagged stretches, oral contrast, bladder, aorta, "
               "rectal tube%s\n", size.c_str(), pad_to > 0 ? (", padded to " + std::to_string(pad_to) + " slices").c_str() : "");
-  std::printf("%4s %7s %7s %7s %7s %7s %8s %7s %9s %8s %7s %7s %6s %s\n", "seed", "pos", "slices", "gen_s", "read_s", "seg_s",
-              "seg_MiB", "dice", "stretches", "sb_vox", "bl_vox", "ao_vox", "tube", "gravity");
+  std::printf("%4s %7s %7s %7s %7s %7s %7s %5s %8s %7s %9s %8s %7s %7s %6s %s\n", "seed", "pos", "slices", "gen_s", "read_s",
+              "seg_s", "seg_cpu", "load", "seg_MiB", "dice", "stretches", "sb_vox", "bl_vox", "ao_vox", "tube", "gravity");
   for (int seed : seeds)
     for (const char* position : {"supine", "prone"}) {
       fs::remove_all(tmp);
@@ -283,21 +294,30 @@ void realistic_table(const std::string& size, const std::vector<int>& seeds, int
       if (pad_to > 0) ct = pad_inferior(ct, pad_to);
       const double read_s = t.seconds();
       cf::SegmentStats st;
+      const double load = load_average();
       t.restart();
       cf::MaskImage::Pointer mask = cf::segment_colon(ct, {}, &st);
       const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
       const std::size_t slices = ct->GetLargestPossibleRegion().GetSize()[2];
       ct = nullptr;
-      if (pad_to > 0) mask = crop_to(mask, p.lumen);
+      std::size_t pad_vox = 0;  // lumen segmented in the appended slices (none expected: body tissue and the tube)
+      if (pad_to > 0) {
+        const std::size_t extra = mask->GetLargestPossibleRegion().GetNumberOfPixels() - p.lumen->GetLargestPossibleRegion().GetNumberOfPixels();
+        pad_vox = std::size_t(std::count_if(mask->GetBufferPointer(), mask->GetBufferPointer() + extra, [](unsigned char v) { return v != 0; }));
+        mask = crop_to(mask, p.lumen);
+      }
       const RealisticScore r = score_realistic(mask, p);
       const double dice = evaluate(mask, p).dice;
-      std::printf("%4d %7s %7zu %7.2f %7.2f %7.2f %8.0f %7.4f %6d/%-2d %8zu %7zu %7zu %6zu %s (%s)\n", seed, position, slices,
-                  gen_s, read_s, seg_s, seg_mib, dice, r.stretches_kept, r.stretches,
+      std::printf("%4d %7s %7zu %7.2f %7.2f %7.2f %7.2f %5.1f %8.0f %7.4f %6d/%-2d %8zu %7zu %7zu %6zu %s (%s)\n", seed, position,
+                  slices, gen_s, read_s, seg_s, st.cpu_time_s, load, seg_mib, dice, r.stretches_kept, r.stretches,
                   r.kept_by_label[3] + r.kept_by_label[4], r.kept_by_label[5], r.kept_by_label[8], r.kept_by_label[6],
                   st.gravity.c_str(), st.gravity_source.c_str());
+      if (pad_to > 0) std::printf("     %zu lumen voxels segmented in the %zu appended slices\n", pad_vox, slices - p.lumen->GetLargestPossibleRegion().GetSize()[2]);
       std::fflush(stdout);
     }
   fs::remove_all(tmp);
+  std::printf("columns: seg_s / seg_cpu = segment_colon wall-clock / user + system CPU time (getrusage, all threads); load = "
+              "1-minute load average before the segmentation; seg_MiB = peak resident memory of reading (and padding) + segmentation\n");
   std::printf("columns: stretches = fully tagged stretches with >= 95 %% of their voxels segmented / in the phantom; sb_vox, bl_vox, "
               "ao_vox, tube = segmented voxels that are small bowel (contrast or gas), bladder, aorta, rectal tube\n");
 }

@@ -13,6 +13,8 @@
 #include <numeric>
 #include <sstream>
 
+#include <sys/resource.h>
+
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/params.h"
@@ -41,7 +43,9 @@ nlohmann::json SegmentStats::to_json() const {
           {"time_s", time_s},
           {"graph_cut_time_s", graph_cut_time_s},
           {"peak_memory_mib", peak_memory_mib},
-          {"timings_s", timings}};
+          {"timings_s", timings},
+          {"cpu_time_s", cpu_time_s},
+          {"cpu_timings_s", cpu_timings}};
 }
 
 void validate(const SegmentOptions& o) {
@@ -77,7 +81,14 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
 
 namespace segment_detail {
 
+double process_cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
 MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
+  cpu_start_ = cpu_lap_ = process_cpu_seconds();
   check_input();
   gravity_from_metadata();
   lap("checks");
@@ -98,6 +109,8 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
   MaskImage::Pointer out = paste();
   lap("final_segments");
   st_.time_s = clock_.seconds();
+  st_.cpu_time_s = process_cpu_seconds() - cpu_start_;
+  st_.cpu_timings = cpu_timings_;
   st_.peak_memory_mib = peak_memory_mib();
   st_.timings = timings_;
   st_.gravity_source = gravity_source_;
@@ -115,6 +128,9 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
 void ColonSegmenter::lap(const char* name) {
   timings_[name] = step_.seconds();
   step_.restart();
+  const double cpu = process_cpu_seconds();
+  cpu_timings_[name] = cpu - cpu_lap_;
+  cpu_lap_ = cpu;
   phase_done(name);
 }
 

@@ -13,23 +13,29 @@ constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExclud
 }
 
 void ColonSegmenter::find_fluid_bodies() {
+  RunLabels fl;
   {
-    const std::vector<float> sm = box_mean3(hu_, d_);  // noise spikes in soft tissue are not fluid
-    for (std::size_t q = 0; q < d_.total; ++q)
-      if (!lab_[q] && sm[q] >= opts_.fluid_threshold && sm[q] <= opts_.fluid_max) lab_[q] = kCandidate;
+    Bytes bright(d_.total);
+    const std::size_t plane = d_.n[0] * d_.n[1];
+    box_mean3_slices(hu_.data(), d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
+      for (std::size_t t = 0, q = k * plane; t < plane; ++t, ++q) {
+        bright[q] = !lab_[q] && mean[t] >= opts_.fluid_threshold && mean[t] <= opts_.fluid_max;
+        if (bright[q]) lab_[q] = kCandidate;
+      }
+    });
+    fl = component_runs(bright.data(), d_);
   }
-  MaskImage::Pointer work = mask_of_size(d_.n);
-  unsigned char* w = work->GetBufferPointer();
-  for (std::size_t q = 0; q < d_.total; ++q) w[q] = lab_[q] == kCandidate;
-  LabelImage::Pointer fl = components(work, fluid_count_);
-  fluid_label_.assign(fl->GetBufferPointer(), fl->GetBufferPointer() + d_.total);
+  fluid_count_ = fl.count();
+  fluid_label_.assign(d_.total, 0);
+  for (std::uint32_t l = 1; l <= fluid_count_; ++l)
+    for (const Run* r = fl.begin(l); r != fl.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, l);
   pool_.assign(fluid_count_ + 1, 0);
 }
 
 // Scans every line along `axis` for gas and fluid at most interface-width apart. contact: 1 where
 // a fluid voxel has gas on its lower-index side, 2 on its higher-index side (candidates). With
 // `layer`, the voxels between gas and kept pools become layer.
-void ColonSegmenter::scan_contacts(int axis, std::vector<unsigned char>* contact, bool layer) {
+void ColonSegmenter::scan_contacts(int axis, Bytes* contact, bool layer) {
   const int wvox = int(std::ceil(opts_.interface_width / d_.sp[axis]));
   const std::size_t stride = d_.stride[axis], len = d_.n[axis];
   const unsigned char fluid = layer ? kPool : kCandidate;
@@ -60,7 +66,7 @@ void ColonSegmenter::scan_contacts(int axis, std::vector<unsigned char>* contact
 // Per fluid body and side (0: gas at lower index, 1: at higher index) along `axis`: the number of
 // contact columns when they lie at one height (spread <= level-tolerance), else 0.
 std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis) {
-  std::vector<unsigned char> contact(d_.total, 0);
+  Bytes contact(d_.total, 0);
   scan_contacts(axis, &contact, false);
   std::vector<std::vector<float>> heights[2];
   heights[0].resize(fluid_count_ + 1);

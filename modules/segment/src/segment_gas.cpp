@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <set>
+#include <vector>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/params.h"
@@ -17,51 +18,73 @@ constexpr unsigned char kExcluded = 5;
 }
 
 void ColonSegmenter::find_gas_bodies() {
-  MaskImage::Pointer work = mask_of_size(full_.n);
-  unsigned char* w = work->GetBufferPointer();
+  Bytes gas(full_.total);
   const float* fhu = ct_->GetBufferPointer();
-  for (std::size_t q = 0; q < full_.total; ++q) w[q] = fhu[q] < opts_.air_threshold;
-  std::uint32_t ngas = 0;
-  LabelImage::Pointer gl = components(work, ngas);
-  const std::uint32_t* glb = gl->GetBufferPointer();
-  std::vector<BodyStats> bodies(ngas + 1);
-  for (std::size_t k = 0, q = 0; k < full_.n[2]; ++k)
-    for (std::size_t j = 0; j < full_.n[1]; ++j)
-      for (std::size_t i = 0; i < full_.n[0]; ++i, ++q) {
-        if (!glb[q]) continue;  // not gas (most of the volume)
-        BodyStats& b = bodies[glb[q]];
-        ++b.voxels;
-        b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
-      }
-  std::vector<unsigned char> drop(ngas + 1, 0);  // 1 outside air, 2 lungs
-  for (int a = 0; a < 3; ++a)
-    for (int hi_side = 0; hi_side < 2; ++hi_side) {
-      const bool superior = a == sup_axis_ && bool(hi_side) == sup_pos_;
-      if (a == sup_axis_ && !superior) continue;  // the inferior face may hold the rectum
+  parallel_for(full_.total, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) gas[q] = fhu[q] < opts_.air_threshold;
+  });
+  const RunLabels gl = component_runs(gas.data(), full_);
+  const std::vector<unsigned char> drop = outside_gas(gl);
+  if (opts_.tube_area > 0) trim_rectal_tube(inferior_face_dropped(gl, drop), gas.data());
+  for (std::uint32_t l = 1; l <= gl.count(); ++l)
+    if (drop[l])
+      for (const Run* r = gl.begin(l); r != gl.end(l); ++r) std::fill_n(gas.data() + r->start, r->length, 0);
+  lap("gas_components");
+  crop_to_gas(gas.data());
+  lap("crop");
+}
+
+// Per gas body: 1 outside air (touches a lateral face of the volume), 2 lungs (the superior face),
+// 0 kept (the inferior face may hold the rectum). A body touching several faces gets the code of
+// the first in the order x-, x+, y-, y+, z-, z+. Removed bodies are reported.
+std::vector<unsigned char> ColonSegmenter::outside_gas(const RunLabels& gl) {
+  std::vector<unsigned char> drop(gl.count() + 1, 0);
+  for (std::uint32_t l = 1; l <= gl.count(); ++l) {
+    double sum[3] = {0, 0, 0}, voxels = 0;
+    unsigned faces = 0;  // bit 2 a + hi_side
+    for (const Run* r = gl.begin(l); r != gl.end(l); ++r) {
       std::size_t c[3];
-      const std::size_t u = (a + 1) % 3, v = (a + 2) % 3;
-      c[a] = hi_side ? full_.n[a] - 1 : 0;
-      for (c[v] = 0; c[v] < full_.n[v]; ++c[v])
-        for (c[u] = 0; c[u] < full_.n[u]; ++c[u]) {
-          unsigned char& dr = drop[glb[full_.idx(c[0], c[1], c[2])]];
-          if (!dr) dr = superior ? 2 : 1;
-        }
+      full_.coords(r->start, c[0], c[1], c[2]);
+      const double len = double(r->length);
+      voxels += len;
+      sum[0] += len * double(c[0]) + len * (len - 1) / 2;
+      sum[1] += len * double(c[1]), sum[2] += len * double(c[2]);
+      faces |= (c[0] == 0 ? 1u : 0u) | (c[0] + r->length == full_.n[0] ? 2u : 0u);
+      for (int a = 1; a < 3; ++a) faces |= (c[a] == 0 ? 1u << (2 * a) : 0u) | (c[a] + 1 == full_.n[a] ? 2u << (2 * a) : 0u);
     }
-  for (std::uint32_t l = 1; l <= ngas; ++l) {
+    for (int a = 0; a < 3 && !drop[l]; ++a)
+      for (int hi_side = 0; hi_side < 2 && !drop[l]; ++hi_side) {
+        const bool superior = a == sup_axis_ && bool(hi_side) == sup_pos_;
+        if ((a == sup_axis_ && !superior) || !(faces & (1u << (2 * a + hi_side)))) continue;
+        drop[l] = superior ? 2 : 1;
+      }
     if (!drop[l]) continue;
     ++st_.removed_components;
-    const double c[3] = {bodies[l].sum[0] / double(bodies[l].voxels), bodies[l].sum[1] / double(bodies[l].voxels),
-                         bodies[l].sum[2] / double(bodies[l].voxels)};
-    decide("gas body", double(bodies[l].voxels) * voxel_ml_, c, false,
+    const double c[3] = {sum[0] / voxels, sum[1] / voxels, sum[2] / voxels};
+    decide("gas body", voxels * voxel_ml_, c, false,
            drop[l] == 1 ? "outside air (touches a lateral face of the volume)" : "lungs (touch the superior face)");
   }
-  drop[0] = 1;
-  if (opts_.tube_area > 0) trim_rectal_tube(glb, drop, w);
-  for (std::size_t q = 0; q < full_.total; ++q) w[q] = w[q] && !drop[glb[q]];
-  gl = nullptr;
-  lap("gas_components");
-  crop_to_gas(w);
-  lap("crop");
+  return drop;
+}
+
+// The pixels of the inferior face slice (in-plane index b * n[u] + a, as slice_index) that belong
+// to a removed gas body.
+std::vector<unsigned char> ColonSegmenter::inferior_face_dropped(const RunLabels& gl, const std::vector<unsigned char>& drop) const {
+  const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
+  const std::size_t face = sup_pos_ ? 0 : full_.n[sup_axis_] - 1;
+  std::vector<unsigned char> out(full_.n[u] * full_.n[v], 0);
+  for (std::uint32_t l = 1; l <= gl.count(); ++l) {
+    if (!drop[l]) continue;
+    for (const Run* r = gl.begin(l); r != gl.end(l); ++r) {
+      std::size_t c[3];
+      full_.coords(r->start, c[0], c[1], c[2]);
+      for (std::size_t i = c[0]; i < c[0] + r->length; ++i) {
+        const std::size_t at[3] = {i, c[1], c[2]};
+        if (at[sup_axis_] == face) out[at[v] * full_.n[u] + at[u]] = 1;
+      }
+    }
+  }
+  return out;
 }
 
 // Crop to the candidate gas plus a margin (fluid below the gas, the band, the tissue shell).
@@ -88,6 +111,8 @@ void ColonSegmenter::crop_to_gas(const unsigned char* gas) {
     cn[a] = bhi_[a] - blo_[a] + 1;
   }
   d_ = make_dims(cn, full_.sp);
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
+    std::fprintf(stderr, "crop %zu x %zu x %zu of %zu x %zu x %zu\n", cn[0], cn[1], cn[2], full_.n[0], full_.n[1], full_.n[2]);
   lab_.assign(d_.total, 0);
   hu_.resize(d_.total);
   const float* fhu = ct_->GetBufferPointer();

@@ -1,6 +1,8 @@
-// The band graph cut (docs/segment.md step 6): partial-volume data terms, contrast-sensitive
+// The band graph cut (docs/segment.md step 8): partial-volume data terms, contrast-sensitive
 // smoothness, Boost.Graph's boykov_kolmogorov_max_flow on a compressed-sparse-row graph, in slabs of
-// 32 slices with 6 slices of overlap, two slabs at a time.
+// 32 slices with 6 slices of overlap, two slabs at a time. Each of the two workers keeps one
+// SlabCut whose arrays (node map, edges, capacities, flow state) are reused from slab to slab, and
+// the energy terms are plain inline functions (no per-edge callbacks).
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 #include <boost/graph/compressed_sparse_row_graph.hpp>
 
@@ -18,16 +20,52 @@ namespace {
 using Csr = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
                                                boost::no_property, std::uint32_t, std::uint32_t>;
 using CsrEdge = boost::graph_traits<Csr>::edge_descriptor;
-using DataFn = std::function<void(std::size_t, long&, long&)>;
-using PairFn = std::function<long(std::size_t, std::size_t, int)>;
+constexpr double kScale = 1000.0;  // capacities are integers: costs x 1000
 
-// Min cut of the band voxels of slices [k0, k1); results written for slices [c0, c1).
+// The energy: data terms from the partial-volume lumen fraction (the cut passes where it is one
+// half) and the contrast-sensitive pair weight, tabulated per 1/4 HU up to 8 sigma (0 beyond).
+class Energy {
+ public:
+  explicit Energy(const GraphCutInput& in) : in_(in), hu_(in.hu), near_fluid_(in.near_fluid->data()) {
+    const Dims& d = *in.d;
+    const double hmin = std::min({d.sp[0], d.sp[1], d.sp[2]});
+    for (int a = 0; a < 3; ++a) wax_[a] = kScale * in.smoothness * hmin / d.sp[a];
+    const double inv2s2 = 1.0 / (2.0 * in.edge_sigma * in.edge_sigma);
+    gauss_.resize(std::size_t(8 * in.edge_sigma / kStep) + 2);
+    for (std::size_t t = 0; t < gauss_.size(); ++t) gauss_[t] = std::exp(-(t * kStep) * (t * kStep) * inv2s2);
+    gauss_.back() = 0;
+  }
+  // src: paid when q becomes wall; snk: paid when q becomes lumen.
+  void data(std::size_t q, long& src, long& snk) const {
+    const double v = hu_[q], tis = in_.tissue;
+    double a = 0;
+    if (v < tis) a = std::clamp((tis - v) / (tis - in_.air), 0.0, 1.0);
+    else if (near_fluid_[q]) a = std::clamp((v - tis) / (in_.fluid - tis), 0.0, 1.0);
+    src = std::lround(kScale * a);
+    snk = std::lround(kScale * (1.0 - a));
+  }
+  long pair(std::size_t p, std::size_t q, int axis) const {
+    const std::size_t t = std::min(gauss_.size() - 1, std::size_t(std::abs(double(hu_[p]) - double(hu_[q])) / kStep + 0.5));
+    return std::lround(wax_[axis] * gauss_[t]);
+  }
+
+ private:
+  static constexpr double kStep = 0.25;
+  const GraphCutInput& in_;
+  const float* hu_;
+  const unsigned char* near_fluid_;
+  double wax_[3] = {0, 0, 0};
+  std::vector<double> gauss_;
+};
+
+// Min cut of the band voxels of slices [k0, k1); results written for the core slices [c0, c1).
+// One SlabCut per worker: solve() may be called for many slabs, its arrays keep their capacity.
 class SlabCut {
  public:
-  SlabCut(const Dims& d, const unsigned char* state, const DataFn& data, const PairFn& pair_w, std::size_t k0, std::size_t k1)
-      : d_(d), state_(state), data_(data), pair_w_(pair_w), k0_(k0), k1_(k1) {}
-  GraphCutOutput solve(std::size_t c0, std::size_t c1, std::vector<unsigned char>& result) {
+  SlabCut(const Dims& d, const unsigned char* state, const Energy& energy) : d_(d), state_(state), energy_(energy) {}
+  GraphCutOutput solve(std::size_t k0, std::size_t k1, std::size_t c0, std::size_t c1, Bytes& result) {
     GraphCutOutput out;
+    k0_ = k0, k1_ = k1;
     collect_voxels();
     if (vox_.empty()) return out;
     Stopwatch sw;
@@ -42,6 +80,7 @@ class SlabCut {
     for (std::uint32_t i = 0; i < n_; ++i) {
       const std::size_t k = vox_[i] / slice;
       if (k >= c0 && k < c1) result[vox_[i]] = color_[i] == black ? 1 : 0;
+      node_[vox_[i] - base_] = UINT32_MAX;  // the node map is clean for the next slab
     }
     return out;
   }
@@ -49,26 +88,29 @@ class SlabCut {
  private:
   void collect_voxels() {
     const std::size_t slice = d_.n[0] * d_.n[1];
+    vox_.clear();
     for (std::size_t q = k0_ * slice; q < k1_ * slice; ++q)
       if (state_[q] == 2) vox_.push_back(q);
     n_ = std::uint32_t(vox_.size());
     base_ = k0_ * slice;
-    node_.assign(k1_ * slice - base_, UINT32_MAX);  // dense map: faster than searching vox_
+    if (node_.size() < k1_ * slice - base_) node_.resize(k1_ * slice - base_, UINT32_MAX);  // dense map: faster than searching vox_
     for (std::uint32_t i = 0; i < n_; ++i) node_[vox_[i] - base_] = i;
   }
   // Out-edges per node, sorted by target: band neighbours (ascending), then S, then T.
   void add_edges() {
     const std::uint32_t S = n_, T = n_ + 1;
+    edges_.clear();
+    cap_.clear();
     edges_.reserve(std::size_t(n_) * 10);
     cap_.reserve(edges_.capacity());
-    std::vector<long> src(n_);
+    src_.resize(n_);
     first_.assign(n_ + 3, 0);
     for (std::uint32_t i = 0; i < n_; ++i) {
       first_[i] = std::uint32_t(edges_.size());
       long s_cap = 0, t_cap = 0;
       neighbour_edges(i, s_cap, t_cap);
       const long m = std::min(s_cap, t_cap);
-      src[i] = s_cap - m;
+      src_[i] = s_cap - m;
       edges_.emplace_back(i, S);
       cap_.push_back(0);
       edges_.emplace_back(i, T);
@@ -77,7 +119,7 @@ class SlabCut {
     first_[S] = std::uint32_t(edges_.size());
     for (std::uint32_t i = 0; i < n_; ++i) {
       edges_.emplace_back(S, i);
-      cap_.push_back(src[i]);
+      cap_.push_back(src_[i]);
     }
     first_[T] = std::uint32_t(edges_.size());
     for (std::uint32_t i = 0; i < n_; ++i) {
@@ -90,7 +132,7 @@ class SlabCut {
   // add to the terminal capacities.
   void neighbour_edges(std::uint32_t i, long& s_cap, long& t_cap) {
     const std::size_t q = vox_[i];
-    data_(q, s_cap, t_cap);
+    energy_.data(q, s_cap, t_cap);
     std::size_t c[3];
     d_.coords(q, c[0], c[1], c[2]);
     static const int order[6][2] = {{2, -1}, {1, -1}, {0, -1}, {0, 1}, {1, 1}, {2, 1}};
@@ -99,7 +141,7 @@ class SlabCut {
       if ((dir < 0 && c[ax] == 0) || (dir > 0 && c[ax] + 1 == d_.n[ax])) continue;
       if (ax == 2 && (std::int64_t(c[2]) + dir < std::int64_t(k0_) || std::int64_t(c[2]) + dir >= std::int64_t(k1_))) continue;
       const std::size_t r = dir < 0 ? q - d_.stride[ax] : q + d_.stride[ax];
-      const long w = pair_w_(q, r, ax);
+      const long w = energy_.pair(q, r, ax);
       if (state_[r] == 1) s_cap += w;
       else if (state_[r] == 0) t_cap += w;
       else if (node_[r - base_] != UINT32_MAX) {
@@ -127,77 +169,52 @@ class SlabCut {
   }
   void max_flow(GraphCutOutput& out) {
     Csr g(boost::edges_are_sorted, edges_.begin(), edges_.end(), n_ + 2);
-    std::vector<long> res(cap_.size(), 0);
-    color_.resize(n_ + 2);
-    std::vector<CsrEdge> pred(n_ + 2);
-    std::vector<long> dist(n_ + 2, 0);
+    res_.assign(cap_.size(), 0);
+    color_.assign(n_ + 2, boost::default_color_type());
+    pred_.assign(n_ + 2, CsrEdge());
+    dist_.assign(n_ + 2, 0);
     auto eim = boost::get(boost::edge_index, g);
     auto vim = boost::get(boost::vertex_index, g);
     out.flow = double(boost::boykov_kolmogorov_max_flow(
-        g, boost::make_iterator_property_map(cap_.begin(), eim), boost::make_iterator_property_map(res.begin(), eim),
-        boost::make_iterator_property_map(rev_.begin(), eim), boost::make_iterator_property_map(pred.begin(), vim),
-        boost::make_iterator_property_map(color_.begin(), vim), boost::make_iterator_property_map(dist.begin(), vim),
+        g, boost::make_iterator_property_map(cap_.begin(), eim), boost::make_iterator_property_map(res_.begin(), eim),
+        boost::make_iterator_property_map(rev_.begin(), eim), boost::make_iterator_property_map(pred_.begin(), vim),
+        boost::make_iterator_property_map(color_.begin(), vim), boost::make_iterator_property_map(dist_.begin(), vim),
         vim, n_, n_ + 1));
     out.edges = cap_.size();
   }
 
   const Dims& d_;
   const unsigned char* state_;
-  const DataFn& data_;
-  const PairFn& pair_w_;
-  std::size_t k0_, k1_, base_ = 0;
+  const Energy& energy_;
+  std::size_t k0_ = 0, k1_ = 0, base_ = 0;
   std::uint32_t n_ = 0;
-  std::vector<std::size_t> vox_;
-  std::vector<std::uint32_t> node_, first_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges_;
-  std::vector<long> cap_;
-  std::vector<CsrEdge> rev_;
-  std::vector<boost::default_color_type> color_;
+  Buffer<std::size_t> vox_;
+  Buffer<std::uint32_t> node_, first_;
+  Buffer<std::pair<std::uint32_t, std::uint32_t>> edges_;
+  Buffer<long> cap_, res_, src_, dist_;
+  Buffer<CsrEdge> rev_, pred_;
+  Buffer<boost::default_color_type> color_;
 };
-
-constexpr double kScale = 1000.0;  // capacities are integers: costs x 1000
 
 }  // namespace
 
-GraphCutOutput graph_cut_band(const GraphCutInput& in, std::vector<unsigned char>& state) {
+GraphCutOutput graph_cut_band(const GraphCutInput& in, Bytes& state) {
   const Dims& d = *in.d;
-  const float* hu = in.hu;
-  const std::vector<unsigned char>& near_fluid = *in.near_fluid;
-  const double air = in.air, tis = in.tissue, flu = in.fluid;
-  // Data terms from the partial-volume lumen fraction: the cut passes where it is one half.
-  const DataFn data = [&](std::size_t q, long& src, long& snk) {
-    const double v = hu[q];
-    double a = 0;
-    if (v < tis) a = std::clamp((tis - v) / (tis - air), 0.0, 1.0);
-    else if (near_fluid[q]) a = std::clamp((v - tis) / (flu - tis), 0.0, 1.0);
-    src = std::lround(kScale * a);          // paid when q becomes wall
-    snk = std::lround(kScale * (1.0 - a));  // paid when q becomes lumen
-  };
-  const double inv2s2 = 1.0 / (2.0 * in.edge_sigma * in.edge_sigma);
-  const double hmin = std::min({d.sp[0], d.sp[1], d.sp[2]});
-  double wax[3];
-  for (int a = 0; a < 3; ++a) wax[a] = kScale * in.smoothness * hmin / d.sp[a];
-  const double step = 0.25;  // exp(-dv^2 / 2 sigma^2) tabulated per 1/4 HU up to 8 sigma (0 beyond)
-  std::vector<double> gauss(std::size_t(8 * in.edge_sigma / step) + 2);
-  for (std::size_t t = 0; t < gauss.size(); ++t) gauss[t] = std::exp(-(t * step) * (t * step) * inv2s2);
-  gauss.back() = 0;
-  const PairFn pair_w = [&](std::size_t p, std::size_t q, int a) -> long {
-    const std::size_t t = std::min(gauss.size() - 1, std::size_t(std::abs(double(hu[p]) - double(hu[q])) / step + 0.5));
-    return std::lround(wax[a] * gauss[t]);
-  };
+  const Energy energy(in);
   const std::size_t nz = d.n[2], core = 32, margin = 6;
   const std::size_t nslabs = (nz + core - 1) / core;
   std::atomic<std::size_t> next{0};
   std::mutex mu;
-  std::vector<unsigned char> result(d.total, 0);
+  Bytes result(d.total, 0);
   std::exception_ptr failure;
   GraphCutOutput total;
   parallel_for(2, [&](std::size_t, std::size_t) {
     try {
+      SlabCut cut(d, state.data(), energy);
       for (std::size_t s; (s = next.fetch_add(1)) < nslabs;) {
         const std::size_t c0 = s * core, c1 = std::min(nz, c0 + core);
         const std::size_t k0 = c0 > margin ? c0 - margin : 0, k1 = std::min(nz, c1 + margin);
-        const GraphCutOutput so = SlabCut(d, state.data(), data, pair_w, k0, k1).solve(c0, c1, result);
+        const GraphCutOutput so = cut.solve(k0, k1, c0, c1, result);
         std::lock_guard<std::mutex> lock(mu);
         total.flow += so.flow / kScale;
         total.edges += so.edges;

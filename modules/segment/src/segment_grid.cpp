@@ -1,14 +1,42 @@
 // Voxel-grid helpers of the segmentation: dims, threads, connected components, box dilation and
-// erosion, the 3 x 3 x 3 mean, line enumeration.
-#include <itkConnectedComponentImageFilter.h>
+// erosion, the 3 x 3 x 3 mean (slice by slice), line enumeration.
+#include <itkBinaryImageToLabelMapFilter.h>
+#include <itkLabelMap.h>
+#include <itkLabelObject.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
+#include <new>
 #include <thread>
+
+#include <sys/mman.h>
 
 #include "segment_internal.h"
 
 namespace cf::segment_detail {
+
+namespace {
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+constexpr std::size_t kHugeMin = std::size_t(4) << 20;  // smaller blocks: the ordinary heap
+}  // namespace
+
+void* huge_page_alloc(std::size_t bytes) {
+  if (bytes < kHugeMin) return ::operator new(bytes);
+  const std::size_t size = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+  ::madvise(p, size, MADV_HUGEPAGE);  // advice only: without transparent huge pages, 4 KiB pages
+#endif
+  return p;
+}
+
+void huge_page_free(void* p, std::size_t bytes) {
+  if (!p) return;
+  if (bytes < kHugeMin) return ::operator delete(p);
+  ::munmap(p, (bytes + kHugePage - 1) / kHugePage * kHugePage);
+}
 
 Dims make_dims(const std::size_t n[3], const double sp[3]) {
   Dims d;
@@ -31,94 +59,155 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size
   for (auto& t : ts) t.join();
 }
 
-LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count) {
-  using CC = itk::ConnectedComponentImageFilter<MaskImage, LabelImage>;
-  auto cc = CC::New();
-  cc->SetInput(m);
-  cc->SetFullyConnected(false);
-  cc->SetNumberOfWorkUnits(2);
-  cc->Update();
-  count = cc->GetObjectCount();
-  LabelImage::Pointer out = cc->GetOutput();
-  out->DisconnectPipeline();
+RunLabels component_runs(const unsigned char* mask, const Dims& d) {
+  auto image = MaskImage::New();  // wraps `mask` without copying it
+  image->SetRegions(MaskImage::SizeType{{d.n[0], d.n[1], d.n[2]}});
+  auto container = MaskImage::PixelContainer::New();
+  container->SetImportPointer(const_cast<unsigned char*>(mask), d.total, false);
+  image->SetPixelContainer(container);
+  using Map = itk::LabelMap<itk::LabelObject<std::uint32_t, 3>>;
+  auto filter = itk::BinaryImageToLabelMapFilter<MaskImage, Map>::New();
+  filter->SetInput(image);
+  filter->SetFullyConnected(false);
+  filter->SetInputForegroundValue(1);
+  filter->SetOutputBackgroundValue(0);
+  filter->SetNumberOfWorkUnits(2);
+  filter->Update();
+  const Map* map = filter->GetOutput();
+  RunLabels out;
+  const std::uint32_t n = std::uint32_t(map->GetNumberOfLabelObjects());
+  out.first.reserve(n + 1);
+  for (std::uint32_t l = 1; l <= n; ++l) {
+    const auto* object = map->GetLabelObject(l);
+    for (std::size_t i = 0, lines = object->GetNumberOfLines(); i < lines; ++i) {
+      const auto& line = object->GetLine(i);
+      const auto& at = line.GetIndex();
+      out.runs.push_back({d.idx(std::size_t(at[0]), std::size_t(at[1]), std::size_t(at[2])), std::size_t(line.GetLength())});
+    }
+    out.first.push_back(out.runs.size());
+  }
   return out;
 }
 
-MaskImage::Pointer mask_of_size(const std::size_t n[3]) {
-  auto m = MaskImage::New();
-  MaskImage::SizeType sz{{n[0], n[1], n[2]}};
-  m->SetRegions(sz);
-  m->Allocate();
-  return m;
+std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<unsigned char>& keep) const {
+  std::vector<std::pair<Run, std::uint32_t>> out;
+  for (std::uint32_t l = 1; l <= count(); ++l)
+    if (keep[l])
+      for (const Run* r = begin(l); r != end(l); ++r) out.emplace_back(*r, l);
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first.start < b.first.start; });
+  return out;
 }
 
-void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
-  std::vector<unsigned char> tmp(v.size());
+namespace {
+// Dilation of v along axis 0 (contiguous rows) into out, rows [row0, row1).
+void dilate_rows(const unsigned char* v, unsigned char* out, std::size_t nx, std::size_t row0, std::size_t row1, long radius) {
+  for (std::size_t row = row0; row < row1; ++row) {
+    const unsigned char* in = v + row * nx;
+    unsigned char* o = out + row * nx;
+    long last = -1000000;
+    for (long i = 0; i < long(nx); ++i) {
+      if (in[i]) last = i;
+      o[i] = (i - last <= radius) ? 1 : 0;
+    }
+    last = 1000000;
+    for (long i = long(nx) - 1; i >= 0; --i) {
+      if (in[i]) last = i;
+      if (last - i <= radius) o[i] = 1;
+    }
+  }
+}
+
+// Dilation along a line of `count` rows `step` bytes apart (rows of nx bytes) starting at `base`:
+// per x, the nearest set row before and after each row (two sweeps, O(1) per voxel).
+void dilate_across(const unsigned char* v, unsigned char* out, std::size_t nx, std::size_t base, std::size_t step,
+                   std::size_t count, long radius, std::vector<std::int32_t>& near) {
+  near.assign(nx, -1000000);
+  for (std::size_t t = 0; t < count; ++t) {
+    const unsigned char* in = v + base + t * step;
+    unsigned char* o = out + base + t * step;
+    const std::int32_t pos = std::int32_t(t);
+    for (std::size_t i = 0; i < nx; ++i) {
+      near[i] = in[i] ? pos : near[i];
+      o[i] = pos - near[i] <= radius;
+    }
+  }
+  near.assign(nx, 1000000);
+  for (std::size_t t = count; t-- > 0;) {
+    const unsigned char* in = v + base + t * step;
+    unsigned char* o = out + base + t * step;
+    const std::int32_t pos = std::int32_t(t);
+    for (std::size_t i = 0; i < nx; ++i) {
+      near[i] = in[i] ? pos : near[i];
+      o[i] |= near[i] - pos <= radius;
+    }
+  }
+}
+}  // namespace
+
+void dilate_box(Bytes& v, const Dims& d, const int r[3]) {
+  Bytes tmp(v.size());
   const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
   for (int ax = 0; ax < 3; ++ax) {
     if (r[ax] <= 0) continue;
-    const long R = r[ax];
-    // Rows (x lines) are contiguous: along y and z whole rows are OR-ed (cache friendly).
-    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
-      for (std::size_t k = k0; k < k1; ++k)
-        for (std::size_t j = 0; j < ny; ++j) {
-          unsigned char* out = tmp.data() + (k * ny + j) * nx;
-          if (ax == 0) {
-            const unsigned char* in = v.data() + (k * ny + j) * nx;
-            long last = -1000000;
-            for (long i = 0; i < long(nx); ++i) {
-              if (in[i]) last = i;
-              out[i] = (i - last <= R) ? 1 : 0;
-            }
-            last = 1000000;
-            for (long i = long(nx) - 1; i >= 0; --i) {
-              if (in[i]) last = i;
-              if (last - i <= R) out[i] = 1;
-            }
-            continue;
-          }
-          std::memset(out, 0, nx);
-          const long c = ax == 1 ? long(j) : long(k), n = ax == 1 ? long(ny) : long(nz);
-          for (long o = std::max(0L, c - R); o <= std::min(n - 1, c + R); ++o) {
-            const unsigned char* in = v.data() + (ax == 1 ? (k * ny + std::size_t(o)) : (std::size_t(o) * ny + j)) * nx;
-            for (std::size_t i = 0; i < nx; ++i) out[i] |= in[i];
-          }
-        }
-    });
+    const long radius = r[ax];
+    if (ax == 0) {
+      parallel_for(ny * nz, [&](std::size_t r0, std::size_t r1) { dilate_rows(v.data(), tmp.data(), nx, r0, r1, radius); });
+    } else if (ax == 1) {  // lines along y: one per slice
+      parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+        std::vector<std::int32_t> near;
+        for (std::size_t k = k0; k < k1; ++k) dilate_across(v.data(), tmp.data(), nx, k * nx * ny, nx, ny, radius, near);
+      });
+    } else {  // lines along z: one per row index j
+      parallel_for(ny, [&](std::size_t j0, std::size_t j1) {
+        std::vector<std::int32_t> near;
+        for (std::size_t j = j0; j < j1; ++j) dilate_across(v.data(), tmp.data(), nx, j * nx, nx * ny, nz, radius, near);
+      });
+    }
     v.swap(tmp);
   }
 }
 
-void erode_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]) {
+void erode_box(Bytes& v, const Dims& d, const int r[3]) {
   for (auto& x : v) x = !x;
   dilate_box(v, d, r);
   for (auto& x : v) x = !x;
 }
 
-std::vector<float> box_mean3(const std::vector<float>& in, const Dims& d) {
-  std::vector<float> sm(in), tmp(d.total);
-  const std::size_t nx = d.n[0], ny = d.n[1], nz = d.n[2];
-  for (int ax = 0; ax < 3; ++ax) {
-    parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
-      for (std::size_t k = k0; k < k1; ++k)
-        for (std::size_t j = 0; j < ny; ++j) {
-          float* out = tmp.data() + (k * ny + j) * nx;
-          const float* mid = sm.data() + (k * ny + j) * nx;
-          if (ax == 0) {
-            for (std::size_t i = 0; i < nx; ++i)
-              out[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
-            continue;
-          }
-          const std::size_t rs = ax == 1 ? nx : nx * ny;  // row stride along the axis
-          const std::size_t c = ax == 1 ? j : k, n = ax == 1 ? ny : nz;
-          const float* lo = c > 0 ? mid - rs : mid;
-          const float* hi = c + 1 < n ? mid + rs : mid;
-          for (std::size_t i = 0; i < nx; ++i) out[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
-        }
-    });
-    sm.swap(tmp);
+namespace {
+// The x-then-y 3 x 3 box mean of slice k (edges clamped) into `out`; `tmp` holds the x pass.
+void mean_xy(const float* in, const Dims& d, std::size_t k, float* tmp, float* out) {
+  const std::size_t nx = d.n[0], ny = d.n[1];
+  const float* plane = in + k * nx * ny;
+  for (std::size_t j = 0; j < ny; ++j) {
+    const float* mid = plane + j * nx;
+    float* row = tmp + j * nx;
+    for (std::size_t i = 0; i < nx; ++i) row[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
   }
-  return sm;
+  for (std::size_t j = 0; j < ny; ++j) {
+    const float* mid = tmp + j * nx;
+    const float* lo = j > 0 ? mid - nx : mid;
+    const float* hi = j + 1 < ny ? mid + nx : mid;
+    float* row = out + j * nx;
+    for (std::size_t i = 0; i < nx; ++i) row[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
+  }
+}
+}  // namespace
+
+void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+  const std::size_t plane = d.n[0] * d.n[1], nz = d.n[2];
+  parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
+    if (k0 >= k1) return;
+    std::vector<float> tmp(plane), mean(plane), lo(plane), mid(plane), hi(plane);
+    mean_xy(in, d, k0 > 0 ? k0 - 1 : 0, tmp.data(), lo.data());
+    mean_xy(in, d, k0, tmp.data(), mid.data());
+    for (std::size_t k = k0; k < k1; ++k) {
+      mean_xy(in, d, std::min(k + 1, nz - 1), tmp.data(), hi.data());
+      for (std::size_t q = 0; q < plane; ++q) mean[q] = (lo[q] + mid[q] + hi[q]) * (1.0f / 3.0f);
+      slice(k, mean.data());
+      lo.swap(mid);
+      mid.swap(hi);
+    }
+  });
 }
 
 std::size_t line_base(const Dims& d, int ax, std::size_t l) {

@@ -23,7 +23,28 @@ namespace cf::segment_detail {
 class LinkGrid;
 struct Contact;
 struct LocalShape;
-using LabelImage = itk::Image<std::uint32_t, 3>;
+
+// Large voxel buffers (crop-sized and more): blocks of at least 4 MiB are mapped directly and
+// advised for transparent huge pages, so a fresh buffer costs 1/512 of the page faults (on 2 loaded
+// virtual cores the 4 KiB faults of the ~20 full-crop buffers cost about a third of the CPU time).
+void* huge_page_alloc(std::size_t bytes);
+void huge_page_free(void* p, std::size_t bytes);
+template <class T>
+struct HugePageAllocator {
+  using value_type = T;
+  HugePageAllocator() = default;
+  template <class U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(huge_page_alloc(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) { huge_page_free(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const HugePageAllocator<U>&) const { return true; }
+  template <class U>
+  bool operator!=(const HugePageAllocator<U>&) const { return false; }
+};
+template <class T>
+using Buffer = std::vector<T, HugePageAllocator<T>>;
+using Bytes = Buffer<unsigned char>;
 
 struct Dims {
   std::size_t n[3];
@@ -39,15 +60,35 @@ struct Dims {
 };
 
 Dims make_dims(const std::size_t n[3], const double sp[3]);
+// User + system CPU seconds of this process so far (all threads; getrusage).
+double process_cpu_seconds();
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
-// Face-connected components of a 0/1 image; labels 1..count (0 background).
-LabelImage::Pointer components(const MaskImage* m, std::uint32_t& count);
-MaskImage::Pointer mask_of_size(const std::size_t n[3]);
+// A run of voxels along axis 0: linear index of its first voxel and its length.
+struct Run {
+  std::size_t start;
+  std::size_t length;
+};
+// Face-connected components of a 0/1 voxel array as runs along axis 0, without a dense label
+// image: runs of label l (1..count()) are runs[first[l - 1] .. first[l]), in raster order. Labels
+// are numbered as itk::ConnectedComponentImageFilter numbers them (the same scanline union-find of
+// itk::BinaryImageToLabelMapFilter, 2 work units).
+struct RunLabels {
+  std::vector<std::size_t> first{0};
+  std::vector<Run> runs;
+  std::uint32_t count() const { return std::uint32_t(first.size() - 1); }
+  const Run* begin(std::uint32_t l) const { return runs.data() + first[l - 1]; }
+  const Run* end(std::uint32_t l) const { return runs.data() + first[l]; }
+  // All runs of the labels with keep[l] != 0 as (run, label), in raster order (ascending start).
+  std::vector<std::pair<Run, std::uint32_t>> raster(const std::vector<unsigned char>& keep) const;
+};
+RunLabels component_runs(const unsigned char* mask, const Dims& d);
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
-void dilate_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]);
-void erode_box(std::vector<unsigned char>& v, const Dims& d, const int r[3]);
-// 3 x 3 x 3 box mean (edges clamped).
-std::vector<float> box_mean3(const std::vector<float>& in, const Dims& d);
+void dilate_box(Bytes& v, const Dims& d, const int r[3]);
+void erode_box(Bytes& v, const Dims& d, const int r[3]);
+// 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
+// slice(k, mean of slice k) for every k, from two workers (each slice once, slices of one worker
+// in order); only a few slices are held in memory.
+void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
 // Base index of line `l` along axis `ax` (lines enumerate the other two axes).
 std::size_t line_base(const Dims& d, int ax, std::size_t l);
 
@@ -55,7 +96,7 @@ std::size_t line_base(const Dims& d, int ax, std::size_t l);
 struct GraphCutInput {
   const Dims* d = nullptr;
   const float* hu = nullptr;
-  const std::vector<unsigned char>* near_fluid = nullptr;  // where bright voxels count as lumen
+  const Bytes* near_fluid = nullptr;  // where bright voxels count as lumen
   double air = -1000, tissue = 40, fluid = 450;            // class means (HU)
   double smoothness = 0.5, edge_sigma = 60;
 };
@@ -64,7 +105,7 @@ struct GraphCutOutput {
   std::size_t edges = 0;
   double build_cpu_s = 0, flow_cpu_s = 0;
 };
-GraphCutOutput graph_cut_band(const GraphCutInput& in, std::vector<unsigned char>& state);
+GraphCutOutput graph_cut_band(const GraphCutInput& in, Bytes& state);
 
 // One decision about a gas or fluid body, for the report.
 struct Decision {
@@ -94,7 +135,9 @@ class ColonSegmenter {
   void gravity_from_metadata();
   void find_gas_bodies();
   // Rectal tube (segment_tube.cpp).
-  void trim_rectal_tube(const std::uint32_t* labels, const std::vector<unsigned char>& drop, unsigned char* gas);
+  std::vector<unsigned char> outside_gas(const RunLabels& gas_labels);
+  std::vector<unsigned char> inferior_face_dropped(const RunLabels& gas_labels, const std::vector<unsigned char>& drop) const;
+  void trim_rectal_tube(const std::vector<unsigned char>& face_dropped, unsigned char* gas);
   std::size_t track_tube(std::vector<std::pair<long, long>> channel, unsigned char* gas, double sum[3]);
   std::size_t slice_index(std::size_t s, long a, long b) const;
   std::vector<std::pair<long, long>> slice_component(std::size_t s, const std::vector<std::pair<long, long>>& seeds,
@@ -109,7 +152,7 @@ class ColonSegmenter {
   MaskImage::Pointer paste() const;
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
-  void scan_contacts(int axis, std::vector<unsigned char>* contact, bool layer);
+  void scan_contacts(int axis, Bytes* contact, bool layer);
   std::vector<std::array<std::size_t, 2>> level_contacts(int axis);
   void gravity_from_levels();
   void keep_level_pools();
@@ -117,7 +160,8 @@ class ColonSegmenter {
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
   void check_colon_found(const std::vector<double>& vols) const;
-  std::vector<BodyStats> body_stats(const std::uint32_t* labels, std::uint32_t n, const std::function<bool(std::size_t)>& gas) const;
+  std::vector<BodyStats> body_stats(const RunLabels& labels, const std::function<bool(std::size_t)>& gas) const;
+  void mark_grid(const std::vector<std::pair<Run, std::uint32_t>>& runs, bool segment);
   void link_tagged_stretches();
   std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
   bool continues_colon(const Contact& c, std::string& why) const;
@@ -134,6 +178,8 @@ class ColonSegmenter {
   SegmentOptions opts_;
   SegmentStats st_;
   nlohmann::json timings_ = nlohmann::json::object();
+  nlohmann::json cpu_timings_ = nlohmann::json::object();
+  double cpu_start_ = 0, cpu_lap_ = 0;
   Stopwatch clock_, step_;
   Dims full_{}, d_{};
   double voxel_ml_ = 0;
@@ -143,16 +189,16 @@ class ColonSegmenter {
   bool gravity_known_ = false;
   std::string gravity_source_;
   std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
-  std::vector<float> hu_;              // CT in the crop
+  Buffer<float> hu_;                   // CT in the crop
   std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
-  std::vector<unsigned char> lab_;     // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
-  std::vector<std::uint32_t> fluid_label_;  // fluid components in the crop
+  Bytes lab_;                          // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
+  Buffer<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
   std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
   std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
-  std::vector<unsigned char> state_;   // crop: final 0/1 (after the graph cut)
-  std::vector<unsigned char> lumen0_;  // crop: initial lumen
+  Bytes state_;                        // crop: final 0/1 (after the graph cut)
+  Bytes lumen0_;                       // crop: initial lumen
   std::vector<Decision> decisions_;
 };
 

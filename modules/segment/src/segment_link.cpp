@@ -43,14 +43,12 @@ ColonSegmenter::~ColonSegmenter() = default;
 // with enough fluid become candidates for fully tagged stretches (lab 4). Kept segments are marked
 // on the link grid.
 void ColonSegmenter::select_segments() {
-  MaskImage::Pointer work = mask_of_size(d_.n);
-  unsigned char* w = work->GetBufferPointer();
-  for (std::size_t q = 0; q < d_.total; ++q) w[q] = colon_kind(lab_[q]);
-  std::uint32_t n = 0;
-  LabelImage::Pointer cl = components(work, n);
-  work = nullptr;
-  const std::uint32_t* clb = cl->GetBufferPointer();
-  const std::vector<BodyStats> bodies = body_stats(clb, n, [&](std::size_t q) { return lab_[q] == kGas; });
+  Bytes colon(d_.total);
+  for (std::size_t q = 0; q < d_.total; ++q) colon[q] = colon_kind(lab_[q]);
+  const RunLabels cl = component_runs(colon.data(), d_);
+  Bytes().swap(colon);
+  const std::uint32_t n = cl.count();
+  const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return lab_[q] == kGas; });
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 1u);
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return bodies[a].voxels > bodies[b].voxels; });
@@ -76,14 +74,13 @@ void ColonSegmenter::select_segments() {
     }
   }
   grid_ = std::make_unique<LinkGrid>(d_, kLinkCellMm);
-  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
-    for (std::size_t j = 0; j < d_.n[1]; ++j)
-      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
-        if (!clb[q]) continue;
-        const unsigned char f = fate[clb[q]];
-        if (f == 1) grid_->mark(i, j, k, clb[q], 0);
-        else lab_[q] = f == 2 ? kCandidate : 0;
-      }
+  std::vector<unsigned char> kept(n + 1, 0);
+  for (std::uint32_t l = 1; l <= n; ++l) {
+    kept[l] = fate[l] == 1;
+    if (!kept[l])
+      for (const Run* r = cl.begin(l); r != cl.end(l); ++r) std::fill_n(lab_.data() + r->start, r->length, fate[l] == 2 ? kCandidate : 0);
+  }
+  mark_grid(cl.raster(kept), true);
   check_colon_found(vols);
 }
 
@@ -99,40 +96,45 @@ void ColonSegmenter::check_colon_found(const std::vector<double>& vols) const {
 }
 
 // Per-label voxel count, `gas` count, coordinate sums and whether the body touches the crop's faces.
-std::vector<BodyStats> ColonSegmenter::body_stats(const std::uint32_t* labels, std::uint32_t n,
-                                                  const std::function<bool(std::size_t)>& gas) const {
-  std::vector<BodyStats> bodies(n + 1);
-  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
-    for (std::size_t j = 0; j < d_.n[1]; ++j) {
+std::vector<BodyStats> ColonSegmenter::body_stats(const RunLabels& labels, const std::function<bool(std::size_t)>& gas) const {
+  std::vector<BodyStats> bodies(labels.count() + 1);
+  for (std::uint32_t l = 1; l <= labels.count(); ++l) {
+    BodyStats& b = bodies[l];
+    for (const Run* r = labels.begin(l); r != labels.end(l); ++r) {
+      std::size_t i, j, k;
+      d_.coords(r->start, i, j, k);
+      const double len = double(r->length);
+      b.voxels += r->length;
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) b.gas += gas(q);
+      b.sum[0] += len * double(i) + len * (len - 1) / 2, b.sum[1] += len * double(j), b.sum[2] += len * double(k);
       const bool face_row = j == 0 || k == 0 || j + 1 == d_.n[1] || k + 1 == d_.n[2];
-      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q) {
-        if (!labels[q]) continue;
-        BodyStats& b = bodies[labels[q]];
-        ++b.voxels;
-        b.gas += gas(q);
-        b.sum[0] += double(i), b.sum[1] += double(j), b.sum[2] += double(k);
-        b.touches_face = b.touches_face || face_row || i == 0 || i + 1 == d_.n[0];
-      }
+      b.touches_face = b.touches_face || face_row || i == 0 || i + r->length == d_.n[0];
     }
+  }
   return bodies;
+}
+
+// Marks the link grid with the voxels of `runs` (raster order: where bodies share a cell, the
+// last voxel in raster order names it), as segment (`segment`) or candidate ids.
+void ColonSegmenter::mark_grid(const std::vector<std::pair<Run, std::uint32_t>>& runs, bool segment) {
+  for (const auto& [run, label] : runs) {
+    std::size_t i, j, k;
+    d_.coords(run.start, i, j, k);
+    for (std::size_t t = 0; t < run.length; ++t) grid_->mark(i + t, j, k, segment ? label : 0, segment ? 0 : label);
+  }
 }
 
 // Candidates (lab 4): kept when they continue a colon segment's end within link-gap, in passes (a
 // body kept in one pass is colon for the next: chains of stretches and small gas pieces between
 // them); then every other candidate is rejected with its reason.
 void ColonSegmenter::link_tagged_stretches() {
-  MaskImage::Pointer work = mask_of_size(d_.n);
-  unsigned char* w = work->GetBufferPointer();
-  for (std::size_t q = 0; q < d_.total; ++q) w[q] = lab_[q] == kCandidate;
-  std::uint32_t n = 0;
-  LabelImage::Pointer cl = components(work, n);
-  work = nullptr;
-  const std::uint32_t* clb = cl->GetBufferPointer();
-  const std::vector<BodyStats> bodies = body_stats(clb, n, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
-  for (std::size_t k = 0, q = 0; k < d_.n[2]; ++k)
-    for (std::size_t j = 0; j < d_.n[1]; ++j)
-      for (std::size_t i = 0; i < d_.n[0]; ++i, ++q)
-        if (clb[q]) grid_->mark(i, j, k, 0, clb[q]);
+  Bytes candidate(d_.total);
+  for (std::size_t q = 0; q < d_.total; ++q) candidate[q] = lab_[q] == kCandidate;
+  const RunLabels cl = component_runs(candidate.data(), d_);
+  Bytes().swap(candidate);
+  const std::uint32_t n = cl.count();
+  const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
+  mark_grid(cl.raster(std::vector<unsigned char>(n + 1, 1)), false);
   std::vector<unsigned char> eligible(n + 1, 0);
   std::vector<std::string> why(n + 1);
   for (std::uint32_t l = 1; l <= n; ++l) {
@@ -154,8 +156,9 @@ void ColonSegmenter::link_tagged_stretches() {
     }
     report_candidate(bodies[l], kept_gap[l], why[l]);
   }
-  for (std::size_t q = 0; q < d_.total; ++q)
-    if (lab_[q] == kCandidate) lab_[q] = keep[clb[q]] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
+  for (std::uint32_t l = 1; l <= n; ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) lab_[q] = keep[l] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
   grid_.reset();
 }
 

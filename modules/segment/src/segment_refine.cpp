@@ -24,7 +24,7 @@ void ColonSegmenter::class_means() {
   }
   st_.air_hu = an ? as / double(an) : -1000.0;
   st_.fluid_hu = fn ? fs / double(fn) : 0.0;
-  std::vector<unsigned char> shell = lumen0_;
+  Bytes shell = lumen0_;
   const int r2[3] = {int(std::ceil(2.5 / d_.sp[0])), int(std::ceil(2.5 / d_.sp[1])), int(std::ceil(2.5 / d_.sp[2]))};
   dilate_box(shell, d_, r2);
   double ts = 0;
@@ -48,13 +48,13 @@ void ColonSegmenter::refine_boundary() {
                      std::max(1, int(std::round(opts_.band_width / d_.sp[1]))),
                      std::max(1, int(std::round(opts_.band_width / d_.sp[2])))};
   {
-    std::vector<unsigned char> outer = lumen0_, inner = lumen0_;
+    Bytes outer = lumen0_, inner = lumen0_;
     dilate_box(outer, d_, rb);
     erode_box(inner, d_, rb);
     for (std::size_t q = 0; q < d_.total; ++q)
       state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0));
   }
-  std::vector<unsigned char> near_fluid(d_.total);
+  Bytes near_fluid(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) near_fluid[q] = lab_[q] == 2;
   const int rf[3] = {rb[0] + 1, rb[1] + 1, rb[2] + 1};
   dilate_box(near_fluid, d_, rf);
@@ -79,34 +79,33 @@ void ColonSegmenter::refine_boundary() {
 // Components of the refined lumen that hold initial lumen and at least min(1 mL, half the
 // smallest body the options allow) stay; they are the final segments.
 void ColonSegmenter::final_segments() {
-  MaskImage::Pointer work = mask_of_size(d_.n);
-  unsigned char* w = work->GetBufferPointer();
-  std::copy(state_.begin(), state_.end(), w);
-  std::uint32_t n = 0;
-  LabelImage::Pointer cl = components(work, n);
-  const std::uint32_t* clb = cl->GetBufferPointer();
+  const RunLabels cl = component_runs(state_.data(), d_);
+  const std::uint32_t n = cl.count();
   std::vector<std::size_t> count(n + 1, 0), core(n + 1, 0);
-  for (std::size_t q = 0; q < d_.total; ++q) {
-    ++count[clb[q]];
-    core[clb[q]] += lumen0_[q];
-  }
+  for (std::uint32_t l = 1; l <= n; ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r) {
+      count[l] += r->length;
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) core[l] += lumen0_[q];
+    }
   const double min_ml = std::min(1.0, 0.5 * std::min(opts_.min_segment_volume, opts_.min_tagged_volume));
   std::vector<unsigned char> keep(n + 1, 0);
   std::vector<double> vols;
   for (std::uint32_t l = 1; l <= n; ++l)
     if (core[l] > 0 && double(count[l]) * voxel_ml_ >= min_ml) keep[l] = 1, vols.push_back(double(count[l]) * voxel_ml_);
   std::size_t fluid = 0;
-  for (std::size_t q = 0; q < d_.total; ++q) {
-    state_[q] = state_[q] && keep[clb[q]];
-    fluid += state_[q] && hu_[q] >= opts_.fluid_threshold;
-  }
+  for (std::uint32_t l = 1; l <= n; ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r) {
+      if (!keep[l]) std::fill_n(state_.data() + r->start, r->length, 0);
+      else
+        for (std::size_t q = r->start; q < r->start + r->length; ++q) fluid += hu_[q] >= opts_.fluid_threshold;
+    }
   if (vols.empty()) throw PreconditionError("no colon found after graph-cut refinement");
   std::sort(vols.rbegin(), vols.rend());
   st_.segments = int(vols.size());
   st_.segment_volumes_ml = vols;
   st_.lumen_volume_ml = std::accumulate(vols.begin(), vols.end(), 0.0);
   st_.fluid_volume_ml = double(fluid) * voxel_ml_;
-  std::vector<unsigned char>().swap(lumen0_);
+  Bytes().swap(lumen0_);
 }
 
 MaskImage::Pointer ColonSegmenter::paste() const {

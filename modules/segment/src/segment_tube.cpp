@@ -59,7 +59,7 @@ std::vector<std::pair<long, long>> ColonSegmenter::slice_component(std::size_t s
 
 // Gas bodies reaching the inferior face through channels thinner than tube-area: each channel of
 // the face slice is tracked up to its open tip and trimmed; its wall is excluded.
-void ColonSegmenter::trim_rectal_tube(const std::uint32_t* glb, const std::vector<unsigned char>& drop, unsigned char* gas) {
+void ColonSegmenter::trim_rectal_tube(const std::vector<unsigned char>& face_dropped, unsigned char* gas) {
   const int u = (sup_axis_ + 1) % 3, v = (sup_axis_ + 2) % 3;
   const double pixel_mm2 = full_.sp[u] * full_.sp[v];
   const std::size_t limit = std::size_t(std::ceil(opts_.tube_area / pixel_mm2));
@@ -69,7 +69,7 @@ void ColonSegmenter::trim_rectal_tube(const std::uint32_t* glb, const std::vecto
   for (long b = 0; b < long(full_.n[v]); ++b)
     for (long a = 0; a < long(full_.n[u]); ++a) {
       const std::size_t q = slice_index(0, a, b);
-      if (!gas[q] || drop[glb[q]] || visited[std::size_t(b) * full_.n[u] + std::size_t(a)]) continue;
+      if (!gas[q] || face_dropped[std::size_t(b) * full_.n[u] + std::size_t(a)] || visited[std::size_t(b) * full_.n[u] + std::size_t(a)]) continue;
       const auto channel = slice_component(0, {{a, b}}, gas, limit);
       for (const auto& p : channel) visited[std::size_t(p.second) * full_.n[u] + std::size_t(p.first)] = 1;
       if (channel.size() < limit) trimmed += track_tube(channel, gas, sum);

@@ -57,7 +57,9 @@ struct SegmentStats {
   nlohmann::json decision_counts = nlohmann::json::array();  // every decision, grouped by reason: count, mL
   double time_s = 0, graph_cut_time_s = 0;
   double peak_memory_mib = 0;
-  nlohmann::json timings;  // seconds per step
+  nlohmann::json timings;  // seconds per step (wall clock)
+  double cpu_time_s = 0;        // user + system CPU time of the process during segment_colon (all threads)
+  nlohmann::json cpu_timings;   // user + system CPU seconds per step
   nlohmann::json to_json() const;
 };
 

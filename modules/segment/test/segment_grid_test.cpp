@@ -1,0 +1,109 @@
+// The segmentation's voxel-grid helpers against references: run labelling against
+// itk::ConnectedComponentImageFilter, box dilation / erosion and the streamed 3 x 3 x 3 mean against
+// brute force, on small random volumes.
+#include <gtest/gtest.h>
+#include <itkConnectedComponentImageFilter.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+
+#include "../src/segment_internal.h"
+
+namespace cf::segment_detail {
+namespace {
+
+Dims dims(std::size_t nx, std::size_t ny, std::size_t nz) {
+  const std::size_t n[3] = {nx, ny, nz};
+  const double sp[3] = {1, 1, 1};
+  return make_dims(n, sp);
+}
+
+Bytes random_mask(const Dims& d, double density, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::bernoulli_distribution on(density);
+  Bytes m(d.total);
+  for (auto& v : m) v = on(rng);
+  return m;
+}
+
+// Run labels carry the same label per voxel as ITK's connected components (same numbering), for a
+// mask with many irregular components.
+TEST(SegmentGrid, RunLabelsMatchItkConnectedComponents) {
+  const Dims d = dims(37, 29, 23);
+  const Bytes m = random_mask(d, 0.45, 7);
+  auto image = MaskImage::New();
+  image->SetRegions(MaskImage::SizeType{{d.n[0], d.n[1], d.n[2]}});
+  image->Allocate();
+  std::copy(m.begin(), m.end(), image->GetBufferPointer());
+  auto cc = itk::ConnectedComponentImageFilter<MaskImage, itk::Image<std::uint32_t, 3>>::New();
+  cc->SetInput(image);
+  cc->SetFullyConnected(false);
+  cc->SetNumberOfWorkUnits(2);
+  cc->Update();
+  const std::uint32_t* ref = cc->GetOutput()->GetBufferPointer();
+  const RunLabels runs = component_runs(m.data(), d);
+  ASSERT_EQ(runs.count(), cc->GetObjectCount());
+  ASSERT_GT(runs.count(), 10u);
+  std::vector<std::uint32_t> label(d.total, 0);
+  for (std::uint32_t l = 1; l <= runs.count(); ++l)
+    for (const segment_detail::Run* r = runs.begin(l); r != runs.end(l); ++r)
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) label[q] = l;
+  for (std::size_t q = 0; q < d.total; ++q) ASSERT_EQ(label[q], ref[q]) << "voxel " << q;
+}
+
+// Box dilation (and erosion, its dual) equals the brute-force maximum over the box.
+TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
+  const Dims d = dims(31, 26, 19);
+  const Bytes m = random_mask(d, 0.03, 11);
+  const int r[3] = {2, 1, 3};
+  Bytes dil = m, ero = random_mask(d, 0.9, 12);
+  const Bytes ero_in = ero;
+  dilate_box(dil, d, r);
+  erode_box(ero, d, r);
+  for (std::size_t q = 0; q < d.total; ++q) {
+    std::size_t c[3];
+    d.coords(q, c[0], c[1], c[2]);
+    bool any = false, all = true;
+    for (long dk = -r[2]; dk <= r[2]; ++dk)
+      for (long dj = -r[1]; dj <= r[1]; ++dj)
+        for (long di = -r[0]; di <= r[0]; ++di) {
+          const long i = long(c[0]) + di, j = long(c[1]) + dj, k = long(c[2]) + dk;
+          if (i < 0 || j < 0 || k < 0 || i >= long(d.n[0]) || j >= long(d.n[1]) || k >= long(d.n[2])) continue;
+          any = any || m[d.idx(i, j, k)];
+          all = all && ero_in[d.idx(i, j, k)];
+        }
+    ASSERT_EQ(bool(dil[q]), any) << "voxel " << q;
+    ASSERT_EQ(bool(ero[q]), all) << "voxel " << q;
+  }
+}
+
+// The streamed 3 x 3 x 3 mean equals the brute-force mean with clamped edges, every slice once.
+TEST(SegmentGrid, StreamedBoxMeanMatchesBruteForce) {
+  const Dims d = dims(17, 13, 11);
+  std::mt19937 rng(3);
+  std::normal_distribution<float> hu(40, 300);
+  std::vector<float> in(d.total);
+  for (auto& v : in) v = hu(rng);
+  std::vector<float> mean(d.total, NAN);
+  std::vector<int> calls(d.n[2], 0);
+  box_mean3_slices(in.data(), d, [&](std::size_t k, const float* slice) {
+    ++calls[k];
+    std::copy(slice, slice + d.n[0] * d.n[1], mean.begin() + long(k * d.n[0] * d.n[1]));
+  });
+  for (int c : calls) EXPECT_EQ(c, 1);
+  auto clamp = [](long v, std::size_t n) { return std::size_t(std::min(std::max(v, 0L), long(n) - 1)); };
+  for (std::size_t q = 0; q < d.total; ++q) {
+    std::size_t c[3];
+    d.coords(q, c[0], c[1], c[2]);
+    double sum = 0;
+    for (long dk = -1; dk <= 1; ++dk)
+      for (long dj = -1; dj <= 1; ++dj)
+        for (long di = -1; di <= 1; ++di)
+          sum += in[d.idx(clamp(long(c[0]) + di, d.n[0]), clamp(long(c[1]) + dj, d.n[1]), clamp(long(c[2]) + dk, d.n[2]))];
+    ASSERT_NEAR(mean[q], sum / 27.0, 1e-2) << "voxel " << q;
+  }
+}
+
+}  // namespace
+}  // namespace cf::segment_detail
