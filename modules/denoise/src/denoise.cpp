@@ -216,7 +216,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   nlohmann::json totals;
   const nlohmann::json loops = loops_report(res.loops, &totals);
   if (o.strict && totals["cap_intersections"].get<std::size_t>() > 0)
-    throw Error("denoise: --strict: " + totals["loops_with_cap_intersections"].dump() + " loop(s) have caps that intersect the surface (" +
+    throw CapIntersectionError("--strict: " + totals["loops_with_cap_intersections"].dump() + " loop(s) have caps that intersect the surface (" +
                 totals["cap_intersections"].dump() + " triangle pairs); see the report's loops[].cap_intersections");
   auto g = [](const TopologyReport& t) { return t.genus ? nlohmann::json(*t.genus) : nlohmann::json(nullptr); };
   res.report = {{"method", o.method},

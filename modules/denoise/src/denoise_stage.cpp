@@ -52,7 +52,13 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
       ctx.progress("denoise: " + std::to_string(removed) + "/" + std::to_string(total) + " handles removed");
     }
   };
-  DenoiseResult r = denoise(in, opts_, progress);
+  DenoiseResult r;
+  try {
+    r = denoise(in, opts_, progress);
+  } catch (const CapIntersectionError& e) {  // --strict: the error line names the input file
+    if (!bag.has("surface.file")) throw;  // not read from a file (pipeline run)
+    throw Error(bag.get<std::string>("surface.file") + ": " + e.problem());
+  }
   std::ostringstream msg;
   msg << "denoise: genus " << r.report["genus_before"].dump() << " -> " << r.report["genus_after"].dump() << ", "
       << r.loops.size() << " loops (" << r.report["stop_reason"].get<std::string>() << ")";

@@ -57,6 +57,7 @@ struct Slot {
   bool active = false;
   SourceBound bound;
   double own_limit = 0;  // limit of its last own search (the next one at least doubles it)
+  double group_radius = -1;  // mm: radius of the next group search around it (-1: the default)
 };
 
 class ExactGreedy {
@@ -81,6 +82,11 @@ class ExactGreedy {
   void spread_bounds(int centre_slot, double bound);
   void add_surgery_sources(const SurgeryResult& sr);
   void lower_bounds_near(const SurgeryResult& sr);
+  // exact_groups.cpp
+  std::vector<int> collect_group(int seed, double best, double radius, std::vector<int>* root_parent);
+  void search_group(int seed, double best);
+  void settle_group(const std::vector<int>& members, const CycleCandidate& c, double own, double best, double radius);
+  static constexpr double kGroupRadius = 0.5;  // first group radius, times the best known loop
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
                             int iteration);
@@ -125,6 +131,9 @@ class ExactGreedy {
   double far_value_ = 0;
   std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
   long long far_searches_ = 0;
+  long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0;
+  std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
+  std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;  // loops replaced by another of the same class (caps)
   double build_time_ = 0, search_time_at_build_ = 0;
   double largest_limit_ = 0;

@@ -3,6 +3,8 @@
 // between nearby sources (docs/denoise.md, "How it is fast").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <numeric>
 
@@ -105,6 +107,7 @@ CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(slot, SourceBound{own, c.found, v, 0});
+  if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "S fam %d cross %d bound %.3f limit %.2f best %.2f own %.3f found %d settled %zu\n", family, int(crossing_), slots_[slot].bound.value, limit, best_exact_value(), own, int(c.found), search_->last_settled());
   if (!want_type_) spread_bounds(slot, own);  // with a type filter F is no closed-walk minimum
   if (crossing_ && families_.size() == 2 && c.found) add_transversal_family(c);  // Z
   st_.t.search += sw.seconds();
@@ -142,8 +145,8 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
         continue;
       }
       const int far = want_type_ ? -1 : farthest_pending(best);
-      const int s = far >= 0 ? far : top.slot;
-      search_from(s, search_limit(s));
+      if (far >= 0) search_group(far, best);
+      else search_from(top.slot, search_limit(top.slot));
       continue;
     }
     // Exact and the smallest key: the global minimum if the value still holds on the current
@@ -151,6 +154,7 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
     // family exists (before, the top is the shortest cycle crossing A, which becomes Z).
     const CycleCandidate c = search_from(top.slot, top.key * (1 + 1e-12) + 1e-12);
     if (!c.found || c.value > top.key * (1 + 1e-12) + 1e-12) continue;  // re-queued with its new bound
+    if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "CUT %.3f\n", c.value);
     cut(top.slot, c, ++cuts);
     if (progress) progress(cuts, needed);
     if (cuts < needed && crossing_) leave_crossing_mode();
@@ -182,6 +186,9 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["settled_vertices"] = settled_;
   stats["bounds_spread"] = bounds_spread_;
   stats["farthest_first_searches"] = far_searches_;
+  stats["group_searches"] = group_searches_;
+  stats["group_members"] = group_members_;
+  stats["group_exact_bounds"] = group_exact_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["crossing_family_switches"] = crossing_modes_;

@@ -40,6 +40,7 @@ void ExactGreedy::deactivate_all_slots() {
   for (Slot& slot : slots_) {
     slot.bound = SourceBound{0, false, -1, slot.bound.version + 1};
     slot.own_limit = 0;
+    slot.group_radius = -1;
   }
   active_.clear();
 }
