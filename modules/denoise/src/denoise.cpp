@@ -21,6 +21,7 @@ void validate_denoise_options(const DenoiseOptions& o) {
   if (!(o.ring_pull >= 0 && o.ring_pull <= 0.5))
     throw UsageError("--ring-pull must be in [0, 0.5] (got " + format_number(o.ring_pull) + ")");
   if (!(o.initial_radius >= 0)) throw UsageError("--initial-radius must be >= 0");
+  if (o.threads < 1 || o.threads > 2) throw UsageError("--threads must be 1 or 2 (got " + std::to_string(o.threads) + ")");
   if (!(o.remove_stumps >= 0)) throw UsageError("--remove-stumps must be >= 0 (got " + format_number(o.remove_stumps) + ")");
   if (o.method == "paper" && o.remove_stumps > 0)
     throw UsageError("--remove-stumps needs --method exact (the paper's method is kept as published)");

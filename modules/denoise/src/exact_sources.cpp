@@ -20,6 +20,7 @@ void ExactGreedy::build_homology() {
   homology_.build(st_.mesh);
   span_.reset(homology_.words());
   search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  if (opts_.threads > 1) search2_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
   deactivate_all_slots();
   queue_ = {};
   exact_queue_ = {};
@@ -197,14 +198,14 @@ int ExactGreedy::farthest_pending(double best) {
 }
 
 // F(t) >= F(c) - 2 d(c, t) for every source t of c's family that the search from c settled.
-void ExactGreedy::spread_bounds(int centre_slot, double bound) {
+void ExactGreedy::spread_bounds(int centre_slot, double bound, const FundamentalCycleSearch& search) {
   const int centre = slots_[centre_slot].vertex;
   const Family& fam = families_[slots_[centre_slot].family];
-  for (int t : search_->last_settled_vertices()) {
+  for (int t : search.last_settled_vertices()) {
     if (t == centre || t >= static_cast<int>(fam.slot_of.size()) || fam.slot_of[t] < 0) continue;
     const int s = fam.slot_of[t];
     if (!slots_[s].active) continue;
-    const double lower = bound - 2.0 * search_->distance(t);
+    const double lower = bound - 2.0 * search.distance(t);
     if (!(lower > slots_[s].bound.value)) continue;  // also keeps dropped sources (inf) dropped
     set_bound(s, SourceBound{lower, false, centre, 0});
     ++bounds_spread_;

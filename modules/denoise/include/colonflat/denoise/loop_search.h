@@ -62,6 +62,11 @@ class FundamentalCycleSearch {
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
   std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
+  // The root whose tree holds the settled vertex v (the first vertex at distance 0 above it).
+  int root_of(int v) const {
+    while (dist_[v] > 0 && parent_[v] >= 0) v = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(parent_[v])).idx();
+    return v;
+  }
   std::size_t last_settled() const { return settled_count_; }
   // Vertices the last run() settled, nearest first, and their distances from its source (mm):
   // the ball whose geometry and classes the run's result depends on.
