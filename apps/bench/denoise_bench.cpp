@@ -11,7 +11,7 @@
 // of the row (both threads), the figure to compare when the machine is shared.
 // Run in Release: ./build/apps/denoise_bench [--quick] [--exact-only] [--only real|colon|shared|spheres]
 //   or one case: --sphere RADIUS HANDLES VOXEL, --colon VOXEL CONTACT_MM [OUT.vtp]
-// Environment: DENOISE_BENCH_THREADS=1 runs the exact method's search on one thread (default 2).
+// Environment: DENOISE_BENCH_THREADS=2 runs the exact method's search on two threads (default 1).
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>

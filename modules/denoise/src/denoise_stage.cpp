@@ -35,7 +35,7 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
     t.real("remove-stumps", &DenoiseOptions::remove_stumps, "mm",
            "remove the finger-like stumps up to this long that cutting thin strands leaves (0 = keep; exact only)", 0.0);
     t.integer("threads", &DenoiseOptions::threads, "",
-              "threads of the exact method's loop search (2: two independent searches at once; same loops)", 1, 2);
+              "threads of the exact method's loop search (2: two independent searches at once when they are large; same loops)", 1, 2);
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
            "first loop-search radius of the exact method (0 = 10 x mean edge length)", 0.0);
     return t;

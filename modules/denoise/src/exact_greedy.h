@@ -150,7 +150,11 @@ class ExactGreedy {
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
   std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;  // loops replaced by another of the same class (caps)
-  double build_time_ = 0, search_time_at_build_ = 0;
+  long long settled_at_build_ = 0;
+  // A rebuild once the searches since the last build settled this many times the vertex count
+  // (about two builds' worth of CPU: a build costs about as much as settling 1.3 n vertices;
+  // counted in work, not seconds, so that the result does not depend on the machine's load).
+  static constexpr double kRebuildWork = 2.5;
   double largest_limit_ = 0;
 };
 

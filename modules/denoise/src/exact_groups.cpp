@@ -9,8 +9,6 @@
 // counted as length 0, gives each of them F >= U at the cost of about two single searches.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "colonflat/core/run_stats.h"
 #include "exact_greedy.h"
@@ -76,7 +74,6 @@ void ExactGreedy::search_group(int seed, double best) {
     const int other = second_seed(seed, best, first);
     if (other >= 0) runs.push_back(prepare_group(other, best, first));
   }
-  if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "P pair %d runs %zu last %zu\n", int(pair), runs.size(), last_group_settled_);
   run_groups(runs);
   last_group_settled_ = search_->last_settled();
   for (std::size_t i = 0; i < runs.size(); ++i) finish_group(runs[i], i == 0 ? *search_ : *search2_, best);
@@ -128,7 +125,6 @@ void ExactGreedy::finish_group(const GroupRun& g, FundamentalCycleSearch& search
   largest_limit_ = std::max(largest_limit_, g.limit);
   slots_[g.seed].own_limit = g.limit;
   const double own = c.found ? c.value : c.truncated ? g.limit : kInf;
-  if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "G fam %d cross %d members %zu radius %.2f limit %.2f best %.2f own %.3f settled %zu\n", slots_[g.seed].family, int(crossing_), g.members.size(), g.radius, g.limit, best, own, search.last_settled());
   spread_bounds(g.seed, own, search);
   if (slots_[g.seed].bound.value < own) set_bound(g.seed, SourceBound{own, false, slots_[g.seed].vertex, 0});
   const std::vector<int>& slot_of = families_[slots_[g.seed].family].slot_of;

@@ -3,8 +3,6 @@
 // between nearby sources (docs/denoise.md, "How it is fast").
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <numeric>
 
@@ -108,7 +106,6 @@ CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(slot, SourceBound{own, c.found, v, 0});
-  if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "S fam %d cross %d bound %.3f limit %.2f best %.2f own %.3f found %d settled %zu\n", family, int(crossing_), slots_[slot].bound.value, limit, best_exact_value(), own, int(c.found), search_->last_settled());
   if (!want_type_) spread_bounds(slot, own, *search_);  // with a type filter F is no closed-walk minimum
   if (crossing_ && families_.size() == 2 && c.found) add_transversal_family(c);  // Z
   st_.t.search += sw.seconds();
@@ -156,7 +153,6 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
     // family exists (before, the top is the shortest cycle crossing A, which becomes Z).
     const CycleCandidate c = search_from(top.slot, top.key * (1 + 1e-12) + 1e-12);
     if (!c.found || c.value > top.key * (1 + 1e-12) + 1e-12) continue;  // re-queued with its new bound
-    if (std::getenv("DENOISE_TRACE")) std::fprintf(stderr, "CUT %.3f\n", c.value);
     cut(top.slot, c, ++cuts);
     if (progress) progress(cuts, needed);
     if (cuts < needed && crossing_) leave_crossing_mode();

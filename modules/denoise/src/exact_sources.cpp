@@ -28,9 +28,8 @@ void ExactGreedy::build_homology() {
   families_.resize(1);
   for (int v : homology_.pruned_cut_graph_vertices()) add_source(0, v);
   for (int s : active_) set_bound(s, kept[slots_[s].vertex]);
-  build_time_ = sw.seconds();
-  st_.t.homology += build_time_;
-  search_time_at_build_ = st_.t.search;
+  st_.t.homology += sw.seconds();
+  settled_at_build_ = settled_;
   ++builds_;
 }
 
@@ -48,10 +47,12 @@ void ExactGreedy::deactivate_all_slots() {
 
 // A fresh cut graph of the lower-genus mesh is much smaller than the old one plus every ring,
 // and searches start only from it; rebuilt once half the genus is gone, if searching has cost
-// more than two builds since the last one.
+// more than two builds since the last one (measured in settled vertices, kRebuildWork).
 void ExactGreedy::maybe_rebuild(int cuts, int total_genus) {
-  if (total_genus < 1 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
-  if (st_.t.search - search_time_at_build_ < 2 * build_time_) return;
+  // Not for the last handle: the crossing families start from the span family's bounds, which a
+  // rebuild would drop (colon-like 60 mm contact: 29.9 M settled vertices with, 16.7 M without).
+  if (total_genus < 2 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
+  if (double(settled_ - settled_at_build_) < kRebuildWork * double(st_.mesh.n_vertices())) return;
   build_homology();
   cuts_at_build_ = cuts;
   genus_at_build_ = total_genus;

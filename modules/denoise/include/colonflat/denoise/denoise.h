@@ -41,8 +41,8 @@ struct DenoiseOptions {
   bool check_caps = true;            // test each cap for intersections with the surface and try
                                      // other placements until none remains
   bool strict = false;               // fail (cf::Error) when a cap still intersects the surface
-  int threads = 2;                   // 1 or 2: "exact" runs two independent loop searches at once
-                                     // when searches are large (same loops either way)
+  int threads = 1;                   // 1 or 2: with 2, "exact" runs two independent loop searches
+                                     // at once when searches are large (same loops either way)
   double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
                                      // stumps up to this long that cutting thin strands leaves
                                      // (stumps.h); changes vertex ids
