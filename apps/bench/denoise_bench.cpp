@@ -11,6 +11,7 @@
 // of the row (both threads), the figure to compare when the machine is shared.
 // Run in Release: ./build/apps/denoise_bench [--quick] [--exact-only] [--only real|colon|shared|spheres]
 //   or one case: --sphere RADIUS HANDLES VOXEL, --colon VOXEL CONTACT_MM [OUT.vtp]
+// Environment: DENOISE_BENCH_THREADS=2 runs the exact method's search on two threads (default 1).
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -44,6 +45,7 @@ void row(const std::string& name, const Mesh& m, const std::string& method, int 
   if (g_exact_only && method != "exact") return;
   DenoiseOptions o;
   o.method = method;
+  if (const char* t = std::getenv("DENOISE_BENCH_THREADS")) o.threads = std::atoi(t);
   const int genus = *analyze_topology(m).genus;
   if (max_loops >= 0) o.target_genus = std::max(0, genus - max_loops);
   Stopwatch sw;
@@ -152,7 +154,9 @@ int main(int argc, char** argv) {
     Mesh m = bench::sphere_with_handles(std::atof(argv[2]), std::atoi(argv[3]), std::atof(argv[4]));
     Stopwatch sw;
     const std::clock_t cpu0 = std::clock();
-    DenoiseResult r = denoise(m, DenoiseOptions{});
+    DenoiseOptions o;
+    if (const char* t = std::getenv("DENOISE_BENCH_THREADS")) o.threads = std::atoi(t);
+    DenoiseResult r = denoise(m, o);
     std::printf("wall %.2f s, cpu %.2f s, peak %.0f MiB\n", sw.seconds(), double(std::clock() - cpu0) / CLOCKS_PER_SEC,
                 peak_memory_mib());
     std::printf("faces %zu genus %s -> %s\ntime %s\nsearch %s\n", m.n_faces(), r.report["genus_before"].dump().c_str(),

@@ -129,6 +129,7 @@ class StageTool : public Tool {
       const std::string& f = files.inputs.at(p.name);
       if (f.empty()) continue;
       bag.put(p.name, p.type->read(f));
+      bag.put(p.name + ".file", f);  // the file name, for error lines that name the input
       inputs[p.name] = f;
     }
     RunContext ctx;

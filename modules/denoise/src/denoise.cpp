@@ -21,6 +21,7 @@ void validate_denoise_options(const DenoiseOptions& o) {
   if (!(o.ring_pull >= 0 && o.ring_pull <= 0.5))
     throw UsageError("--ring-pull must be in [0, 0.5] (got " + format_number(o.ring_pull) + ")");
   if (!(o.initial_radius >= 0)) throw UsageError("--initial-radius must be >= 0");
+  if (o.threads < 1 || o.threads > 2) throw UsageError("--threads must be 1 or 2 (got " + std::to_string(o.threads) + ")");
   if (!(o.remove_stumps >= 0)) throw UsageError("--remove-stumps must be >= 0 (got " + format_number(o.remove_stumps) + ")");
   if (o.method == "paper" && o.remove_stumps > 0)
     throw UsageError("--remove-stumps needs --method exact (the paper's method is kept as published)");
@@ -216,7 +217,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   nlohmann::json totals;
   const nlohmann::json loops = loops_report(res.loops, &totals);
   if (o.strict && totals["cap_intersections"].get<std::size_t>() > 0)
-    throw Error("denoise: --strict: " + totals["loops_with_cap_intersections"].dump() + " loop(s) have caps that intersect the surface (" +
+    throw CapIntersectionError("--strict: " + totals["loops_with_cap_intersections"].dump() + " loop(s) have caps that intersect the surface (" +
                 totals["cap_intersections"].dump() + " triangle pairs); see the report's loops[].cap_intersections");
   auto g = [](const TopologyReport& t) { return t.genus ? nlohmann::json(*t.genus) : nlohmann::json(nullptr); };
   res.report = {{"method", o.method},

@@ -34,6 +34,8 @@ const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
            "fail (non-zero exit, no output) when a cap still intersects the surface after every placement; default: report it");
     t.real("remove-stumps", &DenoiseOptions::remove_stumps, "mm",
            "remove the finger-like stumps up to this long that cutting thin strands leaves (0 = keep; exact only)", 0.0);
+    t.integer("threads", &DenoiseOptions::threads, "",
+              "threads of the exact method's loop search (2: two independent searches at once when they are large; same loops)", 1, 2);
     t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
            "first loop-search radius of the exact method (0 = 10 x mean edge length)", 0.0);
     return t;
@@ -52,7 +54,13 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
       ctx.progress("denoise: " + std::to_string(removed) + "/" + std::to_string(total) + " handles removed");
     }
   };
-  DenoiseResult r = denoise(in, opts_, progress);
+  DenoiseResult r;
+  try {
+    r = denoise(in, opts_, progress);
+  } catch (const CapIntersectionError& e) {  // --strict: the error line names the input file
+    if (!bag.has("surface.file")) throw;  // not read from a file (pipeline run)
+    throw Error(bag.get<std::string>("surface.file") + ": " + e.problem());
+  }
   std::ostringstream msg;
   msg << "denoise: genus " << r.report["genus_before"].dump() << " -> " << r.report["genus_after"].dump() << ", "
       << r.loops.size() << " loops (" << r.report["stop_reason"].get<std::string>() << ")";

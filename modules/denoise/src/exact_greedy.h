@@ -12,6 +12,7 @@
 
 #include "colonflat/denoise/loop_search.h"
 #include "denoise_internal.h"
+#include "search_worker.h"
 
 namespace cf::detail {
 
@@ -57,6 +58,7 @@ struct Slot {
   bool active = false;
   SourceBound bound;
   double own_limit = 0;  // limit of its last own search (the next one at least doubles it)
+  double group_radius = -1;  // mm: radius of the next group search around it (-1: the default)
 };
 
 class ExactGreedy {
@@ -78,9 +80,25 @@ class ExactGreedy {
   void set_bound(int slot, const SourceBound& b);
   double best_exact_value();
   int farthest_pending(double best);
-  void spread_bounds(int centre_slot, double bound);
+  void spread_bounds(int centre_slot, double bound, const FundamentalCycleSearch& search);
   void add_surgery_sources(const SurgeryResult& sr);
   void lower_bounds_near(const SurgeryResult& sr);
+  // exact_groups.cpp
+  struct GroupRun {
+    int seed = -1;
+    double radius = 0, limit = 0;
+    std::vector<int> members, roots, root_parent;  // slots; their vertices; tree halfedges
+    CycleCandidate result;
+  };
+  std::vector<int> collect_group(int seed, double best, double radius, std::uint32_t taken,
+                                 std::vector<int>* root_parent);
+  GroupRun prepare_group(int seed, double best, std::uint32_t taken);
+  void search_group(int seed, double best);
+  void run_groups(std::vector<GroupRun>& runs);
+  void finish_group(const GroupRun& g, FundamentalCycleSearch& search, double best);
+  int second_seed(int seed, double best, std::uint32_t taken);
+  static constexpr double kGroupRadius = 0.5;       // first group radius, times the best known loop
+  static constexpr std::size_t kParallelFrom = 4000;  // settled vertices of the last group search
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
                             int iteration);
@@ -107,6 +125,9 @@ class ExactGreedy {
   HomologyBasis homology_;
   Z2Span span_;
   std::unique_ptr<FundamentalCycleSearch> search_;
+  std::unique_ptr<FundamentalCycleSearch> search2_;  // the second thread's (DenoiseOptions::threads > 1)
+  std::unique_ptr<SearchWorker> worker_;
+  std::size_t last_group_settled_ = 0;
   bool crossing_wanted_ = false;  // closed, total genus 1, policy shortest: use crossing families
   int closed_ = 0;               // mesh without boundary: 1, with: -1, unknown: 0
   bool crossing_ = false;         // crossing families in use (span family inactive)
@@ -125,8 +146,15 @@ class ExactGreedy {
   double far_value_ = 0;
   std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
   long long far_searches_ = 0;
+  long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
+  std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
+  std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;  // loops replaced by another of the same class (caps)
-  double build_time_ = 0, search_time_at_build_ = 0;
+  long long settled_at_build_ = 0;
+  // A rebuild once the searches since the last build settled this many times the vertex count
+  // (about two builds' worth of CPU: a build costs about as much as settling 1.3 n vertices;
+  // counted in work, not seconds, so that the result does not depend on the machine's load).
+  static constexpr double kRebuildWork = 2.5;
   double largest_limit_ = 0;
 };
 

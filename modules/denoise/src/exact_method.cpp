@@ -63,6 +63,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
 
 ExactGreedy::ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge)
     : st_(st), opts_(o), first_radius_(o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge) {
+  if (o.threads > 1) worker_ = std::make_unique<SearchWorker>();
   want_type_ = o.policy != "shortest";
   wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
   accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
@@ -105,7 +106,7 @@ CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(slot, SourceBound{own, c.found, v, 0});
-  if (!want_type_) spread_bounds(slot, own);  // with a type filter F is no closed-walk minimum
+  if (!want_type_) spread_bounds(slot, own, *search_);  // with a type filter F is no closed-walk minimum
   if (crossing_ && families_.size() == 2 && c.found) add_transversal_family(c);  // Z
   st_.t.search += sw.seconds();
   return c;
@@ -143,7 +144,8 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
       }
       const int far = want_type_ ? -1 : farthest_pending(best);
       const int s = far >= 0 ? far : top.slot;
-      search_from(s, search_limit(s));
+      if (!want_type_ && std::isfinite(best)) search_group(s, best);
+      else search_from(s, search_limit(s));
       continue;
     }
     // Exact and the smallest key: the global minimum if the value still holds on the current
@@ -182,6 +184,10 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["settled_vertices"] = settled_;
   stats["bounds_spread"] = bounds_spread_;
   stats["farthest_first_searches"] = far_searches_;
+  stats["group_searches"] = group_searches_;
+  stats["group_members"] = group_members_;
+  stats["group_exact_bounds"] = group_exact_;
+  stats["parallel_search_pairs"] = parallel_pairs_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["crossing_family_switches"] = crossing_modes_;

@@ -107,6 +107,9 @@ void HomologyBasis::build(const Mesh& mesh) {
   const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
+  // Room for the edges later surgeries add (set_edge_class): growing a vector of n_edges x words
+  // words by reallocation costs a copy of the whole table per growth.
+  ann_.reserve((mesh.n_edges() + mesh.n_edges() / 16 + 4096) * words_);
   ann_.assign(mesh.n_edges() * words_, 0);
   for (int i = 0; i < rank_; ++i) ann_[std::size_t(x_edges[i]) * words_ + i / 64] |= (1ull << (i % 64));
   // Leaf peeling of the dual forest: children before parents.
@@ -161,7 +164,7 @@ void HomologyBasis::prune_cut_graph(const Mesh& mesh) {
 
 void HomologyBasis::set_edge_class(Mesh::EdgeHandle e, const std::uint64_t* cls) {
   const std::size_t need = (std::size_t(e.idx()) + 1) * words_;
-  if (ann_.size() < need) ann_.resize(std::max(need, ann_.size() * 3 / 2), 0);
+  if (ann_.size() < need) ann_.resize(need, 0);  // within the reserve; beyond it the vector grows geometrically
   std::copy(cls, cls + words_, &ann_[std::size_t(e.idx()) * words_]);
 }
 

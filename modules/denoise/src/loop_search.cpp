@@ -24,7 +24,7 @@ void FundamentalCycleSearch::grow() {
   mark_.resize(cap, 0);
 }
 
-void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
+void FundamentalCycleSearch::reset_run() {
   grow();
   ++run_id_;
   if (run_id_ == 0) {  // wrapped: reset stamps
@@ -35,7 +35,22 @@ void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
   settled_order_.clear();
   acc_.clear();
   heap_.clear();
+}
+
+void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
+  reset_run();
   relax(s.idx(), 0.0, -1);
+}
+
+// Every root at distance 0 with its tree parent, so that expanding one never re-parents another.
+void FundamentalCycleSearch::start_roots(const std::vector<int>& roots, const std::vector<int>& root_parent) {
+  reset_run();
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    stamp_[roots[i]] = run_id_;
+    settled_flag_[roots[i]] = 0;
+    dist_[roots[i]] = 0.0;
+    parent_[roots[i]] = root_parent[i];
+  }
 }
 
 // Tentative distance d for w through parent halfedge `parent` (-1 at the source).
@@ -103,6 +118,26 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
   start(s);
   CycleCandidate best;
   best.source = s;
+  drain(limit, accept, frontier, best);
+  return best;
+}
+
+CycleCandidate FundamentalCycleSearch::run_group(const std::vector<int>& roots, const std::vector<int>& root_parent,
+                                                 double limit) {
+  start_roots(roots, root_parent);
+  CycleCandidate best;
+  best.source = Mesh::VertexHandle(roots.front());
+  for (int r : roots) {  // parents first: each root's class is its parent's XOR the tree edge's
+    settle(r);
+    expand(r, 0.0, limit, nullptr, best);
+  }
+  drain(limit, nullptr, false, best);
+  return best;
+}
+
+// Dijkstra until the queue is empty or the nearest unsettled vertex is beyond half the limit or
+// half the best cycle found.
+void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool frontier, CycleCandidate& best) {
   while (!heap_.empty()) {
     const auto [d, vi] = heap_.front();
     if (d > 0.5 * std::min(limit, best.value)) {
@@ -114,21 +149,26 @@ CycleCandidate FundamentalCycleSearch::run(Mesh::VertexHandle s, double limit, c
     heap_.pop_back();
     if (settled_flag_[vi] || d > dist_[vi]) continue;
     settle(vi);
-    const auto v = Mesh::VertexHandle(vi);
-    const Vec3& pv = mesh_.point(v);
-    const int parent_edge = parent_[vi] >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])).idx() : -1;
-    for (auto h : mesh_.voh_range(v)) {
-      const int wi = mesh_.to_vertex_handle(h).idx();
-      if (blocked_[wi] || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
-      const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
-      if (stamp_[wi] == run_id_ && settled_flag_[wi]) {  // non-tree edge between settled vertices
-        if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + dist_[wi], limit, accept, best);
-        continue;
-      }
-      relax(wi, d + len, h.idx());
-    }
+    expand(vi, d, limit, accept, best);
   }
-  return best;
+}
+
+// The edges out of the settled vertex vi (distance d): non-tree edges to settled vertices close
+// fundamental cycles, the others relax their end.
+void FundamentalCycleSearch::expand(int vi, double d, double limit, const Accept* accept, CycleCandidate& best) {
+  const auto v = Mesh::VertexHandle(vi);
+  const Vec3& pv = mesh_.point(v);
+  const int parent_edge = parent_[vi] >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])).idx() : -1;
+  for (auto h : mesh_.voh_range(v)) {
+    const int wi = mesh_.to_vertex_handle(h).idx();
+    if (blocked_[wi] || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
+    const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
+    if (stamp_[wi] == run_id_ && settled_flag_[wi]) {  // non-tree edge between settled vertices
+      if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + dist_[wi], limit, accept, best);
+      continue;
+    }
+    relax(wi, d + len, h.idx());
+  }
 }
 
 double FundamentalCycleSearch::frontier_bound() {

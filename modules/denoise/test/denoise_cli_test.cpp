@@ -136,6 +136,7 @@ TEST(DenoiseCli, StrictFailsWhenNoCleanCapExists) {
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(r.err.rfind("colonflat denoise: error: ", 0), 0u) << r.err;  // -q: nothing but the error line
   EXPECT_NE(r.err.find("--strict"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.rfind("colonflat denoise: error: " + dir.str("in.off") + ": --strict: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("intersect"), std::string::npos) << r.err;
   std::size_t error_lines = 0;
   std::istringstream lines(r.err);

@@ -134,6 +134,11 @@ TEST(DenoiseExact, GenusZeroAndInvalidOptions) {
   bad.method = "paper";
   bad.policy = "fill";
   EXPECT_THROW(denoise(s, bad), UsageError);
+  for (int threads : {0, 3}) {
+    bad = DenoiseOptions{};
+    bad.threads = threads;
+    EXPECT_THROW(denoise(s, bad), UsageError) << threads;
+  }
 }
 
 // The paper method refuses open meshes with an actionable message.

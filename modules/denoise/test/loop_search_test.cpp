@@ -2,6 +2,7 @@
 // non-separating cycle; loop types on a torus.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "brute_force.h"
@@ -116,6 +117,42 @@ TEST(DenoiseLoopSearch, CrossingCochainCountsIntersections) {
   const auto across_parallel = crossing_cochain(m, parallel(3));
   EXPECT_EQ(crossings(across_parallel, meridian(0)), 1);
   EXPECT_EQ(crossings(across_parallel, parallel(5)), 0);
+}
+
+// A multi-root search (tree edges of length 0) bounds F(t) from below for every root t, and its
+// value is F(root) exactly when both tree paths of its cycle lead to the same root: roots along a
+// stretch of the outer equator of a torus (every meridian through them has the same length) and
+// of a bumpy torus, as a path and as a single root, compared with one search per root.
+TEST(DenoiseLoopSearch, GroupSearchBoundsEveryRootAndIsExactAtItsRoot) {
+  const int nu = 40, nv = 10;
+  Mesh bumpy = to_mesh(torus(3, 1, nu, nv));
+  for (auto v : bumpy.vertices()) bumpy.point(v) *= 1.0 + 0.05 * std::sin(3.0 * v.idx());
+  const std::vector<Mesh> meshes{to_mesh(torus(3, 1, nu, nv)), bumpy};
+  for (const Mesh& mesh : meshes) {
+    const Mesh* m = &mesh;
+    HomologyBasis hb;
+    hb.build(*m);
+    Z2Span span(hb.words());
+    FundamentalCycleSearch search(*m, hb, span);
+    for (int count : {1, 2, 6, 15}) {
+      std::vector<int> roots, parents{-1};
+      for (int i = 0; i < count; ++i) roots.push_back(i * nv);
+      for (int i = 1; i < count; ++i) parents.push_back(m->find_halfedge(VH(roots[i - 1]), VH(roots[i])).idx());
+      double own_min = kInf;
+      std::vector<double> own(count);
+      for (int i = 0; i < count; ++i) own_min = std::min(own_min, own[i] = search.run(VH(roots[i]), 100).value);
+      const CycleCandidate g = search.run_group(roots, parents, 100);
+      ASSERT_TRUE(g.found) << count;
+      EXPECT_LE(g.value, own_min * (1 + 1e-12)) << count;
+      const int root = search.root_of(g.u.idx());
+      if (count == 1) EXPECT_EQ(root, roots[0]);
+      if (root == search.root_of(g.v.idx())) {
+        const int i = static_cast<int>(std::find(roots.begin(), roots.end(), root) - roots.begin());
+        ASSERT_LT(i, count);
+        EXPECT_NEAR(g.value, own[i], 1e-9 * own[i]) << count;
+      }
+    }
+  }
 }
 
 // On genus-1 surfaces whose loop must be certified against many sources, the search switches to

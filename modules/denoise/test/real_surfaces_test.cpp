@@ -87,6 +87,18 @@ TEST(DenoiseRealLike, MaxLoopLengthKeepsTheLongContactHandle) {
   EXPECT_GE(*r.after.genus, 1);
 }
 
+// Two threads (two group searches at once) cut loops of the same lengths as one thread on the
+// colon-like surface, whose long last loop needs large searches (so pairs do run).
+TEST(DenoiseRealLike, TwoThreadsCutLoopsOfTheSameLengths) {
+  const Mesh m = bench::colon_like_surface({1.0, 60, true, true, true});
+  DenoiseOptions one, two;
+  two.threads = 2;
+  const DenoiseResult a = denoise(m, one), b = denoise(m, two);
+  EXPECT_GT(b.report["search"]["parallel_search_pairs"].get<long long>(), 0);
+  ASSERT_EQ(a.loops.size(), b.loops.size());
+  for (std::size_t i = 0; i < a.loops.size(); ++i) EXPECT_NEAR(a.loops[i].length, b.loops[i].length, 1e-9) << i;
+}
+
 // The real GCA large-intestine surfaces (genus 1): one loop, clean caps (whole-mesh CGAL).
 TEST(DenoiseReal, GcaLargeIntestine) {
   for (const char* f : {"gca_large_intestine_20k.vtk", "gca_large_intestine_100k.vtk"}) {

@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/error.h"
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/params.h"
 #include "colonflat/core/topology.h"
@@ -40,6 +41,8 @@ struct DenoiseOptions {
   bool check_caps = true;            // test each cap for intersections with the surface and try
                                      // other placements until none remains
   bool strict = false;               // fail (cf::Error) when a cap still intersects the surface
+  int threads = 1;                   // 1 or 2: with 2, "exact" runs two independent loop searches
+                                     // at once when searches are large (same loops either way)
   double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
                                      // stumps up to this long that cutting thin strands leaves
                                      // (stumps.h); changes vertex ids
@@ -78,8 +81,19 @@ struct DenoiseResult {
 
 using DenoiseProgress = std::function<void(int removed, int total)>;
 
+// Thrown by denoise() with `strict` when caps still intersect the surface (exit code 1).
+// problem(): the message without the "denoise: " prefix, for callers that name the input file.
+class CapIntersectionError : public Error {
+ public:
+  explicit CapIntersectionError(const std::string& problem) : Error("denoise: " + problem), problem_(problem) {}
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string problem_;
+};
+
 // Throws PreconditionError on invalid input, UsageError on invalid options, Error when a
-// postcondition fails.
+// postcondition fails, CapIntersectionError when `strict` and a cap intersects the surface.
 DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {});
 
 // Validates options (ranges and choices); throws UsageError.

@@ -41,6 +41,15 @@ class FundamentalCycleSearch {
   // `accept` approves, when given). The search state is kept for extract().
   // With `frontier`, a truncated search without a loop also computes frontier_bound.
   CycleCandidate run(Mesh::VertexHandle s, double limit, const Accept* accept = nullptr, bool frontier = false);
+  // Multi-root search: one run from a tree T of roots whose edges count as length 0 (classes and
+  // cochain sums as they are). `roots` are vertex ids, `root_parent[i]` the halfedge from an
+  // earlier root to roots[i] (-1 for roots[0]). Every closed walk W through a root t extends
+  // (T-path to t, W, back) to a walk through roots[0] of the same class and no greater length,
+  // so the result's value M (or the limit when truncated without a loop) bounds F(t) from below
+  // for every root t, and F(t) >= M - 2 d(t, T) for every vertex t settled. When the extracted
+  // cycle uses no edge of T (its real length equals M), it is a real closed walk through its
+  // first vertex, a root: F(that root) = M exactly. Precondition: the roots are interior.
+  CycleCandidate run_group(const std::vector<int>& roots, const std::vector<int>& root_parent, double limit);
   // Cochain mode: with an edge cochain x (one flag per edge id), run() looks for cycles whose
   // edges have an odd sum of x instead of a class outside the span. That family also satisfies
   // the 3-path condition (the sum is additive), so the same fundamental-cycle argument holds.
@@ -53,6 +62,11 @@ class FundamentalCycleSearch {
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
   std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
+  // The root whose tree holds the settled vertex v (the first vertex at distance 0 above it).
+  int root_of(int v) const {
+    while (dist_[v] > 0 && parent_[v] >= 0) v = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(parent_[v])).idx();
+    return v;
+  }
   std::size_t last_settled() const { return settled_count_; }
   // Vertices the last run() settled, nearest first, and their distances from its source (mm):
   // the ball whose geometry and classes the run's result depends on.
@@ -62,6 +76,10 @@ class FundamentalCycleSearch {
  private:
   void grow();
   void start(Mesh::VertexHandle s);
+  void start_roots(const std::vector<int>& roots, const std::vector<int>& root_parent);
+  void reset_run();
+  void drain(double limit, const Accept* accept, bool frontier, CycleCandidate& best);
+  void expand(int vi, double d, double limit, const Accept* accept, CycleCandidate& best);
   void relax(int w, double d, int parent);
   void settle(int v);
   void try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept, CycleCandidate& best);
