@@ -12,16 +12,7 @@
 namespace cf {
 
 void validate_denoise_options(const DenoiseOptions& o) {
-  if (o.method != "exact" && o.method != "paper")
-    throw UsageError("--method must be exact or paper (got '" + o.method + "')");
-  if (o.policy != "shortest" && o.policy != "cut" && o.policy != "fill")
-    throw UsageError("--policy must be shortest, cut or fill (got '" + o.policy + "')");
-  if (!(o.max_loop_length > 0)) throw UsageError("--max-loop-length must be > 0 (got " + format_number(o.max_loop_length) + ")");
-  if (o.target_genus < 0) throw UsageError("--target-genus must be >= 0 (got " + std::to_string(o.target_genus) + ")");
-  if (!(o.ring_pull >= 0 && o.ring_pull <= 0.5))
-    throw UsageError("--ring-pull must be in [0, 0.5] (got " + format_number(o.ring_pull) + ")");
-  if (!(o.initial_radius >= 0)) throw UsageError("--initial-radius must be >= 0");
-  if (!(o.remove_stumps >= 0)) throw UsageError("--remove-stumps must be >= 0 (got " + format_number(o.remove_stumps) + ")");
+  denoise_param_table().validate(o);  // each parameter's range and choices
   if (o.method == "paper" && o.remove_stumps > 0)
     throw UsageError("--remove-stumps needs --method exact (the paper's method is kept as published)");
   if (o.method == "paper" && o.policy != "shortest")

@@ -35,25 +35,13 @@ const StageSpec& RenderStage::spec() const {
   return s;
 }
 
-const ParamTable<RenderOptions>& RenderStage::table() const {
-  static const ParamTable<RenderOptions> t = [] {
-    ParamTable<RenderOptions> t;
-    t.real("pixel-size", &RenderOptions::pixel_size, "mm", "pixel size of the colon image", 0.15, 10);
-    t.choice("color", &RenderOptions::color, {"shading", "curvature"},
-             "colon image colouring: shading (virtual dissection) or curvature (shape index) on top");
-    t.real("smooth-normal", &RenderOptions::smooth_normal, "mm", "scale of the reference normal for shading", 0.5, 100);
-    t.text("known-polyps", &RenderOptions::known_polyps,
-           "JSON list of known polyp positions (LPS mm; {center_lps_mm, diameter_mm, id} or [x,y,z]) to overlay");
-    t.flag("detect", &RenderOptions::detect, "detect polyp candidates (shape index, curvedness, region growing)");
-    t.flag("snapshots", &RenderOptions::snapshots, "render 3D snapshots off-screen (X display or Xvfb)");
-    t.integer("snapshot-size", &RenderOptions::snapshot_size, "px", "snapshot width and height", 64, 4096);
-    t.real("fit-radius", &RenderOptions::fit_radius, "mm", "neighbourhood of the curvature fit", 0.3, 20);
-    t.real("min-size", &RenderOptions::min_size, "mm", "smallest candidate diameter reported", 0, 100);
-    t.real("min-score", &RenderOptions::min_score, "", "smallest candidate score reported", 0, 1);
-    t.real("seed-si", &RenderOptions::seed_si, "", "shape index of candidate seeds", 0, 1);
+const ParamTable<RenderOptions>& render_param_table() {
+  static const ParamTable<RenderOptions> table = [](ParamTable<RenderOptions> t) {
+#define COLONFLAT_PARAMS "colonflat/render/render_params.def"
+#include "colonflat/core/params_as_rows.h"
     return t;
-  }();
-  return t;
+  }({});
+  return table;
 }
 
 void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {

@@ -30,20 +30,15 @@
 
 namespace cf {
 
+// The options of denoise: every field is a parameter declared once, with its default, unit, range and
+// help, in denoise_params.def (also the source of `colonflat denoise`'s options and docs/denoise.md's table).
 struct DenoiseOptions {
-  std::string method = "exact";      // exact | paper
-  std::string policy = "shortest";   // shortest | cut (handle loops only) | fill (tunnel loops only)
-  double max_loop_length = kInf;     // mm; only loops shorter than this are cut
-  int target_genus = 0;              // stop when the total genus reaches this
-  double ring_pull = 0.25;           // 0..0.5; how far each ring moves into its own side (0 = paper's caps)
-  double initial_radius = 0;         // mm; first search radius for "exact" (0 = 10 x mean edge length)
-  bool check_caps = true;            // test each cap for intersections with the surface and try
-                                     // other placements until none remains
-  bool strict = false;               // fail (cf::Error) when a cap still intersects the surface
-  double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
-                                     // stumps up to this long that cutting thin strands leaves
-                                     // (stumps.h); changes vertex ids
+#define COLONFLAT_PARAMS "colonflat/denoise/denoise_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
+
+// The table of DenoiseOptions (generated from denoise_params.def): option names, units, help, ranges.
+const ParamTable<DenoiseOptions>& denoise_param_table();
 
 struct LoopRecord {
   int id = 0;                   // 0-based, in cutting order
@@ -82,7 +77,8 @@ using DenoiseProgress = std::function<void(int removed, int total)>;
 // postcondition fails.
 DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {});
 
-// Validates options (ranges and choices); throws UsageError.
+// Validates options: the table's ranges and choices (denoise_param_table()), then the rules
+// between parameters; throws UsageError.
 void validate_denoise_options(const DenoiseOptions& o);
 
 }  // namespace cf
