@@ -19,24 +19,6 @@ void validate_denoise_options(const DenoiseOptions& o) {
     throw UsageError("--policy " + o.policy + " needs --method exact (the paper's method has no loop types)");
 }
 
-void describe_cross_section(LoopRecord* loop) {
-  const auto& p = loop->points;
-  if (p.empty()) return;
-  Vec3 c(0, 0, 0);
-  for (const auto& q : p) c += q;
-  c /= double(p.size());
-  Vec3 area(0, 0, 0);  // vector area: half the sum of (p_i - c) x (p_i+1 - c)
-  for (std::size_t i = 0; i < p.size(); ++i) area += OpenMesh::cross(p[i] - c, p[(i + 1) % p.size()] - c);
-  area *= 0.5;
-  double diameter = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t j = i + 1; j < p.size(); ++j) diameter = std::max(diameter, (p[i] - p[j]).sqrnorm());
-  loop->centroid = c;
-  loop->diameter_mm = std::sqrt(diameter);
-  loop->cross_section_area_mm2 = area.norm();
-  loop->cross_section_normal = area.norm() > 0 ? area / area.norm() : Vec3(0, 0, 0);
-}
-
 namespace {
 
 void check_input(const TopologyReport& b, const DenoiseOptions& o) {
