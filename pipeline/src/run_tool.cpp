@@ -1,4 +1,4 @@
-// `colonflat run [INPUT] -o OUTDIR`: chains the stages in memory (pipeline_stage_order()), then
+// `colonflat run [INPUT] -o OUTDIR`: chains the stages in memory (pipeline_stage_order(): from their ports), then
 // the finishers (the review report) on the artifacts still in memory. With `--prone PRONE`: both
 // scans, then the register tool's pair step (registration, supine-prone review) on their memory. Everything is checked
 // first (run_plan.cpp); outputs go to OUTDIR/.colonflat-staging-<pid>-<n>/ and are renamed into

@@ -14,6 +14,7 @@
 #include "colonflat/core/stage.h"
 #include "colonflat/pipeline/registry.h"
 #include "colonflat/testing/command.h"
+#include "colonflat/testing/files.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
 
@@ -45,10 +46,7 @@ void write_tube_mask(const fs::path& file) {
   write_mask(m, file);
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using testing::slurp;
 
 // The JSON the page embeds (window.REPORT = {...};).
 nlohmann::json page_data(const fs::path& html) {
@@ -61,15 +59,7 @@ nlohmann::json page_data(const fs::path& html) {
   return j;
 }
 
-// Every file below `dir`, relative to it.
-std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> v;
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) return v;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) v.push_back(e.path().lexically_relative(dir).string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
+using testing::listing;
 
 class RunReport : public ::testing::Test {
  protected:

@@ -25,6 +25,7 @@
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/pipeline/registry.h"
 #include "colonflat/testing/command.h"
+#include "colonflat/testing/files.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace cf::robust {
@@ -34,22 +35,11 @@ using testing::CommandResult;
 
 inline CommandResult colonflat(const std::vector<std::string>& args) { return testing::run_colonflat(args); }
 
-inline std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using testing::slurp;
 
 inline void spit(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
 
-// Every file below `dir` (recursively), as paths relative to it.
-inline std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> v;
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) return v;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) v.push_back(e.path().lexically_relative(dir).string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
+using testing::listing;  // every file below a folder, relative to it
 
 // Runs `colonflat ARGS` in a child process with the rights of the user nobody (uid and gid
 // 65534), so that folder permissions apply when the tests run as root (root ignores them). The

@@ -83,5 +83,65 @@ TEST(Params, CliBinding) {
   EXPECT_FALSE(o.verbose);
 }
 
+// Options declared from a parameter list (core/params_as_fields.h, params_as_rows.h).
+struct ListedOpts {
+#define COLONFLAT_PARAMS "colonflat/testing/params_example.def"
+#include "colonflat/core/params_as_fields.h"
+};
+
+ParamTable<ListedOpts> listed_table() {
+  ParamTable<ListedOpts> t;
+#define COLONFLAT_PARAMS "colonflat/testing/params_example.def"
+#include "colonflat/core/params_as_rows.h"
+  return t;
+}
+
+// One line of a parameter list gives the field with its default and the table row with the
+// option name (member with '-'), unit, help, range and choices.
+TEST(Params, ListDeclaresFieldDefaultAndTableRow) {
+  const ListedOpts defaults;
+  EXPECT_TRUE(std::isinf(defaults.max_loop_length));
+  EXPECT_EQ(defaults.target_genus, 2);
+  EXPECT_EQ(defaults.known_polyps, "");
+  EXPECT_EQ(defaults.method, "exact");
+  EXPECT_TRUE(defaults.check_caps);
+  const auto info = listed_table().info();
+  ASSERT_EQ(info.size(), 5u);
+  EXPECT_EQ(info[0].name, "max-loop-length");
+  EXPECT_EQ(info[0].describe(), "cut only loops shorter than this [mm] (default inf; range [1e-09, inf])");
+  EXPECT_EQ(info[1].describe(), "stop at this genus (default 2; range [0, inf])");
+  EXPECT_EQ(info[2].name, "known-polyps");
+  EXPECT_EQ(info[3].choices, (std::vector<std::string>{"exact", "paper"}));
+  EXPECT_EQ(info[4].default_text, "on");
+  ListedOpts o;
+  o.method = "other";
+  EXPECT_THROW(listed_table().validate(o), UsageError);
+  o = ListedOpts{};
+  o.max_loop_length = 0;
+  try {
+    listed_table().validate(o);
+    ADD_FAILURE() << "a length of 0 passed";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--max-loop-length must be >= 1e-09 (got 0)");
+  }
+  CLI::App app;
+  listed_table().add_to(app, o);
+  app.parse(std::vector<std::string>{"1", "--target-genus", "--no-check-caps"});  // CLI11: reversed
+  EXPECT_EQ(o.target_genus, 1);
+  EXPECT_FALSE(o.check_caps);
+}
+
+// The docs table: one row per parameter with option, default, unit, range and help; `|` escaped.
+TEST(Params, MarkdownTable) {
+  const std::string md = param_markdown(listed_table().info());
+  EXPECT_EQ(md,
+            "| option | default | unit | range | meaning |\n|---|---|---|---|---|\n"
+            "| `--max-loop-length FLOAT` | inf | mm | [1e-09, inf] | cut only loops shorter than this |\n"
+            "| `--target-genus INT` | 2 |  | [0, inf] | stop at this genus |\n"
+            "| `--known-polyps TEXT` | '' |  |  | JSON file of known polyps |\n"
+            "| `--method exact\\|paper` | exact |  |  | which method |\n"
+            "| `--check-caps` / `--no-check-caps` | on |  |  | check every cap |\n");
+}
+
 }  // namespace
 }  // namespace cf

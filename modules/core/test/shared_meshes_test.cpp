@@ -81,42 +81,40 @@ TEST(SharedMeshesManifest, IsPresent) {
   EXPECT_GE(read_manifest().size(), 20u) << "expected ../shared/meshes/MANIFEST.tsv beside the checkout";
 }
 
+// The diagnosis holds a finding `kind` counting `count` items.
+void expect_finding(const MeshDiagnosis& diag, const std::string& kind, std::size_t count) {
+  ASSERT_TRUE(diag.has(kind));
+  EXPECT_EQ(diag.find(kind)->count, count) << kind;
+}
+
 // Each BAD_ mesh gets its specific diagnosis, with the manifest's counts.
 TEST(SharedMeshesBad, SpecificDiagnoses) {
   const fs::path dir = fs::path(COLONFLAT_SHARED_DIR) / "meshes";
   {
     auto x = inspect(dir / "BAD_eight_open.off");
-    ASSERT_TRUE(x.diag.has("boundary_edges"));
-    EXPECT_EQ(x.diag.find("boundary_edges")->count, 96u);
-    ASSERT_TRUE(x.diag.has("coincident_vertices"));
-    EXPECT_EQ(x.diag.find("coincident_vertices")->count, 48u);
+    expect_finding(x.diag, "boundary_edges", 96u);
+    expect_finding(x.diag, "coincident_vertices", 48u);
   }
   {
     auto x = inspect(dir / "BAD_eight_hole.off");
-    ASSERT_TRUE(x.diag.has("boundary_edges"));
-    EXPECT_EQ(x.diag.find("boundary_edges")->count, 6u);
+    expect_finding(x.diag, "boundary_edges", 6u);
     EXPECT_EQ(x.topo.boundary_loops, 1u);
     EXPECT_FALSE(x.diag.has("nonmanifold_edges"));
   }
   {
     auto x = inspect(dir / "BAD_beast.off");
-    ASSERT_TRUE(x.diag.has("nonmanifold_edges"));
-    EXPECT_EQ(x.diag.find("nonmanifold_edges")->count, 2u);
-    ASSERT_TRUE(x.diag.has("nonmanifold_vertices"));
-    EXPECT_EQ(x.diag.find("nonmanifold_vertices")->count, 4u);
+    expect_finding(x.diag, "nonmanifold_edges", 2u);
+    expect_finding(x.diag, "nonmanifold_vertices", 4u);
   }
   {
     auto x = inspect(dir / "BAD_heptoroid_unwelded.off");
-    ASSERT_TRUE(x.diag.has("boundary_edges"));
-    EXPECT_EQ(x.diag.find("boundary_edges")->count, 11056u);
-    ASSERT_TRUE(x.diag.has("coincident_vertices"));
-    EXPECT_EQ(x.diag.find("coincident_vertices")->count, 5291u);
+    expect_finding(x.diag, "boundary_edges", 11056u);
+    expect_finding(x.diag, "coincident_vertices", 5291u);
     ASSERT_TRUE(x.diag.has("nonmanifold_vertices"));
   }
   {
     auto x = inspect(dir / "BAD_happy_vrip_res3.off");
-    ASSERT_TRUE(x.diag.has("nonmanifold_edges"));
-    EXPECT_EQ(x.diag.find("nonmanifold_edges")->count, 2816u);
+    expect_finding(x.diag, "nonmanifold_edges", 2816u);
     ASSERT_TRUE(x.diag.has("duplicate_faces"));
   }
 }

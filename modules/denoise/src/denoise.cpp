@@ -12,39 +12,11 @@
 namespace cf {
 
 void validate_denoise_options(const DenoiseOptions& o) {
-  if (o.method != "exact" && o.method != "paper")
-    throw UsageError("--method must be exact or paper (got '" + o.method + "')");
-  if (o.policy != "shortest" && o.policy != "cut" && o.policy != "fill")
-    throw UsageError("--policy must be shortest, cut or fill (got '" + o.policy + "')");
-  if (!(o.max_loop_length > 0)) throw UsageError("--max-loop-length must be > 0 (got " + format_number(o.max_loop_length) + ")");
-  if (o.target_genus < 0) throw UsageError("--target-genus must be >= 0 (got " + std::to_string(o.target_genus) + ")");
-  if (!(o.ring_pull >= 0 && o.ring_pull <= 0.5))
-    throw UsageError("--ring-pull must be in [0, 0.5] (got " + format_number(o.ring_pull) + ")");
-  if (!(o.initial_radius >= 0)) throw UsageError("--initial-radius must be >= 0");
-  if (o.threads < 1 || o.threads > 2) throw UsageError("--threads must be 1 or 2 (got " + std::to_string(o.threads) + ")");
-  if (!(o.remove_stumps >= 0)) throw UsageError("--remove-stumps must be >= 0 (got " + format_number(o.remove_stumps) + ")");
+  denoise_param_table().validate(o);  // each parameter's range and choices
   if (o.method == "paper" && o.remove_stumps > 0)
     throw UsageError("--remove-stumps needs --method exact (the paper's method is kept as published)");
   if (o.method == "paper" && o.policy != "shortest")
     throw UsageError("--policy " + o.policy + " needs --method exact (the paper's method has no loop types)");
-}
-
-void describe_cross_section(LoopRecord* loop) {
-  const auto& p = loop->points;
-  if (p.empty()) return;
-  Vec3 c(0, 0, 0);
-  for (const auto& q : p) c += q;
-  c /= double(p.size());
-  Vec3 area(0, 0, 0);  // vector area: half the sum of (p_i - c) x (p_i+1 - c)
-  for (std::size_t i = 0; i < p.size(); ++i) area += OpenMesh::cross(p[i] - c, p[(i + 1) % p.size()] - c);
-  area *= 0.5;
-  double diameter = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t j = i + 1; j < p.size(); ++j) diameter = std::max(diameter, (p[i] - p[j]).sqrnorm());
-  loop->centroid = c;
-  loop->diameter_mm = std::sqrt(diameter);
-  loop->cross_section_area_mm2 = area.norm();
-  loop->cross_section_normal = area.norm() > 0 ? area / area.norm() : Vec3(0, 0, 0);
 }
 
 namespace {

@@ -17,34 +17,16 @@ const StageSpec& DenoiseStage::spec() const {
   return s;
 }
 
-const ParamTable<DenoiseOptions>& DenoiseStage::table() const {
-  static const ParamTable<DenoiseOptions> t = [] {
-    ParamTable<DenoiseOptions> t;
-    t.choice("method", &DenoiseOptions::method, {"exact", "paper"},
-             "exact: shortest non-separating loop each step; paper: the seed paper's Algorithms 1-4");
-    t.choice("policy", &DenoiseOptions::policy, {"shortest", "cut", "fill"},
-             "which loops: shortest of any type, handle loops only (cut), tunnel loops only (fill)");
-    t.real("max-loop-length", &DenoiseOptions::max_loop_length, "mm", "cut only loops shorter than this", 1e-9);
-    t.integer("target-genus", &DenoiseOptions::target_genus, "", "stop when the total genus reaches this", 0);
-    t.real("ring-pull", &DenoiseOptions::ring_pull, "",
-           "fraction of the way each cut ring moves into its own side (separates the two caps; 0 = paper)", 0.0, 0.5);
-    t.flag("check-caps", &DenoiseOptions::check_caps,
-           "check every cap for intersections with the surface and try other placements");
-    t.flag("strict", &DenoiseOptions::strict,
-           "fail (non-zero exit, no output) when a cap still intersects the surface after every placement; default: report it");
-    t.real("remove-stumps", &DenoiseOptions::remove_stumps, "mm",
-           "remove the finger-like stumps up to this long that cutting thin strands leaves (0 = keep; exact only)", 0.0);
-    t.integer("threads", &DenoiseOptions::threads, "",
-              "threads of the exact method's loop search (2: two independent searches at once when they are large; same loops)", 1, 2);
-    t.real("initial-radius", &DenoiseOptions::initial_radius, "mm",
-           "first loop-search radius of the exact method (0 = 10 x mean edge length)", 0.0);
+const ParamTable<DenoiseOptions>& denoise_param_table() {
+  static const ParamTable<DenoiseOptions> table = [](ParamTable<DenoiseOptions> t) {
+#define COLONFLAT_PARAMS "colonflat/denoise/denoise_params.def"
+#include "colonflat/core/params_as_rows.h"
     return t;
-  }();
-  return t;
+  }({});
+  return table;
 }
 
 void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
-  validate_denoise_options(opts_);
   const Mesh& in = bag.get<Mesh>("surface");
   int last_shown = -1;
   auto progress = [&](int removed, int total) {

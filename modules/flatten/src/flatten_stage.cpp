@@ -18,37 +18,13 @@ const StageSpec& FlattenStage::spec() const {
   return s;
 }
 
-const ParamTable<FlattenOptions>& FlattenStage::table() const {
-  static const ParamTable<FlattenOptions> t = [] {
-    ParamTable<FlattenOptions> t;
-    t.real("end-cut-radius", &FlattenOptions::end_cut_radius, "mm",
-           "geodesic radius of the cap opened at each closed end (at most 10% of the segment length)", 0.0, 1000.0);
-    t.real("min-segment-fraction", &FlattenOptions::min_segment_fraction, "",
-           "skip components with fewer faces than this fraction of the largest", 0.0, 1.0);
-    t.real("segment-gap", &FlattenOptions::segment_gap, "mm", "gap between segment rectangles in the layout", 0.0,
-           1000.0);
-    t.choice("weights", &FlattenOptions::weights, {"auto", "cotan", "clamped"},
-             "Laplacian weights: cotan; clamped (negative cotangents clamped, never flips in practice); auto = "
-             "cotan, clamped if cotan flips a triangle");
-    t.choice("map", &FlattenOptions::map, {"area-balanced", "conformal"},
-             "area-balanced: x from the rectal end (0) to the cecal end (= centreline length), each slice as wide "
-             "as its wall area, out-of-bounds regions corrected locally (bijective); conformal: the pure conformal "
-             "(holomorphic 1-form) map");
-    t.real("area-ratio-low", &FlattenOptions::area_ratio_low, "",
-           "area-balanced: faces whose 2D/3D area ratio is below this are corrected", 0.0, 1.0);
-    t.real("area-ratio-high", &FlattenOptions::area_ratio_high, "",
-           "area-balanced: faces whose 2D/3D area ratio is above this are corrected", 1.0, 1000.0);
-    t.integer("balance-iterations", &FlattenOptions::balance_iterations, "",
-              "area-balanced: symmetric-Dirichlet descent steps per correction pass (0: no correction)", 0, 10000);
-    t.real("coverage-min-ratio", &FlattenOptions::coverage_min_ratio, "",
-           "a face counts as shown on the image when its 2D/3D area ratio is at least this", 0.0, 1.0);
-    t.real("branch-min-area", &FlattenOptions::branch_min_area, "mm^2",
-           "area-balanced: a pouch behind a neck that the conformal map collapses over at least this wall area "
-           "(diverticulum, blind colon loop) is cut at its neck and shown as a band of its own (0: never)",
-           0.0, 1e7);
+const ParamTable<FlattenOptions>& flatten_param_table() {
+  static const ParamTable<FlattenOptions> table = [](ParamTable<FlattenOptions> t) {
+#define COLONFLAT_PARAMS "colonflat/flatten/flatten_params.def"
+#include "colonflat/core/params_as_rows.h"
     return t;
-  }();
-  return t;
+  }({});
+  return table;
 }
 
 void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {

@@ -13,19 +13,13 @@
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/flatten_stage.h"
 #include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace cf {
 namespace {
 
-synthetic::ColonOptions small_colon() {
-  synthetic::ColonOptions o;
-  o.length = 300;
-  o.radius = 18;
-  o.spacing = 1.2;
-  o.polyps = {{80, 0.5, 8}, {200, 2.5, 10}};
-  return o;
-}
+synthetic::ColonOptions small_colon() { return synthetic::colon_options(300, 18, 1.2, {{80, 0.5, 8}, {200, 2.5, 10}}); }
 
 // An open cylinder maps to a rectangle: length = height, period = circumference, ratio ~1, no flips.
 TEST(FlattenCylinder, MapsToRectangleWithAspectLengthOverCircumference) {
@@ -126,15 +120,8 @@ TEST(FlattenFlatFile, RoundTrip) {
   EXPECT_THROW(read_flat(tmp / "bad.vtp"), InputError);
 }
 
-struct Cli {
-  int code;
-  std::string out, err;
-};
-Cli flatten_cli(const std::vector<std::string>& args) {
-  auto tool = make_stage_tool(make_flatten_stage);
-  std::ostringstream out, err;
-  const int code = tool->run(args, out, err);
-  return {code, out.str(), err.str()};
+testing::CommandResult flatten_cli(const std::vector<std::string>& args) {
+  return testing::run_stage_command(make_flatten_stage, args);
 }
 
 // `colonflat flatten` writes the flat map and a report with 0 flipped triangles.

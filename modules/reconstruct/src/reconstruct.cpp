@@ -25,39 +25,12 @@
 namespace cf {
 
 const ParamTable<ReconstructOptions>& reconstruct_param_table() {
-  static const ParamTable<ReconstructOptions> t = [] {
-    ParamTable<ReconstructOptions> t;
-    t.choice("method", &ReconstructOptions::method, {"flying-edges", "discrete-flying-edges", "marching-cubes"},
-             "VTK isosurface filter run on the binary mask (all give the same closed manifold surface)");
-    t.real("min-component-volume", &ReconstructOptions::min_component_volume, "mm^3",
-           "drop surface components enclosing less than this (noise, tiny air pockets or cavities)", 0.0);
-    t.choice("subvoxel", &ReconstructOptions::subvoxel, {"auto", "ct", "mask", "off"},
-             "sub-voxel surface: ct = the CT's air/tissue boundary inside the mask, mask = the constrained-"
-             "smoothed mask, auto = ct when a CT is given else mask, off = the binary staircase; the surface "
-             "stays < 1/2 voxel from the staircase");
-    t.choice("mask-smoothing", &ReconstructOptions::mask_smoothing, {"sinc", "antialias"},
-             "sub-voxel surface of the mask: sinc = windowed-sinc smoothing of the staircase mesh, antialias = "
-             "Whitaker's constrained curvature flow on the voxels (ITK, slower) before it; both kept within "
-             "1/2 voxel");
-    t.integer("antialias-iterations", &ReconstructOptions::antialias_iterations, "",
-              "mask field: at most this many iterations of Whitaker's constrained curvature flow (ITK anti-alias)",
-              1, 2000);
-    t.real("antialias-rms", &ReconstructOptions::antialias_rms, "voxel",
-           "mask field: stop when the RMS level-set change per iteration falls below this", 0.0001, 0.5);
-    t.real("air-tissue-hu", &ReconstructOptions::air_tissue_hu, "HU",
-           "CT boundary between lumen air and the wall (partial-volume midpoint)", -950.0, -100.0);
-    t.real("fluid-hu", &ReconstructOptions::fluid_hu, "HU",
-           "lumen voxels at or above are tagged fluid: near them the smoothed mask is used, not the CT", -100.0, 3000.0);
-    t.integer("smoothing-iterations", &ReconstructOptions::smoothing_iterations, "",
-              "windowed-sinc mesh smoothing iterations after extraction (moves points only; with a sub-voxel "
-              "surface each vertex is kept within 1/2 voxel of its staircase position; 0 = off)", 0, 1000);
-    t.real("pass-band", &ReconstructOptions::pass_band, "", "windowed-sinc pass band (smaller = smoother)", 0.001,
-           2.0);
-    t.integer("target-faces", &ReconstructOptions::target_faces, "",
-              "topology-preserving quadric decimation to about this many triangles (0 = off)", 0);
+  static const ParamTable<ReconstructOptions> table = [](ParamTable<ReconstructOptions> t) {
+#define COLONFLAT_PARAMS "colonflat/reconstruct/reconstruct_params.def"
+#include "colonflat/core/params_as_rows.h"
     return t;
-  }();
-  return t;
+  }({});
+  return table;
 }
 
 void validate(const ReconstructOptions& o) {

@@ -12,6 +12,7 @@
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include "colonflat/reconstruct/reconstruct_stage.h"
+#include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
 #include "mask_components.h"
@@ -69,15 +70,8 @@ TEST(ReconstructPhantom, SmallPhantomSurfaceIsFaithful) { check_phantom(false); 
 // With a collapsed stretch the lumen falls into separate segments: one surface component each.
 TEST(ReconstructPhantom, CollapsedPhantomGivesOneComponentPerSegment) { check_phantom(true); }
 
-struct Result {
-  int code;
-  std::string out, err;
-};
-Result call(const std::vector<std::string>& args) {
-  auto tool = make_stage_tool([] { return make_reconstruct_stage(); });
-  std::ostringstream out, err;
-  const int code = tool->run(args, out, err);
-  return {code, out.str(), err.str()};
+testing::CommandResult call(const std::vector<std::string>& args) {
+  return testing::run_stage_command([] { return make_reconstruct_stage(); }, args);
 }
 
 MaskImage::Pointer block_mask(bool empty) {

@@ -23,6 +23,13 @@ using namespace testing::masks;
 using P3 = std::array<double, 3>;
 using Distance = std::function<double(const P3&)>;  // signed distance to the analytic surface, mm
 
+// Signed distance to the sphere of centre c and radius r (mm).
+Distance sphere_distance(const P3& c, double r) {
+  return [c, r](const P3& p) {
+    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2])) - r;
+  };
+}
+
 ReconstructOptions with_subvoxel(const std::string& mode, int sinc_iterations = ReconstructOptions{}.smoothing_iterations,
                                  const std::string& smoothing = ReconstructOptions{}.mask_smoothing) {
   ReconstructOptions o;
@@ -140,9 +147,7 @@ TEST(ReconstructSubvoxel, SphereIsCloserAndWithinHalfAVoxel) {
   s.spacing = {0.82, 0.82, 1.25};
   const P3 c{12.1, 11.9, 13.4};
   const double R = 8.7;
-  const Distance sphere = [&](const P3& p) {
-    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2])) - R;
-  };
+  const Distance sphere = sphere_distance(c, R);
   auto mask = rasterize(s, [&](const P3& p) { return sphere(p) <= 0; });
   const auto everywhere = [](const P3&) { return true; };
   const Mesh raw = reconstruct_surface(mask, with_subvoxel("off", 0));
@@ -203,9 +208,7 @@ TEST(ReconstructSubvoxel, CtBoundaryWithinAFifthOfAVoxel) {
   const P3 c{11.3, 11.6, 11.45};
   const double R = 7.3;
   const SyntheticCt data = partial_volume_ball(s, c, R);
-  const Distance sphere = [&](const P3& p) {
-    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2])) - R;
-  };
+  const Distance sphere = sphere_distance(c, R);
   const auto everywhere = [](const P3&) { return true; };
   ReconstructStats st;
   const Mesh surf = reconstruct_surface(data.mask, data.ct, with_subvoxel("auto"), &st);
@@ -231,9 +234,7 @@ TEST(ReconstructSubvoxel, TaggedFluidFallsBackToTheMask) {
   const P3 c{11.3, 11.6, 11.45};
   const double R = 7.3, z_fluid = 9.0;
   const SyntheticCt data = partial_volume_ball(s, c, R, z_fluid);
-  const Distance sphere = [&](const P3& p) {
-    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2])) - R;
-  };
+  const Distance sphere = sphere_distance(c, R);
   ReconstructStats st;
   const Mesh surf = reconstruct_surface(data.mask, data.ct, with_subvoxel("ct"), &st);
   EXPECT_GT(st.fluid_voxels, 100u);

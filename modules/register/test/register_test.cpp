@@ -38,6 +38,13 @@ Errors vertex_errors(const SyntheticPair& pair, const ColonRegistration& reg) {
   return {percentile(along, 0.5), percentile(along, 0.95), percentile(around, 0.5), double(mapped) / double(total)};
 }
 
+// A synthetic pair and its registration (default options), run.
+struct RegisteredPair {
+  explicit RegisteredPair(SyntheticPair p) : pair(std::move(p)), reg(pair.supine, pair.prone) { reg.run(); }
+  SyntheticPair pair;
+  ColonRegistration reg;
+};
+
 // Every true polyp pair is matched to its own id, and no pair joins different ids.
 void expect_polyps_paired(const SyntheticPair& pair, const ColonRegistration& reg) {
   int correct = 0;
@@ -50,11 +57,10 @@ void expect_polyps_paired(const SyntheticPair& pair, const ColonRegistration& re
 
 // Registering a scan to itself maps every vertex onto itself and pairs every candidate with itself.
 TEST(RegisterSynthetic, IdentityPairMapsVerticesOntoThemselves) {
-  SyntheticPair pair = make_synthetic_pair({});
-  pair.prone = pair.supine;
-  pair.prone_sigma = pair.supine_sigma, pair.prone_phi = pair.supine_phi;
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  SyntheticPair input = make_synthetic_pair({});
+  input.prone = input.supine;
+  input.prone_sigma = input.supine_sigma, input.prone_phi = input.supine_phi;
+  auto&& [pair, reg] = RegisteredPair(std::move(input));
   const Errors e = vertex_errors(pair, reg);
   EXPECT_LT(e.along_median, 1.0);
   EXPECT_LT(e.around_median_deg, 2.0);
@@ -65,9 +71,7 @@ TEST(RegisterSynthetic, IdentityPairMapsVerticesOntoThemselves) {
 // A deformed prone scan (middle shifted 40 mm, wall slid +-15 mm along the colon): small
 // along/around errors, every polyp paired with itself, the one-scan-only candidates left single.
 TEST(RegisterSynthetic, DeformedPairWithCentrelineIsAligned) {
-  const SyntheticPair pair = make_synthetic_pair({});
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair({}));
   const Errors e = vertex_errors(pair, reg);
   EXPECT_LT(e.along_median, 5.0);
   EXPECT_LT(e.along_p95, 15.0);
@@ -84,9 +88,7 @@ TEST(RegisterSynthetic, FallbackFindsReversedProneOrientation) {
   SyntheticPairOptions o;
   o.centreline = false;
   o.reverse_prone = true;
-  const SyntheticPair pair = make_synthetic_pair(o);
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair(o));
   EXPECT_TRUE(reg.prone_reversed());
   const Errors e = vertex_errors(pair, reg);
   EXPECT_LT(e.along_median, 6.0);
@@ -99,9 +101,7 @@ TEST(RegisterSynthetic, FallbackFindsReversedProneOrientation) {
 TEST(RegisterSynthetic, RotationAroundTheColonIsRecovered) {
   SyntheticPairOptions o;
   o.twist_deg = 25;
-  const SyntheticPair pair = make_synthetic_pair(o);
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair(o));
   EXPECT_LT(vertex_errors(pair, reg).around_median_deg, 10.0);
   RegisterOptions off;
   off.twist.max_twist_deg = 0;
@@ -113,9 +113,7 @@ TEST(RegisterSynthetic, RotationAroundTheColonIsRecovered) {
 // LPS points map between the scans: each polyp's supine centre lands within 6 mm of its prone
 // centre, and back.
 TEST(RegisterSynthetic, LpsPointMapLandsOnTheSamePolyp) {
-  const SyntheticPair pair = make_synthetic_pair({});
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair({}));
   for (const auto& q : pair.polyps) {
     EXPECT_LT((reg.map_lps(q.supine_lps, Direction::kSupineToProne) - q.prone_lps).norm(), 6.0) << "polyp " << q.id;
     EXPECT_LT((reg.map_lps(q.prone_lps, Direction::kProneToSupine) - q.supine_lps).norm(), 6.0) << "polyp " << q.id;
@@ -124,9 +122,7 @@ TEST(RegisterSynthetic, LpsPointMapLandsOnTheSamePolyp) {
 
 // The length map is strictly increasing and its inverse undoes it.
 TEST(RegisterSynthetic, LengthMapIsMonotoneAndInvertible) {
-  const SyntheticPair pair = make_synthetic_pair({});
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair({}));
   const auto& l = reg.length();
   for (size_t k = 1; k < l.b_mm.size(); ++k) EXPECT_GT(l.b_mm[k], l.b_mm[k - 1]);
   for (double s = 0; s < 500; s += 37) EXPECT_NEAR(l.b_to_a(l.a_to_b(s)), s, 1e-6);
@@ -134,10 +130,9 @@ TEST(RegisterSynthetic, LengthMapIsMonotoneAndInvertible) {
 
 // A prone candidate four times the size of its supine partner is not paired; both stay single.
 TEST(RegisterCandidates, SizeMismatchIsNotPaired) {
-  SyntheticPair pair = make_synthetic_pair({});
-  pair.prone.candidates[0].size_mm *= 4;
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  SyntheticPair input = make_synthetic_pair({});
+  input.prone.candidates[0].size_mm *= 4;
+  auto&& [pair, reg] = RegisteredPair(std::move(input));
   for (const auto& m : reg.matching().pairs) EXPECT_NE(m.supine_id, 1);
   EXPECT_EQ(reg.matching().supine_only.size(), 2u);
   EXPECT_EQ(reg.matching().prone_only.size(), 2u);
@@ -145,9 +140,7 @@ TEST(RegisterCandidates, SizeMismatchIsNotPaired) {
 
 // A pair's score is raised above both candidates' own scores.
 TEST(RegisterCandidates, PairScoreIsRaised) {
-  const SyntheticPair pair = make_synthetic_pair({});
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  auto&& [pair, reg] = RegisteredPair(make_synthetic_pair({}));
   ASSERT_FALSE(reg.matching().pairs.empty());
   for (const auto& m : reg.matching().pairs) EXPECT_NEAR(m.score, 1 - 0.3 * 0.3, 1e-9);
 }

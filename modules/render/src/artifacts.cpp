@@ -5,7 +5,6 @@
 #include <vtkPNGReader.h>
 #include <vtkPNGWriter.h>
 #include <vtkPolyData.h>
-#include <vtkXMLPolyDataReader.h>
 
 #include <fstream>
 
@@ -56,28 +55,6 @@ const ArtifactType& json_artifact() {
       [](const std::filesystem::path& p) { return std::any(read_json_file(p)); },
       [](const std::any& v, const std::filesystem::path& tmp, const std::filesystem::path&) {
         write_text_atomically(tmp, std::any_cast<const nlohmann::json&>(v).dump(2) + "\n");
-      }};
-  return t;
-}
-
-const ArtifactType& polylines_artifact() {
-  static const ArtifactType t{
-      "loops", "polylines (.vtp), e.g. the cut loops of denoise",
-      [](const std::filesystem::path& p) {
-        if (!std::filesystem::exists(p)) throw InputError(p.string(), "no such file");
-        VtkMessageCapture msgs;
-        vtkNew<vtkXMLPolyDataReader> r;
-        r->SetFileName(p.c_str());
-        r->Update();
-        if (!msgs.first_problem().empty() || r->GetErrorCode() != 0)
-          throw InputError(p.string(), "cannot read VTK XML PolyData: " +
-                                           (msgs.first_problem().empty() ? std::string("parse error") : msgs.first_problem()));
-        PolylinesPtr pd = PolylinesPtr::New();
-        pd->DeepCopy(r->GetOutput());
-        return std::any(pd);
-      },
-      [](const std::any&, const std::filesystem::path& tmp, const std::filesystem::path& target) {
-        throw Error(target.string() + ": the render stage does not write polylines");
       }};
   return t;
 }

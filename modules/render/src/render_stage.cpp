@@ -3,6 +3,7 @@
 #include <vtkImageData.h>
 #include <vtkPolyData.h>
 
+#include "colonflat/core/loops.h"
 #include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/progress.h"
@@ -10,11 +11,6 @@
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/render/artifacts.h"
 #include "colonflat/render/snapshot.h"
-
-#ifdef COLONFLAT_RENDER_HAVE_DENOISE
-#include "colonflat/core/atomic_file.h"
-#include "colonflat/denoise/loops_io.h"
-#endif
 
 namespace cf {
 
@@ -24,7 +20,7 @@ const StageSpec& RenderStage::spec() const {
       "2D colon-wall image with polyp candidates, candidate JSON, 3D snapshots",
       {{"flat", &flat_artifact(), "flat colon map (from flatten)", "flat.vtp"},
        {"surface", &mesh_artifact(), "surface before denoising (snapshot)", "surface.vtp", false},
-       {"loops", &polylines_artifact(), "cut loops of denoise (snapshot)", "loops.vtp", false},
+       {"loops", &loops_artifact(), "cut loops of denoise (snapshot)", "loops.vtp", false},
        {"denoised", &mesh_artifact(), "surface after denoising (snapshot)", "denoised.vtp", false}},
       {{"colon_image", &png_image_artifact(), "2D colon-wall image", "colon.png"},
        {"candidates", &json_artifact(), "polyp candidates (3D and 2D positions, size, score)", "candidates.json"},
@@ -35,25 +31,13 @@ const StageSpec& RenderStage::spec() const {
   return s;
 }
 
-const ParamTable<RenderOptions>& RenderStage::table() const {
-  static const ParamTable<RenderOptions> t = [] {
-    ParamTable<RenderOptions> t;
-    t.real("pixel-size", &RenderOptions::pixel_size, "mm", "pixel size of the colon image", 0.15, 10);
-    t.choice("color", &RenderOptions::color, {"shading", "curvature"},
-             "colon image colouring: shading (virtual dissection) or curvature (shape index) on top");
-    t.real("smooth-normal", &RenderOptions::smooth_normal, "mm", "scale of the reference normal for shading", 0.5, 100);
-    t.text("known-polyps", &RenderOptions::known_polyps,
-           "JSON list of known polyp positions (LPS mm; {center_lps_mm, diameter_mm, id} or [x,y,z]) to overlay");
-    t.flag("detect", &RenderOptions::detect, "detect polyp candidates (shape index, curvedness, region growing)");
-    t.flag("snapshots", &RenderOptions::snapshots, "render 3D snapshots off-screen (X display or Xvfb)");
-    t.integer("snapshot-size", &RenderOptions::snapshot_size, "px", "snapshot width and height", 64, 4096);
-    t.real("fit-radius", &RenderOptions::fit_radius, "mm", "neighbourhood of the curvature fit", 0.3, 20);
-    t.real("min-size", &RenderOptions::min_size, "mm", "smallest candidate diameter reported", 0, 100);
-    t.real("min-score", &RenderOptions::min_score, "", "smallest candidate score reported", 0, 1);
-    t.real("seed-si", &RenderOptions::seed_si, "", "shape index of candidate seeds", 0, 1);
+const ParamTable<RenderOptions>& render_param_table() {
+  static const ParamTable<RenderOptions> table = [](ParamTable<RenderOptions> t) {
+#define COLONFLAT_PARAMS "colonflat/render/render_params.def"
+#include "colonflat/core/params_as_rows.h"
     return t;
-  }();
-  return t;
+  }({});
+  return table;
 }
 
 void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
@@ -71,25 +55,9 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   bag.put("candidates", r.candidates_json);
   if (!opts_.snapshots) return;
   try {
-    PolylinesPtr loops;
-    if (bag.has("loops")) {
-      if (const auto* lp = std::any_cast<PolylinesPtr>(&bag.raw("loops"))) loops = *lp;
-#ifdef COLONFLAT_RENDER_HAVE_DENOISE
-      else if (const auto* ls = std::any_cast<LoopSet>(&bag.raw("loops"))) {
-        // through denoise's writer and our reader: exactly what `colonflat render --loops` sees
-        const auto tmp = temp_sibling(std::filesystem::temp_directory_path() / "colonflat_render_loops.vtp");
-        write_loops(*ls, tmp);
-        try {
-          loops = std::any_cast<PolylinesPtr>(polylines_artifact().read(tmp));
-        } catch (...) {
-          std::filesystem::remove(tmp);
-          throw;
-        }
-        std::filesystem::remove(tmp);
-      }
-#endif
-      else ctx.report["snapshot_note"] = "loops artifact of another type: not drawn";
-    }
+    // denoise's loops, in memory in `colonflat run` or read from --loops: drawn as polylines
+    vtkSmartPointer<vtkPolyData> loops;
+    if (bag.has("loops")) loops = loops_to_polydata(bag.get<LoopSet>("loops"));
     SnapshotOptions so;
     so.width = so.height = opts_.snapshot_size;
     if (bag.has("surface")) {

@@ -16,12 +16,7 @@ namespace cf {
 namespace {
 
 synthetic::ColonOptions polyp_colon() {
-  synthetic::ColonOptions o;
-  o.length = 420;
-  o.radius = 20;
-  o.spacing = 0.8;
-  o.polyps = {{45, 0.3, 6}, {115, 2.0, 8}, {185, 4.0, 10}, {255, 1.0, 12}, {325, 5.5, 7}};
-  return o;
+  return synthetic::colon_options(420, 20, 0.8, {{45, 0.3, 6}, {115, 2.0, 8}, {185, 4.0, 10}, {255, 1.0, 12}, {325, 5.5, 7}});
 }
 
 std::vector<KnownPolyp> truth(const synthetic::Colon& c) {

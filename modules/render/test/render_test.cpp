@@ -23,18 +23,14 @@
 #include "colonflat/render/artifacts.h"
 #include "colonflat/render/render_stage.h"
 #include "colonflat/render/snapshot.h"
+#include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace cf {
 namespace {
 
 synthetic::Colon test_colon() {
-  synthetic::ColonOptions o;
-  o.length = 300;
-  o.radius = 18;
-  o.spacing = 0.8;
-  o.polyps = {{45, 0.3, 8}, {150, 3.0, 10}, {220, 5.0, 7}};
-  return synthetic::colon(o);
+  return synthetic::colon(synthetic::colon_options(300, 18, 0.8, {{45, 0.3, 8}, {150, 3.0, 10}, {220, 5.0, 7}}));
 }
 
 const unsigned char* at(vtkImageData* img, int col, int row_from_top) {
@@ -203,15 +199,8 @@ TEST(RenderSnapshot, OffScreenWithoutDisplay) {
   EXPECT_GT(red, 50);
 }
 
-struct Cli {
-  int code;
-  std::string out, err;
-};
-Cli render_cli(const std::vector<std::string>& args) {
-  auto tool = make_stage_tool(make_render_stage);
-  std::ostringstream out, err;
-  const int code = tool->run(args, out, err);
-  return {code, out.str(), err.str()};
+testing::CommandResult render_cli(const std::vector<std::string>& args) {
+  return testing::run_stage_command(make_render_stage, args);
 }
 
 // `colonflat render` writes the colon PNG, the candidate JSON and both snapshots.

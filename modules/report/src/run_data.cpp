@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 
+#include "colonflat/core/candidate_list.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/stage.h"
 #include "colonflat/core/vtk_messages.h"
@@ -24,13 +25,6 @@ namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
-
-std::array<double, 3> lps_of(const nlohmann::json& c, const std::string& name) {
-  for (const char* key : {"position_lps_mm", "center_lps_mm"})
-    if (c.contains(key) && c[key].is_array() && c[key].size() == 3)
-      return {c[key][0].get<double>(), c[key][1].get<double>(), c[key][2].get<double>()};
-  throw InputError(name, "a candidate has no position_lps_mm [L, P, S]");
-}
 
 // flat.vtp (read here unless `pd` holds it already) with the optional contract-1 extras
 // (centreline_mm, FlatSegments as written).
@@ -106,14 +100,14 @@ void set_flat(RunData& run, FlatMap flat) {
 }
 
 void load_candidates(RunData& run) {
-  for (const char* name : {"candidates.json", "polyps.json"}) {
-    if (!fs::exists(run.dir / name)) continue;
-    run.candidates_file = name;
-    run.candidates_doc = read_json_file(run.dir / name);
-    run.candidates = candidates_from_json(run.candidates_doc, (run.dir / name).string());
+  const fs::path file = find_candidate_file(run.dir);
+  if (file.empty()) {
+    run.warnings.push_back("no candidates.json (nor polyps.json) in the run folder: no candidate cards");
     return;
   }
-  run.warnings.push_back("no candidates.json (nor polyps.json) in the run folder: no candidate cards");
+  run.candidates_file = file.filename().string();
+  run.candidates_doc = read_json_file(file);
+  run.candidates = candidates_from_json(run.candidates_doc, file.string());
 }
 
 void load_truth(RunData& run, const RunLoadOptions& opts) {
@@ -146,23 +140,14 @@ void complete_run(RunData& run, const RunLoadOptions& opts) {
 }  // namespace
 
 std::vector<ReportFinding> candidates_from_json(const nlohmann::json& doc, const std::string& name) {
-  const nlohmann::json* list = &doc;
-  if (doc.is_object()) {
-    if (!doc.contains("candidates") || !doc["candidates"].is_array())
-      throw InputError(name, "no \"candidates\" list");
-    list = &doc["candidates"];
-  } else if (!doc.is_array()) {
-    throw InputError(name, "expected a JSON object with a \"candidates\" list");
-  }
   std::vector<ReportFinding> out;
-  for (const auto& c : *list) {
-    if (!c.is_object()) throw InputError(name, "a candidate is not a JSON object");
+  for (const CandidateEntry& c : candidate_list_from_json(doc, name)) {
     ReportFinding f;
-    f.id = c.value("id", int(out.size()) + 1);
+    f.id = c.id;
     f.key = "P" + std::to_string(f.id);
-    f.lps_mm = lps_of(c, name);
-    f.size_mm = c.value("size_mm", 0.0);
-    f.score = c.value("score", 0.0);
+    f.lps_mm = c.lps_mm;
+    f.size_mm = c.size_mm;
+    f.score = c.score.value_or(0.0);
     out.push_back(f);
   }
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.score > b.score; });

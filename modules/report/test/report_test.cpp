@@ -196,7 +196,7 @@ TEST(ReportTool, RejectsBadInputWithoutPartialOutput) {
   std::ofstream(tmp / "run" / "candidates.json") << "{\"candidates\": [{\"id\": 1}]}";
   r = run_report_tool({(tmp / "run").string(), "--quiet"});
   EXPECT_EQ(r.code, 3);
-  EXPECT_NE(r.err.find("candidates.json: a candidate has no position_lps_mm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("candidates.json: candidate 1 has no position_lps_mm"), std::string::npos) << r.err;
   for (const auto& e : fs::directory_iterator(tmp / "run")) {
     const std::string name = e.path().filename().string();
     EXPECT_TRUE(name.rfind("report", 0) != 0 && name.rfind(".report", 0) != 0) << name;

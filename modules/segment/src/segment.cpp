@@ -49,28 +49,10 @@ nlohmann::json SegmentStats::to_json() const {
 }
 
 void validate(const SegmentOptions& o) {
-  auto check = [](bool ok, const std::string& what) {
-    if (!ok) throw UsageError(what);
-  };
-  auto num = [](double v) { return " (got " + format_number(v) + ")"; };
-  check(o.air_threshold >= -1000 && o.air_threshold <= -200, "--air-threshold must be in [-1000, -200] HU" + num(o.air_threshold));
-  check(o.fluid_threshold >= 50 && o.fluid_threshold <= 1000, "--fluid-threshold must be in [50, 1000] HU" + num(o.fluid_threshold));
-  check(o.fluid_max > o.fluid_threshold && o.fluid_max <= 4000, "--fluid-max must be above --fluid-threshold and <= 4000 HU" + num(o.fluid_max));
-  check(o.interface_width >= 0 && o.interface_width <= 20, "--interface-width must be in [0, 20] mm" + num(o.interface_width));
-  check(o.level_tolerance >= 0.5 && o.level_tolerance <= 50, "--level-tolerance must be in [0.5, 50] mm" + num(o.level_tolerance));
-  check(o.band_width >= 0.5 && o.band_width <= 10, "--band-width must be in [0.5, 10] mm" + num(o.band_width));
-  check(o.smoothness >= 0 && o.smoothness <= 10, "--smoothness must be in [0, 10]" + num(o.smoothness));
-  check(o.edge_sigma >= 1 && o.edge_sigma <= 2000, "--edge-sigma must be in [1, 2000] HU" + num(o.edge_sigma));
-  check(o.min_segment_volume >= 0 && o.min_segment_volume <= 5000, "--min-segment-volume must be in [0, 5000] mL" + num(o.min_segment_volume));
-  check(o.min_colon_volume >= 0 && o.min_colon_volume <= 10000, "--min-colon-volume must be in [0, 10000] mL" + num(o.min_colon_volume));
-  check(o.min_segment_fraction >= 0 && o.min_segment_fraction <= 1, "--min-segment-fraction must be in [0, 1]" + num(o.min_segment_fraction));
-  check(o.max_segments >= 1 && o.max_segments <= 100, "--max-segments must be in [1, 100] (got " + std::to_string(o.max_segments) + ")");
-  check(o.min_tagged_volume >= 0.5 && o.min_tagged_volume <= 1000, "--min-tagged-volume must be in [0.5, 1000] mL" + num(o.min_tagged_volume));
-  check(o.link_gap >= 0 && o.link_gap <= 100, "--link-gap must be in [0, 100] mm" + num(o.link_gap));
-  check(o.tube_area >= 0 && o.tube_area <= 2000, "--tube-area must be in [0, 2000] mm^2" + num(o.tube_area));
-  static const std::vector<std::string> positions = {"auto", "levels", "supine", "prone", "left-down", "right-down"};
-  check(std::find(positions.begin(), positions.end(), o.position) != positions.end(),
-        "--position must be one of auto, levels, supine, prone, left-down, right-down (got '" + o.position + "')");
+  segment_param_table().validate(o);  // each parameter's range and choices
+  if (!(o.fluid_max > o.fluid_threshold))
+    throw UsageError("--fluid-max must be above --fluid-threshold (got " + format_number(o.fluid_max) + " <= " +
+                     format_number(o.fluid_threshold) + ")");
 }
 
 MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, SegmentStats* stats_out) {

@@ -14,6 +14,25 @@ namespace {
 
 double tube_dist(double y, double z, double cy, double cz) { return std::sqrt((y - cy) * (y - cy) + (z - cz) * (z - cz)); }
 
+// The small-volume options, with fully tagged stretches from `min_tagged_ml` mL on.
+SegmentOptions tagged_options(double min_tagged_ml) {
+  SegmentOptions o = small_volume_options();
+  o.min_tagged_volume = min_tagged_ml;
+  return o;
+}
+
+struct Segmented {
+  MaskImage::Pointer mask;
+  SegmentStats stats;
+};
+
+// segment_colon with its statistics.
+Segmented segment_small(const CtImage::Pointer& ct, const SegmentOptions& o = small_volume_options()) {
+  Segmented r;
+  r.mask = segment_colon(ct, o, &r.stats);
+  return r;
+}
+
 bool has_decision(const SegmentStats& st, const std::string& decision, const std::string& reason_part,
                   const std::string& what_part = "") {
   for (const auto& d : st.decisions)
@@ -33,10 +52,7 @@ TEST(SegmentRules, FullyTaggedTubeBetweenGasTubesKept) {
     if (x >= 77 && x <= 92) return -1000.0;
     return kKeep;
   }, 0.6, 10);
-  SegmentOptions o = small_volume_options();
-  o.min_tagged_volume = 2;
-  SegmentStats st;
-  auto m = segment_colon(ct, o, &st);
+  auto [m, st] = segment_small(ct, tagged_options(2));
   EXPECT_EQ(st.tagged_stretches, 1) << st.to_json().dump(1);
   std::size_t inside = 0, kept = 0;
   for (int x = 48; x <= 67; ++x)
@@ -60,10 +76,7 @@ TEST(SegmentRules, ContrastLoopBesideColonRejected) {
       if (x >= 20 && x <= 70 && tube_dist(y, z, 60, 50) < 7) return bubble && y < 56 ? -1000.0 : 450.0;
       return kKeep;
     }, 0.6, 10);
-    SegmentOptions o = small_volume_options();
-    o.min_tagged_volume = 2;
-    SegmentStats st;
-    auto m = segment_colon(ct, o, &st);
+    auto [m, st] = segment_small(ct, tagged_options(2));
     EXPECT_EQ(st.tagged_stretches, 0);
     std::size_t loop_kept = 0;
     for (int x = 20; x <= 70; ++x)
@@ -86,8 +99,7 @@ TEST(SegmentRules, ProneFluidLevelsRecognised) {
   for (const char* header : {"", "HFP"}) {
     SCOPED_TRACE(header);
     set_patient_position(ct.GetPointer(), header);
-    SegmentStats st;
-    auto m = segment_colon(ct, small_volume_options(), &st);
+    auto [m, st] = segment_small(ct);
     EXPECT_EQ(st.gravity, "-y (anterior)");
     EXPECT_NE(st.gravity_source.find(*header ? "PatientPosition HFP" : "fluid levels"), std::string::npos) << st.gravity_source;
     EXPECT_EQ(components(m), 1u);
@@ -97,8 +109,7 @@ TEST(SegmentRules, ProneFluidLevelsRecognised) {
   }
   // The same volume declared supine: the fluid lies above the gas, which no pool does.
   set_patient_position(ct.GetPointer(), "HFS");
-  SegmentStats st;
-  auto m = segment_colon(ct, small_volume_options(), &st);
+  auto [m, st] = segment_small(ct);
   EXPECT_EQ(st.gravity, "+y (posterior)");
   EXPECT_FALSE(at(m, 32, 22, 32));
 }
@@ -112,8 +123,7 @@ TEST(SegmentRules, RectalTubeTrimmedRectumKept) {
     if (z < 20 && d < 2) return -1000.0;               // tube lumen down to the inferior face
     return kKeep;
   }, 0.6, 10);
-  SegmentStats st;
-  auto m = segment_colon(ct, small_volume_options(), &st);
+  auto [m, st] = segment_small(ct);
   EXPECT_TRUE(at(m, 40, 40, 40));
   EXPECT_TRUE(at(m, 30, 40, 22));
   for (int z = 0; z < 16; ++z) EXPECT_FALSE(at(m, 40, 40, z)) << z;
@@ -137,10 +147,7 @@ TEST(SegmentRules, ThinTubeAtColonEndRejectedByCalibre) {
       if (x >= 47 && x <= 80 && d < radius) return 500.0;
       return kKeep;
     }, 0.6, 10);
-    SegmentOptions o = small_volume_options();
-    o.min_tagged_volume = 1;
-    SegmentStats st;
-    auto m = segment_colon(ct, o, &st);
+    auto [m, st] = segment_small(ct, tagged_options(1));
     EXPECT_EQ(st.tagged_stretches, radius > 5 ? 1 : 0) << st.to_json()["decisions"].dump(1);
     EXPECT_EQ(at(m, 70, 50, 50), radius > 5);
     if (radius < 5) EXPECT_TRUE(has_decision(st, "rejected", "calibre")) << st.to_json()["decisions"].dump(1);
@@ -160,8 +167,7 @@ TEST(SegmentRules, CatheterInsideRectumExcluded) {
     if (z >= 15 && z <= 65 && d < 16) return -1000.0;  // rectum
     return kKeep;
   }, 0.6, 10);
-  SegmentStats st;
-  auto m = segment_colon(ct, small_volume_options(), &st);
+  auto [m, st] = segment_small(ct);
   for (int z = 0; z <= 32; ++z) EXPECT_FALSE(at(m, 40, 40, z)) << "channel kept at z " << z;
   for (int z = 18; z <= 32; ++z) EXPECT_FALSE(at(m, 43, 40, z)) << "wall kept at z " << z;
   EXPECT_TRUE(at(m, 50, 40, 25));  // rectal gas beside the catheter

@@ -17,6 +17,7 @@
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/segment/segment.h"
 #include "colonflat/segment/segment_stage.h"
+#include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "segment_volumes.h"
 
@@ -228,15 +229,8 @@ TEST(SegmentPhantom, CollapsedColonTwoSegments) {
   EXPECT_GE(dice(m, p.lumen), 0.99);
 }
 
-struct Run {
-  int code;
-  std::string out, err;
-};
-Run run_segment(const std::vector<std::string>& args) {
-  auto tool = make_stage_tool([] { return make_segment_stage(); });
-  std::ostringstream out, err;
-  const int code = tool->run(args, out, err);
-  return {code, out.str(), err.str()};
+testing::CommandResult run_segment(const std::vector<std::string>& args) {
+  return testing::run_stage_command([] { return make_segment_stage(); }, args);
 }
 
 // The DICOM-series and NRRD forms of the same phantom give identical masks (via `colonflat segment`).

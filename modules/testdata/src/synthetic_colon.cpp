@@ -222,4 +222,13 @@ void ColonBuilder::ground_truth() {
 
 Colon colon(const ColonOptions& o) { return ColonBuilder(o).run(); }
 
+ColonOptions colon_options(double length, double radius, double spacing, std::vector<PolypSpec> polyps) {
+  ColonOptions o;
+  o.length = length;
+  o.radius = radius;
+  o.spacing = spacing;
+  o.polyps = std::move(polyps);
+  return o;
+}
+
 }  // namespace cf::synthetic

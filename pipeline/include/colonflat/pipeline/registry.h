@@ -9,7 +9,9 @@
 
 namespace cf {
 
-// The order in which `colonflat run` chains stages; stages not built yet are skipped.
+// The order in which `colonflat run` chains the registered stages, derived from their ports: a
+// stage comes after every stage that outputs one of its input ports (same port name); ties keep
+// the registration (module) order. Throws cf::Error if the ports form a cycle.
 const std::vector<std::string>& pipeline_stage_order();
 
 // Generated from the modules' registrations (pipeline/CMakeLists.txt).

@@ -1,7 +1,7 @@
 #pragma once
 // The polyp candidate lists the stages exchange (contract 2): render's candidates.json
 // ({"candidates": [...], ...}; called polyps.json before) and the phantom's truth polyps.json (a
-// plain list, or {"polyps": [...]}). One reader for every consumer (register; report can follow).
+// plain list, or {"polyps": [...]}). One reader for every consumer (register, report).
 //
 //   for (const cf::CandidateEntry& c : cf::read_candidate_list(dir / "candidates.json")) ...
 #include <array>

@@ -1,9 +1,20 @@
 #pragma once
-// Declared parameters (the VMTK member table, in C++): each Options field is declared once with
-// its name, unit, help and range; the command line, --help, range checks and JSON round-trips
-// all come from that one declaration. Defaults are the field initialisers of Options{}.
+// Declared parameters (the VMTK member table, in C++). A stage's parameters are declared ONCE, one
+// line each, in a parameter list `<stage>_params.def` beside its header:
 //
-//   struct Options { double max_loop_length = kInf;  // mm; only loops shorter than this };
+//   // member            default  unit  min   max   help
+//   CF_REAL(max_loop_length, kInf, "mm", 1e-9, kInf, "cut only loops shorter than this")
+//   CF_INT(target_genus,     0,    "",   0,    kIntMax, "stop when the total genus reaches this")
+//   CF_TEXT(known_polyps,    "",   "JSON list of known polyps")
+//   CF_CHOICE(method, "exact", ("exact", "paper"), "exact: ...; paper: ...")
+//   CF_FLAG(strict,   false,   "fail when a cap still intersects the surface")
+//
+// From that list come the Options struct's fields with their defaults (core/params_as_fields.h)
+// and the ParamTable (core/params_as_rows.h): the command line (--max-loop-length, --[no-]strict),
+// --help, range checks, --params-in/--params-out JSON, the run report and the parameter table of
+// the stage's docs page (`colonflat help --markdown STAGE`, scripts/update_param_docs.py).
+// A ParamTable can also be written by hand:
+//
 //   ParamTable<Options> t;
 //   t.real("max-loop-length", &Options::max_loop_length, "mm", "cut only loops shorter", 0.0);
 #include <CLI/CLI.hpp>
@@ -22,6 +33,7 @@
 namespace cf {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kIntMax = std::numeric_limits<int>::max();
 
 struct ParamInfo {
   std::string name;          // CLI name without dashes; JSON key
@@ -32,13 +44,21 @@ struct ParamInfo {
   std::optional<double> min, max;
   std::vector<std::string> choices;
   std::string describe() const;  // help line: "help [mm] (default 5; range [0, inf])"
+  std::string range_text() const;  // "[0, inf]"; empty when unbounded
 };
 
 std::string format_number(double v);
 
+// The option name of a parameter list's member: '_' -> '-' (max_loop_length -> max-loop-length).
+std::string param_option_name(const std::string& member);
+
+// The Markdown table of parameters for a docs page: option, default, unit, range, meaning.
+std::string param_markdown(const std::vector<ParamInfo>& params);
+
 template <class O>
 class ParamTable {
  public:
+  using options_type = O;
   ParamTable& real(const std::string& name, double O::*m, const std::string& unit, const std::string& help,
                    double min = -kInf, double max = kInf) {
     ParamInfo pi{name, "float", unit, help, format_number(O{}.*m), min, max, {}};

@@ -26,51 +26,21 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/mesh.h"
+#include "colonflat/core/loops.h"
 #include "colonflat/core/params.h"
 #include "colonflat/core/topology.h"
 
 namespace cf {
 
+// The options of denoise: every field is a parameter declared once, with its default, unit, range and
+// help, in denoise_params.def (also the source of `colonflat denoise`'s options and docs/denoise.md's table).
 struct DenoiseOptions {
-  std::string method = "exact";      // exact | paper
-  std::string policy = "shortest";   // shortest | cut (handle loops only) | fill (tunnel loops only)
-  double max_loop_length = kInf;     // mm; only loops shorter than this are cut
-  int target_genus = 0;              // stop when the total genus reaches this
-  double ring_pull = 0.25;           // 0..0.5; how far each ring moves into its own side (0 = paper's caps)
-  double initial_radius = 0;         // mm; first search radius for "exact" (0 = 10 x mean edge length)
-  bool check_caps = true;            // test each cap for intersections with the surface and try
-                                     // other placements until none remains
-  bool strict = false;               // fail (cf::Error) when a cap still intersects the surface
-  int threads = 1;                   // 1 or 2: with 2, "exact" runs two independent loop searches
-                                     // at once when searches are large (same loops either way)
-  double remove_stumps = 0;          // mm; 0 = off. Else ("exact" only) remove the finger-like
-                                     // stumps up to this long that cutting thin strands leaves
-                                     // (stumps.h); changes vertex ids
+#define COLONFLAT_PARAMS "colonflat/denoise/denoise_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
 
-struct LoopRecord {
-  int id = 0;                   // 0-based, in cutting order
-  int iteration = 0;            // 1-based step of the greedy loop
-  int component = 0;            // component of the input (largest first, as in TopologyReport)
-  std::vector<int> vertex_ids;  // input vertex ids; -1 for vertices created by earlier surgery
-  std::vector<Vec3> points;     // positions when the loop was cut (LPS mm)
-  double length = 0;            // Euclidean length (mm)
-  std::string type;             // "handle" | "tunnel"
-  bool separating = false;      // only "paper" can cut separating loops
-  std::size_t cap_intersections = 0;  // triangle pairs its caps still intersect (0 unless no placement worked)
-  // Set when this loop replaces the shortest one, whose caps intersected the surface in every
-  // placement: another loop of the same class (modulo the classes cut before), away from it.
-  double replaced_length = 0;               // mm: length of the shortest loop it replaces (0: none)
-  std::size_t replaced_intersections = 0;   // triangle pairs that loop's caps intersected
-  // Where it is and what it cuts (describe_cross_section):
-  Vec3 centroid{0, 0, 0};              // mean of its points (LPS mm)
-  double diameter_mm = 0;              // largest distance between two of its points
-  double cross_section_area_mm2 = 0;   // |vector area| = area of the loop projected on its best plane
-  Vec3 cross_section_normal{0, 0, 0};  // unit normal of that plane (direction of the cut tube or bridge)
-};
-
-// Fills centroid, diameter_mm, cross_section_area_mm2 and cross_section_normal from `points`.
-void describe_cross_section(LoopRecord* loop);
+// The table of DenoiseOptions (generated from denoise_params.def): option names, units, help, ranges.
+const ParamTable<DenoiseOptions>& denoise_param_table();
 
 struct DenoiseResult {
   Mesh mesh;
@@ -96,7 +66,8 @@ class CapIntersectionError : public Error {
 // postcondition fails, CapIntersectionError when `strict` and a cap intersects the surface.
 DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {});
 
-// Validates options (ranges and choices); throws UsageError.
+// Validates options: the table's ranges and choices (denoise_param_table()), then the rules
+// between parameters; throws UsageError.
 void validate_denoise_options(const DenoiseOptions& o);
 
 }  // namespace cf

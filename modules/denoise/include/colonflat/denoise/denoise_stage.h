@@ -1,8 +1,6 @@
 #pragma once
-// `colonflat denoise IN -o OUT [--loops F] [--report F] [--method exact|paper] [--policy P]
-//  [--max-loop-length L] [--target-genus G] [--ring-pull F] [--[no-]check-caps] [--strict]
-//  [--remove-stumps MM] [--initial-radius MM]` and its pipeline stage (parameters: table() in
-//  denoise_stage.cpp, the one place they are declared; docs/denoise.md).
+// `colonflat denoise IN -o OUT [--loops F] [--report F] [parameters]` and its pipeline stage.
+// The parameters are declared once, in denoise_params.def (--help and docs/denoise.md list them).
 #include <memory>
 
 #include "colonflat/core/stage.h"
@@ -13,10 +11,12 @@ namespace cf {
 class DenoiseStage : public StageWithOptions<DenoiseOptions> {
  public:
   const StageSpec& spec() const override;
+  // The table's ranges and choices, then the rules between parameters.
+  void validate_params() const override { validate_denoise_options(opts_); }
   void run(ArtifactBag& bag, RunContext& ctx) override;
 
  protected:
-  const ParamTable<DenoiseOptions>& table() const override;
+  const ParamTable<DenoiseOptions>& table() const override { return denoise_param_table(); }
 };
 
 std::unique_ptr<Stage> make_denoise_stage();

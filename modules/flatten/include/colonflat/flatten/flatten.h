@@ -25,21 +25,18 @@
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/soup.h"
 
+#include "colonflat/core/params.h"
 namespace cf {
 
+// The options of flatten: every field is a parameter declared once, with its default, unit, range and
+// help, in flatten_params.def (also the source of `colonflat flatten`'s options and docs/flatten.md's table).
 struct FlattenOptions {
-  double end_cut_radius = 15.0;        // mm; geodesic radius of the cap opened at each closed end
-  double min_segment_fraction = 0.02;  // components with fewer faces than this fraction of the largest are skipped
-  double segment_gap = 20.0;           // mm between the rectangles of several segments in the 2D layout
-  std::string weights = "auto";        // "cotan", "clamped" (negative cotangents clamped), "auto" (cotan; clamped if > 1% crowded)
-  std::string map = "area-balanced";   // "area-balanced" (x = centreline arc length, area corrected) or "conformal"
-  double area_ratio_low = 0.4;         // area-balanced: faces below this 2D/3D area ratio seed a correction region
-  double area_ratio_high = 3.0;        // area-balanced: faces above this ratio seed a correction region
-  int balance_iterations = 30;         // area-balanced: descent steps per correction pass
-  double coverage_min_ratio = 0.1;     // a face counts as shown when its 2D/3D area ratio is at least this
-  double branch_min_area = 50.0;       // mm^2; area-balanced: a pouch the conformal map collapses over at
-                                       // least this area is cut at its neck and shown as a band of its own (0: never)
+#define COLONFLAT_PARAMS "colonflat/flatten/flatten_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
+
+// The table of FlattenOptions (generated from flatten_params.def): option names, units, help, ranges.
+const ParamTable<FlattenOptions>& flatten_param_table();
 
 // How much of the 3D wall the map shows.
 struct Coverage {

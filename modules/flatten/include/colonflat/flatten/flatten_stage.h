@@ -1,5 +1,6 @@
 #pragma once
-// `colonflat flatten DENOISED -o FLAT.vtp`: the pipeline stage around cf::flatten_colon().
+// `colonflat flatten DENOISED -o FLAT.vtp [parameters: flatten_params.def]`: the pipeline stage
+// around cf::flatten_colon().
 #include <memory>
 
 #include "colonflat/core/stage.h"
@@ -14,7 +15,7 @@ class FlattenStage : public StageWithOptions<FlattenOptions> {
   void run(ArtifactBag& bag, RunContext& ctx) override;
 
  protected:
-  const ParamTable<FlattenOptions>& table() const override;
+  const ParamTable<FlattenOptions>& table() const override { return flatten_param_table(); }
 };
 
 std::unique_ptr<Stage> make_flatten_stage();

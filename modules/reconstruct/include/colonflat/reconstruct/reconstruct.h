@@ -37,22 +37,15 @@ namespace cf {
 using MaskImage = itk::Image<unsigned char, 3>;
 using CtImage = itk::Image<float, 3>;  // HU, on the mask's voxel grid
 
+// The options of reconstruct: every field is a parameter declared once, with its default, unit, range and
+// help, in reconstruct_params.def (also the source of `colonflat reconstruct`'s options and docs/reconstruct.md's table).
 struct ReconstructOptions {
-  std::string method = "flying-edges";  // flying-edges | discrete-flying-edges | marching-cubes
-  double min_component_volume = 500.0;  // mm^3; smaller surface components are dropped
-  std::string subvoxel = "auto";          // auto (CT if given, else mask) | ct | mask | off
-  std::string mask_smoothing = "sinc";  // sinc (windowed sinc, clamped to 1/2 voxel) | antialias (Whitaker field, then sinc)
-  int antialias_iterations = 20;        // mask field: at most this many Whitaker (ITK anti-alias) iterations
-  double antialias_rms = 0.001;         // mask field: stop when the RMS level-set change per iteration is below
-  double air_tissue_hu = -500.0;        // HU; the CT boundary placed between air and the wall
-  double fluid_hu = 150.0;              // HU; lumen voxels at or above are tagged fluid (mask field near them)
-  int smoothing_iterations = 20;        // windowed-sinc iterations on the mesh; 0 = no smoothing
-  double pass_band = 0.1;               // windowed-sinc pass band (smaller = smoother)
-  int target_faces = 0;                 // quadric decimation to this many triangles; 0 = none
+#define COLONFLAT_PARAMS "colonflat/reconstruct/reconstruct_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
 
-// The one declaration of the options (names, units, help, ranges) used by the stage's command
-// line, --help, JSON and validate().
+// The table of ReconstructOptions (generated from reconstruct_params.def): option names, units,
+// help, ranges; used by the stage's command line, --help, JSON and validate().
 const ParamTable<ReconstructOptions>& reconstruct_param_table();
 // Throws UsageError naming the first invalid option.
 void validate(const ReconstructOptions& o);

@@ -1,7 +1,8 @@
 #pragma once
 // `colonflat render FLAT -o colon.png [--candidates candidates.json] [--surface S.vtp] [--loops L.vtp]
-//  [--denoised D.vtp] [--snapshot-before B.png] [--snapshot-after A.png]`: polyp candidates on the
-// 3D wall, the 2D colon image with overlays, their JSON, and 3D snapshots.
+//  [--denoised D.vtp] [--snapshot-before B.png] [--snapshot-after A.png] [parameters:
+// render_params.def]`: polyp candidates on the 3D wall, the 2D colon image with overlays, their
+// JSON, and 3D snapshots.
 #include <memory>
 #include <string>
 
@@ -10,21 +11,18 @@
 #include "colonflat/render/colon_image.h"
 #include "colonflat/render/polyps.h"
 
+#include "colonflat/core/params.h"
 namespace cf {
 
+// The options of render: every field is a parameter declared once, with its default, unit, range and
+// help, in render_params.def (also the source of `colonflat render`'s options and docs/render.md's table).
 struct RenderOptions {
-  double pixel_size = 0.5;          // mm per pixel
-  std::string color = "shading";    // shading | curvature
-  double smooth_normal = 8.0;       // mm
-  std::string known_polyps;         // JSON file of known polyp positions (LPS mm) to overlay
-  bool detect = true;               // detect polyp candidates
-  bool snapshots = true;            // 3D snapshots (need X or Xvfb)
-  int snapshot_size = 900;          // pixels
-  double fit_radius = 2.5;          // mm
-  double min_size = 4.0;            // mm
-  double min_score = 0.65;
-  double seed_si = 0.9;
+#define COLONFLAT_PARAMS "colonflat/render/render_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
+
+// The table of RenderOptions (generated from render_params.def): option names, units, help, ranges.
+const ParamTable<RenderOptions>& render_param_table();
 
 struct RenderResult {
   ColonImage colon;
@@ -42,7 +40,7 @@ class RenderStage : public StageWithOptions<RenderOptions> {
   void run(ArtifactBag& bag, RunContext& ctx) override;
 
  protected:
-  const ParamTable<RenderOptions>& table() const override;
+  const ParamTable<RenderOptions>& table() const override { return render_param_table(); }
 };
 
 std::unique_ptr<Stage> make_render_stage();

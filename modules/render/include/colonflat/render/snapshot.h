@@ -10,6 +10,7 @@
 #include "colonflat/render/artifacts.h"
 
 class vtkActor;
+class vtkPolyData;
 
 namespace cf {
 

@@ -76,8 +76,8 @@ RunData load_run(const std::filesystem::path& dir, const RunLoadOptions& opts = 
 RunData run_from_artifacts(ArtifactBag& bag, const std::filesystem::path& dir, const nlohmann::json& run_report,
                            const std::string& input, const RunLoadOptions& opts = {});
 
-// The candidates of a candidates.json / polyps.json document (render stage format; LPS under
-// "position_lps_mm" or "center_lps_mm"), sorted by decreasing score. Throws InputError.
+// The candidates of a candidates.json / polyps.json document, read with core's
+// candidate_list_from_json (core/candidate_list.h), sorted by decreasing score. Throws InputError.
 std::vector<ReportFinding> candidates_from_json(const nlohmann::json& doc, const std::string& name_for_errors);
 
 // Position along the colon of flat vertex v: mm from the rectal end (or end A), with the label of

@@ -14,29 +14,18 @@
 
 #include "colonflat/volume/volume_io.h"
 
+#include "colonflat/core/params.h"
 namespace cf {
 
+// The options of segment: every field is a parameter declared once, with its default, unit, range and
+// help, in segment_params.def (also the source of `colonflat segment`'s options and docs/segment.md's table).
 struct SegmentOptions {
-  double air_threshold = -600;        // HU; below: gas (seed of the lumen)
-  double fluid_threshold = 200;       // HU; above (and below fluid-max): tagged-fluid candidate
-  double fluid_max = 1400;            // HU; above: not fluid (metal, dense bone)
-  double interface_width = 3.0;       // mm; air/fluid layer thickness taken as lumen
-  double level_tolerance = 4.0;       // mm; spread (10th-90th percentile) of a fluid pool's surface height
-  double band_width = 2.0;            // mm; half-width of the graph-cut band around the initial boundary
-  double smoothness = 0.5;            // weight of the boundary (smoothness) term against the data term
-  double edge_sigma = 60;             // HU; contrast sensitivity of the smoothness term
-  double min_segment_volume = 20;     // mL; smaller gas/fluid bodies are not colon
-  double min_segment_fraction = 0.05; // fraction of the largest kept segment a further segment must reach
-  double min_colon_volume = 100;      // mL; less gas + fluid in all kept segments: no (insufflated) colon
-  int max_segments = 6;               // at most this many colon segments kept
-  bool graph_cut = true;              // refine the boundary by graph cut (off: thresholds only)
-  // Gravity: "auto" = from the DICOM PatientPosition (0018,5100) and the image direction, else from
-  // the fluid levels; "levels" = from the fluid levels only; or fixed: supine, prone, left-down, right-down.
-  std::string position = "auto";
-  double min_tagged_volume = 5;       // mL; smallest fully tagged colon stretch considered
-  double link_gap = 25;               // mm; widest gap between a fully tagged stretch and the gas segment it continues
-  double tube_area = 150;             // mm^2; thinner gas channels reaching the inferior face (rectal tube) are trimmed (0: off)
+#define COLONFLAT_PARAMS "colonflat/segment/segment_params.def"
+#include "colonflat/core/params_as_fields.h"
 };
+
+// The table of SegmentOptions (generated from segment_params.def): option names, units, help, ranges.
+const ParamTable<SegmentOptions>& segment_param_table();
 
 struct SegmentStats {
   int segments = 0;

@@ -44,4 +44,8 @@ struct Colon {
 
 Colon colon(const ColonOptions& o);
 
+// The options of a test colon: centreline length and radius (mm), edge length (mm), polyps; the
+// other fields keep their defaults (bent, closed, with folds).
+ColonOptions colon_options(double length, double radius, double spacing, std::vector<PolypSpec> polyps);
+
 }  // namespace cf::synthetic

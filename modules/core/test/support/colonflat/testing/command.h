@@ -6,13 +6,9 @@
 #include <vector>
 
 #include "colonflat/pipeline/dispatch.h"
+#include "colonflat/testing/stage_command.h"
 
 namespace cf::testing {
-
-struct CommandResult {
-  int code;
-  std::string out, err;
-};
 
 inline CommandResult run_colonflat(const std::vector<std::string>& args) {
   std::ostringstream out, err;

@@ -1,4 +1,7 @@
-#include "colonflat/denoise/loops_io.h"
+#include "colonflat/core/loops.h"
+
+#include <algorithm>
+#include <cmath>
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -20,9 +23,26 @@
 namespace fs = std::filesystem;
 
 namespace cf {
-namespace {
 
-void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& target) {
+void describe_cross_section(LoopRecord* loop) {
+  const auto& p = loop->points;
+  if (p.empty()) return;
+  Vec3 c(0, 0, 0);
+  for (const auto& q : p) c += q;
+  c /= double(p.size());
+  Vec3 area(0, 0, 0);  // vector area: half the sum of (p_i - c) x (p_i+1 - c)
+  for (std::size_t i = 0; i < p.size(); ++i) area += OpenMesh::cross(p[i] - c, p[(i + 1) % p.size()] - c);
+  area *= 0.5;
+  double diameter = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j) diameter = std::max(diameter, (p[i] - p[j]).sqrnorm());
+  loop->centroid = c;
+  loop->diameter_mm = std::sqrt(diameter);
+  loop->cross_section_area_mm2 = area.norm();
+  loop->cross_section_normal = area.norm() > 0 ? area / area.norm() : Vec3(0, 0, 0);
+}
+
+vtkSmartPointer<vtkPolyData> loops_to_polydata(const LoopSet& loops) {
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines;
@@ -58,7 +78,7 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
     area->InsertNextValue(L.cross_section_area_mm2);
     caps_x->InsertNextValue(static_cast<double>(L.cap_intersections));
   }
-  vtkNew<vtkPolyData> pd;
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetLines(lines);
   for (vtkDataArray* a : {static_cast<vtkDataArray*>(id), static_cast<vtkDataArray*>(iteration),
@@ -69,6 +89,13 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
     pd->GetCellData()->AddArray(a);
   pd->GetPointData()->AddArray(input_id);
   tag_polydata_space(pd, "mm", "LPS");
+  return pd;
+}
+
+namespace {
+
+void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& target) {
+  vtkSmartPointer<vtkPolyData> pd = loops_to_polydata(loops);
   VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataWriter> w;
   w->SetFileName(file.c_str());
@@ -77,6 +104,25 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
   w->SetCompressorTypeToZLib();
   if (!w->Write() || !capture.errors().empty())
     throw Error(target.string() + ": cannot write loops: " + capture.first_problem());
+}
+
+// Declared sizes agree with the data: one value per point and per line, line ids within the
+// points (a damaged or hand-made file must not be read out of bounds).
+void check_loop_arrays(vtkPolyData* pd, const fs::path& path) {
+  const vtkIdType points = pd->GetNumberOfPoints(), lines = pd->GetNumberOfLines();
+  if (pd->GetNumberOfCells() != lines)
+    throw InputError(path.string(), "a loops file holds closed polylines only (found other cells)");
+  if (pd->GetPointData()->GetArray("input_vertex_id")->GetNumberOfTuples() != points)
+    throw InputError(path.string(), "input_vertex_id has not one value per point");
+  vtkCellData* cd = pd->GetCellData();
+  for (int a = 0; a < cd->GetNumberOfArrays(); ++a)
+    if (cd->GetArray(a) && cd->GetArray(a)->GetNumberOfTuples() != lines)
+      throw InputError(path.string(), std::string("cell array ") + cd->GetArrayName(a) + " has not one value per loop");
+  vtkNew<vtkIdList> cell;
+  pd->GetLines()->InitTraversal();
+  while (pd->GetLines()->GetNextCell(cell))
+    for (vtkIdType k = 0; k < cell->GetNumberOfIds(); ++k)
+      if (cell->GetId(k) < 0 || cell->GetId(k) >= points) throw InputError(path.string(), "a loop refers to a missing point");
 }
 
 }  // namespace
@@ -100,6 +146,7 @@ LoopSet read_loops(const fs::path& path) {
   auto* input_id = vtkIntArray::SafeDownCast(pd->GetPointData()->GetArray("input_vertex_id"));
   if (!geti("loop_id") || !len || !geti("type") || !input_id)
     throw InputError(path.string(), "not a ColonFlat loops file (missing loop_id/length_mm/type arrays)");
+  check_loop_arrays(pd, path);
   LoopSet loops;
   vtkNew<vtkIdList> cell;
   pd->GetLines()->InitTraversal();
