@@ -173,10 +173,19 @@ int main(int argc, char** argv) {
   }
   bool quick = false;
   std::string only;
+  const char* usage =
+      "usage: denoise_bench [--quick] [--exact-only] [--only real|colon|shared|spheres]\n"
+      "       denoise_bench --sphere RADIUS HANDLES VOXEL | --colon VOXEL CONTACT_MM [OUT.vtp]\n";
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     else if (std::strcmp(argv[i], "--exact-only") == 0) g_exact_only = true;
     else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc) only = argv[++i];
+    else {
+      const bool help = std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0;
+      if (!help) std::fprintf(stderr, "denoise_bench: error: unknown argument '%s'\n", argv[i]);
+      std::fputs(usage, help ? stdout : stderr);
+      return help ? 0 : 2;
+    }
   }
   header();
   if (only.empty() || only == "real") real_cases();
