@@ -161,6 +161,11 @@ double ColonImagePainter::rolled_y(const Band& band, double y) const {
   return std::fmod(std::fmod(y - band.c0, s.period) + s.period, s.period);
 }
 
+std::array<double, 2> ColonImagePainter::pixel_of(const Band& band, double x, double y) const {
+  const FlatSegment& s = flat_.segments[band.seg];
+  return {band.col0 + (x - s.x0) / px_, band.row0 + rolled_y(band, y) / px_};
+}
+
 }  // namespace detail
 
 ColonImage render_colon_image(const FlatMap& f, const std::vector<double>& si, std::vector<ImageMarker>& markers,

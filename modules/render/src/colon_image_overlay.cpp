@@ -154,9 +154,7 @@ void ColonImagePainter::draw_markers(vtkImageCanvasSource2D* canvas) {
 // A circle (dashed green for a known polyp, yellow for a candidate) with its label beside it; the
 // marker's pixel position is recorded.
 void ColonImagePainter::draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& mk, const Band& band) {
-  const FlatSegment& s = flat_.segments[mk.segment];
-  const double y = rolled_y(band, mk.y);
-  const double cx = band.col0 + (mk.x - s.x0) / px_, cy = band.row0 + y / px_;
+  const auto [cx, cy] = pixel_of(band, mk.x, mk.y);
   mk.px = cx;
   mk.py = height_ - 1 - cy;
   const double r = std::max(6.0, mk.radius_mm / px_ + 4);
@@ -180,9 +178,8 @@ void ColonImagePainter::draw_not_shown_rings(vtkImageCanvasSource2D* canvas) {
   for (const NotShownMark& m : not_shown_marks(flat_)) {
     const Band* band = band_of(m.segment);
     if (!band) continue;
-    const FlatSegment& s = flat_.segments[m.segment];
-    const double y = rolled_y(*band, m.y);
-    const int cx = int(band->col0 + (m.x - s.x0) / px_), cy = int(band->row0 + y / px_), r = 9;
+    const auto pixel = pixel_of(*band, m.x, m.y);
+    const int cx = int(pixel[0]), cy = int(pixel[1]), r = 9;
     canvas->FillBox(cx - r, cx + r, cy - r, cy - r + 1);
     canvas->FillBox(cx - r, cx + r, cy + r - 1, cy + r);
     canvas->FillBox(cx - r, cx - r + 1, cy - r, cy + r);
@@ -198,8 +195,8 @@ void ColonImagePainter::draw_branch_necks(vtkImageCanvasSource2D* canvas) {
   for (const NeckMark& m : neck_marks(flat_)) {
     const Band* band = band_of(m.segment);
     if (!band) continue;
-    const FlatSegment& s = flat_.segments[m.segment];
-    const int cx = int(band->col0 + (m.x - s.x0) / px_), cy = int(band->row0 + rolled_y(*band, m.y) / px_), r = 10;
+    const auto pixel = pixel_of(*band, m.x, m.y);
+    const int cx = int(pixel[0]), cy = int(pixel[1]), r = 10;
     const int corner[5][2] = {{cx, cy - r}, {cx + r, cy}, {cx, cy + r}, {cx - r, cy}, {cx, cy - r}};
     for (int k = 0; k < 4; ++k) canvas->FillTube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
     labels_.push_back({"branch: segment " + std::to_string(m.branch + 1), cx + r + 2, height_ - 1 - cy - 6,

@@ -7,6 +7,7 @@
 //   colon_image_overlay.cpp  markers, not-shown rings, scale bar and ticks (VTK canvas), then the
 //                            text (scale, tick labels, band captions, legend, title, marker labels).
 // Pixel rows count from the image bottom (VTK) unless a name says "from the top".
+#include <array>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,8 @@ class ColonImagePainter {
   void fill_background();
   const Band* band_of(int segment) const;
   double rolled_y(const Band& band, double y) const;  // y - roll, wrapped into [0, period)
+  // Image column and row (from the bottom, not rounded) of the flat point (x, y) of `band`'s segment.
+  std::array<double, 2> pixel_of(const Band& band, double x, double y) const;
   // Rasterising and shading (colon_image_raster.cpp).
   void paint_band(const Band& band);
   vtkSmartPointer<vtkPolyData> rolled_segment(const FlatSegment& segment, double c0) const;
