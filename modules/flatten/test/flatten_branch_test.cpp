@@ -12,6 +12,7 @@
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/flatten_stage.h"
 #include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "flatten_shapes.h"
 
@@ -110,12 +111,10 @@ TEST(FlattenBranches, BranchFieldsSurviveTheFlatFile) {
 TEST(FlattenBranches, NegativeMinAreaIsRefused) {
   testing::TempDir tmp;
   write_mesh(synthetic::to_mesh(synthetic::open_cylinder(10, 50, 32, 40)), tmp / "in.vtp");
-  auto tool = make_stage_tool(make_flatten_stage);
-  std::ostringstream out, err;
-  const int code = tool->run({tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "-5"}, out, err);
-  EXPECT_EQ(code, 2);
-  EXPECT_EQ(err.str().rfind("colonflat flatten: error: ", 0), 0u) << err.str();
-  EXPECT_NE(err.str().find("branch-min-area"), std::string::npos) << err.str();
+  const auto r = testing::run_stage_command(make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "-5"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("colonflat flatten: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("branch-min-area"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
 }
 
