@@ -96,40 +96,6 @@ void local_frames(const Surface& s, const std::vector<int>& faces, std::vector<s
   }
 }
 
-// Largest t in (0, 1] such that along pos + t (next - pos) every face keeps at least
-// min(half its current area, `floor_ratio` x its 3D area): no face can collapse (a barrier in
-// place of the one ARAP lacks), and none that is readable now can become unreadable.
-double max_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
-                const std::vector<double>& area3, double floor_ratio) {
-  auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
-  double tmax = 1.0;
-  for (int f : faces) {
-    const auto c = emb.corners(s, f);
-    const Tri& t = s.t[f];
-    const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
-    const V2 g1 = (next[t[1]] - emb.pos[t[1]]) - (next[t[0]] - emb.pos[t[0]]);
-    const V2 g2 = (next[t[2]] - emb.pos[t[2]]) - (next[t[0]] - emb.pos[t[0]]);
-    const double A = cross(e1, e2), B = cross(e1, g2) + cross(g1, e2), C = cross(g1, g2);
-    if (A <= 0) continue;  // degenerate or already folded: not judged
-    const double floor2 = std::min(0.5 * A, 2 * floor_ratio * area3[f]);  // twice the area, like A
-    // smallest t > 0 with C t^2 + B t + (A - floor2) = 0
-    const double a0 = A - floor2;
-    double root = 1e300;
-    if (std::abs(C) < 1e-300) {
-      if (B < 0) root = -a0 / B;
-    } else {
-      const double disc = B * B - 4 * a0 * C;
-      if (disc >= 0) {
-        const double sq = std::sqrt(disc);
-        for (double r : {(-B - sq) / (2 * C), (-B + sq) / (2 * C)})
-          if (r > 0) root = std::min(root, r);
-      }
-    }
-    tmax = std::min(tmax, root);
-  }
-  return std::max(0.0, tmax);
-}
-
 // Symmetric Dirichlet energy sum_f A3_f (|J|^2 + |J^-1|^2) of the region's faces (Smith &
 // Schaefer 2015; infinite for a folded face), with J the 3D -> 2D Jacobian of each face.
 struct SymmetricDirichlet {
@@ -216,7 +182,7 @@ int minimise_region(const Surface& s, Embedding& emb, const Region& r, int itera
     if (!(slope < 0)) break;
     std::vector<V2> next = emb.pos;
     for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
-    double t = std::min(1.0, 0.9 * max_step(s, emb, next, unfolded, area3, 0.0));
+    double t = std::min(1.0, 0.9 * max_area_step(s, emb, next, unfolded, area3, 0.0));
     double e1 = SymmetricDirichlet::kHugeEnergy;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
       trial = emb.pos;
@@ -234,6 +200,45 @@ int minimise_region(const Surface& s, Embedding& emb, const Region& r, int itera
 }
 
 }  // namespace
+
+double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep) {
+  auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
+  const auto c = emb.corners(s, f);
+  const Tri& t = s.t[f];
+  const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
+  const V2 g1 = (next[t[1]] - emb.pos[t[1]]) - (next[t[0]] - emb.pos[t[0]]);
+  const V2 g2 = (next[t[2]] - emb.pos[t[2]]) - (next[t[0]] - emb.pos[t[0]]);
+  const double A = cross(e1, e2), B = cross(e1, g2) + cross(g1, e2), C = cross(g1, g2);
+  if (A <= 0) return 1e300;  // degenerate or already folded: not judged
+  // smallest t > 0 with C t^2 + B t + (1 - keep) A = 0 (twice the areas)
+  const double a0 = (1 - std::clamp(keep, 0.0, 1.0)) * A;
+  double root = 1e300;
+  if (std::abs(C) < 1e-300) {
+    if (B < 0) root = -a0 / B;
+  } else {
+    const double disc = B * B - 4 * a0 * C;
+    if (disc >= 0) {
+      const double sq = std::sqrt(disc);
+      for (double r : {(-B - sq) / (2 * C), (-B + sq) / (2 * C)})
+        if (r > 0) root = std::min(root, r);
+    }
+  }
+  return root;
+}
+
+// Largest t in (0, 1] such that along pos + t (next - pos) every face keeps at least
+// min(half its current area, `floor_ratio` x its 3D area): no face can collapse (a barrier in
+// place of the one ARAP lacks), and none that is readable now can become unreadable.
+double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
+                     const std::vector<double>& area3, double floor_ratio) {
+  double tmax = 1.0;
+  for (int f : faces) {
+    const double a = emb.area2(s, f);
+    if (a <= 0) continue;
+    tmax = std::min(tmax, face_step_limit(s, emb, next, f, std::min(0.5, floor_ratio * area3[f] / a)));
+  }
+  return std::max(0.0, tmax);
+}
 
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                            const std::vector<char>& fixed, const std::vector<char>& degenerate,

@@ -208,6 +208,7 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
   j["order"] = s.order;
   j["centreline_offset_mm"] = s.centreline_offset;
   j["balanced_vertices"] = s.balanced_vertices;
+  j["area_correction_iterations"] = s.corrected_iterations;
   j["balance_strength"] = s.balance_strength;
   j["coverage"] = coverage_to_json(s.coverage);
   j["kind"] = s.kind;

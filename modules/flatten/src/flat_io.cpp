@@ -66,6 +66,7 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.order = j.value("order", s.id);
   s.centreline_offset = j.value("centreline_offset_mm", 0.0);
   s.balanced_vertices = j.value("balanced_vertices", std::size_t(0));
+  s.corrected_iterations = j.value("area_correction_iterations", 0);
   s.balance_strength = j.value("balance_strength", 0.0);
   if (j.contains("coverage")) s.coverage = coverage_from_json(j["coverage"]);
   s.kind = j.value("kind", "colon");

@@ -181,6 +181,30 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
                            const std::vector<char>& fixed, const std::vector<char>& degenerate,
                            const FlattenOptions& o);
 
+// Largest t in [0, 1] such that moving the vertices along pos + t (next - pos) keeps every face of
+// `faces` that is positive now above min(half its area, floor_ratio x its 3D area `area3[f]`).
+// Largest t > 0 (1e300: none) at which face f, moving along pos + t (next - pos), is down to `keep`
+// (in [0, 1)) x its current 2D area; 1e300 for a face whose area is not positive now.
+double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep);
+double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
+                     const std::vector<double>& area3, double floor_ratio);
+
+// Area correction (area_correct.cpp): the map as conformal as possible with every face's area
+// ratio within [area_ratio_low, area_ratio_high]: minimises the cotangent Dirichlet energy of the
+// 2D positions plus area_weight x sum_f A3_f (log ratio outside the bounds)^2, at most
+// area_correction_iterations Newton steps on the quadratic part, each cut so that no face folds.
+// Fixed vertices (the band's ends, the rims of cut-off branches) stay. Post: bijective if `emb` was.
+struct AreaCorrection {
+  int iterations = 0;
+  std::size_t faces = 0;  // faces the correction worked on
+  double energy_before = 0, energy_after = 0;
+};
+// `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
+// move (their rim fixed): for a band whose distortion is within bounds except for pockets.
+AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                            const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
+                            const FlattenOptions& o);
+
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
 // the least angle-distorting axis F whose area ratios stay in bounds, B the band length (the

@@ -88,7 +88,8 @@ struct FlatSegment {
   std::string x0_end = "end A", x1_end = "end B";    // "rectum", "cecum", "end A", "end B"
   int order = 0;                                     // position rectum -> cecum among segments
   double centreline_offset = 0;                      // mm of centreline of the segments before it
-  std::size_t balanced_vertices = 0;                 // vertices moved by the area correction
+  std::size_t balanced_vertices = 0;                 // vertices moved by the local symmetric-Dirichlet balancing
+  int corrected_iterations = 0;                      // Newton steps of the area correction (0: band within bounds)
   double balance_strength = 0;                       // beta of the x axis: 0 conformal spacing, 1 area fraction
   Coverage coverage;
   // side branches (a pouch cut off at its neck and shown as a band of its own: x0 = neck, x1 = tip)

@@ -1,0 +1,188 @@
+// Area correction of the band: the map that is as conformal as possible while every face's area
+// ratio stays within [lo, hi]. Minimises
+//   E = sum_f sum_k w_fk |c_a - c_b|^2  +  lambda sum_f A3_f pen(log r_f),
+// the first term the Dirichlet energy of the 2D corners with the (clamped) cotangent weights of
+// the 3D triangles (its minimiser is the conformal map; it penalises angle distortion), the
+// second a penalty on each face's log area ratio outside [log lo, log hi] (pen(l) = distance of
+// l to the interval, squared; +infinity for a folded face). Newton steps on the quadratic part:
+// direction = -A^-1 grad E with A the cotangent Laplacian, factorised once (the quadratic term's
+// exact Hessian / 2, the "accelerated quadratic proxy" of Kovalsky et al. 2016), step cut so that
+// no face folds and halved until E decreases (Armijo). The band's ends and the rims of cut-off
+// branches are fixed, so the map stays bijective.
+#include <algorithm>
+#include <cmath>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace {
+
+double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+class ConformalAreaEnergy {
+ public:
+  ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
+                      double lo, double hi, double lambda)
+      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), log_lo_(std::log(lo)), log_hi_(std::log(hi)),
+        lambda_(lambda) {
+    w_.reserve(faces_.size());
+    double a2 = 0, a3 = 0;
+    for (int f : faces_) {
+      std::array<double, 3> w{};
+      for (int k = 0; k < 3; ++k) {
+        const V3 e1 = s.p[s.t[f][(k + 1) % 3]] - s.p[s.t[f][k]], e2 = s.p[s.t[f][(k + 2) % 3]] - s.p[s.t[f][k]];
+        w[k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-300), 0.01, 100.0);
+      }
+      w_.push_back(w);
+      a2 += emb.area2(s, f), a3 += area3[f];
+    }
+    scale_ = a2 > 0 ? a3 / a2 : 1.0;  // area ratios at the area-preserving scale
+  }
+  const std::vector<std::array<double, 3>>& weights() const { return w_; }
+  const std::vector<int>& faces() const { return faces_; }
+
+  // Excess of a log ratio outside [log lo, log hi] (signed).
+  double excess(double log_ratio) const { return log_ratio - std::clamp(log_ratio, log_lo_, log_hi_); }
+
+  double energy(const std::vector<V2>& pos) const {
+    double e = 0;
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+      const auto c = corners(pos, faces_[i]);
+      const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
+      if (a2 <= 0) return kHuge;
+      for (int k = 0; k < 3; ++k) e += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
+      const int f = faces_[i];
+      const double x = excess(std::log(scale_ * a2 / area3_[f]));
+      e += lambda_ * area3_[f] * x * x;
+    }
+    return e;
+  }
+
+  // Gradient with respect to the unknowns of `sys` (n x 2).
+  Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const {
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Eigen::Index(sys.unknowns().size()), 2);
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+      const int f = faces_[i];
+      const auto c = corners(pos, f);
+      const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
+      const double x = excess(std::log(scale_ * a2 / area3_[f]));
+      const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
+      V2 grad[3] = {V2::Zero(), V2::Zero(), V2::Zero()};
+      for (int k = 0; k < 3; ++k) {
+        const int a = (k + 1) % 3, b = (k + 2) % 3;
+        const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
+        grad[a] += e, grad[b] -= e;
+        grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
+      }
+      for (int k = 0; k < 3; ++k)
+        if (sys.index(s_.t[f][k]) >= 0) g.row(sys.index(s_.t[f][k])) += grad[k].transpose();
+    }
+    return g;
+  }
+  static constexpr double kHuge = 1e300;
+
+ private:
+  std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
+    const Tri& t = s_.t[f];
+    return {pos[t[0]] + V2(0, emb_.dy[f][0]), pos[t[1]] + V2(0, emb_.dy[f][1]), pos[t[2]] + V2(0, emb_.dy[f][2])};
+  }
+  const Surface& s_;
+  const Embedding& emb_;
+  std::vector<int> faces_;
+  const std::vector<double>& area3_;
+  double log_lo_, log_hi_, lambda_, scale_ = 1;
+  std::vector<std::array<double, 3>> w_;
+};
+
+// One step along d (n x 2 over sys' unknowns): the largest t <= 1 keeping faces unfolded (x 0.9),
+// halved until the energy decreases enough. Returns the new energy (e0 when no step was taken).
+double line_search(const Surface& s, Embedding& emb, const ConformalAreaEnergy& energy, const RegionSystem& sys,
+                   const Eigen::MatrixXd& d, double slope, double e0, const std::vector<double>& area3) {
+  std::vector<V2> next = emb.pos;
+  for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
+  double t = std::min(1.0, 0.9 * max_area_step(s, emb, next, energy.faces(), area3, 0.0));
+  for (int half = 0; half < 30; ++half, t *= 0.5) {
+    std::vector<V2> trial = emb.pos;
+    for (std::size_t i = 0; i < sys.unknowns().size(); ++i) trial[sys.unknowns()[i]] += t * V2(d(i, 0), d(i, 1));
+    const double e1 = energy.energy(trial);
+    if (e1 <= e0 + 1e-4 * t * slope) {
+      emb.pos.swap(trial);
+      return e1;
+    }
+  }
+  return e0;
+}
+
+// The faces the correction works on: all of them (`local` false), or the pockets not shown (area
+// ratio below coverage_min_ratio) grown by kLocalRings vertex rings; free: their vertices that are not fixed and,
+// when local, not on the region's rim. Folds left by untangle are not judged.
+constexpr int kLocalRings = 12;
+std::vector<int> correction_faces(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
+                                  const std::vector<double>& area3, const std::vector<char>& fixed,
+                                  const std::vector<char>& degenerate, const FlattenOptions& o, bool local,
+                                  std::vector<char>& free_vertex) {
+  std::vector<char> in(s.t.size(), !local);
+  if (local) {
+    double a2 = 0, a3 = 0;
+    for (std::size_t f = 0; f < s.t.size(); ++f) a2 += std::max(emb.area2(s, int(f)), 0.0), a3 += area3[f];
+    std::vector<int> ring;
+    for (std::size_t f = 0; f < s.t.size(); ++f) {
+      const double r = emb.area2(s, int(f)) * a3 / (a2 * std::max(area3[f], 1e-300));
+      if (r < o.coverage_min_ratio) in[f] = 1, ring.push_back(int(f));
+    }
+    for (int k = 0; k < kLocalRings; ++k) {
+      std::vector<int> next;
+      for (int f : ring)
+        for (int v : s.t[f])
+          for (int g : vf[v])
+            if (!in[g]) in[g] = 1, next.push_back(g);
+      ring.swap(next);
+    }
+  }
+  std::vector<int> faces;
+  free_vertex.assign(s.p.size(), 0);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (in[f] && !degenerate[f] && emb.area2(s, int(f)) > 0) {
+      faces.push_back(int(f));
+      for (int v : s.t[f]) free_vertex[v] = !fixed[v];
+    }
+  if (local)  // the region's rim stays
+    for (std::size_t v = 0; v < s.p.size(); ++v)
+      if (free_vertex[v])
+        for (int g : vf[v])
+          if (!in[g]) free_vertex[v] = 0;
+  return faces;
+}
+
+}  // namespace
+
+AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                            const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
+                            const FlattenOptions& o) {
+  AreaCorrection res;
+  if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
+  std::vector<double> area3(s.t.size());
+  for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
+  std::vector<char> free_vertex;
+  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, o, local, free_vertex);
+  res.faces = faces.size();
+  const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight);
+  RegionSystem sys;
+  if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return res;
+  double e0 = energy.energy(emb.pos);
+  res.energy_before = e0;
+  for (; res.iterations < o.area_correction_iterations && e0 < ConformalAreaEnergy::kHuge; ++res.iterations) {
+    const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
+    const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
+    const double slope = (g.array() * d.array()).sum();
+    if (!(slope < 0)) break;
+    const double e1 = line_search(s, emb, energy, sys, d, slope, e0, area3);
+    const double gain = (e0 - e1) / e0;
+    e0 = e1;
+    if (!(gain > 1e-5)) break;
+  }
+  res.energy_after = e0;
+  return res;
+}
+
+}  // namespace cf::flat_detail

@@ -1,0 +1,78 @@
+// The area correction (src/area_correct.cpp): faces the conformal map crushes to zero area (a
+// pouch behind a narrow neck left in the band) are brought back into the map without a fold (a
+// polyp head behind its stalk: not yet, disabled test); a band already within bounds is left as
+// it is; invalid parameters are refused.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "colonflat/core/mesh_io.h"
+#include "colonflat/core/synthetic.h"
+#include "colonflat/flatten/flatten.h"
+#include "colonflat/flatten/flatten_stage.h"
+#include "colonflat/testing/stage_command.h"
+#include "colonflat/testing/temp_dir.h"
+#include "flatten_shapes.h"
+
+namespace cf {
+namespace {
+
+FlatMap flatten_with(const TriangleList& mesh, int iterations, double branch_min_area) {
+  FlattenOptions o;
+  o.area_correction_iterations = iterations;
+  o.branch_min_area = branch_min_area;
+  return flatten_colon(mesh, o);
+}
+
+// Issue 11 target NOT met yet (measured: 97.66 % of the wall shown without the correction, 97.64 %
+// with it: the Newton steps on the quadratic proxy open a head squeezed through a 1.6 mm stalk too
+// slowly): a pedunculated polyp's head is shown, nothing folds, the area ratios within bounds.
+TEST(AreaCorrection, DISABLED_StalkedPolypHeadIsShown) {
+  const FlatMap f = flatten_with(test_shapes::stalked_polyp(), 60, 50);
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_GE(f.coverage.fraction, 0.995);
+  EXPECT_EQ(f.stats.flipped, 0u);
+  EXPECT_GE(f.stats.area_p05, 0.2);
+  EXPECT_LE(f.stats.area_p95, 5.0);
+}
+
+// A pouch behind a 4 mm neck kept in the colon's band (branch cutting off): the conformal map
+// crushes thousands of its faces to zero area; the correction brings them back into the map
+// without a fold.
+TEST(AreaCorrection, PouchLeftInTheBandIsOpened) {
+  const TriangleList mesh = test_shapes::pouch_behind_neck(4.0);
+  const FlatMap before = flatten_with(mesh, 0, 0);
+  const FlatMap after = flatten_with(mesh, 60, 0);
+  ASSERT_EQ(after.segments.size(), 1u);
+  EXPECT_GT(before.segments[0].crowded_faces, 1000u);
+  EXPECT_LE(after.segments[0].crowded_faces * 100, before.segments[0].crowded_faces);
+  EXPECT_GE(after.coverage.fraction, before.coverage.fraction);
+  EXPECT_EQ(after.stats.flipped, 0u);
+}
+
+// A plain cylinder is within every bound after the axis step: no correction step is taken and the
+// map keeps its angles.
+TEST(AreaCorrection, BandWithinBoundsIsLeftAsItIs) {
+  const FlatMap f = flatten_with(synthetic::open_cylinder(10, 100, 96, 150), 60, 50);
+  ASSERT_EQ(f.segments.size(), 1u);
+  EXPECT_EQ(f.segments[0].corrected_iterations, 0);
+  EXPECT_LT(f.stats.qc_mean, 1.01);
+}
+
+// Out-of-range correction parameters are refused by `colonflat flatten` before any work: exit 2,
+// one error line naming the option, no output.
+TEST(AreaCorrection, InvalidParametersAreRefused) {
+  testing::TempDir tmp;
+  write_mesh(synthetic::to_mesh(synthetic::open_cylinder(10, 50, 32, 40)), tmp / "in.vtp");
+  for (const auto& [option, value] : {std::pair<std::string, std::string>{"--area-weight", "-1"},
+                                      {"--area-correction-iterations", "-3"}}) {
+    const auto r = testing::run_stage_command(make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), option, value});
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_EQ(r.err.rfind("colonflat flatten: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(option.substr(2)), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
+  }
+}
+
+}  // namespace
+}  // namespace cf
