@@ -105,7 +105,9 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
                          const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
-    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp);
+    const std::vector<int>* order = w.elimination_order.empty() ? nullptr : &w.elimination_order;
+    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, order);
+    w.elimination_order = h.vertex_order;
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
@@ -250,6 +252,10 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
   w.lost_area += surface_area(w.ann) - placed;
   for (auto& l : loops)
     for (int& v : l) v = new_of_old[v];
+  std::vector<int> order;  // the colon's elimination order, restricted to what remains
+  for (int v : w.elimination_order)
+    if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
+  w.elimination_order = std::move(order);
   w.ann = std::move(rest);
   p = prepare(w);
   conformal(w, loops, p, o);
