@@ -61,16 +61,16 @@ void check_component(const ComponentTopology& ct, std::size_t c) {
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism).
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
-                                           std::size_t c, SegmentWork& w) {
+                                           std::size_t c, SegmentWork& w, Edges& E) {
   {
     const Edges E0 = build_edges(s.t);
     Opened op = open_ends(s, E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
   }
-  const Edges E = build_edges(w.ann.t);
+  E = build_edges(w.ann.t);
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
   if (loops.size() != 2 || chi != 0)
@@ -161,18 +161,18 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
 }
 
-// What every step on an annulus needs: its edges, degenerate faces, fixed (boundary) vertices and
-// vertex -> faces; also sets the annulus' 3D area.
+// What every step on an annulus needs: its edges (`edges`: those of w.ann, moved in, else built),
+// degenerate faces, fixed (boundary) vertices and vertex -> faces; also sets the annulus' 3D area.
 struct Prepared {
   Edges E;
   std::vector<char> degenerate, fixed;
   std::vector<std::vector<int>> vf;
 };
 
-Prepared prepare(SegmentWork& w) {
+Prepared prepare(SegmentWork& w, Edges* edges = nullptr) {
   Prepared p;
   const Surface& ann = w.ann;
-  p.E = build_edges(ann.t);
+  p.E = edges ? std::move(*edges) : build_edges(ann.t);
   w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) w.seg.area_3d += face_area_3d(ann, int(f));
   p.degenerate.assign(ann.t.size(), 0);
@@ -307,12 +307,13 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   auto phase = [depth](const char* what) {  // progress lines for the colon segments, not their branches
     if (depth == 0) phase_done(what);
   };
-  auto loops = open_annulus(s, nloops, o, c, w);
+  Edges edges;
+  auto loops = open_annulus(s, nloops, o, c, w, edges);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
   w.cap_area = surface_area(s) - surface_area(w.ann);
-  Prepared p = prepare(w);
+  Prepared p = prepare(w, &edges);
   phase("ends opened");
   conformal(w, loops, p, o);
   phase("conformal map");

@@ -2,10 +2,52 @@
 // SimplicialLDLT without CHOLMOD or when CHOLMOD fails (see spd_solver.h).
 #include "spd_solver.h"
 
+#include <sys/mman.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <mutex>
+
 namespace cf::flat_detail {
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
 namespace {
+
+// CHOLMOD's large blocks (a colon's factor: about 300 MB) on transparent huge pages where the
+// system allows them: faulting them in as 4 KiB pages cost about a tenth of the flatten time.
+void advise_huge_pages(void* p, std::size_t bytes) {
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  if (!p || bytes < 2 * kHuge) return;
+  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
+#ifdef MADV_HUGEPAGE
+  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // advice only
+#endif
+}
+void* huge_malloc(std::size_t bytes) {
+  void* p = std::malloc(bytes);
+  advise_huge_pages(p, bytes);
+  return p;
+}
+void* huge_calloc(std::size_t n, std::size_t size) {
+  void* p = std::calloc(n, size);
+  advise_huge_pages(p, n * size);
+  return p;
+}
+void* huge_realloc(void* old, std::size_t bytes) {
+  void* p = std::realloc(old, bytes);
+  advise_huge_pages(p, bytes);
+  return p;
+}
+void use_huge_pages_for_cholmod() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    SuiteSparse_config.malloc_func = huge_malloc;
+    SuiteSparse_config.calloc_func = huge_calloc;
+    SuiteSparse_config.realloc_func = huge_realloc;
+    SuiteSparse_config.free_func = std::free;
+  });
+}
 
 // A read-only CHOLMOD view of the lower triangle of a compressed Eigen matrix.
 cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
@@ -36,6 +78,7 @@ void SpdSolver::release() {
 void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   release();
   ldlt_.reset();
+  use_huge_pages_for_cholmod();
   cholmod_start(&common_);
   started_ = true;
   common_.supernodal = CHOLMOD_SIMPLICIAL;
