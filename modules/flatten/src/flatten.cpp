@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <future>
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
@@ -212,8 +213,39 @@ void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out)
   out[base].parent = -1;
 }
 
-// Cuts the side branches off the annulus (each flattened as a band of its own, recursively),
-// then re-solves the conformal map of what remains. Returns the branches' works.
+// One side branch cut off an annulus: its surface and its neck's vertices in what remains.
+struct BranchPiece {
+  Surface surface;
+  std::vector<int> neck;
+  double neck_mm = 0;
+};
+
+// Flattens the cut-off branches (each as a band of its own, recursively); returns their works and
+// adds their wall area to `placed`. A branch that cannot be flattened counts as wall not shown.
+std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces, int component, double lumen_sign,
+                                          const FlattenOptions& o, int depth, double& placed) {
+  FlattenOptions bo = o;
+  bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
+  std::vector<SegmentWork> out;
+  for (const BranchPiece& piece : pieces) {
+    try {
+      std::vector<SegmentWork> sub =
+          flatten_surface(piece.surface, 1, std::size_t(component), lumen_sign, bo, depth + 1);
+      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
+      sub[0].cap_area = 0;
+      sub[0].seg.neck_mm = piece.neck_mm;
+      sub[0].neck = piece.neck;
+      placed += surface_area(piece.surface);
+      append_branch(sub, out);
+    } catch (const std::exception&) {
+      // not flattenable as a band: its wall counts as not shown
+    }
+  }
+  return out;
+}
+
+// Cuts the side branches off the annulus, then re-solves the conformal map of what remains (on a
+// second thread, while the branches are flattened). Returns the branches' works.
 std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
   const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
@@ -225,31 +257,21 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
   clean_selection(w.ann, p.E, keep);
   std::vector<int> new_of_old;
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
-  double placed = surface_area(rest);
-  FlattenOptions bo = o;
-  bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
-  std::vector<SegmentWork> out;
+  std::vector<BranchPiece> pieces;
   for (const auto& cut : cuts) {
     std::vector<char> in(nf, 0);
     for (int f : cut.faces) in[f] = 1;
     clean_selection(w.ann, p.E, in);
-    const Surface b = sub_surface(w.ann, in);
-    try {
-      std::vector<SegmentWork> sub = flatten_surface(b, 1, std::size_t(w.seg.component), w.lumen_sign, bo, depth + 1);
-      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
-      sub[0].cap_area = 0;
-      sub[0].seg.neck_mm = cut.neck_mm;
-      for (std::size_t f = 0; f < nf; ++f)
-        if (in[f])
-          for (int v : w.ann.t[f])
-            if (new_of_old[v] >= 0) sub[0].neck.push_back(new_of_old[v]);
-      placed += surface_area(b);
-      append_branch(sub, out);
-    } catch (const std::exception&) {
-      // not flattenable as a band: its wall counts as not shown
-    }
+    BranchPiece piece;
+    piece.surface = sub_surface(w.ann, in);
+    piece.neck_mm = cut.neck_mm;
+    for (std::size_t f = 0; f < nf; ++f)
+      if (in[f])
+        for (int v : w.ann.t[f])
+          if (new_of_old[v] >= 0) piece.neck.push_back(new_of_old[v]);
+    pieces.push_back(std::move(piece));
   }
-  w.lost_area += surface_area(w.ann) - placed;
+  const double annulus_area = surface_area(w.ann);
   for (auto& l : loops)
     for (int& v : l) v = new_of_old[v];
   std::vector<int> order;  // the colon's elimination order, restricted to what remains
@@ -257,8 +279,22 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
     if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
   w.elimination_order = std::move(order);
   w.ann = std::move(rest);
-  p = prepare(w);
-  conformal(w, loops, p, o);
+  double placed = surface_area(w.ann);
+  const int component = w.seg.component;
+  const double lumen_sign = w.lumen_sign;
+  auto resolved = std::async(std::launch::async, [&] {
+    p = prepare(w);
+    conformal(w, loops, p, o);
+  });
+  std::vector<SegmentWork> out;
+  try {
+    out = flatten_branches(pieces, component, lumen_sign, o, depth, placed);
+  } catch (...) {
+    resolved.wait();
+    throw;
+  }
+  resolved.get();
+  w.lost_area += annulus_area - placed;
   return out;
 }
 
