@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <mutex>
 
+#include "colonflat/core/error.h"
+
 namespace cf::flat_detail {
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
@@ -115,6 +117,7 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common_);
+  if (!x) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common_.status) + ")");
   Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), b.rows(), b.cols());
   cholmod_free_dense(&x, &common_);
   return out;
