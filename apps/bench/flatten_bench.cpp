@@ -150,8 +150,10 @@ std::filesystem::path denoised_real(const std::filesystem::path& in, const std::
 
 void real_table(const std::string& dir, const std::string& cache, const std::string& map, const std::string& out) {
   std::printf("load average %.2f; map %s\n", load_average(), map.c_str());
-  std::printf("%-30s %8s %4s %8s %9s %7s %7s %7s %7s %7s %7s %8s %8s\n", "case", "faces", "segs", "cover%", "notshown",
-              "area05", "area95", "qc_mean", "qc_p95", "flipped", "leftout", "time_s", "peak_MiB");
+  std::printf("time_s = wall clock of flatten_colon, cpu_s = its CPU time (all threads), load = load average before\n");
+  std::printf("%-30s %8s %4s %8s %9s %7s %7s %7s %7s %7s %7s %8s %8s %8s %5s\n", "case", "faces", "segs", "cover%",
+              "notshown", "area05", "area95", "qc_mean", "qc_p95", "flipped", "leftout", "time_s", "cpu_s", "peak_MiB",
+              "load");
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
     const std::string n = e.path().filename().string();
@@ -164,16 +166,18 @@ void real_table(const std::string& dir, const std::string& cache, const std::str
     const cf::Mesh mesh = cf::load_mesh(den).mesh;
     cf::FlattenOptions fo;
     fo.map = map;
+    const double load = load_average();
     cf::Stopwatch sw;
+    const std::clock_t c0 = std::clock();
     const cf::FlatMap flat = cf::flatten_colon(mesh, fo);
-    const double t = sw.seconds();
+    const double t = sw.seconds(), cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
     std::size_t left_out = 0;
     for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
     const auto& st = flat.stats;
-    std::printf("%-30s %8zu %4zu %8.3f %9.0f %7.3f %7.3f %7.3f %7.3f %7zu %7zu %8.2f %8.0f\n",
+    std::printf("%-30s %8zu %4zu %8.3f %9.0f %7.3f %7.3f %7.3f %7.3f %7zu %7zu %8.2f %8.2f %8.0f %5.2f\n",
                 in.filename().string().c_str(), mesh.n_faces(), flat.segments.size(), 100 * flat.coverage.fraction,
                 flat.coverage.wall_area_mm2 - flat.coverage.shown_area_mm2, st.area_p05, st.area_p95, st.qc_mean,
-                st.qc_p95, st.flipped, left_out, t, cf::peak_memory_mib());
+                st.qc_p95, st.flipped, left_out, t, cpu, cf::peak_memory_mib(), load);
     for (const auto& sg : flat.segments)
       std::printf("    segment %d: %s -> %s, centreline %.0f mm, band %.0f x %.0f mm, balanced %zu vertices\n", sg.id,
                   sg.x0_end.c_str(), sg.x1_end.c_str(), sg.centreline_length, sg.length, sg.period,

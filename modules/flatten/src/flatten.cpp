@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <future>
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
@@ -61,16 +62,16 @@ void check_component(const ComponentTopology& ct, std::size_t c) {
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism).
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
-                                           std::size_t c, SegmentWork& w) {
+                                           std::size_t c, SegmentWork& w, Edges& E) {
   {
     const Edges E0 = build_edges(s.t);
     Opened op = open_ends(s, E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
   }
-  const Edges E = build_edges(w.ann.t);
+  E = build_edges(w.ann.t);
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
   if (loops.size() != 2 || chi != 0)
@@ -105,7 +106,9 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
                          const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
-    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp);
+    const std::vector<int>* order = w.elimination_order.empty() ? nullptr : &w.elimination_order;
+    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, order);
+    w.elimination_order = h.vertex_order;
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
@@ -159,18 +162,18 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
 }
 
-// What every step on an annulus needs: its edges, degenerate faces, fixed (boundary) vertices and
-// vertex -> faces; also sets the annulus' 3D area.
+// What every step on an annulus needs: its edges (`edges`: those of w.ann, moved in, else built),
+// degenerate faces, fixed (boundary) vertices and vertex -> faces; also sets the annulus' 3D area.
 struct Prepared {
   Edges E;
   std::vector<char> degenerate, fixed;
   std::vector<std::vector<int>> vf;
 };
 
-Prepared prepare(SegmentWork& w) {
+Prepared prepare(SegmentWork& w, Edges* edges = nullptr) {
   Prepared p;
   const Surface& ann = w.ann;
-  p.E = build_edges(ann.t);
+  p.E = edges ? std::move(*edges) : build_edges(ann.t);
   w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) w.seg.area_3d += face_area_3d(ann, int(f));
   p.degenerate.assign(ann.t.size(), 0);
@@ -210,8 +213,39 @@ void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out)
   out[base].parent = -1;
 }
 
-// Cuts the side branches off the annulus (each flattened as a band of its own, recursively),
-// then re-solves the conformal map of what remains. Returns the branches' works.
+// One side branch cut off an annulus: its surface and its neck's vertices in what remains.
+struct BranchPiece {
+  Surface surface;
+  std::vector<int> neck;
+  double neck_mm = 0;
+};
+
+// Flattens the cut-off branches (each as a band of its own, recursively); returns their works and
+// adds their wall area to `placed`. A branch that cannot be flattened counts as wall not shown.
+std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces, int component, double lumen_sign,
+                                          const FlattenOptions& o, int depth, double& placed) {
+  FlattenOptions bo = o;
+  bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
+  std::vector<SegmentWork> out;
+  for (const BranchPiece& piece : pieces) {
+    try {
+      std::vector<SegmentWork> sub =
+          flatten_surface(piece.surface, 1, std::size_t(component), lumen_sign, bo, depth + 1);
+      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
+      sub[0].cap_area = 0;
+      sub[0].seg.neck_mm = piece.neck_mm;
+      sub[0].neck = piece.neck;
+      placed += surface_area(piece.surface);
+      append_branch(sub, out);
+    } catch (const std::exception&) {
+      // not flattenable as a band: its wall counts as not shown
+    }
+  }
+  return out;
+}
+
+// Cuts the side branches off the annulus, then re-solves the conformal map of what remains (on a
+// second thread, while the branches are flattened). Returns the branches' works.
 std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
   const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
@@ -223,36 +257,44 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
   clean_selection(w.ann, p.E, keep);
   std::vector<int> new_of_old;
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
-  double placed = surface_area(rest);
-  FlattenOptions bo = o;
-  bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
-  std::vector<SegmentWork> out;
+  std::vector<BranchPiece> pieces;
   for (const auto& cut : cuts) {
     std::vector<char> in(nf, 0);
     for (int f : cut.faces) in[f] = 1;
     clean_selection(w.ann, p.E, in);
-    const Surface b = sub_surface(w.ann, in);
-    try {
-      std::vector<SegmentWork> sub = flatten_surface(b, 1, std::size_t(w.seg.component), w.lumen_sign, bo, depth + 1);
-      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
-      sub[0].cap_area = 0;
-      sub[0].seg.neck_mm = cut.neck_mm;
-      for (std::size_t f = 0; f < nf; ++f)
-        if (in[f])
-          for (int v : w.ann.t[f])
-            if (new_of_old[v] >= 0) sub[0].neck.push_back(new_of_old[v]);
-      placed += surface_area(b);
-      append_branch(sub, out);
-    } catch (const std::exception&) {
-      // not flattenable as a band: its wall counts as not shown
-    }
+    BranchPiece piece;
+    piece.surface = sub_surface(w.ann, in);
+    piece.neck_mm = cut.neck_mm;
+    for (std::size_t f = 0; f < nf; ++f)
+      if (in[f])
+        for (int v : w.ann.t[f])
+          if (new_of_old[v] >= 0) piece.neck.push_back(new_of_old[v]);
+    pieces.push_back(std::move(piece));
   }
-  w.lost_area += surface_area(w.ann) - placed;
+  const double annulus_area = surface_area(w.ann);
   for (auto& l : loops)
     for (int& v : l) v = new_of_old[v];
+  std::vector<int> order;  // the colon's elimination order, restricted to what remains
+  for (int v : w.elimination_order)
+    if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
+  w.elimination_order = std::move(order);
   w.ann = std::move(rest);
-  p = prepare(w);
-  conformal(w, loops, p, o);
+  double placed = surface_area(w.ann);
+  const int component = w.seg.component;
+  const double lumen_sign = w.lumen_sign;
+  auto resolved = std::async(std::launch::async, [&] {
+    p = prepare(w);
+    conformal(w, loops, p, o);
+  });
+  std::vector<SegmentWork> out;
+  try {
+    out = flatten_branches(pieces, component, lumen_sign, o, depth, placed);
+  } catch (...) {
+    resolved.wait();
+    throw;
+  }
+  resolved.get();
+  w.lost_area += annulus_area - placed;
   return out;
 }
 
@@ -301,12 +343,13 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   auto phase = [depth](const char* what) {  // progress lines for the colon segments, not their branches
     if (depth == 0) phase_done(what);
   };
-  auto loops = open_annulus(s, nloops, o, c, w);
+  Edges edges;
+  auto loops = open_annulus(s, nloops, o, c, w, edges);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
   w.cap_area = surface_area(s) - surface_area(w.ann);
-  Prepared p = prepare(w);
+  Prepared p = prepare(w, &edges);
   phase("ends opened");
   conformal(w, loops, p, o);
   phase("conformal map");

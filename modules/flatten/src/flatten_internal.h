@@ -27,7 +27,8 @@ struct Surface {
   std::vector<int> src;  // input vertex id of each local vertex
 };
 
-// Edge graph: edges lo < hi, their one or two faces, and the edge opposite each face corner.
+// Edge graph: edges lo < hi, sorted by (lo, hi), their one or two faces, and the edge opposite
+// each face corner.
 struct Edges {
   std::vector<std::array<int, 2>> ev;
   std::vector<std::array<int, 2>> ef;  // [1] = -1 on the boundary
@@ -68,9 +69,12 @@ struct Harmonic {
   double period = 0;
   double energy_u = 0;
   std::string weights;
+  std::vector<int> vertex_order;  // the fill-reducing elimination order used (all vertices; empty: none)
 };
+// `vertex_order` (optional): a fill-reducing elimination order of the vertices (e.g. the
+// vertex_order of an earlier solve on a surface this one is a subset of); AMD when null.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
-                        const std::vector<int>& loop_b, bool clamp);
+                        const std::vector<int>& loop_b, bool clamp, const std::vector<int>* vertex_order = nullptr);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.
@@ -241,6 +245,7 @@ struct SegmentWork {
   std::vector<int> neck;      // side branch: its neck's vertices in the parent's annulus
   double cap_area = 0;        // mm^2 of wall removed to open the ends (caps)
   double lost_area = 0;       // mm^2 of wall in no band (faces dropped when a branch was cut off)
+  std::vector<int> elimination_order;  // vertices of ann in the conformal solve's fill-reducing order
 };
 
 // Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those

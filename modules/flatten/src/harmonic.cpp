@@ -34,12 +34,6 @@ std::vector<double> cot_weights(const Surface& s, const Edges& E, bool clamp) {
   return w;
 }
 
-Eigen::VectorXd solve_spd(const SpMat& A, const Eigen::VectorXd& rhs) {
-  SpdSolver solver;
-  if (!solver.compute(A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
-  return solver.solve(rhs);
-}
-
 // The cut cocycle: a shortest dual path of faces from loop A (mark 1) to loop B (mark 2); each
 // edge it crosses gets +-1 (per edge, lo -> hi).
 std::vector<signed char> cut_cocycle(const Surface& s, const Edges& E, const std::vector<char>& mark) {
@@ -90,54 +84,127 @@ std::vector<signed char> cut_cocycle(const Surface& s, const Edges& E, const std
   return eta;
 }
 
-// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2).
-Eigen::VectorXd solve_u(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark) {
-  const int nv = int(mark.size());
-  std::vector<int> idx(nv);  // >= 0 unknown index; -1 loop A; -2 loop B
-  int n = 0;
-  for (int v = 0; v < nv; ++v) idx[v] = mark[v] == 1 ? -1 : mark[v] == 2 ? -2 : n++;
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(4 * E.ev.size());
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+// A sparse system A x = rhs over some vertices (A: lower triangle only, as SpdSolver reads it):
+// unknown_of[v] = the unknown of vertex v, -1 when the vertex is not one.
+struct LinearSystem {
+  SpMat A;
+  Eigen::VectorXd rhs;
+  std::vector<int> unknown_of;
+};
+
+// The lower triangle (CSC) of the weighted graph Laplacian over the unknowns: column j holds the
+// diagonal (the sum of the weights of all edges at unknown j's vertex, fixed neighbours included)
+// and -w for each edge to an unknown of a higher vertex id. `unknown_of` increases with the vertex
+// id, and E.ev is sorted by (lo, hi) (build_edges), so each column comes out with its rows sorted.
+SpMat laplacian_lower(const Edges& E, const std::vector<double>& w, const std::vector<int>& unknown_of, int n) {
+  std::vector<double> diagonal(n, 0.0);
+  std::vector<int> below(n, 0);
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
-    const int ia = idx[E.ev[e][0]], ib = idx[E.ev[e][1]];
-    if (ia >= 0) trip.emplace_back(ia, ia, w[e]);
-    if (ib >= 0) trip.emplace_back(ib, ib, w[e]);
-    if (ia >= 0 && ib >= 0) trip.emplace_back(ia, ib, -w[e]), trip.emplace_back(ib, ia, -w[e]);
-    if (ia >= 0 && ib == -2) rhs[ia] += w[e];
-    if (ib >= 0 && ia == -2) rhs[ib] += w[e];
+    const int ia = unknown_of[E.ev[e][0]], ib = unknown_of[E.ev[e][1]];
+    if (ia >= 0) diagonal[ia] += w[e];
+    if (ib >= 0) diagonal[ib] += w[e];
+    if (ia >= 0 && ib >= 0) ++below[ia];
   }
   SpMat A(n, n);
-  A.setFromTriplets(trip.begin(), trip.end());
-  const Eigen::VectorXd x = solve_spd(A, rhs);
-  Eigen::VectorXd u(nv);
-  for (int v = 0; v < nv; ++v) u[v] = idx[v] >= 0 ? x[idx[v]] : idx[v] == -1 ? 0.0 : 1.0;
-  return u;
+  std::size_t nnz = 0;
+  for (int j = 0; j < n; ++j) nnz += 1 + below[j];
+  A.resizeNonZeros(Eigen::Index(nnz));
+  int* outer = A.outerIndexPtr();
+  int* rows = A.innerIndexPtr();
+  double* values = A.valuePtr();
+  outer[0] = 0;
+  for (int j = 0; j < n; ++j) {
+    outer[j + 1] = outer[j] + 1 + below[j];
+    rows[outer[j]] = j, values[outer[j]] = diagonal[j];
+    below[j] = outer[j] + 1;  // next free slot of column j
+  }
+  bool sorted = true;
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {
+    const int ia = unknown_of[E.ev[e][0]], ib = unknown_of[E.ev[e][1]];
+    if (ia < 0 || ib < 0) continue;
+    const int slot = below[ia]++;
+    sorted = sorted && rows[slot - 1] < ib;
+    rows[slot] = ib, values[slot] = -w[e];
+  }
+  if (!sorted) A = SpMat(SpMat(A.transpose()).transpose());  // transposing sorts the rows
+  return A;
 }
 
-// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned at vertex 0.
-Eigen::VectorXd solve_v(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv) {
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(4 * E.ev.size());
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nv - 1);
+// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2); unknowns: the other vertices.
+LinearSystem u_system(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark) {
+  const int nv = int(mark.size());
+  LinearSystem sys;
+  std::vector<int>& idx = sys.unknown_of;
+  idx.resize(nv);
+  int n = 0;
+  for (int v = 0; v < nv; ++v) idx[v] = mark[v] == 0 ? n++ : -1;
+  sys.A = laplacian_lower(E, w, idx, n);
+  sys.rhs = Eigen::VectorXd::Zero(n);
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     const int a = E.ev[e][0], b = E.ev[e][1];
-    const double we = w[e];
-    if (a > 0) trip.emplace_back(a - 1, a - 1, we);
-    if (b > 0) trip.emplace_back(b - 1, b - 1, we);
-    if (a > 0 && b > 0) trip.emplace_back(a - 1, b - 1, -we), trip.emplace_back(b - 1, a - 1, -we);
-    if (eta[e]) {
-      if (a > 0) rhs[a - 1] += we * eta[e];
-      if (b > 0) rhs[b - 1] -= we * eta[e];
-    }
+    if (idx[a] >= 0 && mark[b] == 2) sys.rhs[idx[a]] += w[e];
+    if (idx[b] >= 0 && mark[a] == 2) sys.rhs[idx[b]] += w[e];
   }
-  SpMat A(nv - 1, nv - 1);
-  A.setFromTriplets(trip.begin(), trip.end());
-  const Eigen::VectorXd x = solve_spd(A, rhs);
-  Eigen::VectorXd v(nv);
-  v[0] = 0;
-  v.tail(nv - 1) = x;
-  return v;
+  return sys;
+}
+
+// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned at vertex 0; unknown v - 1 of vertex v.
+LinearSystem v_system(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv) {
+  LinearSystem sys;
+  sys.unknown_of.resize(nv);
+  for (int v = 0; v < nv; ++v) sys.unknown_of[v] = v - 1;
+  sys.A = laplacian_lower(E, w, sys.unknown_of, nv - 1);
+  sys.rhs = Eigen::VectorXd::Zero(nv - 1);
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {
+    if (!eta[e]) continue;
+    const int a = E.ev[e][0], b = E.ev[e][1];
+    if (a > 0) sys.rhs[a - 1] += w[e] * eta[e];
+    if (b > 0) sys.rhs[b - 1] -= w[e] * eta[e];
+  }
+  return sys;
+}
+
+// The elimination order of a system's unknowns induced by a vertex order (vertices that are not
+// unknowns skipped, the relative order kept).
+std::vector<int> restrict_order(const std::vector<int>& vertex_order, const std::vector<int>& unknown_of) {
+  std::vector<int> order;
+  order.reserve(vertex_order.size());
+  for (int v : vertex_order)
+    if (v >= 0 && v < int(unknown_of.size()) && unknown_of[v] >= 0) order.push_back(unknown_of[v]);
+  return order;
+}
+
+Eigen::VectorXd factorize_and_solve(SpdSolver& solver, const LinearSystem& sys) {
+  if (!solver.factorize(sys.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  return solver.solve(sys.rhs);
+}
+
+// Solves the u and v systems, u on a second thread; one fill-reducing order for both (the given
+// vertex order, else AMD on the v system, which holds all vertices but one). Returns the vertex
+// order used (empty when the solver gives none).
+std::vector<int> solve_uv(const LinearSystem& us, const LinearSystem& vs, const std::vector<int>* vertex_order,
+                          Eigen::VectorXd& xu, Eigen::VectorXd& xv) {
+  SpdSolver v_solver;
+  std::vector<int> order;
+  if (vertex_order) {
+    const std::vector<int> v_order = restrict_order(*vertex_order, vs.unknown_of);
+    v_solver.analyze(vs.A, &v_order);
+    order = *vertex_order;
+  } else {
+    v_solver.analyze(vs.A);
+    order = v_solver.order();
+    for (int& k : order) k += 1;  // unknown k is vertex k + 1
+    if (!order.empty()) order.push_back(0);
+  }
+  const std::vector<int> u_order = restrict_order(order, us.unknown_of);
+  auto u_done = std::async(std::launch::async, [&] {
+    SpdSolver u_solver;
+    u_solver.analyze(us.A, u_order.empty() ? nullptr : &u_order);
+    return factorize_and_solve(u_solver, us);
+  });
+  xv = factorize_and_solve(v_solver, vs);
+  xu = u_done.get();
+  return order;
 }
 
 double eta_dir(const std::vector<signed char>& eta, const Edges& E, int e, int from) {
@@ -147,7 +214,7 @@ double eta_dir(const std::vector<signed char>& eta, const Edges& E, int e, int f
 }  // namespace
 
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
-                        const std::vector<int>& loop_b, bool clamp) {
+                        const std::vector<int>& loop_b, bool clamp, const std::vector<int>* vertex_order) {
   Harmonic h;
   h.weights = clamp ? "clamped" : "cotan";
   const int nv = int(s.p.size());
@@ -156,10 +223,14 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   for (int v : loop_a) mark[v] = 1;
   for (int v : loop_b) mark[v] = 2;
   h.eta = cut_cocycle(s, E, mark);
-  // u and v need one factorisation each; they are independent, so run them on two threads.
-  auto u_done = std::async(std::launch::async, [&] { return solve_u(E, w, mark); });
-  h.v = solve_v(E, w, h.eta, nv);
-  h.u = u_done.get();
+  const LinearSystem us = u_system(E, w, mark), vs = v_system(E, w, h.eta, nv);
+  Eigen::VectorXd xu, xv;
+  h.vertex_order = solve_uv(us, vs, vertex_order, xu, xv);
+  h.u.resize(nv);
+  for (int v = 0; v < nv; ++v) h.u[v] = mark[v] == 0 ? xu[us.unknown_of[v]] : mark[v] == 1 ? 0.0 : 1.0;
+  h.v.resize(nv);
+  h.v[0] = 0;
+  h.v.tail(nv - 1) = xv;
   double ev = 0;
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     const double du = h.u[E.ev[e][1]] - h.u[E.ev[e][0]];

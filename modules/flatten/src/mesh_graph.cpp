@@ -12,27 +12,40 @@
 
 namespace cf::flat_detail {
 
+// The face corners bucketed by the lower vertex of the edge opposite them (a counting sort), each
+// bucket sorted by the higher vertex (stable, so corners of one edge stay in face order): edges
+// come out sorted by (lo, hi) in O(faces), with the same numbering as a global sort of the keys.
 Edges build_edges(const std::vector<Tri>& t) {
-  Edges E;
-  std::vector<std::pair<std::uint64_t, int>> keys;
-  keys.reserve(3 * t.size());
+  int nv = 0;
+  for (const Tri& tri : t) nv = std::max({nv, tri[0] + 1, tri[1] + 1, tri[2] + 1});
+  std::vector<int> start(std::size_t(nv) + 1, 0);
+  for (const Tri& tri : t)
+    for (int k = 0; k < 3; ++k) ++start[std::min(tri[(k + 1) % 3], tri[(k + 2) % 3]) + 1];
+  for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<int, int>> corner(3 * t.size());  // (hi, 3 f + k) per bucket
+  std::vector<int> fill(start.begin(), start.end() - 1);
   for (std::size_t f = 0; f < t.size(); ++f)
     for (int k = 0; k < 3; ++k) {
-      std::uint64_t a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
-      if (a > b) std::swap(a, b);
-      keys.push_back({(a << 32) | b, int(3 * f + k)});
+      const int a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
+      corner[fill[std::min(a, b)]++] = {std::max(a, b), int(3 * f + k)};
     }
-  std::sort(keys.begin(), keys.end());
+  Edges E;
   E.fe.assign(t.size(), {-1, -1, -1});
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i;
-    while (j < keys.size() && keys[j].first == keys[i].first) ++j;
-    if (j - i > 2) throw PreconditionError("non-manifold edge in a colon segment; flatten needs a 2-manifold");
-    const int e = int(E.ev.size());
-    E.ev.push_back({int(keys[i].first >> 32), int(keys[i].first & 0xffffffffu)});
-    E.ef.push_back({keys[i].second / 3, j - i == 2 ? keys[i + 1].second / 3 : -1});
-    for (std::size_t q = i; q < j; ++q) E.fe[keys[q].second / 3][keys[q].second % 3] = e;
-    i = j;
+  E.ev.reserve(3 * t.size() / 2 + 1);
+  E.ef.reserve(3 * t.size() / 2 + 1);
+  for (int lo = 0; lo < nv; ++lo) {
+    const auto first = corner.begin() + start[lo], last = corner.begin() + start[lo + 1];
+    std::stable_sort(first, last, [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto i = first; i != last;) {
+      auto j = i;
+      while (j != last && j->first == i->first) ++j;
+      if (j - i > 2) throw PreconditionError("non-manifold edge in a colon segment; flatten needs a 2-manifold");
+      const int e = int(E.ev.size());
+      E.ev.push_back({lo, i->first});
+      E.ef.push_back({i->second / 3, j - i == 2 ? (i + 1)->second / 3 : -1});
+      for (auto q = i; q != j; ++q) E.fe[q->second / 3][q->second % 3] = e;
+      i = j;
+    }
   }
   return E;
 }

@@ -1,0 +1,118 @@
+// The sparse pieces of the flatten stage's conformal solve: the edge numbering the Laplacians are
+// built from, and the SPD solver with a reused elimination order.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+
+#include "../src/flatten_internal.h"
+#include "../src/spd_solver.h"
+#include "colonflat/core/error.h"
+
+namespace {
+
+using cf::flat_detail::SpdSolver;
+using cf::flat_detail::Tri;
+
+// An nx x ny grid of vertices, two triangles per cell, faces in a shuffled order.
+std::vector<Tri> grid_faces(int nx, int ny, unsigned seed) {
+  std::vector<Tri> t;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+      t.push_back({a, b, d});
+      t.push_back({a, d, c});
+    }
+  std::shuffle(t.begin(), t.end(), std::mt19937(seed));
+  return t;
+}
+
+// Laplacian of the grid's edges (weight 1 + (lo + hi) % 3) over the vertices with keep[v], plus
+// 1 on the diagonal of the first column's vertices (so that it is positive definite).
+SpdSolver::SpMat grid_system(const cf::flat_detail::Edges& E, int nx, const std::vector<int>& unknown_of, int n) {
+  std::vector<Eigen::Triplet<double>> trip;
+  for (const auto& e : E.ev) {
+    const int a = unknown_of[e[0]], b = unknown_of[e[1]];
+    const double w = 1.0 + (e[0] + e[1]) % 3;
+    if (a < 0 || b < 0) continue;
+    trip.emplace_back(a, a, w), trip.emplace_back(b, b, w), trip.emplace_back(a, b, -w), trip.emplace_back(b, a, -w);
+  }
+  for (std::size_t v = 0; v < unknown_of.size(); ++v)
+    if (unknown_of[v] >= 0 && int(v) % nx == 0) trip.emplace_back(unknown_of[v], unknown_of[v], 1.0);
+  SpdSolver::SpMat A(n, n);
+  A.setFromTriplets(trip.begin(), trip.end());
+  return A;
+}
+
+}  // namespace
+
+// build_edges numbers the edges in (lo, hi) order, as a sort of all corner keys does, with the
+// faces on each side (lower face id first) and the edge opposite each face corner.
+TEST(FlattenSolver, EdgesAreNumberedInLoHiOrderWithTheirFaces) {
+  const std::vector<Tri> t = grid_faces(7, 5, 3);
+  const cf::flat_detail::Edges E = cf::flat_detail::build_edges(t);
+  std::map<std::pair<int, int>, std::vector<int>> brute;  // (lo, hi) -> faces, increasing
+  for (std::size_t f = 0; f < t.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
+      brute[{std::min(a, b), std::max(a, b)}].push_back(int(f));
+    }
+  ASSERT_EQ(E.ev.size(), brute.size());
+  std::size_t e = 0;
+  for (const auto& [key, faces] : brute) {
+    EXPECT_EQ(E.ev[e][0], key.first);
+    EXPECT_EQ(E.ev[e][1], key.second);
+    EXPECT_EQ(E.ef[e][0], faces[0]);
+    EXPECT_EQ(E.ef[e][1], faces.size() == 2 ? faces[1] : -1);
+    ++e;
+  }
+  for (std::size_t f = 0; f < t.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto& ev = E.ev[E.fe[f][k]];
+      const int a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
+      EXPECT_EQ(ev[0], std::min(a, b));
+      EXPECT_EQ(ev[1], std::max(a, b));
+    }
+  std::vector<Tri> fan = {{0, 1, 2}, {0, 2, 1}, {0, 1, 3}};  // edge (0, 1) in three faces
+  EXPECT_THROW(cf::flat_detail::build_edges(fan), cf::PreconditionError);
+}
+
+// A system on a subgraph solved with the elimination order of the whole graph, restricted to the
+// subgraph's vertices, has the same solution as with its own AMD order; the orders reported are
+// permutations of the unknowns (empty only without CHOLMOD).
+TEST(FlattenSolver, RestrictedOrderOfALargerGraphSolvesTheSubgraph) {
+  const int nx = 40, ny = 25, nv = nx * ny;
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, ny, 5));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  SpdSolver whole;
+  ASSERT_TRUE(whole.compute(grid_system(E, nx, all, nv)));
+  const std::vector<int> order = whole.order();
+  if (!order.empty()) {
+    std::vector<int> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, all);
+  }
+  std::vector<int> unknown_of(nv, -1), restricted;  // the subgraph: a 10 x 8 block removed
+  int n = 0;
+  for (int v = 0; v < nv; ++v)
+    if (!(v % nx >= 20 && v % nx < 30 && v / nx >= 5 && v / nx < 13)) unknown_of[v] = n++;
+  for (int v : order)
+    if (unknown_of[v] >= 0) restricted.push_back(unknown_of[v]);
+  const SpdSolver::SpMat A = grid_system(E, nx, unknown_of, n);
+  Eigen::VectorXd b(n);
+  for (int i = 0; i < n; ++i) b[i] = std::sin(0.37 * i) + 0.1;
+  SpdSolver amd, reused;
+  ASSERT_TRUE(amd.compute(A));
+  ASSERT_TRUE(reused.compute(A, order.empty() ? nullptr : &restricted));
+  const Eigen::VectorXd x_amd = amd.solve(b), x_reused = reused.solve(b);
+  EXPECT_LT((A * x_reused - b).norm(), 1e-10 * b.norm());
+  EXPECT_LT((x_reused - x_amd).norm(), 1e-10 * x_amd.norm());
+  if (!order.empty()) {  // CHOLMOD may postorder the given order: still a permutation of the unknowns
+    std::vector<int> used = reused.order(), expected(n);
+    std::sort(used.begin(), used.end());
+    for (int i = 0; i < n; ++i) expected[i] = i;
+    EXPECT_EQ(used, expected);
+  }
+}
