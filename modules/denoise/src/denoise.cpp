@@ -145,7 +145,6 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   phase_done("topology analysis");
   const TopologyReport& b = res.before;
   const int needed = std::max(0, *b.genus - o.target_genus);
-  if (needed > 0) detail::prepare_search(st, o);
   nlohmann::json stats = nlohmann::json::object();
   std::string reason = "target genus reached";
   if (needed > 0)

@@ -27,10 +27,10 @@ struct DenoiseState {
   std::vector<LoopRecord> loops;
   std::vector<std::vector<Mesh::VertexHandle>> cap_rings;  // both rings of every surgery
   Timers t;
-  std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked (or by prepare())
+  std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked (or by prepare_input())
   double mean_edge = 0;
   std::unique_ptr<SearchWorker> worker;             // the helper thread (DenoiseOptions::threads > 1)
-  std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare() on two threads, taken by the exact method
+  std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare_input() on two threads, taken by the exact method
 
   // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others
   // (caps) have no input id.
@@ -41,12 +41,10 @@ struct DenoiseState {
 
 // Copies `input` into st.mesh (garbage-collected) and analyses the input's topology into
 // `before` (time in *t_analysis). With st.worker, the analysis runs on the helper thread while
-// the copy is made. Throws PreconditionError when the input is not a valid denoise input.
+// this one copies the mesh and builds the cap guard grid and (exact method) the first homology
+// basis. Throws PreconditionError when the input is not a valid denoise input.
 void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
                    double* t_analysis);
-// With st.worker and loops to cut: the cap guard grid (on the helper) and, for the exact method,
-// the first homology basis (on this thread) at the same time; both only read st.mesh.
-void prepare_search(DenoiseState& st, const DenoiseOptions& o);
 
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,

@@ -42,17 +42,41 @@ void init_state(DenoiseState& st, const TopologyReport& b) {
   for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
 }
 
-// Runs `mine` here and `theirs` on the helper thread; rethrows the helper's exception.
+// Runs `mine` here and `theirs` on the helper thread, returns when both are done and rethrows
+// the first exception of either (neither may leave the other running on freed state).
 void run_both(SearchWorker& worker, const std::function<void()>& mine, const std::function<void()>& theirs) {
-  std::exception_ptr error;
-  worker.run_both(mine, [&] {
+  std::exception_ptr mine_error, their_error;
+  auto guarded = [](const std::function<void()>& job, std::exception_ptr& error) {
     try {
-      theirs();
+      job();
     } catch (...) {
       error = std::current_exception();
     }
-  });
-  if (error) std::rethrow_exception(error);
+  };
+  worker.run_both([&] { guarded(mine, mine_error); }, [&] { guarded(theirs, their_error); });
+  if (mine_error) std::rethrow_exception(mine_error);
+  if (their_error) std::rethrow_exception(their_error);
+}
+
+// Mean edge length over the mesh's edges (the guard grid's cell size is twice it).
+double mean_edge_length(const Mesh& mesh) {
+  double sum = 0;
+  for (auto e : mesh.edges()) sum += mesh.calc_edge_length(e);
+  return mesh.n_edges() ? sum / static_cast<double>(mesh.n_edges()) : 0.0;
+}
+
+// What the first surgery and the first search need, built while the helper thread analyses the
+// input (wasted when the input needs no cut): the cap guard grid and, for the exact method,
+// the homology basis. Both only read st.mesh.
+void build_ahead(DenoiseState& st, const DenoiseOptions& o) {
+  Stopwatch sw;
+  if (o.check_caps) st.guard = std::make_unique<FaceGrid>(st.mesh, 2.0 * mean_edge_length(st.mesh));
+  st.t.surgery += sw.seconds();  // where cut_loop() counts it when it builds the grid
+  if (o.method != "exact") return;
+  sw.restart();
+  st.initial_homology = std::make_unique<HomologyBasis>();
+  st.initial_homology->build(st.mesh);
+  st.t.homology += sw.seconds();
 }
 
 }  // namespace
@@ -69,32 +93,19 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     *t_analysis = sw.seconds();
   };
   if (st.worker && !has_garbage(input)) {  // the copy keeps the input's element ids
-    run_both(*st.worker, copy, [&] { analyse(input); });
+    run_both(
+        *st.worker,
+        [&] {
+          copy();
+          build_ahead(st, o);
+        },
+        [&] { analyse(input); });
   } else {
     copy();
     analyse(st.mesh);
   }
   check_input(*before, o);
   init_state(st, *before);
-}
-
-void prepare_search(DenoiseState& st, const DenoiseOptions& o) {
-  if (!st.worker) return;
-  auto guard = [&] {
-    Stopwatch grid_sw;
-    if (o.check_caps && !st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, 2.0 * st.mean_edge);
-    st.t.surgery += grid_sw.seconds();  // where cut_loop() counts it when it builds the grid
-  };
-  if (o.method != "exact") return guard();
-  Stopwatch sw;
-  run_both(
-      *st.worker,
-      [&] {
-        st.initial_homology = std::make_unique<HomologyBasis>();
-        st.initial_homology->build(st.mesh);
-        st.t.homology += sw.seconds();
-      },
-      guard);
 }
 
 }  // namespace cf::detail

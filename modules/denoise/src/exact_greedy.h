@@ -105,7 +105,9 @@ class ExactGreedy {
   void run_group(GroupRun& g, FundamentalCycleSearch& search) const;
   void run_groups(std::vector<GroupRun>& runs);
   void finish_group(const GroupRun& g, double best);
-  int second_seed(int seed, double best, std::uint32_t taken);
+  int next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken);
+  bool near_group(int seed, const GroupRun& g) const;
+  static constexpr std::size_t kMaxSkipped = 64;  // far-first entries set aside per batch, at most
   static constexpr double kGroupRadius = 0.5;  // first group radius, times the best known loop
   // Two threads: groups are searched in batches, half on each thread, of about this many
   // settled vertices per thread (from the last batch's mean), at most kMaxBatch groups per
@@ -159,6 +161,8 @@ class ExactGreedy {
   double far_value_ = 0;
   std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
   std::vector<double> distances_;  // scratch: distances of the last single search's settled vertices
+  std::vector<std::pair<double, int>> far_skipped_;  // popped while forming a batch, pushed back after it
+  double far_popped_distance_ = 0;                  // key of the entry farthest_pending() returned last
   std::vector<double> from_anchor_;                // per vertex: scratch for farthest_pending(), +inf between calls
   long long far_searches_ = 0;
   long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;

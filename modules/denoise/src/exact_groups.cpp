@@ -73,10 +73,15 @@ void ExactGreedy::search_group(int seed, double best) {
   std::vector<GroupRun> runs{prepare_group(seed, best, 0)};
   const std::uint32_t first = group_stamp_;  // the batch's groups have marks >= first
   for (std::size_t want = batch_size(); runs.size() < want;) {
-    const int other = second_seed(seed, best, first);
+    const int other = next_seed(runs, best, first);
     if (other < 0) break;
     runs.push_back(prepare_group(other, best, first));
   }
+  for (const auto& entry : far_skipped_) {  // back into the far-first order
+    far_order_.push_back(entry);
+    std::push_heap(far_order_.begin(), far_order_.end());
+  }
+  far_skipped_.clear();
   run_groups(runs);
   std::size_t settled = 0;
   for (const GroupRun& g : runs) {
@@ -95,12 +100,31 @@ std::size_t ExactGreedy::batch_size() const {
   return 2 * std::clamp<std::size_t>(per_thread, 1, kMaxBatch);
 }
 
-// The next farthest pending source outside the groups marked since `taken`, else the pending
-// source of the seed's family farthest (in space) from the seed, or -1. Sources the far-first
-// order skips stay pending: they are searched later in the smallest-bound order.
-int ExactGreedy::second_seed(int seed, double best, std::uint32_t taken) {
-  for (int s = farthest_pending(best); s >= 0; s = farthest_pending(best))
-    if (group_mark_[slots_[s].vertex] < taken) return s;
+// Whether a group search from `seed` may settle a vertex that the search of g settles (their
+// balls, within limit/2 of the group's roots, can meet: Euclidean test, which bounds the graph
+// distance from below). Groups of a batch are kept apart so that none certifies another.
+bool ExactGreedy::near_group(int seed, const GroupRun& g) const {
+  const double reach = g.radius + g.limit;  // both balls: roots within the radius, searched to limit/2
+  const Vec3& a = st_.mesh.point(Mesh::VertexHandle(slots_[seed].vertex));
+  const Vec3& b = st_.mesh.point(Mesh::VertexHandle(slots_[g.seed].vertex));
+  return (a - b).sqrnorm() < reach * reach;
+}
+
+// The next seed of a batch: the next farthest pending source outside the batch's groups
+// (marked since `taken`) and away from them (the near ones go to far_skipped_ and back into
+// the far-first order after the batch), else the pending source of the first seed's family
+// farthest in space from it and away from the batch, or -1.
+int ExactGreedy::next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken) {
+  auto away = [&](int s) {
+    return std::none_of(batch.begin(), batch.end(), [&](const GroupRun& g) { return near_group(s, g); });
+  };
+  for (int s = farthest_pending(best); s >= 0; s = farthest_pending(best)) {
+    if (group_mark_[slots_[s].vertex] >= taken) continue;
+    if (away(s)) return s;
+    far_skipped_.push_back({far_popped_distance_, s});
+    if (far_skipped_.size() >= kMaxSkipped) return -1;
+  }
+  const int seed = batch.front().seed;
   const Vec3& from = st_.mesh.point(Mesh::VertexHandle(slots_[seed].vertex));
   int other = -1;
   double farthest = -1;
@@ -109,7 +133,7 @@ int ExactGreedy::second_seed(int seed, double best, std::uint32_t taken) {
     if (!slot.active || slot.bound.exact || !(slot.bound.value < best) || slot.family != slots_[seed].family) continue;
     if (group_mark_[slot.vertex] >= taken) continue;
     const double d = (st_.mesh.point(Mesh::VertexHandle(slot.vertex)) - from).sqrnorm();
-    if (d > farthest) farthest = d, other = s;
+    if (d > farthest && away(s)) farthest = d, other = s;
   }
   return other;
 }

@@ -17,7 +17,7 @@ void ExactGreedy::build_homology() {
   std::vector<SourceBound> kept(st_.mesh.n_vertices());
   for (int s : active_)
     if (slots_[s].active && slots_[s].family == 0) kept[slots_[s].vertex] = slots_[s].bound;
-  if (st_.initial_homology) {  // built by prepare_search() while the guard grid was built
+  if (st_.initial_homology) {  // built by prepare_input() while the input was analysed
     homology_ = std::move(*st_.initial_homology);
     st_.initial_homology.reset();
   } else {
@@ -197,6 +197,7 @@ int ExactGreedy::farthest_pending(double best) {
   while (!far_order_.empty()) {
     std::pop_heap(far_order_.begin(), far_order_.end());
     const int s = far_order_.back().second;
+    far_popped_distance_ = far_order_.back().first;
     far_order_.pop_back();
     const Slot& slot = slots_[s];
     if (!slot.active || slot.bound.exact || !(slot.bound.value < best)) continue;  // done meanwhile
