@@ -120,15 +120,20 @@ void HomologyBasis::build(const Mesh& mesh) {
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const int pe = parent_edge[*it];
     if (pe < 0) continue;
-    std::fill(cls.begin(), cls.end(), 0);
+    bool any = false;  // most faces have only zero classes around them: no vector work
     const auto h0 = dual.face_halfedge(*it);
     auto h = h0;
     do {
-      const auto e = mesh.edge_handle(h);
-      if (e.idx() != pe) xor_into(cls.data(), edge_class(e), words_);
+      const int e = mesh.edge_handle(h).idx();
+      const std::uint32_t row = row_of_[e];
+      if (e != pe && row != 0) {
+        if (!any) std::fill(cls.begin(), cls.end(), 0);
+        any = true;
+        xor_into(cls.data(), &rows_[std::size_t(row) * words_], words_);
+      }
       h = mesh.next_halfedge_handle(h);
     } while (h != h0);
-    if (!is_zero(cls.data(), words_)) row_of_[pe] = new_row(cls.data());
+    if (any && !is_zero(cls.data(), words_)) row_of_[pe] = new_row(cls.data());
   }
   prune_cut_graph(mesh);
 }
