@@ -31,7 +31,7 @@ void FundamentalCycleSearch::reset_run() {
   }
   settled_count_ = 0;
   settled_order_.clear();
-  acc_.clear();
+  acc_.assign(W_, 0);  // row 0: the zero class, shared by every path whose class is zero
   heap_.clear();
 }
 
@@ -73,11 +73,13 @@ void FundamentalCycleSearch::settle(int v) {
   node.settled = 1;
   ++settled_count_;
   settled_order_.push_back(v);
-  node.slot = static_cast<int>(acc_.size() / W_);
-  acc_.resize(acc_.size() + W_, 0);
+  node.slot = 0;
   if (node.parent < 0) return;
   const auto ph = Mesh::HalfedgeHandle(node.parent);
   const int pu = mesh_.from_vertex_handle(ph).idx();
+  if (node_[pu].slot == 0 && edge_zero(mesh_.edge_handle(ph))) return;  // most paths: no vector work
+  node.slot = static_cast<int>(acc_.size() / W_);
+  acc_.resize(acc_.size() + W_, 0);
   std::uint64_t* mine = &acc_[std::size_t(node.slot) * W_];
   const std::uint64_t* theirs = &acc_[std::size_t(node_[pu].slot) * W_];
   const std::uint64_t* e = edge_bits(mesh_.edge_handle(ph));
@@ -90,6 +92,7 @@ void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, dou
                                        CycleCandidate& best) {
   if (value >= best.value || value > limit) return;
   const int vi = mesh_.from_vertex_handle(h).idx(), wi = mesh_.to_vertex_handle(h).idx();
+  if (node_[vi].slot == 0 && node_[wi].slot == 0 && edge_zero(mesh_.edge_handle(h))) return;  // class zero
   const std::uint64_t* a = &acc_[std::size_t(node_[vi].slot) * W_];
   const std::uint64_t* b = &acc_[std::size_t(node_[wi].slot) * W_];
   const std::uint64_t* e = edge_bits(mesh_.edge_handle(h));

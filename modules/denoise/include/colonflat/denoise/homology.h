@@ -35,6 +35,10 @@ class HomologyBasis {
     const std::size_t e_id = static_cast<std::size_t>(e.idx());
     return &rows_[std::size_t(e_id < row_of_.size() ? row_of_[e_id] : 0) * words_];
   }
+  bool edge_class_is_zero(Mesh::EdgeHandle e) const {
+    const std::size_t e_id = static_cast<std::size_t>(e.idx());
+    return e_id >= row_of_.size() || row_of_[e_id] == 0;
+  }
   // Sets the class of an edge (also one created after build()). `cls` must not point into this
   // table (pass a copy).
   void set_edge_class(Mesh::EdgeHandle e, const std::uint64_t* cls);

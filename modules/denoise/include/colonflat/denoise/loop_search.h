@@ -89,6 +89,9 @@ class FundamentalCycleSearch {
   const std::uint64_t* edge_bits(Mesh::EdgeHandle e) const {
     return cochain_ ? &kBit[(*cochain_)[e.idx()] & 1] : hom_.edge_class(e);
   }
+  bool edge_zero(Mesh::EdgeHandle e) const {
+    return cochain_ ? ((*cochain_)[e.idx()] & 1) == 0 : hom_.edge_class_is_zero(e);
+  }
   static constexpr std::uint64_t kBit[2] = {0, 1};
   bool settled(int v) const { return node_[v].stamp == run_id_ && node_[v].settled; }
   const Mesh& mesh_;
@@ -109,7 +112,7 @@ class FundamentalCycleSearch {
   };
   std::vector<Node> node_;
   std::size_t blocked_known_ = 0;
-  std::vector<std::uint64_t> acc_;
+  std::vector<std::uint64_t> acc_;  // class rows of settled vertices' paths; row 0 is zero
   std::vector<std::uint64_t> tmp_;
   std::vector<std::uint32_t> mark_;
   std::uint32_t mark_id_ = 0;
