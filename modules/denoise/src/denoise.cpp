@@ -21,29 +21,6 @@ void validate_denoise_options(const DenoiseOptions& o) {
 
 namespace {
 
-void check_input(const TopologyReport& b, const DenoiseOptions& o) {
-  if (b.faces == 0) throw PreconditionError("input mesh has no faces");
-  if (!b.manifold || !b.orientable)
-    throw PreconditionError("input must be an orientable 2-manifold; got " + std::to_string(b.nonmanifold_edges) +
-                            " non-manifold edges, " + std::to_string(b.nonmanifold_vertices) + " non-manifold vertices" +
-                            (b.orientable ? "" : ", non-orientable"));
-  if (b.unreferenced_vertices) throw PreconditionError("input has unreferenced vertices");
-  if (o.method == "paper" && !b.closed)
-    throw PreconditionError("--method paper needs closed components (the paper's Algorithm 4 input); got " +
-                            std::to_string(b.boundary_loops) + " boundary loops - use --method exact");
-}
-
-void init_state(detail::DenoiseState& st, const TopologyReport& b) {
-  st.n_input = st.mesh.n_vertices();
-  st.mean_edge = b.mean_edge_length;
-  st.origin.resize(st.n_input);
-  for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
-  st.component.assign(st.n_input, -1);
-  for (auto f : st.mesh.faces())
-    for (auto v : st.mesh.fv_range(f)) st.component[v.idx()] = b.face_component[f.idx()];
-  for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
-}
-
 // Postconditions of the exact method (components, boundaries, manifold, oriented, genus per
 // component as counted); returns the per-component report.
 nlohmann::json check_exact_result(const detail::DenoiseState& st, const TopologyReport& b, const TopologyReport& a) {
@@ -162,15 +139,11 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   Stopwatch total;
   DenoiseResult res;
   detail::DenoiseState st;
-  st.mesh = input;
-  st.mesh.garbage_collection();
-  Stopwatch sw;
-  res.before = analyze_topology(st.mesh);
-  const double t_analysis = sw.seconds();
+  if (o.threads > 1) st.worker = std::make_unique<detail::SearchWorker>();
+  double t_analysis = 0;
+  detail::prepare_input(st, input, o, &res.before, &t_analysis);
   phase_done("topology analysis");
   const TopologyReport& b = res.before;
-  check_input(b, o);
-  init_state(st, b);
   const int needed = std::max(0, *b.genus - o.target_genus);
   nlohmann::json stats = nlohmann::json::object();
   std::string reason = "target genus reached";
@@ -178,7 +151,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
     reason = o.method == "exact" ? detail::run_exact(st, o, needed, progress, b.mean_edge_length, stats)
                                  : detail::run_paper(st, o, needed, progress, stats);
   phase_done("loops found and cut");
-  sw.restart();
+  Stopwatch sw;
   res.after = analyze_topology(st.mesh);
   st.t.verify += sw.seconds();
   const nlohmann::json comps = o.method == "exact" ? check_exact_result(st, b, res.after) : paper_components(res.after);

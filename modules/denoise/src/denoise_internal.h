@@ -9,6 +9,7 @@
 #include "colonflat/denoise/denoise.h"
 #include "colonflat/denoise/homology.h"
 #include "colonflat/denoise/surgery.h"
+#include "search_worker.h"
 
 namespace cf::detail {
 
@@ -26,8 +27,10 @@ struct DenoiseState {
   std::vector<LoopRecord> loops;
   std::vector<std::vector<Mesh::VertexHandle>> cap_rings;  // both rings of every surgery
   Timers t;
-  std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked
+  std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked (or by prepare_input())
   double mean_edge = 0;
+  std::unique_ptr<SearchWorker> worker;             // the helper thread (DenoiseOptions::threads > 1)
+  std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare_input() on two threads, taken by the exact method
 
   // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others
   // (caps) have no input id.
@@ -35,6 +38,13 @@ struct DenoiseState {
                        int comp);
   LoopRecord& record(const std::vector<Mesh::VertexHandle>& loop, int iteration, bool separating);
 };
+
+// Copies `input` into st.mesh (garbage-collected) and analyses the input's topology into
+// `before` (time in *t_analysis). With st.worker, the analysis runs on the helper thread while
+// this one copies the mesh and builds the cap guard grid and (exact method) the first homology
+// basis. Throws PreconditionError when the input is not a valid denoise input.
+void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
+                   double* t_analysis);
 
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,

@@ -80,7 +80,7 @@ class ExactGreedy {
   void set_bound(int slot, const SourceBound& b);
   double best_exact_value();
   int farthest_pending(double best);
-  void spread_bounds(int centre_slot, double bound, const FundamentalCycleSearch& search);
+  void spread_bounds(int centre_slot, double bound, const std::vector<int>& ball, const std::vector<double>& distance);
   void add_surgery_sources(const SurgeryResult& sr);
   void lower_bounds_near(const SurgeryResult& sr);
   // exact_groups.cpp
@@ -89,16 +89,31 @@ class ExactGreedy {
     double radius = 0, limit = 0;
     std::vector<int> members, roots, root_parent;  // slots; their vertices; tree halfedges
     CycleCandidate result;
+    // What finish_group() needs of the search, kept so that the search object can run the next
+    // group of a batch: the vertices it settled, the family's sources among them with their
+    // distances from the group, and the roots whose trees hold the cycle's two ends.
+    std::size_t settled = 0;
+    std::vector<int> ball;
+    std::vector<double> ball_distance;
+    int root_u = -1, root_v = -1;
   };
   std::vector<int> collect_group(int seed, double best, double radius, std::uint32_t taken,
                                  std::vector<int>* root_parent);
   GroupRun prepare_group(int seed, double best, std::uint32_t taken);
   void search_group(int seed, double best);
+  std::size_t batch_size() const;
+  void run_group(GroupRun& g, FundamentalCycleSearch& search) const;
   void run_groups(std::vector<GroupRun>& runs);
-  void finish_group(const GroupRun& g, FundamentalCycleSearch& search, double best);
-  int second_seed(int seed, double best, std::uint32_t taken);
-  static constexpr double kGroupRadius = 0.5;       // first group radius, times the best known loop
-  static constexpr std::size_t kParallelFrom = 4000;  // settled vertices of the last group search
+  void finish_group(const GroupRun& g, double best);
+  int next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken);
+  bool near_group(int seed, const GroupRun& g) const;
+  static constexpr std::size_t kMaxSkipped = 64;  // far-first entries set aside per batch, at most
+  static constexpr double kGroupRadius = 0.5;  // first group radius, times the best known loop
+  // Two threads: groups are searched in batches, half on each thread, of about this many
+  // settled vertices per thread (from the last batch's mean), at most kMaxBatch groups per
+  // thread: one hand-over costs about as much as a small search.
+  static constexpr std::size_t kBatchWork = 2000;
+  static constexpr std::size_t kMaxBatch = 8;
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
                             int iteration);
@@ -126,8 +141,8 @@ class ExactGreedy {
   Z2Span span_;
   std::unique_ptr<FundamentalCycleSearch> search_;
   std::unique_ptr<FundamentalCycleSearch> search2_;  // the second thread's (DenoiseOptions::threads > 1)
-  std::unique_ptr<SearchWorker> worker_;
-  std::size_t last_group_settled_ = 0;
+  SearchWorker* worker_ = nullptr;  // DenoiseState::worker (two threads)
+  std::size_t last_group_settled_ = 0;  // mean settled vertices per group search of the last batch
   bool crossing_wanted_ = false;  // closed, total genus 1, policy shortest: use crossing families
   int closed_ = 0;               // mesh without boundary: 1, with: -1, unknown: 0
   bool crossing_ = false;         // crossing families in use (span family inactive)
@@ -145,6 +160,10 @@ class ExactGreedy {
   int far_anchor_ = -1;
   double far_value_ = 0;
   std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
+  std::vector<double> distances_;  // scratch: distances of the last single search's settled vertices
+  std::vector<std::pair<double, int>> far_skipped_;  // popped while forming a batch, pushed back after it
+  double far_popped_distance_ = 0;                  // key of the entry farthest_pending() returned last
+  std::vector<double> from_anchor_;                // per vertex: scratch for farthest_pending(), +inf between calls
   long long far_searches_ = 0;
   long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected

@@ -17,7 +17,7 @@ namespace cf::detail {
 
 // Pending sources (active, not exact, bound < best, own group radius >= radius) of the seed's
 // family connected to it by mesh edges within `radius` mm along the tree grown breadth-first
-// from it, none marked `taken` (another group of this round). Returns member slots, seed first,
+// from it, none marked `taken` or later (the other groups of this batch). Returns member slots, seed first,
 // parents before children; root_parent[i] = the halfedge from member i's parent (-1 for the
 // seed). Marks the members with a new group_stamp_.
 std::vector<int> ExactGreedy::collect_group(int seed, double best, double radius, std::uint32_t taken,
@@ -37,7 +37,7 @@ std::vector<int> ExactGreedy::collect_group(int seed, double best, double radius
     const auto v = Mesh::VertexHandle(slots_[members[i]].vertex);
     for (auto h : st_.mesh.voh_range(v)) {
       const int w = st_.mesh.to_vertex_handle(h).idx();
-      if (group_mark_[w] == group_stamp_ || (taken != 0 && group_mark_[w] == taken)) continue;
+      if (group_mark_[w] == group_stamp_ || (taken != 0 && group_mark_[w] >= taken)) continue;
       if (w >= static_cast<int>(fam.slot_of.size()) || fam.slot_of[w] < 0) continue;
       const Slot& slot = slots_[fam.slot_of[w]];
       if (!slot.active || slot.bound.exact || !(slot.bound.value < best)) continue;
@@ -64,73 +64,128 @@ ExactGreedy::GroupRun ExactGreedy::prepare_group(int seed, double best, std::uin
 }
 
 // One search from the group around `seed` (best = the best known loop's value) and, with two
-// threads and large searches, at the same time one from a second group far from it.
+// threads, a batch of further groups from the next seeds of the far-first order (or far in
+// space from the seed), half of them searched on each thread. Any order of searches keeps the
+// result exact (every bound stays a valid lower bound); a group that an earlier one of its
+// batch would have certified costs one search more.
 void ExactGreedy::search_group(int seed, double best) {
   Stopwatch sw;
   std::vector<GroupRun> runs{prepare_group(seed, best, 0)};
-  const bool pair = worker_ && last_group_settled_ >= kParallelFrom && !(crossing_ && families_.size() == 2);
-  if (pair) {
-    const std::uint32_t first = group_stamp_;
-    const int other = second_seed(seed, best, first);
-    if (other >= 0) runs.push_back(prepare_group(other, best, first));
+  const std::uint32_t first = group_stamp_;  // the batch's groups have marks >= first
+  for (std::size_t want = batch_size(); runs.size() < want;) {
+    const int other = next_seed(runs, best, first);
+    if (other < 0) break;
+    runs.push_back(prepare_group(other, best, first));
   }
+  for (const auto& entry : far_skipped_) {  // back into the far-first order
+    far_order_.push_back(entry);
+    std::push_heap(far_order_.begin(), far_order_.end());
+  }
+  far_skipped_.clear();
   run_groups(runs);
-  last_group_settled_ = search_->last_settled();
-  for (std::size_t i = 0; i < runs.size(); ++i) finish_group(runs[i], i == 0 ? *search_ : *search2_, best);
+  std::size_t settled = 0;
+  for (const GroupRun& g : runs) {
+    settled += g.settled;
+    finish_group(g, best);
+  }
+  last_group_settled_ = settled / runs.size();
   st_.t.search += sw.seconds();
 }
 
-// The next farthest pending source outside the group marked `taken`, else the pending source
-// of the seed's family farthest (in space) from the seed, or -1. Sources the far-first order
-// skips stay pending: they are searched later in the smallest-bound order.
-int ExactGreedy::second_seed(int seed, double best, std::uint32_t taken) {
-  for (int s = farthest_pending(best); s >= 0; s = farthest_pending(best))
-    if (group_mark_[slots_[s].vertex] != taken) return s;
+// Groups in the next batch: 1 with one thread or while the Z family is being found (its first
+// loop comes from run 0's search state); else enough for kBatchWork settled vertices per thread.
+std::size_t ExactGreedy::batch_size() const {
+  if (!worker_ || (crossing_ && families_.size() == 2)) return 1;
+  const std::size_t per_thread = kBatchWork / std::max<std::size_t>(1, last_group_settled_);
+  return 2 * std::clamp<std::size_t>(per_thread, 1, kMaxBatch);
+}
+
+// Whether a group search from `seed` may settle a vertex that the search of g settles (their
+// balls, within limit/2 of the group's roots, can meet: Euclidean test, which bounds the graph
+// distance from below). Groups of a batch are kept apart so that none certifies another.
+bool ExactGreedy::near_group(int seed, const GroupRun& g) const {
+  const double reach = g.radius + g.limit;  // both balls: roots within the radius, searched to limit/2
+  const Vec3& a = st_.mesh.point(Mesh::VertexHandle(slots_[seed].vertex));
+  const Vec3& b = st_.mesh.point(Mesh::VertexHandle(slots_[g.seed].vertex));
+  return (a - b).sqrnorm() < reach * reach;
+}
+
+// The next seed of a batch: the next farthest pending source outside the batch's groups
+// (marked since `taken`) and away from them (the near ones go to far_skipped_ and back into
+// the far-first order after the batch), else the pending source of the first seed's family
+// farthest in space from it and away from the batch, or -1.
+int ExactGreedy::next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken) {
+  auto away = [&](int s) {
+    return std::none_of(batch.begin(), batch.end(), [&](const GroupRun& g) { return near_group(s, g); });
+  };
+  for (int s = farthest_pending(best); s >= 0; s = farthest_pending(best)) {
+    if (group_mark_[slots_[s].vertex] >= taken) continue;
+    if (away(s)) return s;
+    far_skipped_.push_back({far_popped_distance_, s});
+    if (far_skipped_.size() >= kMaxSkipped) return -1;
+  }
+  const int seed = batch.front().seed;
   const Vec3& from = st_.mesh.point(Mesh::VertexHandle(slots_[seed].vertex));
   int other = -1;
   double farthest = -1;
   for (int s : active_) {
     const Slot& slot = slots_[s];
     if (!slot.active || slot.bound.exact || !(slot.bound.value < best) || slot.family != slots_[seed].family) continue;
-    if (group_mark_[slot.vertex] == taken) continue;
+    if (group_mark_[slot.vertex] >= taken) continue;
     const double d = (st_.mesh.point(Mesh::VertexHandle(slot.vertex)) - from).sqrnorm();
-    if (d > farthest) farthest = d, other = s;
+    if (d > farthest && away(s)) farthest = d, other = s;
   }
   return other;
 }
 
+// Searches one group and keeps what finish_group() needs (reads the greedy's state only, so two
+// threads may run it at once with their own search objects).
+void ExactGreedy::run_group(GroupRun& g, FundamentalCycleSearch& search) const {
+  const Family& fam = families_[slots_[g.seed].family];
+  search.set_cochain(fam.cochain.empty() ? nullptr : &fam.cochain);
+  g.result = search.run_group(g.roots, g.root_parent, g.limit);
+  g.settled = search.last_settled();
+  for (int t : search.last_settled_vertices())
+    if (t < static_cast<int>(fam.slot_of.size()) && fam.slot_of[t] >= 0) {
+      g.ball.push_back(t);
+      g.ball_distance.push_back(search.distance(t));
+    }
+  if (g.result.found) {
+    g.root_u = search.root_of(g.result.u.idx());
+    g.root_v = search.root_of(g.result.v.idx());
+  }
+}
+
+// Run 0 on this thread's search object (extract() of its result stays possible); with a batch,
+// the even runs here and the odd ones on the helper thread.
 void ExactGreedy::run_groups(std::vector<GroupRun>& runs) {
-  auto run = [this, &runs](std::size_t i) {
-    GroupRun& g = runs[i];
-    FundamentalCycleSearch& search = i == 0 ? *search_ : *search2_;
-    const int family = slots_[g.seed].family;
-    search.set_cochain(family == 0 ? nullptr : &families_[family].cochain);
-    g.result = search.run_group(g.roots, g.root_parent, g.limit);
+  auto run_share = [this, &runs](std::size_t parity, FundamentalCycleSearch& search) {
+    for (std::size_t i = parity; i < runs.size(); i += 2) run_group(runs[i], search);
   };
-  if (runs.size() == 1) return run(0);
-  ++parallel_pairs_;
-  worker_->run_both([&] { run(0); }, [&] { run(1); });
+  if (runs.size() == 1) return run_group(runs[0], *search_);
+  parallel_pairs_ += static_cast<long long>(runs.size() / 2);
+  worker_->run_both([&] { run_share(0, *search_); }, [&] { run_share(1, *search2_); });
 }
 
 // Bounds after a group search of value `own`: F >= own for every member, F >= own - 2d for
 // the family's sources settled at distance d from the group, F = own for the root both tree
 // paths of the cycle lead to (a real closed walk through it). Members still below `best` are
 // searched next in groups of half the radius (down to single searches).
-void ExactGreedy::finish_group(const GroupRun& g, FundamentalCycleSearch& search, double best) {
+void ExactGreedy::finish_group(const GroupRun& g, double best) {
   const CycleCandidate& c = g.result;
   ++searches_;
   group_searches_ += g.members.size() > 1;
   group_members_ += g.members.size() > 1 ? static_cast<long long>(g.members.size()) : 0;
-  settled_ += static_cast<long long>(search.last_settled());
+  settled_ += static_cast<long long>(g.settled);
   largest_limit_ = std::max(largest_limit_, g.limit);
   slots_[g.seed].own_limit = g.limit;
   const double own = c.found ? c.value : c.truncated ? g.limit : kInf;
-  spread_bounds(g.seed, own, search);
+  spread_bounds(g.seed, own, g.ball, g.ball_distance);
   if (slots_[g.seed].bound.value < own) set_bound(g.seed, SourceBound{own, false, slots_[g.seed].vertex, 0});
   const std::vector<int>& slot_of = families_[slots_[g.seed].family].slot_of;
   if (c.found) {
-    const int root = search.root_of(c.u.idx());
-    if (root == search.root_of(c.v.idx()) && root < static_cast<int>(slot_of.size()) && slot_of[root] >= 0 &&
+    const int root = g.root_u;
+    if (root == g.root_v && root < static_cast<int>(slot_of.size()) && slot_of[root] >= 0 &&
         slots_[slot_of[root]].active) {
       set_bound(slot_of[root], SourceBound{own, true, root, 0});
       group_exact_ += g.members.size() > 1;

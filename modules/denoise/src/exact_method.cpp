@@ -63,7 +63,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
 
 ExactGreedy::ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge)
     : st_(st), opts_(o), first_radius_(o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge) {
-  if (o.threads > 1) worker_ = std::make_unique<SearchWorker>();
+  worker_ = st.worker.get();  // null with one thread
   want_type_ = o.policy != "shortest";
   wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
   accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
@@ -106,7 +106,12 @@ CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
   set_bound(slot, SourceBound{own, c.found, v, 0});
-  if (!want_type_) spread_bounds(slot, own, *search_);  // with a type filter F is no closed-walk minimum
+  if (!want_type_) {  // with a type filter F is no closed-walk minimum
+    const std::vector<int>& ball = search_->last_settled_vertices();
+    distances_.resize(ball.size());
+    for (std::size_t i = 0; i < ball.size(); ++i) distances_[i] = search_->distance(ball[i]);
+    spread_bounds(slot, own, ball, distances_);
+  }
   if (crossing_ && families_.size() == 2 && c.found) add_transversal_family(c);  // Z
   st_.t.search += sw.seconds();
   return c;

@@ -17,7 +17,12 @@ void ExactGreedy::build_homology() {
   std::vector<SourceBound> kept(st_.mesh.n_vertices());
   for (int s : active_)
     if (slots_[s].active && slots_[s].family == 0) kept[slots_[s].vertex] = slots_[s].bound;
-  homology_.build(st_.mesh);
+  if (st_.initial_homology) {  // built by prepare_input() while the input was analysed
+    homology_ = std::move(*st_.initial_homology);
+    st_.initial_homology.reset();
+  } else {
+    homology_.build(st_.mesh);
+  }
   span_.reset(homology_.words());
   search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
   if (opts_.threads > 1) search2_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
@@ -177,18 +182,22 @@ int ExactGreedy::farthest_pending(double best) {
     far_value_ = best;
     std::vector<double> dist;
     const std::vector<int> near = vertices_within(st_.mesh, {Mesh::VertexHandle(slots_[anchor].vertex)}, best, &dist);
-    std::vector<double> from_anchor(st_.mesh.n_vertices(), kInf);
-    for (std::size_t i = 0; i < near.size(); ++i) from_anchor[near[i]] = dist[i];
+    // Distances from the anchor in a per-vertex table kept at +inf between calls (only the
+    // ball's entries are set and reset: no mesh-sized array per call).
+    if (from_anchor_.size() < st_.mesh.n_vertices()) from_anchor_.resize(st_.mesh.n_vertices(), kInf);
+    for (std::size_t i = 0; i < near.size(); ++i) from_anchor_[near[i]] = dist[i];
     far_order_.clear();
     for (int s : active_) {
       const Slot& slot = slots_[s];
-      if (slot.active && slot.bound.value < best && !slot.bound.exact) far_order_.push_back({from_anchor[slot.vertex], s});
+      if (slot.active && slot.bound.value < best && !slot.bound.exact) far_order_.push_back({from_anchor_[slot.vertex], s});
     }
+    for (int v : near) from_anchor_[v] = kInf;
     std::make_heap(far_order_.begin(), far_order_.end());
   }
   while (!far_order_.empty()) {
     std::pop_heap(far_order_.begin(), far_order_.end());
     const int s = far_order_.back().second;
+    far_popped_distance_ = far_order_.back().first;
     far_order_.pop_back();
     const Slot& slot = slots_[s];
     if (!slot.active || slot.bound.exact || !(slot.bound.value < best)) continue;  // done meanwhile
@@ -198,15 +207,18 @@ int ExactGreedy::farthest_pending(double best) {
   return -1;
 }
 
-// F(t) >= F(c) - 2 d(c, t) for every source t of c's family that the search from c settled.
-void ExactGreedy::spread_bounds(int centre_slot, double bound, const FundamentalCycleSearch& search) {
+// F(t) >= F(c) - 2 d(c, t) for every source t of c's family in `ball` (settled vertices of the
+// search from c, at distance[i] from it).
+void ExactGreedy::spread_bounds(int centre_slot, double bound, const std::vector<int>& ball,
+                                const std::vector<double>& distance) {
   const int centre = slots_[centre_slot].vertex;
   const Family& fam = families_[slots_[centre_slot].family];
-  for (int t : search.last_settled_vertices()) {
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const int t = ball[i];
     if (t == centre || t >= static_cast<int>(fam.slot_of.size()) || fam.slot_of[t] < 0) continue;
     const int s = fam.slot_of[t];
     if (!slots_[s].active) continue;
-    const double lower = bound - 2.0 * search.distance(t);
+    const double lower = bound - 2.0 * distance[i];
     if (!(lower > slots_[s].bound.value)) continue;  // also keeps dropped sources (inf) dropped
     set_bound(s, SourceBound{lower, false, centre, 0});
     ++bounds_spread_;

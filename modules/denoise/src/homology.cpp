@@ -107,24 +107,33 @@ void HomologyBasis::build(const Mesh& mesh) {
   const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
-  // Room for the edges later surgeries add (set_edge_class): growing a vector of n_edges x words
-  // words by reallocation costs a copy of the whole table per growth.
-  ann_.reserve((mesh.n_edges() + mesh.n_edges() / 16 + 4096) * words_);
-  ann_.assign(mesh.n_edges() * words_, 0);
-  for (int i = 0; i < rank_; ++i) ann_[std::size_t(x_edges[i]) * words_ + i / 64] |= (1ull << (i % 64));
-  // Leaf peeling of the dual forest: children before parents.
+  row_of_.assign(mesh.n_edges(), 0);
+  rows_.assign(words_, 0);  // row 0: the zero class
+  std::vector<std::uint64_t> cls(words_, 0);
+  for (int i = 0; i < rank_; ++i) {
+    std::fill(cls.begin(), cls.end(), 0);
+    cls[i / 64] = 1ull << (i % 64);
+    row_of_[x_edges[i]] = new_row(cls.data());
+  }
+  // Leaf peeling of the dual forest, children before parents: the parent edge of a face gets
+  // the XOR of its other edges (final by then), so that the face sums to zero.
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
-    const int f = *it;
-    const int pe = parent_edge[f];
+    const int pe = parent_edge[*it];
     if (pe < 0) continue;
-    std::uint64_t* dst = &ann_[std::size_t(pe) * words_];
-    const auto h0 = dual.face_halfedge(f);
+    bool any = false;  // most faces have only zero classes around them: no vector work
+    const auto h0 = dual.face_halfedge(*it);
     auto h = h0;
     do {
       const int e = mesh.edge_handle(h).idx();
-      if (e != pe) xor_into(dst, &ann_[std::size_t(e) * words_], words_);
+      const std::uint32_t row = row_of_[e];
+      if (e != pe && row != 0) {
+        if (!any) std::fill(cls.begin(), cls.end(), 0);
+        any = true;
+        xor_into(cls.data(), &rows_[std::size_t(row) * words_], words_);
+      }
       h = mesh.next_halfedge_handle(h);
     } while (h != h0);
+    if (any && !is_zero(cls.data(), words_)) row_of_[pe] = new_row(cls.data());
   }
   prune_cut_graph(mesh);
 }
@@ -162,10 +171,19 @@ void HomologyBasis::prune_cut_graph(const Mesh& mesh) {
     if (degree[v] >= 2) pruned_vertices_.push_back(static_cast<int>(v));
 }
 
+std::uint32_t HomologyBasis::new_row(const std::uint64_t* cls) {
+  const std::size_t row = rows_.size() / words_;
+  if (row > 0xffffffffu) throw Error("homology: more class rows than 32-bit ids");
+  rows_.insert(rows_.end(), cls, cls + words_);
+  return static_cast<std::uint32_t>(row);
+}
+
 void HomologyBasis::set_edge_class(Mesh::EdgeHandle e, const std::uint64_t* cls) {
-  const std::size_t need = (std::size_t(e.idx()) + 1) * words_;
-  if (ann_.size() < need) ann_.resize(need, 0);  // within the reserve; beyond it the vector grows geometrically
-  std::copy(cls, cls + words_, &ann_[std::size_t(e.idx()) * words_]);
+  const std::size_t id = static_cast<std::size_t>(e.idx());
+  if (row_of_.size() <= id) row_of_.resize(std::max(id + 1, row_of_.size() + row_of_.size() / 8), 0);
+  if (is_zero(cls, words_)) row_of_[id] = 0;  // an own row (if any) stays unused
+  else if (row_of_[id] != 0) std::copy(cls, cls + words_, &rows_[std::size_t(row_of_[id]) * words_]);
+  else row_of_[id] = new_row(cls);
 }
 
 std::vector<int> HomologyBasis::pruned_cut_graph_vertices() const { return pruned_vertices_; }

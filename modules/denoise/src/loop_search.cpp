@@ -12,28 +12,26 @@ FundamentalCycleSearch::FundamentalCycleSearch(const Mesh& mesh, const HomologyB
 
 void FundamentalCycleSearch::grow() {
   const std::size_t n = mesh_.n_vertices();
+  if (node_.size() < n) {
+    const std::size_t cap = std::max(n, node_.size() * 5 / 4);
+    node_.resize(cap);
+    mark_.resize(cap, 0);
+  }
   // Boundary flags: vertices created by surgery are interior, so only new entries are computed.
-  for (std::size_t v = blocked_.size(); v < n; ++v) blocked_.push_back(mesh_.is_boundary(Mesh::VertexHandle(static_cast<int>(v))));
-  if (stamp_.size() >= n) return;
-  const std::size_t cap = std::max(n, stamp_.size() * 5 / 4);
-  stamp_.resize(cap, 0);
-  settled_flag_.resize(cap, 0);
-  dist_.resize(cap, 0);
-  parent_.resize(cap, -1);
-  slot_.resize(cap, -1);
-  mark_.resize(cap, 0);
+  for (; blocked_known_ < n; ++blocked_known_)
+    node_[blocked_known_].blocked = mesh_.is_boundary(Mesh::VertexHandle(static_cast<int>(blocked_known_)));
 }
 
 void FundamentalCycleSearch::reset_run() {
   grow();
   ++run_id_;
   if (run_id_ == 0) {  // wrapped: reset stamps
-    std::fill(stamp_.begin(), stamp_.end(), 0);
+    for (Node& node : node_) node.stamp = 0;
     run_id_ = 1;
   }
   settled_count_ = 0;
   settled_order_.clear();
-  acc_.clear();
+  acc_.assign(W_, 0);  // row 0: the zero class, shared by every path whose class is zero
   heap_.clear();
 }
 
@@ -46,39 +44,44 @@ void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
 void FundamentalCycleSearch::start_roots(const std::vector<int>& roots, const std::vector<int>& root_parent) {
   reset_run();
   for (std::size_t i = 0; i < roots.size(); ++i) {
-    stamp_[roots[i]] = run_id_;
-    settled_flag_[roots[i]] = 0;
-    dist_[roots[i]] = 0.0;
-    parent_[roots[i]] = root_parent[i];
+    Node& node = node_[roots[i]];
+    node.stamp = run_id_;
+    node.settled = 0;
+    node.dist = 0.0;
+    node.parent = root_parent[i];
   }
 }
 
 // Tentative distance d for w through parent halfedge `parent` (-1 at the source).
 void FundamentalCycleSearch::relax(int w, double d, int parent) {
-  if (stamp_[w] != run_id_) {
-    stamp_[w] = run_id_;
-    settled_flag_[w] = 0;
-  } else if (!(d < dist_[w])) {
+  Node& node = node_[w];
+  if (node.stamp != run_id_) {
+    node.stamp = run_id_;
+    node.settled = 0;
+  } else if (!(d < node.dist)) {
     return;
   }
-  dist_[w] = d;
-  parent_[w] = parent;
+  node.dist = d;
+  node.parent = parent;
   heap_.emplace_back(d, w);
   std::push_heap(heap_.begin(), heap_.end(), std::greater<Item>());
 }
 
 // Marks v settled and stores the class of path(s, v) (the parent's XOR the tree edge's).
 void FundamentalCycleSearch::settle(int v) {
-  settled_flag_[v] = 1;
+  Node& node = node_[v];
+  node.settled = 1;
   ++settled_count_;
   settled_order_.push_back(v);
-  slot_[v] = static_cast<int>(acc_.size() / W_);
-  acc_.resize(acc_.size() + W_, 0);
-  if (parent_[v] < 0) return;
-  const auto ph = Mesh::HalfedgeHandle(parent_[v]);
+  node.slot = 0;
+  if (node.parent < 0) return;
+  const auto ph = Mesh::HalfedgeHandle(node.parent);
   const int pu = mesh_.from_vertex_handle(ph).idx();
-  std::uint64_t* mine = &acc_[std::size_t(slot_[v]) * W_];
-  const std::uint64_t* theirs = &acc_[std::size_t(slot_[pu]) * W_];
+  if (node_[pu].slot == 0 && edge_zero(mesh_.edge_handle(ph))) return;  // most paths: no vector work
+  node.slot = static_cast<int>(acc_.size() / W_);
+  acc_.resize(acc_.size() + W_, 0);
+  std::uint64_t* mine = &acc_[std::size_t(node.slot) * W_];
+  const std::uint64_t* theirs = &acc_[std::size_t(node_[pu].slot) * W_];
   const std::uint64_t* e = edge_bits(mesh_.edge_handle(ph));
   for (int i = 0; i < W_; ++i) mine[i] = theirs[i] ^ e[i];
 }
@@ -89,8 +92,9 @@ void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, dou
                                        CycleCandidate& best) {
   if (value >= best.value || value > limit) return;
   const int vi = mesh_.from_vertex_handle(h).idx(), wi = mesh_.to_vertex_handle(h).idx();
-  const std::uint64_t* a = &acc_[std::size_t(slot_[vi]) * W_];
-  const std::uint64_t* b = &acc_[std::size_t(slot_[wi]) * W_];
+  if (node_[vi].slot == 0 && node_[wi].slot == 0 && edge_zero(mesh_.edge_handle(h))) return;  // class zero
+  const std::uint64_t* a = &acc_[std::size_t(node_[vi].slot) * W_];
+  const std::uint64_t* b = &acc_[std::size_t(node_[wi].slot) * W_];
   const std::uint64_t* e = edge_bits(mesh_.edge_handle(h));
   for (int i = 0; i < W_; ++i) tmp_[i] = a[i] ^ b[i] ^ e[i];
   if (!wanted(tmp_.data())) return;
@@ -147,7 +151,7 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
     }
     std::pop_heap(heap_.begin(), heap_.end(), std::greater<Item>());
     heap_.pop_back();
-    if (settled_flag_[vi] || d > dist_[vi]) continue;
+    if (node_[vi].settled || d > node_[vi].dist) continue;
     settle(vi);
     expand(vi, d, limit, accept, best);
   }
@@ -158,13 +162,15 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
 void FundamentalCycleSearch::expand(int vi, double d, double limit, const Accept* accept, CycleCandidate& best) {
   const auto v = Mesh::VertexHandle(vi);
   const Vec3& pv = mesh_.point(v);
-  const int parent_edge = parent_[vi] >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent_[vi])).idx() : -1;
+  const int parent = node_[vi].parent;
+  const int parent_edge = parent >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent)).idx() : -1;
   for (auto h : mesh_.voh_range(v)) {
     const int wi = mesh_.to_vertex_handle(h).idx();
-    if (blocked_[wi] || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
+    const Node& w = node_[wi];
+    if (w.blocked || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
     const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
-    if (stamp_[wi] == run_id_ && settled_flag_[wi]) {  // non-tree edge between settled vertices
-      if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + dist_[wi], limit, accept, best);
+    if (w.stamp == run_id_ && w.settled) {  // non-tree edge between settled vertices
+      if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + w.dist, limit, accept, best);
       continue;
     }
     relax(wi, d + len, h.idx());
@@ -177,19 +183,20 @@ double FundamentalCycleSearch::frontier_bound() {
   std::vector<std::uint64_t> cls(W_);
   for (const auto& [dw, wi] : heap_) {
     // Each unsettled vertex once: its current entry (stale duplicates carry a larger distance).
-    if (settled_flag_[wi] || stamp_[wi] != run_id_ || parent_[wi] < 0 || dw != dist_[wi]) continue;
+    const Node& node = node_[wi];
+    if (node.settled || node.stamp != run_id_ || node.parent < 0 || dw != node.dist) continue;
     const auto w = Mesh::VertexHandle(wi);
-    const auto ph = Mesh::HalfedgeHandle(parent_[wi]);
+    const auto ph = Mesh::HalfedgeHandle(node.parent);
     const int p = mesh_.from_vertex_handle(ph).idx();
     // Class of path(s, w) through its tentative parent.
-    const std::uint64_t* ap = &acc_[std::size_t(slot_[p]) * W_];
+    const std::uint64_t* ap = &acc_[std::size_t(node_[p].slot) * W_];
     const std::uint64_t* ae = edge_bits(mesh_.edge_handle(ph));
     for (auto h : mesh_.voh_range(w)) {
       const int u = mesh_.to_vertex_handle(h).idx();
-      if (u == p || stamp_[u] != run_id_ || !settled_flag_[u]) continue;
-      const double value = dist_[wi] + (mesh_.point(Mesh::VertexHandle(u)) - mesh_.point(w)).norm() + dist_[u];
+      if (u == p || !settled(u)) continue;
+      const double value = node.dist + (mesh_.point(Mesh::VertexHandle(u)) - mesh_.point(w)).norm() + node_[u].dist;
       if (value >= bound) continue;
-      const std::uint64_t* au = &acc_[std::size_t(slot_[u]) * W_];
+      const std::uint64_t* au = &acc_[std::size_t(node_[u].slot) * W_];
       const std::uint64_t* eu = edge_bits(mesh_.edge_handle(h));
       for (int i = 0; i < W_; ++i) cls[i] = ap[i] ^ ae[i] ^ au[i] ^ eu[i];
       if (wanted(cls.data())) bound = value;
@@ -209,13 +216,13 @@ std::vector<Mesh::VertexHandle> FundamentalCycleSearch::extract(const CycleCandi
   for (int x = c.u.idx();;) {
     mark_[x] = mark_id_;
     up_u.push_back(Mesh::VertexHandle(x));
-    if (parent_[x] < 0) break;
-    x = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(parent_[x])).idx();
+    if (node_[x].parent < 0) break;
+    x = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[x].parent)).idx();
   }
   int lca = c.v.idx();
   while (mark_[lca] != mark_id_) {
     up_v.push_back(Mesh::VertexHandle(lca));
-    lca = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(parent_[lca])).idx();
+    lca = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[lca].parent)).idx();
   }
   // Cycle: lca -> ... -> u, then v -> ... -> (child of lca on v's side).
   std::vector<Mesh::VertexHandle> loop;

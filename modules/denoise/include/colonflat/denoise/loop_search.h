@@ -64,14 +64,15 @@ class FundamentalCycleSearch {
   std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
   // The root whose tree holds the settled vertex v (the first vertex at distance 0 above it).
   int root_of(int v) const {
-    while (dist_[v] > 0 && parent_[v] >= 0) v = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(parent_[v])).idx();
+    while (node_[v].dist > 0 && node_[v].parent >= 0)
+      v = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[v].parent)).idx();
     return v;
   }
   std::size_t last_settled() const { return settled_count_; }
   // Vertices the last run() settled, nearest first, and their distances from its source (mm):
   // the ball whose geometry and classes the run's result depends on.
   const std::vector<int>& last_settled_vertices() const { return settled_order_; }
-  double distance(int settled_vertex) const { return dist_[settled_vertex]; }
+  double distance(int settled_vertex) const { return node_[settled_vertex].dist; }
 
  private:
   void grow();
@@ -88,8 +89,11 @@ class FundamentalCycleSearch {
   const std::uint64_t* edge_bits(Mesh::EdgeHandle e) const {
     return cochain_ ? &kBit[(*cochain_)[e.idx()] & 1] : hom_.edge_class(e);
   }
+  bool edge_zero(Mesh::EdgeHandle e) const {
+    return cochain_ ? ((*cochain_)[e.idx()] & 1) == 0 : hom_.edge_class_is_zero(e);
+  }
   static constexpr std::uint64_t kBit[2] = {0, 1};
-  bool settled(int v) const { return stamp_[v] == run_id_ && settled_flag_[v]; }
+  bool settled(int v) const { return node_[v].stamp == run_id_ && node_[v].settled; }
   const Mesh& mesh_;
   const HomologyBasis& hom_;
   const Z2Span& span_;
@@ -97,13 +101,18 @@ class FundamentalCycleSearch {
   const std::vector<std::uint8_t>* avoid_ = nullptr;
   int W_;
   std::uint32_t run_id_ = 0;
-  std::vector<std::uint8_t> blocked_;  // boundary vertices (never on a loop)
-  std::vector<std::uint32_t> stamp_;
-  std::vector<std::uint8_t> settled_flag_;
-  std::vector<double> dist_;
-  std::vector<int> parent_;  // parent halfedge (parent -> v) idx, -1 at the source
-  std::vector<int> slot_;    // row of acc_ holding the class of path(s, v)
-  std::vector<std::uint64_t> acc_;
+  // Per-vertex search state in one record (one cache line fetch per neighbour visited).
+  struct Node {
+    double dist = 0;
+    std::uint32_t stamp = 0;  // run_id_ of the run that reached it; the other fields hold only then
+    int parent = -1;          // parent halfedge (parent -> v) idx, -1 at the source
+    int slot = -1;            // row of acc_ holding the class of path(s, v)
+    std::uint8_t settled = 0;
+    std::uint8_t blocked = 0;  // boundary vertex (never on a loop); set for all vertices below blocked_known_
+  };
+  std::vector<Node> node_;
+  std::size_t blocked_known_ = 0;
+  std::vector<std::uint64_t> acc_;  // class rows of settled vertices' paths; row 0 is zero
   std::vector<std::uint64_t> tmp_;
   std::vector<std::uint32_t> mark_;
   std::uint32_t mark_id_ = 0;
