@@ -127,7 +127,10 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   const double band = std::clamp(conformal_length, (1 - std::min(slack, 0.5)) * cl.length, (1 + slack) * cl.length);
   const double period = w.seg.area_3d / band;
   const double yscale = period / emb.period;
-  const std::vector<double> axis = choose_axis(w, cl, band, yscale, degenerate);
+  // A branch keeps the conformal spacing (beta 0: x linear in u, so no fold from the axis; its
+  // x is not a centreline position anyway); the area correction balances it.
+  const std::vector<double> axis = branch ? cl.blended_axis(w.seg.balance_strength = 0.0)
+                                          : choose_axis(w, cl, band, yscale, degenerate);
   for (auto& q : emb.pos) q = V2(band * interpolate_axis(axis, q.x() / conformal_length), q.y() * yscale);
   for (std::size_t i = 0; i < cl.knot_u.size(); ++i)
     w.seg.centreline_x.push_back({cl.knot_s[i], band * interpolate_axis(axis, cl.knot_u[i])});

@@ -100,7 +100,10 @@ std::size_t count_bad(const Surface& s, const Embedding& emb, const std::vector<
 }
 
 // Conformal map scaled to the area-preserving rectangle, fold-overs untangled. With "auto"
-// weights on the conformal map, retried with clamped weights if more than 1 % of faces are bad.
+// weights, retried with clamped weights (no negative weight: folds are rare) if more than 1 % of
+// the faces are bad (conformal map), or if any is (a side branch's band: its pouch folds where the
+// cotangent weights of its steep walls are negative and untangle cannot repair it; the clamped
+// solve costs little on a branch).
 Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& loops,
                          const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                          const std::vector<char>& degenerate, const FlattenOptions& o) {
@@ -122,7 +125,8 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
   };
   std::size_t bad = 0;
   Embedding emb = attempt(o.weights == "clamped", bad);
-  if (o.weights == "auto" && o.map == "conformal" && bad > s.t.size() / 100) {
+  const std::size_t tolerated = o.map == "conformal" || !w.branch ? s.t.size() / 100 : 0;
+  if (o.weights == "auto" && (o.map == "conformal" || w.branch) && bad > tolerated) {
     std::size_t bad2 = 0;
     const FlatSegment keep = w.seg;
     Embedding e2 = attempt(true, bad2);
@@ -337,6 +341,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
                                          const FlattenOptions& o, int depth) {
   SegmentWork w;
   w.lumen_sign = lumen_sign;
+  w.branch = depth > 0;
   w.seg.component = int(c);
   w.seg.input_kind = nloops == 0 ? "closed" : nloops == 1 ? "one open end" : "tube";
   w.seg.map = o.map;

@@ -245,6 +245,7 @@ struct SegmentWork {
   std::vector<int> neck;      // side branch: its neck's vertices in the parent's annulus
   double cap_area = 0;        // mm^2 of wall removed to open the ends (caps)
   double lost_area = 0;       // mm^2 of wall in no band (faces dropped when a branch was cut off)
+  bool branch = false;        // a side branch's band (flattened from its neck)
   std::vector<int> elimination_order;  // vertices of ann in the conformal solve's fill-reducing order
 };
 
