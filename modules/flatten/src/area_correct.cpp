@@ -154,6 +154,16 @@ std::vector<int> correction_faces(const Surface& s, const std::vector<std::vecto
   return faces;
 }
 
+// Steps allowed: `iterations` on a whole band; on local regions (pockets, a polyp head behind its
+// stalk: ratios near 1e-3 that need hundreds of steps) up to 10 x as many, as long as the work
+// (faces x steps) stays within kLocalWork.
+constexpr double kLocalWork = 1e7;
+int iteration_budget(std::size_t faces, bool local, int iterations) {
+  if (!local || faces == 0) return iterations;
+  const double affordable = kLocalWork / double(faces);
+  return int(std::clamp(affordable, double(iterations), 10.0 * iterations));
+}
+
 }  // namespace
 
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
@@ -171,7 +181,8 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return res;
   double e0 = energy.energy(emb.pos);
   res.energy_before = e0;
-  for (; res.iterations < o.area_correction_iterations && e0 < ConformalAreaEnergy::kHuge; ++res.iterations) {
+  const int max_iterations = iteration_budget(res.faces, local, o.area_correction_iterations);
+  for (; res.iterations < max_iterations && e0 < ConformalAreaEnergy::kHuge; ++res.iterations) {
     const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
     const double slope = (g.array() * d.array()).sum();

@@ -100,10 +100,14 @@ static Correction needs_correction(const SegmentWork& w, const std::vector<char>
     fd.push_back(face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]));
     a2 += std::max(fd.back().area2, 0.0), a3 += fd.back().area3;
   }
-  const DistortionStats st = stats_of(fd);
   double hidden = 0;
-  for (const FaceDistortion& d : fd)
+  std::vector<FaceDistortion> in_map;  // the statistics leave the faces out of the map out, as measure() does
+  in_map.reserve(fd.size());
+  for (const FaceDistortion& d : fd) {
     if (d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
+    if (!too_small_in_map(d.area2, d.area3)) in_map.push_back(d);
+  }
+  const DistortionStats st = stats_of(in_map);
   if (st.area_p05 < 0.25 || st.area_p95 > 4 || st.qc_mean > 1.45) return Correction::global;
   return hidden > 0.0025 * a3 ? Correction::local : Correction::none;
 }

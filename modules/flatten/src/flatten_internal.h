@@ -204,7 +204,8 @@ struct AreaCorrection {
   double energy_before = 0, energy_after = 0;
 };
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
-// move (their rim fixed): for a band whose distortion is within bounds except for pockets.
+// move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
+// 10 x area_correction_iterations steps there while faces x steps <= 1e7.
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
                             const FlattenOptions& o);
