@@ -21,12 +21,12 @@ double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); 
 
 class ConformalAreaEnergy {
  public:
+  // `scale`: 3D / 2D area of the whole band (ratios at the area-preserving scale).
   ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
-                      double lo, double hi, double lambda)
+                      double lo, double hi, double lambda, double scale)
       : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), log_lo_(std::log(lo)), log_hi_(std::log(hi)),
-        lambda_(lambda) {
+        lambda_(lambda), scale_(scale) {
     w_.reserve(faces_.size());
-    double a2 = 0, a3 = 0;
     for (int f : faces_) {
       std::array<double, 3> w{};
       for (int k = 0; k < 3; ++k) {
@@ -34,9 +34,7 @@ class ConformalAreaEnergy {
         w[k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-300), 0.01, 100.0);
       }
       w_.push_back(w);
-      a2 += emb.area2(s, f), a3 += area3[f];
     }
-    scale_ = a2 > 0 ? a3 / a2 : 1.0;  // area ratios at the area-preserving scale
   }
   const std::vector<std::array<double, 3>>& weights() const { return w_; }
   const std::vector<int>& faces() const { return faces_; }
@@ -164,25 +162,43 @@ int iteration_budget(std::size_t faces, bool local, int iterations) {
   return int(std::clamp(affordable, double(iterations), 10.0 * iterations));
 }
 
-}  // namespace
+// Faces split into vertex-connected pieces (local regions far apart are corrected independently:
+// a stuck piece, such as a strand stump at zero area, does not hold back the line search of others).
+std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vector<int>& faces) {
+  std::vector<int> parent(s.p.size(), -1);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (int f : faces)
+    for (int v : s.t[f])
+      if (parent[v] < 0) parent[v] = v;
+  for (int f : faces)
+    for (int k = 1; k < 3; ++k) parent[find(s.t[f][k])] = find(s.t[f][0]);
+  std::vector<int> piece_of_root(s.p.size(), -1);
+  std::vector<std::vector<int>> pieces;
+  for (int f : faces) {
+    int& id = piece_of_root[find(s.t[f][0])];
+    if (id < 0) id = int(pieces.size()), pieces.emplace_back();
+    pieces[id].push_back(f);
+  }
+  return pieces;
+}
 
-AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
-                            const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o) {
-  AreaCorrection res;
-  if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
-  std::vector<double> area3(s.t.size());
-  for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
-  std::vector<char> free_vertex;
-  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, o, local, free_vertex);
-  res.faces = faces.size();
-  const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight);
+// Newton steps on one set of faces (free vertices as given); accumulates into `res`.
+void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
+              const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
+              AreaCorrection& res) {
+  const std::size_t nfaces = faces.size();
+  const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
+                                   scale);
   RegionSystem sys;
-  if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return res;
+  if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return;
   double e0 = energy.energy(emb.pos);
-  res.energy_before = e0;
-  const int max_iterations = iteration_budget(res.faces, local, o.area_correction_iterations);
-  for (; res.iterations < max_iterations && e0 < ConformalAreaEnergy::kHuge; ++res.iterations) {
+  res.energy_before += e0;
+  const int max_iterations = iteration_budget(nfaces, local, o.area_correction_iterations);
+  int it = 0;
+  for (; it < max_iterations && e0 < ConformalAreaEnergy::kHuge; ++it) {
     const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
     const double slope = (g.array() * d.array()).sum();
@@ -192,7 +208,33 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
     e0 = e1;
     if (!(gain > 1e-5)) break;
   }
-  res.energy_after = e0;
+  res.energy_after += e0;
+  res.iterations = std::max(res.iterations, it);
+}
+
+}  // namespace
+
+AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                            const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
+                            const FlattenOptions& o) {
+  AreaCorrection res;
+  if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
+  std::vector<double> area3(s.t.size());
+  double a2 = 0, a3 = 0;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    area3[f] = face_area_3d(s, int(f));
+    if (!degenerate[f]) a2 += std::max(emb.area2(s, int(f)), 0.0), a3 += area3[f];
+  }
+  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  std::vector<char> free_vertex;
+  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, o, local, free_vertex);
+  res.faces = faces.size();
+  if (!local) {
+    minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res);
+    return res;
+  }
+  for (std::vector<int>& piece : connected_pieces(s, faces))
+    minimise(s, emb, std::move(piece), free_vertex, area3, scale, o, true, res);
   return res;
 }
 

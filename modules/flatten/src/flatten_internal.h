@@ -205,7 +205,8 @@ struct AreaCorrection {
 };
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
-// 10 x area_correction_iterations steps there while faces x steps <= 1e7.
+// 10 x area_correction_iterations steps there while faces x steps <= 1e7, each vertex-connected
+// piece on its own (`iterations`: the most steps any piece took).
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
                             const FlattenOptions& o);
