@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "flatten_internal.h"
+#include "proxy_descent.h"
 
 namespace cf::flat_detail {
 namespace {
@@ -77,23 +78,17 @@ Region select_region(const Surface& s, const std::vector<std::vector<int>>& vf, 
   return r;
 }
 
-// The 3D triangle in its own plane (2D, mm), and ARAP weights (cotangent of each corner, clamped).
-void local_frames(const Surface& s, const std::vector<int>& faces, std::vector<std::array<V2, 3>>& X,
-                  std::vector<std::array<double, 3>>& w) {
-  X.resize(faces.size());
-  w.resize(faces.size());
+// Each 3D triangle in its own plane (2D, mm): corner 0 at the origin, corner 1 on +x.
+std::vector<std::array<V2, 3>> plane_frames(const Surface& s, const std::vector<int>& faces) {
+  std::vector<std::array<V2, 3>> X(faces.size());
   for (std::size_t i = 0; i < faces.size(); ++i) {
     const Tri& t = s.t[faces[i]];
     const V3 e1 = s.p[t[1]] - s.p[t[0]], e2 = s.p[t[2]] - s.p[t[0]];
     const double l1 = std::max(e1.norm(), 1e-12);
     const V3 ex = e1 / l1, ey = e1.cross(e2).cross(e1).normalized();
     X[i] = {V2::Zero(), V2(l1, 0), V2(e2.dot(ex), std::isfinite(e2.dot(ey)) ? e2.dot(ey) : 0.0)};
-    for (int k = 0; k < 3; ++k) {
-      const V2 a = X[i][(k + 1) % 3] - X[i][k], b = X[i][(k + 2) % 3] - X[i][k];
-      const double c = std::abs(a.x() * b.y() - a.y() * b.x());
-      w[i][k] = std::clamp(0.5 * a.dot(b) / std::max(c, 1e-12), 0.01, 100.0);
-    }
   }
+  return X;
 }
 
 // Symmetric Dirichlet energy sum_f A3_f (|J|^2 + |J^-1|^2) of the region's faces (Smith &
@@ -119,7 +114,7 @@ struct SymmetricDirichlet {
     for (std::size_t i = 0; i < faces.size(); ++i) {
       const Eigen::Matrix2d J = jacobian(pos, i);
       const double det = J.determinant();
-      if (det <= 0) return kHugeEnergy;
+      if (det <= 0) return kHuge;
       e += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
     }
     return e;
@@ -139,14 +134,12 @@ struct SymmetricDirichlet {
     }
     return g;
   }
-  static constexpr double kHugeEnergy = 1e300;
+  static constexpr double kHuge = 1e300;
 };
 
 SymmetricDirichlet make_energy(const Surface& s, const Embedding& emb, const std::vector<int>& faces) {
   SymmetricDirichlet sd{s, emb, faces, {}, {}};  // `faces`: the region's faces that are not folded
-  std::vector<std::array<V2, 3>> X;
-  std::vector<std::array<double, 3>> w;
-  local_frames(s, faces, X, w);
+  const std::vector<std::array<V2, 3>> X = plane_frames(s, faces);
   for (std::size_t i = 0; i < faces.size(); ++i) {
     Eigen::Matrix2d M;
     M.col(0) = X[i][1] - X[i][0];
@@ -158,48 +151,31 @@ SymmetricDirichlet make_energy(const Surface& s, const Embedding& emb, const std
   return sd;
 }
 
-// Minimises the symmetric Dirichlet energy on one region: direction = -L^-1 grad (L the
-// cotangent Laplacian of the 3D triangles: the energy's quadratic proxy, factorised once), step =
-// 0.9 x the largest step keeping every face positive, halved until the energy decreases enough.
+// Minimises the symmetric Dirichlet energy on one region (proxy_descent.h: the cotangent
+// Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps).
 int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3) {
-  std::vector<std::array<V2, 3>> X;
-  std::vector<std::array<double, 3>> w;
-  local_frames(s, r.faces, X, w);
   RegionSystem sys;
-  if (!sys.build(s, r.free_vertex, r.faces, w)) return 0;
+  if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces))) return 0;
   std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
   for (int f : r.faces)
     if (emb.area2(s, f) > 0) unfolded.push_back(f);
   const SymmetricDirichlet sd = make_energy(s, emb, unfolded);
-  double e0 = sd.energy(emb.pos);
-  if (e0 >= SymmetricDirichlet::kHugeEnergy) return 0;  // the region is not injective: leave it
-  int it = 0;
-  std::vector<V2> trial;
-  for (; it < iterations; ++it) {
-    const Eigen::MatrixXd g = sd.gradient(emb.pos, sys);
-    const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
-    const double slope = (g.array() * d.array()).sum();
-    if (!(slope < 0)) break;
-    std::vector<V2> next = emb.pos;
-    for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
-    double t = std::min(1.0, 0.9 * max_area_step(s, emb, next, unfolded, area3, 0.0));
-    double e1 = SymmetricDirichlet::kHugeEnergy;
-    for (int half = 0; half < 30; ++half, t *= 0.5) {
-      trial = emb.pos;
-      for (std::size_t i = 0; i < sys.unknowns().size(); ++i) trial[sys.unknowns()[i]] += t * V2(d(i, 0), d(i, 1));
-      e1 = sd.energy(trial);
-      if (e1 <= e0 + 1e-4 * t * slope) break;
-    }
-    if (!(e1 < e0)) break;
-    emb.pos.swap(trial);
-    const double gain = (e0 - e1) / e0;
-    e0 = e1;
-    if (gain < 1e-4) break;
-  }
-  return it;
+  return proxy_descent(s, emb, sd, sys, unfolded, area3, iterations, 1e-4).steps;
 }
 
 }  // namespace
+
+std::vector<std::array<double, 3>> corner_weights(const Surface& s, const std::vector<int>& faces) {
+  std::vector<std::array<double, 3>> w(faces.size());
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Tri& t = s.t[faces[i]];
+    for (int k = 0; k < 3; ++k) {
+      const V3 e1 = s.p[t[(k + 1) % 3]] - s.p[t[k]], e2 = s.p[t[(k + 2) % 3]] - s.p[t[k]];
+      w[i][k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-12), 0.01, 100.0);
+    }
+  }
+  return w;
+}
 
 double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep) {
   auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };

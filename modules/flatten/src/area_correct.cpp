@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "flatten_internal.h"
+#include "proxy_descent.h"
 
 namespace cf::flat_detail {
 namespace {
@@ -26,15 +27,7 @@ class ConformalAreaEnergy {
                       double lo, double hi, double lambda, double scale)
       : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), log_lo_(std::log(lo)), log_hi_(std::log(hi)),
         lambda_(lambda), scale_(scale) {
-    w_.reserve(faces_.size());
-    for (int f : faces_) {
-      std::array<double, 3> w{};
-      for (int k = 0; k < 3; ++k) {
-        const V3 e1 = s.p[s.t[f][(k + 1) % 3]] - s.p[s.t[f][k]], e2 = s.p[s.t[f][(k + 2) % 3]] - s.p[s.t[f][k]];
-        w[k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-300), 0.01, 100.0);
-      }
-      w_.push_back(w);
-    }
+    w_ = corner_weights(s, faces_);
   }
   const std::vector<std::array<double, 3>>& weights() const { return w_; }
   const std::vector<int>& faces() const { return faces_; }
@@ -92,40 +85,19 @@ class ConformalAreaEnergy {
   std::vector<std::array<double, 3>> w_;
 };
 
-// One step along d (n x 2 over sys' unknowns): the largest t <= 1 keeping faces unfolded (x 0.9),
-// halved until the energy decreases enough. Returns the new energy (e0 when no step was taken).
-double line_search(const Surface& s, Embedding& emb, const ConformalAreaEnergy& energy, const RegionSystem& sys,
-                   const Eigen::MatrixXd& d, double slope, double e0, const std::vector<double>& area3) {
-  std::vector<V2> next = emb.pos;
-  for (std::size_t i = 0; i < sys.unknowns().size(); ++i) next[sys.unknowns()[i]] += V2(d(i, 0), d(i, 1));
-  double t = std::min(1.0, 0.9 * max_area_step(s, emb, next, energy.faces(), area3, 0.0));
-  for (int half = 0; half < 30; ++half, t *= 0.5) {
-    std::vector<V2> trial = emb.pos;
-    for (std::size_t i = 0; i < sys.unknowns().size(); ++i) trial[sys.unknowns()[i]] += t * V2(d(i, 0), d(i, 1));
-    const double e1 = energy.energy(trial);
-    if (e1 <= e0 + 1e-4 * t * slope) {
-      emb.pos.swap(trial);
-      return e1;
-    }
-  }
-  return e0;
-}
-
 // The faces the correction works on: all of them (`local` false), or the pockets not shown (area
-// ratio below coverage_min_ratio) grown by kLocalRings vertex rings; free: their vertices that are not fixed and,
-// when local, not on the region's rim. Folds left by untangle are not judged.
+// ratio at `scale` below coverage_min_ratio) grown by kLocalRings vertex rings; free: their
+// vertices that are not fixed and, when local, not on the region's rim. Folds left by untangle are not judged.
 constexpr int kLocalRings = 12;
 std::vector<int> correction_faces(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
                                   const std::vector<double>& area3, const std::vector<char>& fixed,
-                                  const std::vector<char>& degenerate, const FlattenOptions& o, bool local,
-                                  std::vector<char>& free_vertex) {
+                                  const std::vector<char>& degenerate, double scale, const FlattenOptions& o,
+                                  bool local, std::vector<char>& free_vertex) {
   std::vector<char> in(s.t.size(), !local);
   if (local) {
-    double a2 = 0, a3 = 0;
-    for (std::size_t f = 0; f < s.t.size(); ++f) a2 += std::max(emb.area2(s, int(f)), 0.0), a3 += area3[f];
     std::vector<int> ring;
     for (std::size_t f = 0; f < s.t.size(); ++f) {
-      const double r = emb.area2(s, int(f)) * a3 / (a2 * std::max(area3[f], 1e-300));
+      const double r = scale * emb.area2(s, int(f)) / std::max(area3[f], 1e-300);
       if (r < o.coverage_min_ratio) in[f] = 1, ring.push_back(int(f));
     }
     for (int k = 0; k < kLocalRings; ++k) {
@@ -194,22 +166,11 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
                                    scale);
   RegionSystem sys;
   if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return;
-  double e0 = energy.energy(emb.pos);
-  res.energy_before += e0;
-  const int max_iterations = iteration_budget(nfaces, local, o.area_correction_iterations);
-  int it = 0;
-  for (; it < max_iterations && e0 < ConformalAreaEnergy::kHuge; ++it) {
-    const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
-    const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
-    const double slope = (g.array() * d.array()).sum();
-    if (!(slope < 0)) break;
-    const double e1 = line_search(s, emb, energy, sys, d, slope, e0, area3);
-    const double gain = (e0 - e1) / e0;
-    e0 = e1;
-    if (!(gain > 1e-5)) break;
-  }
-  res.energy_after += e0;
-  res.iterations = std::max(res.iterations, it);
+  const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
+  const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5);
+  res.energy_before += d.energy_before;
+  res.energy_after += d.energy_after;
+  res.iterations = std::max(res.iterations, d.steps);
 }
 
 }  // namespace
@@ -227,7 +188,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   }
   const double scale = a2 > 0 ? a3 / a2 : 1.0;
   std::vector<char> free_vertex;
-  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, o, local, free_vertex);
+  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, scale, o, local, free_vertex);
   res.faces = faces.size();
   if (!local) {
     minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res);

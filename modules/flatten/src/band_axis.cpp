@@ -8,16 +8,21 @@
 
 namespace cf::flat_detail {
 
-// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
-void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
-  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
-  std::vector<FaceDistortion> fd;
+std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate) {
+  std::vector<FaceDistortion> fd(w.ann.t.size());
   for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
     const Tri& t = w.ann.t[f];
     const auto c = w.emb.corners(w.ann, int(f));
-    fd.push_back(face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]));
-    fd.back().degenerate = degenerate[f];
+    fd[f] = face_distortion(w.ann.p[t[0]], w.ann.p[t[1]], w.ann.p[t[2]], c[0], c[1], c[2]);
+    fd[f].degenerate = degenerate[f];
   }
+  return fd;
+}
+
+// COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
+void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
+  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
   const DistortionStats st = stats_of(fd);
   std::size_t crowded = 0;
   for (const FaceDistortion& d : fd) crowded += !d.degenerate && too_small_in_map(d.area2, d.area3);
@@ -89,21 +94,15 @@ std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double ban
 // a global correction costs several times the conformal solve.
 enum class Correction { none, local, global };
 static Correction needs_correction(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o) {
-  const Surface& s = w.ann;
-  std::vector<FaceDistortion> fd;
-  fd.reserve(s.t.size());
+  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
   double a2 = 0, a3 = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (degenerate[f]) continue;
-    const Tri& t = s.t[f];
-    const auto c = w.emb.corners(s, int(f));
-    fd.push_back(face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]));
-    a2 += std::max(fd.back().area2, 0.0), a3 += fd.back().area3;
-  }
+  for (const FaceDistortion& d : fd)
+    if (!d.degenerate) a2 += std::max(d.area2, 0.0), a3 += d.area3;
   double hidden = 0;
   std::vector<FaceDistortion> in_map;  // the statistics leave the faces out of the map out, as measure() does
   in_map.reserve(fd.size());
   for (const FaceDistortion& d : fd) {
+    if (d.degenerate) continue;
     if (d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
     if (!too_small_in_map(d.area2, d.area3)) in_map.push_back(d);
   }

@@ -139,13 +139,7 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
 // Distortion, faces left out (zero or negative area) and coverage of a segment.
 void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
-  std::vector<FaceDistortion> fd(s.t.size());
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    const Tri& t = s.t[f];
-    const auto c = w.emb.corners(s, int(f));
-    fd[f] = face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]);
-    fd[f].degenerate = degenerate[f];
-  }
+  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
   w.in_map.assign(s.t.size(), 1);
   std::vector<FaceDistortion> kept;
   kept.reserve(fd.size());

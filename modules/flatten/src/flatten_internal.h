@@ -187,6 +187,11 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
 
 // Largest t in [0, 1] such that moving the vertices along pos + t (next - pos) keeps every face of
 // `faces` that is positive now above min(half its area, floor_ratio x its 3D area `area3[f]`).
+// Per face of `faces`, the weight of the edge opposite each corner: half the corner's cotangent in
+// the 3D triangle, clamped to [0.01, 100] (the quadratic proxy of the balancing and the area
+// correction: positive, so their systems are M-matrices).
+std::vector<std::array<double, 3>> corner_weights(const Surface& s, const std::vector<int>& faces);
+
 // Largest t > 0 (1e300: none) at which face f, moving along pos + t (next - pos), is down to `keep`
 // (in [0, 1)) x its current 2D area; 1e300 for a face whose area is not positive now.
 double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep);
@@ -250,6 +255,9 @@ struct SegmentWork {
   bool branch = false;        // a side branch's band (flattened from its neck)
   std::vector<int> elimination_order;  // vertices of ann in the conformal solve's fill-reducing order
 };
+
+// Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.
+std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate);
 
 // Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those
 // flagged (x -> L - x, y -> P - y), and writes vertices (one per vertex and sheet), triangles,

@@ -1,0 +1,58 @@
+#pragma once
+// Descent with a quadratic proxy on a region of the band (the "accelerated quadratic proxy" idea):
+// direction d = -A^-1 grad E / 2 with A the region's system matrix (a cotangent Laplacian,
+// factorised once), step 0.9 x the largest keeping every judged face positive (no fold can
+// appear), halved until the Armijo condition holds (after 30 halvings the last trial is kept if it
+// still lowers E). Shared by the symmetric-Dirichlet balancing (area_balance.cpp) and the area
+// correction (area_correct.cpp).
+// Energy: double energy(const std::vector<V2>& pos) const (>= Energy::kHuge: not injective);
+//         Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const (n x 2).
+#include <algorithm>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+
+struct DescentResult {
+  int steps = 0;                                // steps taken (the last one, below min_gain, not counted)
+  double energy_before = 0, energy_after = 0;
+};
+
+// At most `max_steps` steps moving the unknowns of `sys` in emb.pos; stops when E gains less than
+// `min_gain` (relative) or no step lowers it. `judged`: the faces kept positive (the energy's).
+template <class Energy>
+DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
+                            const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
+                            double min_gain) {
+  DescentResult res;
+  double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
+  if (e0 >= Energy::kHuge) return res;  // the region is not injective: leave it
+  const std::vector<int>& unknowns = sys.unknowns();
+  auto moved = [&](const Eigen::MatrixXd& d, double t) {
+    std::vector<V2> pos = emb.pos;
+    for (std::size_t i = 0; i < unknowns.size(); ++i) pos[unknowns[i]] += t * V2(d(i, 0), d(i, 1));
+    return pos;
+  };
+  for (; res.steps < max_steps; ++res.steps) {
+    const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
+    const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
+    const double slope = (g.array() * d.array()).sum();
+    if (!(slope < 0)) break;
+    double t = std::min(1.0, 0.9 * max_area_step(s, emb, moved(d, 1.0), judged, area3, 0.0));
+    std::vector<V2> trial;
+    double e1 = Energy::kHuge;
+    for (int half = 0; half < 30; ++half, t *= 0.5) {
+      trial = moved(d, t);
+      e1 = energy.energy(trial);
+      if (e1 <= e0 + 1e-4 * t * slope) break;
+    }
+    if (!(e1 < e0)) break;
+    emb.pos.swap(trial);
+    const double gain = (e0 - e1) / e0;
+    e0 = res.energy_after = e1;
+    if (!(gain > min_gain)) break;
+  }
+  return res;
+}
+
+}  // namespace cf::flat_detail
