@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "colonflat/core/union_find.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
 
@@ -137,20 +138,13 @@ int iteration_budget(std::size_t faces, bool local, int iterations) {
 // Faces split into vertex-connected pieces (local regions far apart are corrected independently:
 // a stuck piece, such as a strand stump at zero area, does not hold back the line search of others).
 std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vector<int>& faces) {
-  std::vector<int> parent(s.p.size(), -1);
-  auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
+  UnionFind sets(s.p.size());
   for (int f : faces)
-    for (int v : s.t[f])
-      if (parent[v] < 0) parent[v] = v;
-  for (int f : faces)
-    for (int k = 1; k < 3; ++k) parent[find(s.t[f][k])] = find(s.t[f][0]);
+    for (int k = 1; k < 3; ++k) sets.unite(std::uint32_t(s.t[f][0]), std::uint32_t(s.t[f][k]));
   std::vector<int> piece_of_root(s.p.size(), -1);
   std::vector<std::vector<int>> pieces;
   for (int f : faces) {
-    int& id = piece_of_root[find(s.t[f][0])];
+    int& id = piece_of_root[sets.find(std::uint32_t(s.t[f][0]))];
     if (id < 0) id = int(pieces.size()), pieces.emplace_back();
     pieces[id].push_back(f);
   }
