@@ -83,10 +83,14 @@ void row(const std::string& name, const cf::MaskImage* mask, const cf::CtImage* 
               st.kept.size(), st.genus, peak, reset ? "" : "*", peak - base, d.max_mm, d.mean_mm, d.max_voxels);
 }
 
-cf::ReconstructOptions mode(const std::string& subvoxel, int sinc_iterations) {
+cf::ReconstructOptions mode(const std::string& subvoxel, int sinc_iterations,
+                            int fairing = cf::ReconstructOptions{}.fairing_iterations,
+                            const std::string& smoothing = cf::ReconstructOptions{}.mask_smoothing) {
   cf::ReconstructOptions o;
   o.subvoxel = subvoxel;
   o.smoothing_iterations = sinc_iterations;
+  o.fairing_iterations = fairing;
+  o.mask_smoothing = smoothing;
   return o;
 }
 
@@ -94,8 +98,8 @@ void rows_for(const std::string& name, const cf::MaskImage* mask, const cf::CtIm
   row(name + ", defaults", mask, ct, cf::ReconstructOptions{});
   row(name + ", staircase (subvoxel off)", mask, ct, mode("off", 0));
   row(name + ", staircase + sinc 20 (old)", mask, ct, mode("off", 20));
-  row(name + ", mask antialias", mask, ct, mode("mask", 0));
-  row(name + ", mask antialias + sinc 20", mask, ct, mode("mask", 20));
+  row(name + ", mask sinc 20 clamped, no fairing (previous default)", mask, ct, mode("mask", 20, 0));
+  row(name + ", mask antialias + sinc 20 + fairing", mask, ct, mode("mask", 20, 100, "antialias"));
   if (ct) row(name + ", ct", mask, ct, mode("ct", 0));
   if (ct) row(name + ", ct + sinc 20", mask, ct, mode("ct", 20));
 }
@@ -273,7 +277,7 @@ int closeup(const std::string& dir) {
   }
   std::filesystem::create_directories(dir);
   const cf::MaskImage::Pointer mask = cf::read_mask(real);
-  const cf::Mesh smooth = cf::reconstruct_surface(mask.GetPointer(), mode("mask", 20));
+  const cf::Mesh smooth = cf::reconstruct_surface(mask.GetPointer(), mode("mask", 20, 0));
   const cf::Mesh::VertexHandle v = flattest_visible(smooth, mask.GetPointer());
   if (!v.is_valid()) return 1;
   const Ripple ref = ripple(smooth, patch(smooth, v, 12.0));
@@ -284,9 +288,9 @@ int closeup(const std::string& dir) {
               "whole_dihedral");
   const std::vector<std::pair<std::string, cf::ReconstructOptions>> modes = {
       {"staircase", mode("off", 0)},
-      {"staircase_sinc", mode("off", 20)},
-      {"antialias", mode("mask", 0)},
-      {"antialias_sinc", mode("mask", 20)}};
+      {"sinc_clamped", mode("mask", 20, 0)},
+      {"default_fairing", mode("mask", 20)},
+      {"fairing_300", mode("mask", 20, 300)}};
   for (const auto& [name, o] : modes) {
     cf::ReconstructStats st;
     const cf::Mesh m = cf::reconstruct_surface(mask.GetPointer(), o, &st);

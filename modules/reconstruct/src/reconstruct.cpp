@@ -20,6 +20,7 @@
 #include "colonflat/core/progress.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/core/vtk_messages.h"
+#include "fairing.h"
 #include "reconstruct_internal.h"
 
 namespace cf {
@@ -70,6 +71,10 @@ nlohmann::json ReconstructStats::to_json() const {
           {"field_clamped_lumen_voxels", field_clamped_voxels},
           {"smoothing_clamped_vertices", clamped_vertices},
           {"smoothed", smoothed},
+          {"fairing_iterations", fairing_iterations},
+          {"fairing_energy_before_mm2", fairing_energy_before},
+          {"fairing_energy_after_mm2", fairing_energy_after},
+          {"fairing_vertices_at_limit", fairing_vertices_at_limit},
           {"decimated", decimated},
           {"vertices", vertices},
           {"faces", faces},
@@ -82,6 +87,7 @@ nlohmann::json ReconstructStats::to_json() const {
           {"time_extract_s", time_extract_s},
           {"time_check_s", time_check_s},
           {"time_smooth_s", time_smooth_s},
+          {"time_fairing_s", time_fairing_s},
           {"time_decimate_s", time_decimate_s},
           {"time_total_s", time_total_s}};
 }
@@ -147,6 +153,7 @@ class SurfaceReconstruction {
     drop_small_components();
     phase_done("topology check, small components");
     smooth_mesh();
+    fair_mesh();
     phase_done("smoothing");
     mesh_ = to_openmesh(tris_);
     tris_ = TriangleList{};
@@ -341,13 +348,32 @@ class SurfaceReconstruction {
     st_.time_smooth_s = watch.seconds();
   }
 
-  // A sub-voxel surface stays within 1/2 voxel (index space) of the staircase: a vertex the
-  // smoothing moved farther is pulled back along its displacement.
-  void keep_within_half_voxel() {
+  // 4b. Constrained fairing of a mask-only sub-voxel surface (fairing.h): the smoothest surface
+  // within 1/2 voxel of the staircase. Not with a CT: there the vertices already follow the data.
+  void fair_mesh() {
+    if (opts_.fairing_iterations <= 0 || staircase_.empty() || ct_) return;
+    Stopwatch watch;
+    FairingOptions options;
+    options.iterations = opts_.fairing_iterations;
+    const FairingResult r = fair_within_tolerance(tris_, staircase_, lps_to_index(), options);
+    st_.fairing_iterations = r.iterations;
+    st_.fairing_energy_before = r.energy_before;
+    st_.fairing_energy_after = r.energy_after;
+    st_.fairing_vertices_at_limit = r.vertices_at_limit;
+    st_.time_fairing_s = watch.seconds();
+  }
+
+  Eigen::Matrix3d lps_to_index() const {
     Eigen::Matrix3d index_to_lps;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) index_to_lps(r, c) = map_.m[r][c];
-    const Eigen::Matrix3d lps_to_index = index_to_lps.inverse();
+    return index_to_lps.inverse();
+  }
+
+  // A sub-voxel surface stays within 1/2 voxel (index space) of the staircase: a vertex the
+  // smoothing moved farther is pulled back along its displacement.
+  void keep_within_half_voxel() {
+    const Eigen::Matrix3d lps_to_index = this->lps_to_index();
     const double limit = 0.5 * (1 - 1e-6);
     for (std::size_t i = 0; i < tris_.points.size(); ++i) {
       const Eigen::Vector3d moved(tris_.points[i][0] - staircase_[i][0], tris_.points[i][1] - staircase_[i][1],

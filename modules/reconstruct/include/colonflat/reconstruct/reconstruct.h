@@ -74,9 +74,12 @@ struct ReconstructStats {
   std::size_t fluid_voxels = 0;               // lumen voxels >= fluid_hu (ct field only)
   std::size_t field_clamped_voxels = 0;       // lumen voxels the field would have put outside
   bool smoothed = false, decimated = false;
+  int fairing_iterations = 0;                 // constrained fairing (mask surface without a CT)
+  double fairing_energy_before = 0, fairing_energy_after = 0;  // umbrella energy, mm^2
+  std::size_t fairing_vertices_at_limit = 0;  // vertices held at 1/2 voxel by the constraint
   std::size_t vertices = 0, faces = 0;
   int genus = 0;  // total over kept components
-  double time_field_s = 0, time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_decimate_s = 0, time_total_s = 0;
+  double time_field_s = 0, time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_fairing_s = 0, time_decimate_s = 0, time_total_s = 0;
   nlohmann::json to_json() const;
 };
 
