@@ -2,6 +2,7 @@
 #include "fairing.h"
 
 #include <Eigen/Geometry>
+#include <vtkSMPTools.h>
 
 #include <algorithm>
 #include <cmath>
@@ -106,25 +107,25 @@ class ConstrainedFairing {
   // bending is measured there, so a rim vertex is pulled by its neighbours' terms only).
   void umbrella(const Points& x, Points& out) const {
     out.resize(x.rows(), 3);
-    for (std::size_t i = 0; i + 1 < start_.size(); ++i) {
-      if (rim_[i]) {
-        out.row(Eigen::Index(i)).setZero();
-        continue;
+    vtkSMPTools::For(0, vtkIdType(start_.size() - 1), kGrain, [&](vtkIdType first, vtkIdType last) {
+      for (auto i = std::size_t(first); i < std::size_t(last); ++i) {
+        Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+        for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) sum += weight_[k] * x.row(neighbours_[k]);
+        out.row(Eigen::Index(i)) = rim_[i] ? Eigen::RowVector3d::Zero() : Eigen::RowVector3d(sum - x.row(Eigen::Index(i)));
       }
-      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-      for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) sum += weight_[k] * x.row(neighbours_[k]);
-      out.row(Eigen::Index(i)) = sum - x.row(Eigen::Index(i));
-    }
+    });
   }
 
   // out = U^T r: (U^T r)_j = -r_j + sum over neighbours i of j of r_i / deg(i).
   void umbrella_transpose(const Points& r, Points& out) const {
     out.resize(r.rows(), 3);
-    for (std::size_t j = 0; j + 1 < start_.size(); ++j) {
-      Eigen::RowVector3d sum = -r.row(Eigen::Index(j));
-      for (std::size_t k = start_[j]; k < start_[j + 1]; ++k) sum += weight_t_[k] * r.row(neighbours_[k]);
-      out.row(Eigen::Index(j)) = sum;
-    }
+    vtkSMPTools::For(0, vtkIdType(start_.size() - 1), kGrain, [&](vtkIdType first, vtkIdType last) {
+      for (auto j = std::size_t(first); j < std::size_t(last); ++j) {
+        Eigen::RowVector3d sum = -r.row(Eigen::Index(j));
+        for (std::size_t k = start_[j]; k < start_[j + 1]; ++k) sum += weight_t_[k] * r.row(neighbours_[k]);
+        out.row(Eigen::Index(j)) = sum;
+      }
+    });
   }
 
   double energy(const Points& x) {
@@ -191,6 +192,7 @@ class ConstrainedFairing {
   }
 
   const std::vector<std::array<int, 3>>& triangles_;
+  static constexpr vtkIdType kGrain = 16384;  // vertices per parallel chunk (vtkSMPTools)
   Eigen::Matrix3d to_index_;
   double radius_;
   std::vector<std::size_t> start_;
