@@ -78,41 +78,4 @@ Eigen::MatrixXd RegionSystem::solve_raw(const Eigen::MatrixXd& b) const {
   return impl_->solver.solve(b);
 }
 
-std::size_t untangle(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
-                     const std::vector<char>& fixed, const std::vector<char>& degenerate) {
-  const int nv = int(s.p.size());
-  std::vector<char> in(nv, 0);
-  std::vector<int> region;
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f] && too_small_in_map(emb.area2(s, int(f)), face_area_3d(s, int(f))))
-      for (int v : s.t[f])
-        if (!in[v]) in[v] = 1, region.push_back(v);
-  if (region.empty()) return 0;
-  for (int round = 0; round < 4; ++round) {
-    for (int ring = 0; ring < (1 << round) && round > 0; ++ring) {  // grow 1, 2, 4, ... rings
-      const std::size_t n0 = region.size();
-      for (std::size_t k = 0; k < n0; ++k)
-        for (int f : vf[region[k]])
-          for (int v : s.t[f])
-            if (!in[v]) in[v] = 1, region.push_back(v);
-    }
-    std::vector<char> free_vertex(nv, 0);
-    for (int v : region) free_vertex[v] = !fixed[v];
-    std::vector<int> faces;
-    std::vector<char> seen(s.t.size(), 0);
-    for (int v : region)
-      if (free_vertex[v])
-        for (int f : vf[v])
-          if (!seen[f]) seen[f] = 1, faces.push_back(f);
-    RegionSystem sys;  // Tutte: uniform weights, zero targets
-    if (!sys.build(s, free_vertex, faces, std::vector<std::array<double, 3>>(faces.size(), {1.0, 1.0, 1.0}))) break;
-    emb.pos = sys.solve(s, emb, std::vector<std::array<V2, 3>>(faces.size(), {V2::Zero(), V2::Zero(), V2::Zero()}));
-    bool any = false;
-    for (int f : faces)
-      if (!degenerate[f] && too_small_in_map(emb.area2(s, f), face_area_3d(s, f))) any = true;
-    if (!any) break;
-  }
-  return region.size();
-}
-
 }  // namespace cf::flat_detail

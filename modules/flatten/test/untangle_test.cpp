@@ -1,0 +1,100 @@
+// Untangling a band's map (src/untangle.cpp) on a tiny flat grid built here: folds inside are
+// repaired with the boundary kept, a fold at an end is repaired by sliding the end along itself, and
+// a rim that crosses itself gives way (the synthetic pouch tube and the real CTC colon had such folds).
+#include <gtest/gtest.h>
+
+#include "../src/flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace {
+
+constexpr int kNx = 12, kNy = 8;  // x = 0 and x = 11 are the band's ends, y = 0 and y = 7 rims
+int id(int i, int j) { return j * kNx + i; }
+
+struct Grid {
+  Surface s;
+  Embedding emb;
+  std::vector<char> fixed, degenerate;
+  std::vector<std::vector<int>> vf;
+};
+
+// The flat grid as both the surface (z = 0) and its map (no seam: dy = 0, period far larger).
+Grid grid() {
+  Grid g;
+  for (int j = 0; j < kNy; ++j)
+    for (int i = 0; i < kNx; ++i) {
+      g.s.p.push_back(V3(i, j, 0));
+      g.emb.pos.push_back(V2(i, j));
+      g.fixed.push_back(i == 0 || j == 0 || i == kNx - 1 || j == kNy - 1);
+    }
+  for (int j = 0; j + 1 < kNy; ++j)
+    for (int i = 0; i + 1 < kNx; ++i) {
+      g.s.t.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      g.s.t.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  g.emb.dy.assign(g.s.t.size(), {0.0, 0.0, 0.0});
+  g.emb.period = 1000;
+  g.degenerate.assign(g.s.t.size(), 0);
+  g.vf = vertex_faces(g.s);
+  return g;
+}
+
+std::size_t folded_faces(const Grid& g) {
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < g.s.t.size(); ++f)
+    n += too_small_in_map(g.emb.area2(g.s, int(f)), face_area_3d(g.s, int(f)));
+  return n;
+}
+
+// An interior vertex pushed across its neighbour folds faces; untangling repairs them and leaves
+// every boundary vertex where it was.
+TEST(Untangle, InteriorFoldWithTheBoundaryKept) {
+  Grid g = grid();
+  g.emb.pos[id(5, 3)] = V2(7.5, 3.2);
+  ASSERT_GT(folded_faces(g), 0u);
+  const std::vector<V2> before = g.emb.pos;
+  EXPECT_GT(untangle(g.s, g.vf, g.emb, g.fixed, g.degenerate), 0u);
+  EXPECT_EQ(folded_faces(g), 0u);
+  for (int v = 0; v < kNx * kNy; ++v)
+    if (g.fixed[v]) EXPECT_EQ(g.emb.pos[v], before[v]) << v;
+}
+
+// Two vertices of an end in the wrong order (what the conformal map did on the pouch tube's end
+// loop): the end slides along itself (x stays 0), and no face stays folded.
+TEST(Untangle, EndInTheWrongOrderSlidesAlongItself) {
+  Grid g = grid();
+  g.emb.pos[id(0, 3)] = V2(0, 4.4);
+  g.emb.pos[id(0, 4)] = V2(0, 3.6);
+  ASSERT_GT(folded_faces(g), 0u);
+  untangle(g.s, g.vf, g.emb, g.fixed, g.degenerate);
+  EXPECT_EQ(folded_faces(g), 0u);
+  for (int j = 0; j < kNy; ++j) {
+    EXPECT_EQ(g.emb.pos[id(0, j)].x(), 0.0) << j;
+    EXPECT_EQ(g.emb.pos[id(kNx - 1, j)].x(), kNx - 1.0) << j;
+  }
+}
+
+// A rim vertex pushed past its rim neighbour (the rim of a cut-off branch crossing itself, as on
+// the real CTC colon): the rim gives way, no face stays folded, the ends do not move.
+TEST(Untangle, RimCrossingItselfGivesWay) {
+  Grid g = grid();
+  g.emb.pos[id(5, kNy - 1)] = V2(6.6, kNy - 1.3);
+  ASSERT_GT(folded_faces(g), 0u);
+  untangle(g.s, g.vf, g.emb, g.fixed, g.degenerate);
+  EXPECT_EQ(folded_faces(g), 0u);
+  for (int j = 0; j < kNy; ++j) {
+    EXPECT_EQ(g.emb.pos[id(0, j)], V2(0, j)) << j;
+    EXPECT_EQ(g.emb.pos[id(kNx - 1, j)], V2(kNx - 1, j)) << j;
+  }
+}
+
+// Nothing folded: nothing moves.
+TEST(Untangle, UnfoldedMapIsLeftAlone) {
+  Grid g = grid();
+  const std::vector<V2> before = g.emb.pos;
+  EXPECT_EQ(untangle(g.s, g.vf, g.emb, g.fixed, g.degenerate), 0u);
+  EXPECT_EQ(g.emb.pos, before);
+}
+
+}  // namespace
+}  // namespace cf::flat_detail
