@@ -108,7 +108,7 @@ static Correction needs_correction(const SegmentWork& w, const std::vector<char>
   }
   const DistortionStats st = stats_of(in_map);
   if (st.area_p05 < 0.25 || st.area_p95 > 4 || st.qc_mean > 1.45) return Correction::global;
-  return hidden > 0 ? Correction::local : Correction::none;
+  return hidden > 0.0025 * a3 ? Correction::local : Correction::none;
 }
 
 // Band length: the centreline length L, moved towards the conformal length by at most 8 % (the
