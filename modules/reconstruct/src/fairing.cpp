@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/vertex_graph.h"
 
 namespace cf::reconstruct_detail {
 namespace {
@@ -49,27 +50,11 @@ class ConstrainedFairing {
   }
 
  private:
-  // Vertex adjacency (CSR, each undirected edge in both rows) from the triangles.
   void build_graph(const TriangleList& surface) {
-    const std::size_t n = surface.points.size();
-    std::vector<std::pair<int, int>> directed;
-    directed.reserve(6 * surface.triangles.size());
-    for (const auto& t : surface.triangles)
-      for (int k = 0; k < 3; ++k) {
-        directed.emplace_back(t[k], t[(k + 1) % 3]);
-        directed.emplace_back(t[(k + 1) % 3], t[k]);
-      }
-    std::sort(directed.begin(), directed.end());
-    rim_.assign(n, 0);  // an edge in one triangle only: both its ends are on the rim
-    for (std::size_t k = 0; k < directed.size(); ++k)
-      if ((k == 0 || directed[k - 1] != directed[k]) && (k + 1 == directed.size() || directed[k + 1] != directed[k]))
-        rim_[std::size_t(directed[k].first)] = rim_[std::size_t(directed[k].second)] = 1;
-    directed.erase(std::unique(directed.begin(), directed.end()), directed.end());
-    start_.assign(n + 1, 0);
-    for (const auto& e : directed) ++start_[std::size_t(e.first) + 1];
-    for (std::size_t i = 0; i < n; ++i) start_[i + 1] += start_[i];
-    neighbours_.resize(directed.size());
-    for (std::size_t k = 0; k < directed.size(); ++k) neighbours_[k] = directed[k].second;
+    VertexGraph g = vertex_graph(surface);
+    start_ = std::move(g.start);
+    neighbours_ = std::move(g.neighbours);
+    rim_ = std::move(g.on_boundary);
   }
 
   // weight_[k] for the k-th CSR entry: the cotangent weight of the edge on the start surface,
@@ -195,7 +180,7 @@ class ConstrainedFairing {
   static constexpr vtkIdType kGrain = 16384;  // vertices per parallel chunk (vtkSMPTools)
   Eigen::Matrix3d to_index_;
   double radius_;
-  std::vector<std::size_t> start_;
+  std::vector<int> start_;
   std::vector<int> neighbours_;
   std::vector<char> rim_;
   std::vector<double> weight_, weight_t_, row_weight_;

@@ -11,35 +11,12 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/stage.h"
+#include "colonflat/core/vertex_graph.h"
 
 namespace cf {
 namespace {
 
 using V3 = Eigen::Vector3d;
-
-struct Graph {
-  std::vector<int> start, nbr;
-};
-
-Graph vertex_graph(const TriangleList& s) {
-  const std::size_t nv = s.points.size();
-  std::vector<std::pair<int, int>> e;
-  e.reserve(6 * s.triangles.size());
-  for (const auto& t : s.triangles)
-    for (int k = 0; k < 3; ++k) {
-      e.push_back({t[k], t[(k + 1) % 3]});
-      e.push_back({t[(k + 1) % 3], t[k]});
-    }
-  std::sort(e.begin(), e.end());
-  e.erase(std::unique(e.begin(), e.end()), e.end());
-  Graph g;
-  g.start.assign(nv + 1, 0);
-  for (const auto& [a, b] : e) ++g.start[a + 1];
-  for (std::size_t i = 0; i < nv; ++i) g.start[i + 1] += g.start[i];
-  g.nbr.resize(e.size());
-  for (std::size_t i = 0; i < e.size(); ++i) g.nbr[i] = e[i].second;
-  return g;
-}
 
 V3 P(const TriangleList& s, int i) { return {s.points[i][0], s.points[i][1], s.points[i][2]}; }
 
@@ -53,7 +30,7 @@ std::vector<double> vertex_areas(const TriangleList& s) {
 }
 
 // Vertices within Euclidean distance r of `c`, reached through edges (at least the 2-ring).
-void neighbourhood(const Graph& g, const TriangleList& s, int c, double r, std::vector<int>& stamp, int tag,
+void neighbourhood(const VertexGraph& g, const TriangleList& s, int c, double r, std::vector<int>& stamp, int tag,
                    std::vector<int>& out) {
   out.clear();
   out.push_back(c);
@@ -64,7 +41,7 @@ void neighbourhood(const Graph& g, const TriangleList& s, int c, double r, std::
     const bool near_ring = k == 0 || (P(s, v) - pc).norm() <= r;
     if (!near_ring) continue;
     for (int q = g.start[v]; q < g.start[v + 1]; ++q) {
-      const int w = g.nbr[q];
+      const int w = g.neighbours[q];
       if (stamp[w] == tag) continue;
       stamp[w] = tag;
       if ((P(s, w) - pc).norm() <= r || k == 0) out.push_back(w);
@@ -77,7 +54,7 @@ void neighbourhood(const Graph& g, const TriangleList& s, int c, double r, std::
 Curvature surface_curvature(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
                             double fit_radius) {
   const int nv = int(s.points.size());
-  const Graph g = vertex_graph(s);
+  const VertexGraph g = vertex_graph(s);
   Curvature c;
   c.k1.assign(nv, 0);
   c.k2.assign(nv, 0);
@@ -145,7 +122,7 @@ class PolypDetector {
   const TriangleList& s_;
   const PolypOptions& o_;
   Curvature c_;
-  const Graph g_;
+  const VertexGraph g_;
   const std::vector<double> area_;  // per vertex, a third of its triangles' area (mm^2)
   std::vector<int> region_;         // cap region of each vertex, -1 when none
   std::vector<int> footprint_stamp_;
@@ -175,7 +152,7 @@ std::vector<int> PolypDetector::grow_cap(int v0) {
   region_[v0] = regions_;
   for (std::size_t k = 0; k < cap.size(); ++k)
     for (int q = g_.start[cap[k]]; q < g_.start[cap[k] + 1]; ++q) {
-      const int w = g_.nbr[q];
+      const int w = g_.neighbours[q];
       if (region_[w] < 0 && in_cap(w)) region_[w] = regions_, cap.push_back(w);
     }
   ++regions_;
@@ -210,7 +187,7 @@ void PolypDetector::grow_footprint(const std::vector<int>& cap, PolypCandidate& 
   for (std::size_t k = 0; k < fp.size(); ++k) {
     fa += area_[fp[k]];
     for (int q = g_.start[fp[k]]; q < g_.start[fp[k] + 1]; ++q) {
-      const int w = g_.nbr[q];
+      const int w = g_.neighbours[q];
       if (footprint_stamp_[w] == regions_ || c_.si[w] < o_.footprint_si || (P(s_, w) - pa).norm() > o_.max_radius)
         continue;
       footprint_stamp_[w] = regions_;
