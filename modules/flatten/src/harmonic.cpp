@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <queue>
 
 #include "colonflat/core/error.h"
@@ -130,81 +129,82 @@ SpMat laplacian_lower(const Edges& E, const std::vector<double>& w, const std::v
   return A;
 }
 
-// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2); unknowns: the other vertices.
-LinearSystem u_system(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark) {
-  const int nv = int(mark.size());
-  LinearSystem sys;
-  std::vector<int>& idx = sys.unknown_of;
-  idx.resize(nv);
-  int n = 0;
-  for (int v = 0; v < nv; ++v) idx[v] = mark[v] == 0 ? n++ : -1;
-  sys.A = laplacian_lower(E, w, idx, n);
-  sys.rhs = Eigen::VectorXd::Zero(n);
-  for (std::size_t e = 0; e < E.ev.size(); ++e) {
-    const int a = E.ev[e][0], b = E.ev[e][1];
-    if (idx[a] >= 0 && mark[b] == 2) sys.rhs[idx[a]] += w[e];
-    if (idx[b] >= 0 && mark[a] == 2) sys.rhs[idx[b]] += w[e];
-  }
-  return sys;
-}
-
-// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned at vertex 0; unknown v - 1 of vertex v.
-LinearSystem v_system(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv) {
+// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned (0) at vertex `pinned`, a vertex of
+// loop A: then u's unknowns (the vertices off the loops) are some of v's, and u's matrix is the
+// principal submatrix of v's on them. Unknown of vertex v: v, or v - 1 past `pinned`.
+LinearSystem v_system(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv,
+                      int pinned) {
   LinearSystem sys;
   sys.unknown_of.resize(nv);
-  for (int v = 0; v < nv; ++v) sys.unknown_of[v] = v - 1;
+  for (int v = 0; v < nv; ++v) sys.unknown_of[v] = v < pinned ? v : v == pinned ? -1 : v - 1;
   sys.A = laplacian_lower(E, w, sys.unknown_of, nv - 1);
   sys.rhs = Eigen::VectorXd::Zero(nv - 1);
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     if (!eta[e]) continue;
-    const int a = E.ev[e][0], b = E.ev[e][1];
-    if (a > 0) sys.rhs[a - 1] += w[e] * eta[e];
-    if (b > 0) sys.rhs[b - 1] -= w[e] * eta[e];
+    const int a = sys.unknown_of[E.ev[e][0]], b = sys.unknown_of[E.ev[e][1]];
+    if (a >= 0) sys.rhs[a] += w[e] * eta[e];
+    if (b >= 0) sys.rhs[b] -= w[e] * eta[e];
   }
   return sys;
 }
 
-// The elimination order of a system's unknowns induced by a vertex order (vertices that are not
-// unknowns skipped, the relative order kept).
-std::vector<int> restrict_order(const std::vector<int>& vertex_order, const std::vector<int>& unknown_of) {
+// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2); its unknowns are the other vertices.
+// Its right-hand side on v's unknowns (the loops' entries 0, not read by the leading solve).
+Eigen::VectorXd u_rhs(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark,
+                      const std::vector<int>& unknown_of) {
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(Eigen::Index(mark.size()) - 1);
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {
+    const int a = E.ev[e][0], b = E.ev[e][1];
+    if (mark[a] == 0 && mark[b] == 2) rhs[unknown_of[a]] += w[e];
+    if (mark[b] == 0 && mark[a] == 2) rhs[unknown_of[b]] += w[e];
+  }
+  return rhs;
+}
+
+// The elimination order of v's unknowns from a vertex order: the vertices off the loops first, then
+// the loops' vertices (each group in the vertex order), so that u's unknowns are the leading block
+// (SpdSolver::solve_leading). `leading`: their number.
+std::vector<int> loops_last(const std::vector<int>& vertex_order, const std::vector<int>& unknown_of,
+                            const std::vector<char>& mark, int& leading) {
   std::vector<int> order;
   order.reserve(vertex_order.size());
-  for (int v : vertex_order)
-    if (v >= 0 && v < int(unknown_of.size()) && unknown_of[v] >= 0) order.push_back(unknown_of[v]);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int v : vertex_order)
+      if (v >= 0 && v < int(unknown_of.size()) && unknown_of[v] >= 0 && (mark[v] != 0) == (pass == 1))
+        order.push_back(unknown_of[v]);
+  leading = int(std::count(mark.begin(), mark.end(), 0));
   return order;
 }
 
-Eigen::VectorXd factorize_and_solve(SpdSolver& solver, const LinearSystem& sys) {
-  if (!solver.factorize(sys.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
-  return solver.solve(sys.rhs);
+// The vertices in the order of v's unknowns `order`, then the pinned vertex.
+std::vector<int> vertex_order_of(const std::vector<int>& order, const std::vector<int>& unknown_of) {
+  std::vector<int> vertex_of(order.size());
+  int pinned = -1;
+  for (std::size_t v = 0; v < unknown_of.size(); ++v)
+    if (unknown_of[v] >= 0) vertex_of[unknown_of[v]] = int(v);
+    else pinned = int(v);
+  std::vector<int> vertices;
+  vertices.reserve(unknown_of.size());
+  for (int k : order) vertices.push_back(vertex_of[k]);
+  vertices.push_back(pinned);
+  return vertices;
 }
 
-// Solves the u and v systems, u on a second thread; one fill-reducing order for both (the given
-// vertex order, else AMD on the v system, which holds all vertices but one). Returns the vertex
-// order used (empty when the solver gives none).
-std::vector<int> solve_uv(const LinearSystem& us, const LinearSystem& vs, const std::vector<int>* vertex_order,
-                          Eigen::VectorXd& xu, Eigen::VectorXd& xv) {
-  SpdSolver v_solver;
-  std::vector<int> order;
-  if (vertex_order) {
-    const std::vector<int> v_order = restrict_order(*vertex_order, vs.unknown_of);
-    v_solver.analyze(vs.A, &v_order);
-    order = *vertex_order;
-  } else {
-    v_solver.analyze(vs.A);
-    order = v_solver.order();
-    for (int& k : order) k += 1;  // unknown k is vertex k + 1
-    if (!order.empty()) order.push_back(0);
-  }
-  const std::vector<int> u_order = restrict_order(order, us.unknown_of);
-  auto u_done = std::async(std::launch::async, [&] {
-    SpdSolver u_solver;
-    u_solver.analyze(us.A, u_order.empty() ? nullptr : &u_order);
-    return factorize_and_solve(u_solver, us);
-  });
-  xv = factorize_and_solve(v_solver, vs);
-  xu = u_done.get();
-  return order;
+// Solves v's system and, with the same factorisation, u's (its leading block, loops last); one
+// fill-reducing order (the given vertex order, else AMD on v's system). Returns the vertex order
+// used.
+std::vector<int> solve_uv(const LinearSystem& vs, const std::vector<char>& mark, const Eigen::VectorXd& rhs_u,
+                          const std::vector<int>* vertex_order, Eigen::VectorXd& xu, Eigen::VectorXd& xv) {
+  const std::vector<int> by_vertex =
+      vertex_order ? *vertex_order : vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
+  int leading = 0;
+  const std::vector<int> order = loops_last(by_vertex, vs.unknown_of, mark, leading);
+  SpdSolver solver;
+  solver.analyze(vs.A, &order);
+  if (!solver.factorize(vs.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  xv = solver.solve(vs.rhs);
+  xu = solver.solve_leading(rhs_u, leading);
+  return vertex_order_of(order, vs.unknown_of);
 }
 
 double eta_dir(const std::vector<signed char>& eta, const Edges& E, int e, int from) {
@@ -218,19 +218,23 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   Harmonic h;
   h.weights = clamp ? "clamped" : "cotan";
   const int nv = int(s.p.size());
+  if (loop_a.empty() || loop_b.empty()) throw Error("a segment end without vertices");
   const std::vector<double> w = cot_weights(s, E, clamp);
   std::vector<char> mark(nv, 0);
   for (int v : loop_a) mark[v] = 1;
   for (int v : loop_b) mark[v] = 2;
   h.eta = cut_cocycle(s, E, mark);
-  const LinearSystem us = u_system(E, w, mark), vs = v_system(E, w, h.eta, nv);
+  const LinearSystem vs = v_system(E, w, h.eta, nv, loop_a.front());
   Eigen::VectorXd xu, xv;
-  h.vertex_order = solve_uv(us, vs, vertex_order, xu, xv);
+  h.vertex_order = solve_uv(vs, mark, u_rhs(E, w, mark, vs.unknown_of), vertex_order, xu, xv);
   h.u.resize(nv);
-  for (int v = 0; v < nv; ++v) h.u[v] = mark[v] == 0 ? xu[us.unknown_of[v]] : mark[v] == 1 ? 0.0 : 1.0;
   h.v.resize(nv);
-  h.v[0] = 0;
-  h.v.tail(nv - 1) = xv;
+  for (int v = 0; v < nv; ++v) {
+    const int k = vs.unknown_of[v];
+    h.u[v] = mark[v] == 0 ? xu[k] : mark[v] == 1 ? 0.0 : 1.0;
+    h.v[v] = k >= 0 ? xv[k] : 0.0;
+  }
+  h.v.array() -= h.v[0];  // v = 0 at vertex 0 (the constant is free; the layout keeps this one)
   double ev = 0;
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     const double du = h.u[E.ev[e][1]] - h.u[E.ev[e][0]];

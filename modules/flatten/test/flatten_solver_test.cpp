@@ -116,3 +116,45 @@ TEST(FlattenSolver, RestrictedOrderOfALargerGraphSolvesTheSubgraph) {
     EXPECT_EQ(used, expected);
   }
 }
+
+// One factorisation of a system with some unknowns ordered last also solves the system on the
+// others with those held at 0 (its leading block, as the conformal map solves u with v's factor):
+// the same solution as a factorisation of that block alone; without a given order it is refused.
+TEST(FlattenSolver, LeadingBlockOfTheOrderSolvesTheSystemWithTheRestHeldAtZero) {
+  const int nx = 30, ny = 20, nv = nx * ny;
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, ny, 7));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  auto held = [&](int v) { return v % nx == nx - 1 || v / nx == 0; };  // last column and first row
+  std::vector<int> order, unknown_of(nv, -1);  // AMD's order with the held unknowns moved last
+  const std::vector<int> amd = SpdSolver::fill_reducing_order(A);
+  ASSERT_EQ(amd.size(), std::size_t(nv));
+  int leading = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int v : amd)
+      if (held(v) == (pass == 1)) order.push_back(v), leading += pass == 0;
+  for (int v = 0, n = 0; v < nv; ++v)
+    if (!held(v)) unknown_of[v] = n++;
+  Eigen::VectorXd b(nv), b_inner(leading);
+  for (int v = 0; v < nv; ++v) {
+    b[v] = held(v) ? 1e3 : std::cos(0.21 * v) + 0.3;  // the held entries must not be read
+    if (!held(v)) b_inner[unknown_of[v]] = b[v];
+  }
+  std::vector<Eigen::Triplet<double>> block;  // A's principal submatrix on the unknowns not held
+  for (int j = 0; j < A.outerSize(); ++j)
+    for (SpdSolver::SpMat::InnerIterator it(A, j); it; ++it)
+      if (unknown_of[it.row()] >= 0 && unknown_of[j] >= 0) block.emplace_back(unknown_of[it.row()], unknown_of[j], it.value());
+  SpdSolver::SpMat A_inner(leading, leading);
+  A_inner.setFromTriplets(block.begin(), block.end());
+  SpdSolver one, inner, unordered;
+  ASSERT_TRUE(one.compute(A, &order));
+  ASSERT_TRUE(inner.compute(A_inner));
+  const Eigen::VectorXd x = one.solve_leading(b, leading), x_inner = inner.solve(b_inner);
+  for (int v = 0; v < nv; ++v) {
+    if (held(v)) EXPECT_EQ(x[v], 0.0);
+    else EXPECT_NEAR(x[v], x_inner[unknown_of[v]], 1e-10 * x_inner.norm());
+  }
+  ASSERT_TRUE(unordered.compute(A));
+  EXPECT_THROW(unordered.solve_leading(b, leading), cf::Error);
+}
