@@ -109,9 +109,8 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
                          const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
-    const std::vector<int>* order = w.elimination_order.empty() ? nullptr : &w.elimination_order;
-    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, order);
-    w.elimination_order = h.vertex_order;
+    Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, &w.prior);
+    w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}};
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
@@ -273,9 +272,10 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
   for (auto& l : loops)
     for (int& v : l) v = new_of_old[v];
   std::vector<int> order;  // the colon's elimination order, restricted to what remains
-  for (int v : w.elimination_order)
+  for (int v : w.prior.vertex_order)
     if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
-  w.elimination_order = std::move(order);
+  w.prior.vertex_order = std::move(order);
+  w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factorisation
   w.ann = std::move(rest);
   double placed = surface_area(w.ann);
   const int component = w.seg.component;
@@ -355,6 +355,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   std::vector<SegmentWork> branches;
   if (o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth)
     branches = cut_branches(w, loops, p, o, depth);
+  w.prior = PriorSolve{};  // the last factorisation's memory back
   if (!branches.empty()) phase("side branches cut and flattened, conformal map again");
   const Centreline cl = centreline_step(w, loops);
   attach_branches(w, branches);

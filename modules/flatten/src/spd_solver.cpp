@@ -215,6 +215,26 @@ Eigen::MatrixXd SpdSolver::cholmod_leading(const Eigen::MatrixXd& b, int leading
   return take_dense(y, common_);
 }
 
+bool SpdSolver::modify(const SpMat& C, bool update) {
+  if (!cholmod_ok_ || C.cols() == 0) return cholmod_ok_;
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  std::vector<int> place(factor_->n);  // CHOLMOD wants C's rows in the factor's order
+  for (std::size_t k = 0; k < factor_->n; ++k) place[perm[k]] = int(k);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(std::size_t(C.nonZeros()));
+  for (int j = 0; j < C.outerSize(); ++j)
+    for (SpMat::InnerIterator it(C, j); it; ++it) entries.emplace_back(place[it.row()], j, it.value());
+  SpMat permuted(C.rows(), C.cols());
+  permuted.setFromTriplets(entries.begin(), entries.end());  // compressed, rows sorted
+  cholmod_sparse view = view_lower(permuted);
+  view.nrow = std::size_t(C.rows());
+  view.ncol = std::size_t(C.cols());
+  view.stype = 0;  // unsymmetric: C itself
+  cholmod_updown(update ? 1 : 0, &view, factor_, &common_);
+  cholmod_ok_ = common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
+  return cholmod_ok_;
+}
+
 std::vector<int> SpdSolver::order() const {
   if (!factor_ || !factor_->Perm) return {};
   const int* perm = static_cast<const int*>(factor_->Perm);
@@ -236,6 +256,8 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
 bool SpdSolver::factorize(const SpMat& A) { return fall_back(A); }
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const { return fallback_->solve(b); }
+
+bool SpdSolver::modify(const SpMat&, bool) { return false; }
 
 std::vector<int> SpdSolver::order() const { return {}; }
 

@@ -55,6 +55,11 @@ class SpdSolver {
   // x_I = A_II^-1 b_I for I = the first `leading` unknowns of the order given to analyze(), and
   // x = 0 off I (b's entries off I are not read). Throws Error without a given order.
   Eigen::MatrixXd solve_leading(const Eigen::MatrixXd& b, int leading) const;
+  // The factorisation of A + C C^T (`update`) or A - C C^T (C: n x k, rows = unknowns), modified in
+  // place (CHOLMOD's update/downdate: the cost of the columns of L it touches, not of a new
+  // factorisation). False without CHOLMOD or when the result is not positive definite; the solver
+  // is then unusable until factorize().
+  bool modify(const SpMat& C, bool update);
   // The elimination order of the analysis (empty without CHOLMOD or before analyze()).
   std::vector<int> order() const;
 
