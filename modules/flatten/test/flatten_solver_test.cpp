@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <cmath>
 #include <random>
 
 #include "../src/flatten_internal.h"
@@ -157,4 +158,68 @@ TEST(FlattenSolver, LeadingBlockOfTheOrderSolvesTheSystemWithTheRestHeldAtZero) 
   }
   ASSERT_TRUE(unordered.compute(A));
   EXPECT_THROW(unordered.solve_leading(b, leading), cf::Error);
+}
+
+namespace {
+
+// An open tube of nz rings of na vertices (radius varying along it and around it, so that the
+// cotangent weights differ), two triangles per cell; vertex j * na + i.
+cf::flat_detail::Surface bumpy_tube(int na, int nz) {
+  cf::flat_detail::Surface s;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < na; ++i) {
+      const double a = 2 * M_PI * i / na, r = 10 + 2 * std::sin(0.3 * j) + std::cos(3 * a);
+      s.p.emplace_back(r * std::cos(a), r * std::sin(a), 1.3 * j + 0.2 * std::sin(a));
+      s.src.push_back(int(s.p.size()) - 1);
+    }
+  for (int j = 0; j + 1 < nz; ++j)
+    for (int i = 0; i < na; ++i) {
+      const int a = j * na + i, b = j * na + (i + 1) % na, c = a + na, d = b + na;
+      s.t.push_back({a, b, d});
+      s.t.push_back({a, d, c});
+    }
+  return s;
+}
+
+}  // namespace
+
+// The map after cutting pieces out of a surface, solved by updating the first map's factorisation
+// (rank-one terms for the changed weights, the cut-off vertices grounded), equals a new solve on
+// what remains; two cut-off pieces (two holes) are each grounded.
+TEST(FlattenSolver, UpdatedFactorisationSolvesTheSurfaceThatRemains) {
+  using namespace cf::flat_detail;
+  const int na = 24, nz = 40;
+  const Surface whole = bumpy_tube(na, nz);
+  const Edges E0 = build_edges(whole.t);
+  auto loops = boundary_loops(whole, E0);
+  ASSERT_EQ(loops.size(), 2u);
+  if (loops[0][0] != 0) std::swap(loops[0], loops[1]);
+  PriorSolve prior;
+  Harmonic first = solve_harmonic(whole, E0, loops[0], loops[1], false, &prior);
+  ASSERT_TRUE(first.factor);
+  std::vector<char> keep(whole.t.size(), 1);
+  for (std::size_t f = 0; f < whole.t.size(); ++f) {
+    const int j = whole.t[f][0] / na, i = whole.t[f][0] % na;
+    if ((j >= 10 && j < 15 && i >= 3 && i < 8) || (j >= 25 && j < 28 && i >= 12 && i < 20)) keep[f] = 0;
+  }
+  std::vector<int> new_of_old;
+  const Surface rest = sub_surface(whole, keep, &new_of_old);
+  const Edges E1 = build_edges(rest.t);
+  ASSERT_EQ(boundary_loops(rest, E1).size(), 4u);  // two ends, two holes
+  for (auto& l : loops)
+    for (int& v : l) v = new_of_old[v];
+  prior = PriorSolve{{}, std::move(first.factor), new_of_old};
+  for (int v : first.vertex_order)
+    if (new_of_old[v] >= 0) prior.vertex_order.push_back(new_of_old[v]);
+  const Harmonic updated = solve_harmonic(rest, E1, loops[0], loops[1], false, &prior);
+  const Harmonic fresh = solve_harmonic(rest, E1, loops[0], loops[1], false);
+  EXPECT_FALSE(updated.factor);  // the update was used, not a new factorisation
+  ASSERT_TRUE(fresh.factor);
+  EXPECT_LT((updated.u - fresh.u).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((updated.v - fresh.v).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_NEAR(updated.period, fresh.period, 1e-10 * fresh.period);
+  double moved = 0;  // the holes change the map: the test compares something that moved
+  for (std::size_t v = 0; v < whole.p.size(); ++v)
+    if (new_of_old[v] >= 0) moved = std::max(moved, std::abs(first.v[Eigen::Index(v)] - fresh.v[new_of_old[v]]));
+  EXPECT_GT(moved, 1e-3);
 }
