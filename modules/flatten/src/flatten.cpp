@@ -62,14 +62,19 @@ void check_component(const ComponentTopology& ct, std::size_t c) {
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism) and sets `E` to the annulus' edges.
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The fill-reducing
+// order of the conformal solve (w.prior) is computed on a second thread meanwhile, on the closed
+// surface, and restricted to the annulus.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const Edges E0 = build_edges(s.t);
+    auto order = std::async(std::launch::async, [&] { return fill_reducing_vertex_order(E0, int(s.p.size())); });
     Opened op = open_ends(s, E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
+    for (int v : order.get())
+      if (op.new_of_old[v] >= 0) w.prior.vertex_order.push_back(op.new_of_old[v]);
   }
   E = build_edges(w.ann.t);
   auto loops = boundary_loops(w.ann, E);

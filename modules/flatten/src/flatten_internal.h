@@ -50,6 +50,7 @@ double face_area_3d(const Surface& s, int f);
 struct Opened {
   Surface annulus;
   std::size_t removed = 0;
+  std::vector<int> new_of_old;  // per vertex of the surface: its id on the annulus, -1 when removed
 };
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
 // Keeps the largest edge-connected set of faces among `keep`.
@@ -85,6 +86,9 @@ struct Harmonic {
 // updated to this surface (conformal_update.cpp) instead of a new factorisation; consumed.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
                         const std::vector<int>& loop_b, bool clamp, PriorSolve* prior = nullptr);
+// A fill-reducing elimination order (AMD) of the vertices of the edge graph E (nv vertices); its
+// restriction to part of the surface is one for that part (the annulus once the ends are opened).
+std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.

@@ -302,6 +302,12 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   return h;
 }
 
+std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
+  std::vector<int> identity(nv);
+  for (int v = 0; v < nv; ++v) identity[v] = v;
+  return SpdSolver::fill_reducing_order(laplacian_lower(E, std::vector<double>(E.ev.size(), 1.0), identity, nv));
+}
+
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {
   const double P = emb.period;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
