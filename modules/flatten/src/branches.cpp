@@ -13,6 +13,7 @@
 //  4. the branch: faces with d < r connected to the cluster, with any enclosed island added; kept
 //     when it is a disk holding lumen (a polyp on a stalk, tissue, stays on the colon band).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -127,14 +128,18 @@ class BranchFinder {
       const Tri& t = s_.t[f];
       if (std::min({d[t[0]], d[t[1]], d[t[2]]}) < limit) near.push_back(int(f));
     }
+    std::array<double, kRadii> radius, len{};
+    for (int k = 0; k < kRadii; ++k) radius[k] = extent * std::pow(limit / extent, double(k) / (kRadii - 1));
+    for (int f : near) {  // a face crosses the level sets min d < r <= max d only: usually one radius
+      const Tri& t = s_.t[f];
+      const double lo = std::min({d[t[0]], d[t[1]], d[t[2]]}), hi = std::max({d[t[0]], d[t[1]], d[t[2]]});
+      for (int k = int(std::upper_bound(radius.begin(), radius.end(), lo) - radius.begin()); k < kRadii && radius[k] <= hi; ++k)
+        len[k] += crossing_length(f, d, radius[k]);
+    }
     double best_r = 0;
     neck_mm = 1e300;
-    for (int k = 0; k < kRadii; ++k) {
-      const double r = extent * std::pow(limit / extent, double(k) / (kRadii - 1));
-      double len = 0;
-      for (int f : near) len += crossing_length(f, d, r);
-      if (len > 0 && len < neck_mm) neck_mm = len, best_r = r;
-    }
+    for (int k = 0; k < kRadii; ++k)
+      if (len[k] > 0 && len[k] < neck_mm) neck_mm = len[k], best_r = radius[k];
     return best_r;
   }
 

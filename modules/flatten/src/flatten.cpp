@@ -62,14 +62,19 @@ void check_component(const ComponentTopology& ct, std::size_t c) {
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism) and sets `E` to the annulus' edges.
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The fill-reducing
+// order of the conformal solve (w.prior) is computed on a second thread meanwhile, on the closed
+// surface, and restricted to the annulus.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const Edges E0 = build_edges(s.t);
+    auto order = std::async(std::launch::async, [&] { return fill_reducing_vertex_order(E0, int(s.p.size())); });
     Opened op = open_ends(s, E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
+    for (int v : order.get())
+      if (op.new_of_old[v] >= 0) w.prior.vertex_order.push_back(op.new_of_old[v]);
   }
   E = build_edges(w.ann.t);
   auto loops = boundary_loops(w.ann, E);
@@ -109,9 +114,8 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
                          const std::vector<char>& degenerate, const FlattenOptions& o) {
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
-    const std::vector<int>* order = w.elimination_order.empty() ? nullptr : &w.elimination_order;
-    const Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, order);
-    w.elimination_order = h.vertex_order;
+    Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, &w.prior);
+    w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}};
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
@@ -242,12 +246,20 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
   return out;
 }
 
-// Cuts the side branches off the annulus, then re-solves the conformal map of what remains (on a
-// second thread, while the branches are flattened). Returns the branches' works.
-std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
+// The side branches' works and the wall area the cut leaves in no band (faces dropped at a neck,
+// branches that could not be flattened).
+struct FlattenedBranches {
+  std::vector<SegmentWork> works;
+  double lost_area = 0;
+};
+
+// Cuts the side branches off the annulus and starts flattening them on a second thread, then
+// re-solves the conformal map of what remains here: the segment goes on (centreline, area
+// balance) while its branches are flattened. The future is invalid when nothing was cut.
+std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
   const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
-  if (cuts.empty()) return {};
+  if (cuts.empty()) return std::future<FlattenedBranches>();
   const std::size_t nf = w.ann.t.size();
   std::vector<char> keep(nf, 1);
   for (const auto& cut : cuts)
@@ -273,27 +285,23 @@ std::vector<SegmentWork> cut_branches(SegmentWork& w, std::vector<std::vector<in
   for (auto& l : loops)
     for (int& v : l) v = new_of_old[v];
   std::vector<int> order;  // the colon's elimination order, restricted to what remains
-  for (int v : w.elimination_order)
+  for (int v : w.prior.vertex_order)
     if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
-  w.elimination_order = std::move(order);
+  w.prior.vertex_order = std::move(order);
+  w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factorisation
   w.ann = std::move(rest);
-  double placed = surface_area(w.ann);
-  const int component = w.seg.component;
-  const double lumen_sign = w.lumen_sign;
-  auto resolved = std::async(std::launch::async, [&] {
-    p = prepare(w);
-    conformal(w, loops, p, o);
+  const double cut_area = annulus_area - surface_area(w.ann);
+  auto flattened = std::async(std::launch::async, [pieces = std::move(pieces), component = w.seg.component,
+                                                   lumen_sign = w.lumen_sign, o, depth, cut_area] {
+    FlattenedBranches b;
+    double placed = 0;
+    b.works = flatten_branches(pieces, component, lumen_sign, o, depth, placed);
+    b.lost_area = cut_area - placed;
+    return b;
   });
-  std::vector<SegmentWork> out;
-  try {
-    out = flatten_branches(pieces, component, lumen_sign, o, depth, placed);
-  } catch (...) {
-    resolved.wait();
-    throw;
-  }
-  resolved.get();
-  w.lost_area += annulus_area - placed;
-  return out;
+  p = prepare(w);  // (an exception here waits for the branches: the future's destructor joins)
+  conformal(w, loops, p, o);
+  return flattened;
 }
 
 // Where each direct branch hangs on this segment: mean centreline position and LPS of its neck.
@@ -352,17 +360,23 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   phase("ends opened");
   conformal(w, loops, p, o);
   phase("conformal map");
-  std::vector<SegmentWork> branches;
+  std::future<FlattenedBranches> cut;
   if (o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth)
-    branches = cut_branches(w, loops, p, o, depth);
-  if (!branches.empty()) phase("side branches cut and flattened, conformal map again");
+    cut = cut_branches(w, loops, p, o, depth);
+  w.prior = PriorSolve{};  // the last factorisation's memory back
+  if (cut.valid()) phase("side branches cut, conformal map again");
   const Centreline cl = centreline_step(w, loops);
-  attach_branches(w, branches);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
   if (o.map == "area-balanced") area_balanced_step(w, cl, p.vf, p.fixed, p.degenerate, o, depth > 0);
   if (o.map == "area-balanced") phase("area balance");
   debug_stats("final", w, p.degenerate);
+  const bool any_cut = cut.valid();
+  FlattenedBranches flattened = any_cut ? cut.get() : FlattenedBranches{};
+  if (any_cut) phase("side branches flattened (beside the above)");
+  std::vector<SegmentWork>& branches = flattened.works;
+  w.lost_area += flattened.lost_area;
+  attach_branches(w, branches);
   w.seg.faces = w.ann.t.size();
   w.seg.vertices = w.ann.p.size();
   measure(w, p.E, p.degenerate, o);

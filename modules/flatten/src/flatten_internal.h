@@ -50,6 +50,7 @@ double face_area_3d(const Surface& s, int f);
 struct Opened {
   Surface annulus;
   std::size_t removed = 0;
+  std::vector<int> new_of_old;  // per vertex of the surface: its id on the annulus, -1 when removed
 };
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
 // Keeps the largest edge-connected set of faces among `keep`.
@@ -63,18 +64,31 @@ void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep);
 
 // Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
 // eta the cut cocycle (per edge, lo -> hi), period = the conformal period in u units.
+struct ConformalFactor;  // conformal_factor.h: the factorisation of a conformal solve
+// What a conformal solve leaves for the next one on the same surface or on the part of it that
+// remains after side branches are cut off.
+struct PriorSolve {
+  std::vector<int> vertex_order;            // the vertices in a fill-reducing elimination order (empty: none)
+  std::shared_ptr<ConformalFactor> factor;  // the factorisation (null: none)
+  std::vector<int> new_of_old;              // per vertex of the factor's surface: its id here, -1 when cut off
+};
 struct Harmonic {
   Eigen::VectorXd u, v;
   std::vector<signed char> eta;
   double period = 0;
   double energy_u = 0;
   std::string weights;
-  std::vector<int> vertex_order;  // the fill-reducing elimination order used (all vertices; empty: none)
+  std::vector<int> vertex_order;            // the fill-reducing elimination order used (all vertices; empty: none)
+  std::shared_ptr<ConformalFactor> factor;  // its factorisation, when new (null when an earlier one was updated)
 };
-// `vertex_order` (optional): a fill-reducing elimination order of the vertices (e.g. the
-// vertex_order of an earlier solve on a surface this one is a subset of); AMD when null.
+// `prior` (optional): an earlier solve's vertex order (e.g. on a surface this one is a subset of;
+// AMD when there is none) and, with the same weights (`clamp`) and `new_of_old` set, its factor,
+// updated to this surface (conformal_update.cpp) instead of a new factorisation; consumed.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
-                        const std::vector<int>& loop_b, bool clamp, const std::vector<int>* vertex_order = nullptr);
+                        const std::vector<int>& loop_b, bool clamp, PriorSolve* prior = nullptr);
+// A fill-reducing elimination order (AMD) of the vertices of the edge graph E (nv vertices); its
+// restriction to part of the surface is one for that part (the annulus once the ends are opened).
+std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.
@@ -253,7 +267,7 @@ struct SegmentWork {
   double cap_area = 0;        // mm^2 of wall removed to open the ends (caps)
   double lost_area = 0;       // mm^2 of wall in no band (faces dropped when a branch was cut off)
   bool branch = false;        // a side branch's band (flattened from its neck)
-  std::vector<int> elimination_order;  // vertices of ann in the conformal solve's fill-reducing order
+  PriorSolve prior;           // the last conformal solve's order and factor, for the next one
 };
 
 // Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.

@@ -6,11 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <queue>
 
 #include "colonflat/core/error.h"
 #include "flatten_internal.h"
+#include "conformal_factor.h"
 #include "spd_solver.h"
 
 namespace cf::flat_detail {
@@ -130,81 +130,135 @@ SpMat laplacian_lower(const Edges& E, const std::vector<double>& w, const std::v
   return A;
 }
 
-// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2); unknowns: the other vertices.
-LinearSystem u_system(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark) {
-  const int nv = int(mark.size());
-  LinearSystem sys;
-  std::vector<int>& idx = sys.unknown_of;
-  idx.resize(nv);
-  int n = 0;
-  for (int v = 0; v < nv; ++v) idx[v] = mark[v] == 0 ? n++ : -1;
-  sys.A = laplacian_lower(E, w, idx, n);
-  sys.rhs = Eigen::VectorXd::Zero(n);
-  for (std::size_t e = 0; e < E.ev.size(); ++e) {
-    const int a = E.ev[e][0], b = E.ev[e][1];
-    if (idx[a] >= 0 && mark[b] == 2) sys.rhs[idx[a]] += w[e];
-    if (idx[b] >= 0 && mark[a] == 2) sys.rhs[idx[b]] += w[e];
-  }
-  return sys;
-}
-
-// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned at vertex 0; unknown v - 1 of vertex v.
-LinearSystem v_system(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv) {
-  LinearSystem sys;
-  sys.unknown_of.resize(nv);
-  for (int v = 0; v < nv; ++v) sys.unknown_of[v] = v - 1;
-  sys.A = laplacian_lower(E, w, sys.unknown_of, nv - 1);
-  sys.rhs = Eigen::VectorXd::Zero(nv - 1);
+// v's right-hand side over the unknowns `unknown_of` (n of them): sum_e w_e eta_e (e_a - e_b).
+Eigen::VectorXd v_rhs(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta,
+                      const std::vector<int>& unknown_of, int n) {
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     if (!eta[e]) continue;
-    const int a = E.ev[e][0], b = E.ev[e][1];
-    if (a > 0) sys.rhs[a - 1] += w[e] * eta[e];
-    if (b > 0) sys.rhs[b - 1] -= w[e] * eta[e];
+    const int a = unknown_of[E.ev[e][0]], b = unknown_of[E.ev[e][1]];
+    if (a >= 0) rhs[a] += w[e] * eta[e];
+    if (b >= 0) rhs[b] -= w[e] * eta[e];
   }
+  return rhs;
+}
+
+// v: minimises sum w (v_b - v_a + eta_ab)^2 with v pinned (0) at vertex `pinned`, a vertex of
+// loop A: then u's unknowns (the vertices off the loops) are some of v's, and u's matrix is the
+// principal submatrix of v's on them. Unknown of vertex v: v, or v - 1 past `pinned`.
+LinearSystem v_system(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta, int nv,
+                      int pinned) {
+  LinearSystem sys;
+  sys.unknown_of.resize(nv);
+  for (int v = 0; v < nv; ++v) sys.unknown_of[v] = v < pinned ? v : v == pinned ? -1 : v - 1;
+  sys.A = laplacian_lower(E, w, sys.unknown_of, nv - 1);
+  sys.rhs = v_rhs(E, w, eta, sys.unknown_of, nv - 1);
   return sys;
 }
 
-// The elimination order of a system's unknowns induced by a vertex order (vertices that are not
-// unknowns skipped, the relative order kept).
-std::vector<int> restrict_order(const std::vector<int>& vertex_order, const std::vector<int>& unknown_of) {
+// u: harmonic, 0 on loop A (mark 1), 1 on loop B (mark 2); its unknowns are the other vertices.
+// Its right-hand side over v's n unknowns (the loops' entries 0, not read by the leading solve).
+Eigen::VectorXd u_rhs(const Edges& E, const std::vector<double>& w, const std::vector<char>& mark,
+                      const std::vector<int>& unknown_of, int n) {
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {
+    const int a = E.ev[e][0], b = E.ev[e][1];
+    if (mark[a] == 0 && mark[b] == 2) rhs[unknown_of[a]] += w[e];
+    if (mark[b] == 0 && mark[a] == 2) rhs[unknown_of[b]] += w[e];
+  }
+  return rhs;
+}
+
+// The elimination order of v's unknowns from a vertex order: the vertices off the loops first, then
+// the loops' vertices (each group in the vertex order), so that u's unknowns are the leading block
+// (SpdSolver::solve_leading). `leading`: their number.
+std::vector<int> loops_last(const std::vector<int>& vertex_order, const std::vector<int>& unknown_of,
+                            const std::vector<char>& mark, int& leading) {
   std::vector<int> order;
   order.reserve(vertex_order.size());
-  for (int v : vertex_order)
-    if (v >= 0 && v < int(unknown_of.size()) && unknown_of[v] >= 0) order.push_back(unknown_of[v]);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int v : vertex_order)
+      if (v >= 0 && v < int(unknown_of.size()) && unknown_of[v] >= 0 && (mark[v] != 0) == (pass == 1))
+        order.push_back(unknown_of[v]);
+  leading = int(std::count(mark.begin(), mark.end(), 0));
   return order;
 }
 
-Eigen::VectorXd factorize_and_solve(SpdSolver& solver, const LinearSystem& sys) {
-  if (!solver.factorize(sys.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
-  return solver.solve(sys.rhs);
+// The vertices in the order of v's unknowns `order`, then the pinned vertex.
+std::vector<int> vertex_order_of(const std::vector<int>& order, const std::vector<int>& unknown_of) {
+  std::vector<int> vertex_of(order.size());
+  int pinned = -1;
+  for (std::size_t v = 0; v < unknown_of.size(); ++v)
+    if (unknown_of[v] >= 0) vertex_of[unknown_of[v]] = int(v);
+    else pinned = int(v);
+  std::vector<int> vertices;
+  vertices.reserve(unknown_of.size());
+  for (int k : order) vertices.push_back(vertex_of[k]);
+  vertices.push_back(pinned);
+  return vertices;
 }
 
-// Solves the u and v systems, u on a second thread; one fill-reducing order for both (the given
-// vertex order, else AMD on the v system, which holds all vertices but one). Returns the vertex
-// order used (empty when the solver gives none).
-std::vector<int> solve_uv(const LinearSystem& us, const LinearSystem& vs, const std::vector<int>* vertex_order,
-                          Eigen::VectorXd& xu, Eigen::VectorXd& xv) {
-  SpdSolver v_solver;
-  std::vector<int> order;
-  if (vertex_order) {
-    const std::vector<int> v_order = restrict_order(*vertex_order, vs.unknown_of);
-    v_solver.analyze(vs.A, &v_order);
-    order = *vertex_order;
-  } else {
-    v_solver.analyze(vs.A);
-    order = v_solver.order();
-    for (int& k : order) k += 1;  // unknown k is vertex k + 1
-    if (!order.empty()) order.push_back(0);
+// u and v per vertex (u 0 / 1 on the loops, v 0 at the pinned vertex), with the order and the
+// factorisation that gave them.
+struct UvSolution {
+  Eigen::VectorXd u, v;
+  std::vector<int> vertex_order;
+  std::shared_ptr<ConformalFactor> factor;
+};
+
+// Solves v's system and u's (v's leading block, `f.leading` unknowns) with the factorisation f;
+// `unknown_of`: each vertex's unknown in f's system.
+void solve_with(const ConformalFactor& f, const Edges& E, const std::vector<double>& w,
+                const std::vector<signed char>& eta, const std::vector<char>& mark,
+                const std::vector<int>& unknown_of, UvSolution& sol) {
+  const int n = int(f.unknown_of.size()) - 1;
+  const Eigen::VectorXd xv = f.solver.solve(v_rhs(E, w, eta, unknown_of, n));
+  const Eigen::VectorXd xu = f.solver.solve_leading(u_rhs(E, w, mark, unknown_of, n), f.leading);
+  const std::size_t nv = mark.size();
+  sol.u.resize(Eigen::Index(nv));
+  sol.v.resize(Eigen::Index(nv));
+  for (std::size_t v = 0; v < nv; ++v) {
+    const int k = unknown_of[v];
+    sol.u[Eigen::Index(v)] = mark[v] == 0 ? xu[k] : mark[v] == 1 ? 0.0 : 1.0;
+    sol.v[Eigen::Index(v)] = k >= 0 ? xv[k] : 0.0;
   }
-  const std::vector<int> u_order = restrict_order(order, us.unknown_of);
-  auto u_done = std::async(std::launch::async, [&] {
-    SpdSolver u_solver;
-    u_solver.analyze(us.A, u_order.empty() ? nullptr : &u_order);
-    return factorize_and_solve(u_solver, us);
-  });
-  xv = factorize_and_solve(v_solver, vs);
-  xu = u_done.get();
-  return order;
+}
+
+// A new factorisation of v's system (pinned at `pinned`), one fill-reducing order for u and v
+// (the given vertex order, else AMD on v's system), loops last.
+UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta,
+                       const std::vector<char>& mark, int pinned, bool clamp, const std::vector<int>* vertex_order) {
+  const LinearSystem vs = v_system(E, w, eta, int(mark.size()), pinned);
+  auto f = std::make_shared<ConformalFactor>();
+  f->unknown_of = vs.unknown_of;
+  f->mark = mark;
+  f->clamp = clamp;
+  f->edges = E.ev;
+  f->weights = w;
+  const std::vector<int> by_vertex =
+      vertex_order ? *vertex_order : vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
+  const std::vector<int> order = loops_last(by_vertex, vs.unknown_of, mark, f->leading);
+  f->solver.analyze(vs.A, &order);
+  if (!f->solver.factorize(vs.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  UvSolution sol;
+  solve_with(*f, E, w, eta, mark, vs.unknown_of, sol);
+  sol.vertex_order = vertex_order_of(order, vs.unknown_of);
+  sol.factor = std::move(f);
+  return sol;
+}
+
+// The earlier solve's factorisation updated to this surface (the part of its surface that remains),
+// when it has the same weights and loops; false otherwise.
+bool solve_updated(PriorSolve& prior, const Edges& E, const std::vector<double>& w,
+                   const std::vector<signed char>& eta, const std::vector<char>& mark, bool clamp, UvSolution& sol) {
+  ConformalFactor& f = *prior.factor;
+  if (f.clamp != clamp || prior.new_of_old.empty() || !restrict_factor(f, E, w, mark, prior.new_of_old)) return false;
+  std::vector<int> unknown_of(mark.size(), -1);
+  for (std::size_t v = 0; v < prior.new_of_old.size(); ++v)
+    if (prior.new_of_old[v] >= 0) unknown_of[prior.new_of_old[v]] = f.unknown_of[v];
+  solve_with(f, E, w, eta, mark, unknown_of, sol);
+  sol.vertex_order = prior.vertex_order;
+  return true;
 }
 
 double eta_dir(const std::vector<signed char>& eta, const Edges& E, int e, int from) {
@@ -214,23 +268,28 @@ double eta_dir(const std::vector<signed char>& eta, const Edges& E, int e, int f
 }  // namespace
 
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
-                        const std::vector<int>& loop_b, bool clamp, const std::vector<int>* vertex_order) {
+                        const std::vector<int>& loop_b, bool clamp, PriorSolve* prior) {
   Harmonic h;
   h.weights = clamp ? "clamped" : "cotan";
   const int nv = int(s.p.size());
+  if (loop_a.empty() || loop_b.empty()) throw Error("a segment end without vertices");
   const std::vector<double> w = cot_weights(s, E, clamp);
   std::vector<char> mark(nv, 0);
   for (int v : loop_a) mark[v] = 1;
   for (int v : loop_b) mark[v] = 2;
   h.eta = cut_cocycle(s, E, mark);
-  const LinearSystem us = u_system(E, w, mark), vs = v_system(E, w, h.eta, nv);
-  Eigen::VectorXd xu, xv;
-  h.vertex_order = solve_uv(us, vs, vertex_order, xu, xv);
-  h.u.resize(nv);
-  for (int v = 0; v < nv; ++v) h.u[v] = mark[v] == 0 ? xu[us.unknown_of[v]] : mark[v] == 1 ? 0.0 : 1.0;
-  h.v.resize(nv);
-  h.v[0] = 0;
-  h.v.tail(nv - 1) = xv;
+  UvSolution sol;
+  const bool updated = prior && prior->factor && solve_updated(*prior, E, w, h.eta, mark, clamp, sol);
+  if (prior) prior->factor.reset();  // consumed (or of no use here): its memory back before a new one
+  if (!updated) {
+    const bool ordered = prior && !prior->vertex_order.empty();
+    sol = solve_fresh(E, w, h.eta, mark, loop_a.front(), clamp, ordered ? &prior->vertex_order : nullptr);
+  }
+  h.u = std::move(sol.u);
+  h.v = std::move(sol.v);
+  h.vertex_order = std::move(sol.vertex_order);
+  h.factor = std::move(sol.factor);
+  h.v.array() -= h.v[0];  // v = 0 at vertex 0 (the constant is free; the layout keeps this one)
   double ev = 0;
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
     const double du = h.u[E.ev[e][1]] - h.u[E.ev[e][0]];
@@ -241,6 +300,12 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   // Period minimising the conformal energy of (u, P v) (signed area of the unit map is 1).
   h.period = 1.0 / ev;
   return h;
+}
+
+std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
+  std::vector<int> identity(nv);
+  for (int v = 0; v < nv; ++v) identity[v] = v;
+  return SpdSolver::fill_reducing_order(laplacian_lower(E, std::vector<double>(E.ev.size(), 1.0), identity, nv));
 }
 
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {

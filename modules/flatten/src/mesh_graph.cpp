@@ -221,7 +221,7 @@ Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double ra
   for (std::size_t f = 0; f < s.t.size(); ++f) keep[f] = !remove[f];
   clean_selection(s, E, keep);
   Opened o;
-  o.annulus = sub_surface(s, keep);
+  o.annulus = sub_surface(s, keep, &o.new_of_old);
   o.removed = s.t.size() - o.annulus.t.size();
   return o;
 }

@@ -28,26 +28,25 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
   if (e0 >= Energy::kHuge) return res;  // the region is not injective: leave it
   const std::vector<int>& unknowns = sys.unknowns();
-  auto moved = [&](const Eigen::MatrixXd& d, double t) {
-    std::vector<V2> pos = emb.pos;
-    for (std::size_t i = 0; i < unknowns.size(); ++i) pos[unknowns[i]] += t * V2(d(i, 0), d(i, 1));
-    return pos;
+  std::vector<V2> trial = emb.pos;  // emb.pos with the unknowns moved (nothing else ever differs)
+  auto move_to = [&](const Eigen::MatrixXd& d, double t) {
+    for (std::size_t i = 0; i < unknowns.size(); ++i) trial[unknowns[i]] = emb.pos[unknowns[i]] + t * V2(d(i, 0), d(i, 1));
   };
   for (; res.steps < max_steps; ++res.steps) {
     const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
     const double slope = (g.array() * d.array()).sum();
     if (!(slope < 0)) break;
-    double t = std::min(1.0, 0.9 * max_area_step(s, emb, moved(d, 1.0), judged, area3, 0.0));
-    std::vector<V2> trial;
+    move_to(d, 1.0);
+    double t = std::min(1.0, 0.9 * max_area_step(s, emb, trial, judged, area3, 0.0));
     double e1 = Energy::kHuge;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
-      trial = moved(d, t);
+      move_to(d, t);
       e1 = energy.energy(trial);
       if (e1 <= e0 + 1e-4 * t * slope) break;
     }
     if (!(e1 < e0)) break;
-    emb.pos.swap(trial);
+    for (int v : unknowns) emb.pos[v] = trial[v];
     const double gain = (e0 - e1) / e0;
     e0 = res.energy_after = e1;
     if (!(gain > min_gain)) break;

@@ -2,8 +2,11 @@
 // SimplicialLDLT without CHOLMOD or when CHOLMOD fails (see spd_solver.h).
 #include "spd_solver.h"
 
+#include <Eigen/OrderingMethods>
+
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <mutex>
@@ -11,6 +14,54 @@
 #include "colonflat/core/error.h"
 
 namespace cf::flat_detail {
+
+// Eigen's SimplicialLDLT of P A P^T with P the given elimination order (else Eigen's AMD), so that
+// the leading block of the order is the factor's top-left corner here too.
+struct SpdSolver::Fallback {
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;  // unknown -> its place in the order
+  Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+
+  bool compute(const SpMat& A, const std::vector<int>& order) {
+    const std::vector<int> used = order.size() == std::size_t(A.rows()) ? order : eigen_amd(A);
+    perm.resize(A.rows());
+    for (std::size_t k = 0; k < used.size(); ++k) perm.indices()[used[k]] = int(k);
+    SpMat permuted;
+    permuted = A.selfadjointView<Eigen::Lower>().twistedBy(perm);
+    ldlt.compute(permuted);
+    return ldlt.info() == Eigen::Success;
+  }
+  static std::vector<int> eigen_amd(const SpMat& A) {
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;  // place -> unknown
+    Eigen::AMDOrdering<int>()(A, inverse);
+    return std::vector<int>(inverse.indices().data(), inverse.indices().data() + inverse.size());
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const { return perm.transpose() * ldlt.solve(perm * b); }
+  Eigen::MatrixXd solve_leading(const Eigen::MatrixXd& b, int leading) const {
+    Eigen::MatrixXd y = perm * b;
+    ldlt.matrixL().solveInPlace(y);
+    y.bottomRows(y.rows() - leading).setZero();
+    y = ldlt.vectorD().asDiagonal().inverse() * y;
+    ldlt.matrixU().solveInPlace(y);
+    return perm.transpose() * y;
+  }
+};
+
+SpdSolver::SpdSolver() = default;
+SpdSolver::~SpdSolver() { release(); }
+
+bool SpdSolver::fall_back(const SpMat& A) {
+  fallback_ = std::make_unique<Fallback>();
+  return fallback_->compute(A, given_order_);
+}
+
+Eigen::MatrixXd SpdSolver::solve_leading(const Eigen::MatrixXd& b, int leading) const {
+  if (given_order_.empty() || leading < 0 || leading > b.rows())
+    throw Error("solve_leading needs the elimination order given to analyze()");
+#ifdef COLONFLAT_HAVE_CHOLMOD
+  if (cholmod_ok_) return cholmod_leading(b, leading);
+#endif
+  return fallback_->solve_leading(b, leading);
+}
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
 namespace {
@@ -68,7 +119,38 @@ cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
   return m;
 }
 
+// A CHOLMOD view of a column-major Eigen matrix.
+cholmod_dense view_dense(const Eigen::MatrixXd& b) {
+  cholmod_dense d{};
+  d.nrow = std::size_t(b.rows());
+  d.ncol = std::size_t(b.cols());
+  d.nzmax = d.nrow * d.ncol;
+  d.d = d.nrow;
+  d.x = const_cast<double*>(b.data());
+  d.xtype = CHOLMOD_REAL;
+  d.dtype = CHOLMOD_DOUBLE;
+  return d;
+}
+
+Eigen::MatrixXd take_dense(cholmod_dense*& x, cholmod_common& common) {
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), Eigen::Index(x->nrow),
+                                                          Eigen::Index(x->ncol));
+  cholmod_free_dense(&x, &common);
+  return out;
+}
+
 }  // namespace
+
+std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
+  use_huge_pages_for_cholmod();
+  cholmod_common common;
+  cholmod_start(&common);
+  cholmod_sparse view = view_lower(A);
+  std::vector<int> order(std::size_t(A.rows()));
+  const bool ok = cholmod_amd(&view, nullptr, 0, order.data(), &common);
+  cholmod_finish(&common);
+  return ok ? order : Fallback::eigen_amd(A);
+}
 
 void SpdSolver::release() {
   if (factor_) cholmod_free_factor(&factor_, &common_);
@@ -79,7 +161,8 @@ void SpdSolver::release() {
 
 void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   release();
-  ldlt_.reset();
+  fallback_.reset();
+  given_order_.clear();
   use_huge_pages_for_cholmod();
   cholmod_start(&common_);
   started_ = true;
@@ -89,7 +172,9 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   if (order && order->size() == std::size_t(A.rows())) {
     common_.nmethods = 1;
     common_.method[0].ordering = CHOLMOD_GIVEN;
+    common_.postorder = 0;  // the order as given: its leading block stays the factor's top-left corner
     factor_ = cholmod_analyze_p(&view, const_cast<int*>(order->data()), nullptr, 0, &common_);
+    if (factor_ && std::equal(order->begin(), order->end(), static_cast<const int*>(factor_->Perm))) given_order_ = *order;
   } else {
     factor_ = cholmod_analyze(&view, &common_);
   }
@@ -102,25 +187,52 @@ bool SpdSolver::factorize(const SpMat& A) {
     cholmod_ok_ = common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;
     if (cholmod_ok_) return true;
   }
-  ldlt_ = std::make_unique<Eigen::SimplicialLDLT<SpMat>>();
-  ldlt_->compute(A);
-  return ldlt_->info() == Eigen::Success;
+  return fall_back(A);
 }
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
-  if (!cholmod_ok_) return ldlt_->solve(b);
-  cholmod_dense rhs{};
-  rhs.nrow = std::size_t(b.rows());
-  rhs.ncol = std::size_t(b.cols());
-  rhs.nzmax = rhs.d = rhs.nrow;
-  rhs.x = const_cast<double*>(b.data());
-  rhs.xtype = CHOLMOD_REAL;
-  rhs.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_ok_) return fallback_->solve(b);
+  cholmod_dense rhs = view_dense(b);
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common_);
   if (!x) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common_.status) + ")");
-  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), b.rows(), b.cols());
-  cholmod_free_dense(&x, &common_);
-  return out;
+  return take_dense(x, common_);
+}
+
+// P, L, (the rows past the leading block zeroed), D, L^T, P^T: one step at a time.
+Eigen::MatrixXd SpdSolver::cholmod_leading(const Eigen::MatrixXd& b, int leading) const {
+  cholmod_dense rhs = view_dense(b);
+  cholmod_dense* y = cholmod_solve(CHOLMOD_P, factor_, &rhs, &common_);
+  for (int system : {CHOLMOD_L, CHOLMOD_D, CHOLMOD_Lt, CHOLMOD_Pt}) {
+    if (!y) break;
+    if (system == CHOLMOD_D)
+      for (std::size_t c = 0; c < y->ncol; ++c)
+        std::fill(static_cast<double*>(y->x) + c * y->d + leading, static_cast<double*>(y->x) + c * y->d + y->nrow, 0.0);
+    cholmod_dense* next = cholmod_solve(system, factor_, y, &common_);
+    cholmod_free_dense(&y, &common_);
+    y = next;
+  }
+  if (!y) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common_.status) + ")");
+  return take_dense(y, common_);
+}
+
+bool SpdSolver::modify(const SpMat& C, bool update) {
+  if (!cholmod_ok_ || C.cols() == 0) return cholmod_ok_;
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  std::vector<int> place(factor_->n);  // CHOLMOD wants C's rows in the factor's order
+  for (std::size_t k = 0; k < factor_->n; ++k) place[perm[k]] = int(k);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(std::size_t(C.nonZeros()));
+  for (int j = 0; j < C.outerSize(); ++j)
+    for (SpMat::InnerIterator it(C, j); it; ++it) entries.emplace_back(place[it.row()], j, it.value());
+  SpMat permuted(C.rows(), C.cols());
+  permuted.setFromTriplets(entries.begin(), entries.end());  // compressed, rows sorted
+  cholmod_sparse view = view_lower(permuted);
+  view.nrow = std::size_t(C.rows());
+  view.ncol = std::size_t(C.cols());
+  view.stype = 0;  // unsymmetric: C itself
+  cholmod_updown(update ? 1 : 0, &view, factor_, &common_);
+  cholmod_ok_ = common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
+  return cholmod_ok_;
 }
 
 std::vector<int> SpdSolver::order() const {
@@ -129,22 +241,23 @@ std::vector<int> SpdSolver::order() const {
   return std::vector<int>(perm, perm + factor_->n);
 }
 
-#else  // Eigen only: the order is Eigen's AMD, a given one is not used
+#else  // Eigen only: the order is Eigen's AMD unless one is given
+
+std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) { return Fallback::eigen_amd(A); }
 
 void SpdSolver::release() {}
 
-void SpdSolver::analyze(const SpMat& A, const std::vector<int>*) {
-  ldlt_ = std::make_unique<Eigen::SimplicialLDLT<SpMat>>();
-  ldlt_->analyzePattern(A);
+void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
+  fallback_.reset();
+  given_order_.clear();
+  if (order && order->size() == std::size_t(A.rows())) given_order_ = *order;
 }
 
-bool SpdSolver::factorize(const SpMat& A) {
-  if (!ldlt_) analyze(A);
-  ldlt_->factorize(A);
-  return ldlt_->info() == Eigen::Success;
-}
+bool SpdSolver::factorize(const SpMat& A) { return fall_back(A); }
 
-Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const { return ldlt_->solve(b); }
+Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const { return fallback_->solve(b); }
+
+bool SpdSolver::modify(const SpMat&, bool) { return false; }
 
 std::vector<int> SpdSolver::order() const { return {}; }
 

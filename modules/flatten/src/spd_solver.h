@@ -5,13 +5,19 @@
 //
 // Simplicial, not supernodal: on the surface Laplacians here (2D graphs, about 40 nonzeros of L
 // per row) the supernodal factorisation with the reference BLAS was 1.7x slower (5.7 s against
-// 3.3 s for 0.69 M unknowns) and spent its time in OpenMP start-up and in zeroing a larger factor.
+// 3.3 s for 0.69 M unknowns) and spent its time in OpenMP start-up and in zeroing a larger factor
+// (with OpenBLAS it was no faster: 4.8 s, session 7).
 //
 // The fill-reducing ordering (AMD) costs about a third of a factorisation; a caller that solves
 // several systems on (subsets of) the same graph computes it once: analyze() takes an elimination
-// order, and order() gives the one used. An order of a graph restricted to a subset of its
-// vertices (relative order kept) is a valid ordering of the subgraph with no more fill than the
-// original (docs/flatten.md, "Speed").
+// order (fill_reducing_order() gives AMD's), and order() gives the one used. An order of a graph
+// restricted to a subset of its vertices (relative order kept) is a valid ordering of the subgraph
+// with no more fill than the original (docs/flatten.md, "Speed").
+//
+// Leading block: with a given order, the factor of P A P^T = L D L^T holds the factor of the
+// leading k x k block A_II (I: the first k unknowns of the order) as its top-left corner, so
+// solve_leading() solves A_II x_I = b_I with the same factorisation. The conformal map uses it to
+// solve u (Dirichlet on both ends: the ends' vertices ordered last) with the factor of v's system.
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -27,14 +33,16 @@ namespace cf::flat_detail {
 class SpdSolver {
  public:
   using SpMat = Eigen::SparseMatrix<double>;
-  SpdSolver() = default;
+  SpdSolver();
   SpdSolver(const SpdSolver&) = delete;
   SpdSolver& operator=(const SpdSolver&) = delete;
-  ~SpdSolver() { release(); }
+  ~SpdSolver();
 
-  // Symbolic analysis of A (n x n, symmetric, compressed; its lower triangle is read).
-  // `order` (optional): the elimination order, a permutation of 0..n-1 (order[k] = the unknown
-  // eliminated k-th); AMD (CHOLMOD's default choice) when null.
+  // AMD's fill-reducing elimination order of A (n x n, symmetric, compressed, lower triangle
+  // read): order[k] = the unknown eliminated k-th.
+  static std::vector<int> fill_reducing_order(const SpMat& A);
+  // Symbolic analysis of A (lower triangle read). `order` (optional): the elimination order, a
+  // permutation of 0..n-1 used as given (not postordered); AMD (CHOLMOD's default) when null.
   void analyze(const SpMat& A, const std::vector<int>* order = nullptr);
   // Numeric factorisation of A (same pattern as analyzed); false when no factorisation succeeded.
   bool factorize(const SpMat& A);
@@ -44,18 +52,30 @@ class SpdSolver {
   }
   // x = A^-1 b (b: n x k).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  // x_I = A_II^-1 b_I for I = the first `leading` unknowns of the order given to analyze(), and
+  // x = 0 off I (b's entries off I are not read). Throws Error without a given order.
+  Eigen::MatrixXd solve_leading(const Eigen::MatrixXd& b, int leading) const;
+  // The factorisation of A + C C^T (`update`) or A - C C^T (C: n x k, rows = unknowns), modified in
+  // place (CHOLMOD's update/downdate: the cost of the columns of L it touches, not of a new
+  // factorisation). False without CHOLMOD or when the result is not positive definite; the solver
+  // is then unusable until factorize().
+  bool modify(const SpMat& C, bool update);
   // The elimination order of the analysis (empty without CHOLMOD or before analyze()).
   std::vector<int> order() const;
 
  private:
+  struct Fallback;  // Eigen's SimplicialLDLT of P A P^T, P the given order (else Eigen's AMD)
   void release();
+  bool fall_back(const SpMat& A);
+  std::vector<int> given_order_;
 #ifdef COLONFLAT_HAVE_CHOLMOD
   mutable cholmod_common common_{};
   bool started_ = false;
   cholmod_factor* factor_ = nullptr;
   bool cholmod_ok_ = false;
+  Eigen::MatrixXd cholmod_leading(const Eigen::MatrixXd& b, int leading) const;
 #endif
-  std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> ldlt_;
+  std::unique_ptr<Fallback> fallback_;
 };
 
 }  // namespace cf::flat_detail

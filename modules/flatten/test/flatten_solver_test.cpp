@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <cmath>
 #include <random>
 
 #include "../src/flatten_internal.h"
@@ -115,4 +116,110 @@ TEST(FlattenSolver, RestrictedOrderOfALargerGraphSolvesTheSubgraph) {
     for (int i = 0; i < n; ++i) expected[i] = i;
     EXPECT_EQ(used, expected);
   }
+}
+
+// One factorisation of a system with some unknowns ordered last also solves the system on the
+// others with those held at 0 (its leading block, as the conformal map solves u with v's factor):
+// the same solution as a factorisation of that block alone; without a given order it is refused.
+TEST(FlattenSolver, LeadingBlockOfTheOrderSolvesTheSystemWithTheRestHeldAtZero) {
+  const int nx = 30, ny = 20, nv = nx * ny;
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, ny, 7));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  auto held = [&](int v) { return v % nx == nx - 1 || v / nx == 0; };  // last column and first row
+  std::vector<int> order, unknown_of(nv, -1);  // AMD's order with the held unknowns moved last
+  const std::vector<int> amd = SpdSolver::fill_reducing_order(A);
+  ASSERT_EQ(amd.size(), std::size_t(nv));
+  int leading = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int v : amd)
+      if (held(v) == (pass == 1)) order.push_back(v), leading += pass == 0;
+  for (int v = 0, n = 0; v < nv; ++v)
+    if (!held(v)) unknown_of[v] = n++;
+  Eigen::VectorXd b(nv), b_inner(leading);
+  for (int v = 0; v < nv; ++v) {
+    b[v] = held(v) ? 1e3 : std::cos(0.21 * v) + 0.3;  // the held entries must not be read
+    if (!held(v)) b_inner[unknown_of[v]] = b[v];
+  }
+  std::vector<Eigen::Triplet<double>> block;  // A's principal submatrix on the unknowns not held
+  for (int j = 0; j < A.outerSize(); ++j)
+    for (SpdSolver::SpMat::InnerIterator it(A, j); it; ++it)
+      if (unknown_of[it.row()] >= 0 && unknown_of[j] >= 0) block.emplace_back(unknown_of[it.row()], unknown_of[j], it.value());
+  SpdSolver::SpMat A_inner(leading, leading);
+  A_inner.setFromTriplets(block.begin(), block.end());
+  SpdSolver one, inner, unordered;
+  ASSERT_TRUE(one.compute(A, &order));
+  ASSERT_TRUE(inner.compute(A_inner));
+  const Eigen::VectorXd x = one.solve_leading(b, leading), x_inner = inner.solve(b_inner);
+  for (int v = 0; v < nv; ++v) {
+    if (held(v)) EXPECT_EQ(x[v], 0.0);
+    else EXPECT_NEAR(x[v], x_inner[unknown_of[v]], 1e-10 * x_inner.norm());
+  }
+  ASSERT_TRUE(unordered.compute(A));
+  EXPECT_THROW(unordered.solve_leading(b, leading), cf::Error);
+}
+
+namespace {
+
+// An open tube of nz rings of na vertices (radius varying along it and around it, so that the
+// cotangent weights differ), two triangles per cell; vertex j * na + i.
+cf::flat_detail::Surface bumpy_tube(int na, int nz) {
+  cf::flat_detail::Surface s;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < na; ++i) {
+      const double a = 2 * M_PI * i / na, r = 10 + 2 * std::sin(0.3 * j) + std::cos(3 * a);
+      s.p.emplace_back(r * std::cos(a), r * std::sin(a), 1.3 * j + 0.2 * std::sin(a));
+      s.src.push_back(int(s.p.size()) - 1);
+    }
+  for (int j = 0; j + 1 < nz; ++j)
+    for (int i = 0; i < na; ++i) {
+      const int a = j * na + i, b = j * na + (i + 1) % na, c = a + na, d = b + na;
+      s.t.push_back({a, b, d});
+      s.t.push_back({a, d, c});
+    }
+  return s;
+}
+
+}  // namespace
+
+// The map after cutting pieces out of a surface, solved by updating the first map's factorisation
+// (rank-one terms for the changed weights, the cut-off vertices grounded), equals a new solve on
+// what remains; two cut-off pieces (two holes) are each grounded.
+TEST(FlattenSolver, UpdatedFactorisationSolvesTheSurfaceThatRemains) {
+  using namespace cf::flat_detail;
+  const int na = 24, nz = 40;
+  const Surface whole = bumpy_tube(na, nz);
+  const Edges E0 = build_edges(whole.t);
+  auto loops = boundary_loops(whole, E0);
+  ASSERT_EQ(loops.size(), 2u);
+  if (loops[0][0] != 0) std::swap(loops[0], loops[1]);
+  PriorSolve prior;
+  Harmonic first = solve_harmonic(whole, E0, loops[0], loops[1], false, &prior);
+  ASSERT_TRUE(first.factor);
+  std::vector<char> keep(whole.t.size(), 1);
+  for (std::size_t f = 0; f < whole.t.size(); ++f) {
+    const int j = whole.t[f][0] / na, i = whole.t[f][0] % na;
+    if ((j >= 10 && j < 15 && i >= 3 && i < 8) || (j >= 25 && j < 28 && i >= 12 && i < 20)) keep[f] = 0;
+  }
+  std::vector<int> new_of_old;
+  const Surface rest = sub_surface(whole, keep, &new_of_old);
+  const Edges E1 = build_edges(rest.t);
+  ASSERT_EQ(boundary_loops(rest, E1).size(), 4u);  // two ends, two holes
+  for (auto& l : loops)
+    for (int& v : l) v = new_of_old[v];
+  prior = PriorSolve{{}, std::move(first.factor), new_of_old};
+  for (int v : first.vertex_order)
+    if (new_of_old[v] >= 0) prior.vertex_order.push_back(new_of_old[v]);
+  const Harmonic updated = solve_harmonic(rest, E1, loops[0], loops[1], false, &prior);
+  const Harmonic fresh = solve_harmonic(rest, E1, loops[0], loops[1], false);
+  EXPECT_FALSE(updated.factor);  // the update was used, not a new factorisation
+  ASSERT_TRUE(fresh.factor);
+  EXPECT_LT((updated.u - fresh.u).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((updated.v - fresh.v).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_NEAR(updated.period, fresh.period, 1e-10 * fresh.period);
+  double moved = 0;  // the holes change the map: the test compares something that moved
+  for (std::size_t v = 0; v < whole.p.size(); ++v)
+    if (new_of_old[v] >= 0) moved = std::max(moved, std::abs(first.v[Eigen::Index(v)] - fresh.v[new_of_old[v]]));
+  EXPECT_GT(moved, 1e-3);
 }
