@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 
+#include "colonflat/core/huge_pages.h"
 #include "colonflat/core/union_find.h"
 #include "colonflat/core/vertex_corners.h"
 
@@ -15,7 +16,9 @@ namespace {
 // Union-find with parity, to 2-colour faces by orientation (orientability test).
 class ParityUnionFind {
  public:
-  explicit ParityUnionFind(std::size_t n) : parent_(n), parity_(n, 0) {
+  explicit ParityUnionFind(std::size_t n) {
+    resize_huge(parent_, n);
+    assign_huge(parity_, n, std::uint8_t(0));
     for (std::size_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint32_t>(i);
   }
   std::uint32_t find(std::uint32_t x, std::uint8_t& par) {
@@ -119,14 +122,16 @@ class LocalFans {
 // style: one short method per step, run in order by run()). Edges are found around each vertex
 // from its corners (one counting sort, no edge table) and classified at their lower end, in
 // the (min, max) order of a sorted edge table.
+// Point: anything p with p[0], p[1], p[2] (std::array<double, 3>, OpenMesh's Vec3), read in place.
+template <class Point>
 class TopologyAnalysis {
  public:
-  explicit TopologyAnalysis(const TriangleList& m)
-      : m_(m), P_(m.points.size()), F_(m.triangles.size()), face_uf_(F_), orient_(F_) {}
+  TopologyAnalysis(const Point* points, std::size_t n_points, const std::vector<std::array<int, 3>>& triangles)
+      : points_(points), triangles_(triangles), P_(n_points), F_(triangles.size()), face_uf_(F_), orient_(F_) {}
 
   TopologyReport run() {
     r_.faces = F_;
-    corners_ = vertex_corners(m_.triangles, P_);
+    corners_ = vertex_corners(triangles_, P_);
     if (!count_vertices_and_bounds()) return std::move(r_);
     scan_vertices();
     count_nonmanifold_vertices();
@@ -155,8 +160,8 @@ class TopologyAnalysis {
       }
       ++r_.vertices;
       for (int a = 0; a < 3; ++a) {
-        r_.bbox_min[a] = std::min(r_.bbox_min[a], m_.points[v][a]);
-        r_.bbox_max[a] = std::max(r_.bbox_max[a], m_.points[v][a]);
+        r_.bbox_min[a] = std::min(r_.bbox_min[a], points_[v][a]);
+        r_.bbox_max[a] = std::max(r_.bbox_max[a], points_[v][a]);
       }
     }
     if (r_.vertices == 0) r_.bbox_min = r_.bbox_max = {0, 0, 0};
@@ -201,7 +206,7 @@ class TopologyAnalysis {
     for (std::uint32_t i = 0; i < corners_.degree(v); ++i) {
       const std::uint32_t f = c[i] / 3, k = c[i] % 3;
       if (i == 0 || c[i - 1] / 3 != f) first = i;  // a triangle's corners at v are adjacent
-      const auto& t = m_.triangles[f];
+      const auto& t = triangles_[f];
       incident_.push_back({static_cast<std::uint32_t>(t[(k + 1) % 3]), f, first, static_cast<std::uint8_t>(k)});
       const auto prev = static_cast<std::uint32_t>(t[(k + 2) % 3]);
       if (prev != v) incident_.push_back({prev, f, first, static_cast<std::uint8_t>((k + 2) % 3)});
@@ -212,8 +217,8 @@ class TopologyAnalysis {
   // The edge (a, b), b = incident_[i].other >= a, with half-edges incident_[i .. j).
   void classify_edge(std::uint32_t a, std::size_t i, std::size_t j) {
     const std::uint32_t b = incident_[i].other;
-    const auto& pa = m_.points[a];
-    const auto& pb = m_.points[b];
+    const auto& pa = points_[a];
+    const auto& pb = points_[b];
     length_sum_ += std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
                              (pa[2] - pb[2]) * (pa[2] - pb[2]));
     ++r_.edges;
@@ -238,7 +243,7 @@ class TopologyAnalysis {
 
   // Two triangles: orientation consistency (the fans are joined around each end vertex).
   void manifold_edge(std::uint32_t a, std::uint32_t b, const Incident& x, const Incident& y) {
-    const bool same_dir = m_.triangles[x.face][x.k] == m_.triangles[y.face][y.k];  // oppositely oriented faces
+    const bool same_dir = triangles_[x.face][x.k] == triangles_[y.face][y.k];  // oppositely oriented faces
     if (same_dir) {
       ++r_.inconsistent_edges;
       push_example(r_.example_inconsistent_edges, {static_cast<int>(a), static_cast<int>(b)});
@@ -267,8 +272,9 @@ class TopologyAnalysis {
 
   // Components numbered by root of the face union-find.
   void build_components() {
-    std::vector<int> root_id(F_, -1);
-    r_.face_component.assign(F_, -1);
+    std::vector<int> root_id;
+    assign_huge(root_id, F_, -1);
+    assign_huge(r_.face_component, F_, -1);
     for (std::size_t f = 0; f < F_; ++f) {
       const std::uint32_t root = face_uf_.find(static_cast<std::uint32_t>(f));
       if (root_id[root] < 0) {
@@ -349,7 +355,8 @@ class TopologyAnalysis {
     if (all_genus_) r_.genus = genus_sum_;
   }
 
-  const TriangleList& m_;
+  const Point* points_;
+  const std::vector<std::array<int, 3>>& triangles_;
   const std::size_t P_, F_;  // #points, #triangles
   TopologyReport r_;
   VertexCorners corners_;
@@ -369,7 +376,26 @@ class TopologyAnalysis {
 
 }  // namespace
 
-TopologyReport analyze_topology(const TriangleList& m) { return TopologyAnalysis(m).run(); }
+TopologyReport analyze_topology(const TriangleList& m) {
+  return TopologyAnalysis<std::array<double, 3>>(m.points.data(), m.points.size(), m.triangles).run();
+}
+
+namespace {
+std::vector<std::array<int, 3>> mesh_triangles(const Mesh& mesh) {
+  std::vector<std::array<int, 3>> triangles;
+  reserve_huge(triangles, mesh.n_faces());
+  for (auto f : mesh.faces()) {
+    std::array<int, 3> tri{};
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) {
+      if (k < 3) tri[k] = v.idx();
+      ++k;
+    }
+    triangles.push_back(tri);
+  }
+  return triangles;
+}
+}  // namespace
 
 TriangleList to_triangle_list(const Mesh& mesh) {
   TriangleList t;
@@ -378,19 +404,13 @@ TriangleList to_triangle_list(const Mesh& mesh) {
     const auto& p = mesh.point(v);
     t.points[v.idx()] = {p[0], p[1], p[2]};
   }
-  t.triangles.reserve(mesh.n_faces());
-  for (auto f : mesh.faces()) {
-    std::array<int, 3> tri{};
-    int k = 0;
-    for (auto v : mesh.fv_range(f)) {
-      if (k < 3) tri[k] = v.idx();
-      ++k;
-    }
-    t.triangles.push_back(tri);
-  }
+  t.triangles = mesh_triangles(mesh);
   return t;
 }
 
-TopologyReport analyze_topology(const Mesh& mesh) { return analyze_topology(to_triangle_list(mesh)); }
+// The mesh's points are read in place (no copy of 24 bytes per vertex).
+TopologyReport analyze_topology(const Mesh& mesh) {
+  return TopologyAnalysis<Vec3>(mesh.points(), mesh.n_vertices(), mesh_triangles(mesh)).run();
+}
 
 }  // namespace cf

@@ -1,14 +1,15 @@
 #include "colonflat/core/vertex_corners.h"
 
+#include "colonflat/core/huge_pages.h"
 namespace cf {
 
 VertexCorners vertex_corners(const std::vector<std::array<int, 3>>& triangles, std::size_t n_vertices) {
   VertexCorners vc;
-  vc.start.assign(n_vertices + 1, 0);
+  assign_huge(vc.start, n_vertices + 1, 0u);
   for (const auto& t : triangles)
     for (int v : t) ++vc.start[static_cast<std::size_t>(v) + 1];
   for (std::size_t v = 0; v < n_vertices; ++v) vc.start[v + 1] += vc.start[v];
-  vc.corner.resize(3 * triangles.size());
+  resize_huge(vc.corner, 3 * triangles.size());
   // Fill through start[v] (moved one bucket along), then shift it back: no second cursor array.
   for (std::size_t f = 0; f < triangles.size(); ++f)
     for (std::uint32_t k = 0; k < 3; ++k)

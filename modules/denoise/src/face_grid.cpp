@@ -6,6 +6,8 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "colonflat/core/huge_pages.h"
+
 namespace cf {
 
 FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) { build_static(mesh, mesh.faces()); }
@@ -107,8 +109,10 @@ std::uint32_t FaceGrid::StaticCells::find_or_add(std::uint64_t code) {
 }
 
 void FaceGrid::StaticCells::rehash(std::size_t slots) {
-  std::vector<std::uint64_t> old_code(slots, kEmpty);
-  std::vector<std::uint32_t> old_row(slots, kNoRow);
+  std::vector<std::uint64_t> old_code;
+  std::vector<std::uint32_t> old_row;
+  assign_huge(old_code, slots, kEmpty);
+  assign_huge(old_row, slots, kNoRow);
   old_code.swap(slot_code_);
   old_row.swap(slot_row_);
   const std::size_t mask = slots - 1;
@@ -124,7 +128,7 @@ void FaceGrid::StaticCells::rehash(std::size_t slots) {
 void FaceGrid::StaticCells::finish_counts() {
   start_.assign(count_.size() + 1, 0);
   for (std::size_t r = 0; r < count_.size(); ++r) start_[r + 1] = start_[r] + count_[r];
-  faces_.resize(start_.back());
+  resize_huge(faces_, start_.back());
   cursor_.assign(start_.begin(), start_.end() - 1);
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/huge_pages.h"
 
 namespace cf {
 
@@ -12,12 +13,14 @@ namespace {
 struct ClosedDual {
   const Mesh& mesh;
   std::size_t real_faces;
-  std::vector<int> boundary_face;                   // per halfedge: its virtual face, or -1
+  std::vector<int> boundary_face;  // per halfedge: its virtual face, or -1 (empty on a closed mesh)
   std::vector<Mesh::HalfedgeHandle> virtual_start;  // a halfedge of each virtual face
 
-  explicit ClosedDual(const Mesh& m) : mesh(m), real_faces(m.n_faces()), boundary_face(m.n_halfedges(), -1) {
+  explicit ClosedDual(const Mesh& m) : mesh(m), real_faces(m.n_faces()) {
     for (auto h : mesh.halfedges()) {
-      if (!mesh.is_boundary(h) || boundary_face[h.idx()] >= 0) continue;
+      if (!mesh.is_boundary(h)) continue;
+      if (boundary_face.empty()) boundary_face.assign(mesh.n_halfedges(), -1);  // not on a closed mesh
+      if (boundary_face[h.idx()] >= 0) continue;
       const int id = static_cast<int>(real_faces + virtual_start.size());
       virtual_start.push_back(h);
       auto x = h;
@@ -41,9 +44,9 @@ struct ClosedDual {
 void dual_spanning_forest(const ClosedDual& dual, std::vector<int>& parent_edge, std::vector<int>& order,
                           std::vector<std::uint8_t>& in_tree) {
   const Mesh& mesh = dual.mesh;
-  parent_edge.assign(dual.faces(), -2);
+  assign_huge(parent_edge, dual.faces(), -2);
   order.clear();
-  order.reserve(dual.faces());
+  reserve_huge(order, dual.faces());
   in_tree.assign(mesh.n_edges(), 0);
   for (std::size_t root = 0; root < dual.faces(); ++root) {
     if (parent_edge[root] != -2) continue;
@@ -107,7 +110,7 @@ void HomologyBasis::build(const Mesh& mesh) {
   const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
-  row_of_.assign(mesh.n_edges(), 0);
+  assign_huge(row_of_, mesh.n_edges(), 0u);
   rows_.assign(words_, 0);  // row 0: the zero class
   std::vector<std::uint64_t> cls(words_, 0);
   for (int i = 0; i < rank_; ++i) {
