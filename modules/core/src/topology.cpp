@@ -74,12 +74,12 @@ inline bool incident_less(const Incident& x, const Incident& y) {
 }
 
 // Insertion sort for the few half-edges around a vertex; std::sort around a large fan.
-void sort_incident(std::vector<Incident>& inc) {
-  if (inc.size() > 32) {
-    std::sort(inc.begin(), inc.end(), incident_less);
+void sort_incident(Incident* inc, std::size_t n) {
+  if (n > 32) {
+    std::sort(inc, inc + n, incident_less);
     return;
   }
-  for (std::size_t i = 1; i < inc.size(); ++i) {
+  for (std::size_t i = 1; i < n; ++i) {
     const Incident x = inc[i];
     std::size_t j = i;
     for (; j > 0 && incident_less(x, inc[j - 1]); --j) inc[j] = inc[j - 1];
@@ -183,9 +183,9 @@ class TopologyAnalysis {
       if (degree == 0) continue;
       gather_incident(static_cast<std::uint32_t>(v));
       fans_.reset(degree);
-      for (std::size_t i = 0; i < incident_.size();) {
+      for (std::size_t i = 0; i < n_incident_;) {
         std::size_t j = i + 1;
-        while (j < incident_.size() && incident_[j].other == incident_[i].other) ++j;
+        while (j < n_incident_ && incident_[j].other == incident_[i].other) ++j;
         if (j - i == 2) fans_.unite(incident_[i].corner, incident_[i + 1].corner);
         if (incident_[i].other >= v) classify_edge(static_cast<std::uint32_t>(v), i, j);
         i = j;
@@ -200,18 +200,19 @@ class TopologyAnalysis {
   // The half-edges of v's corners (out of each corner and into it; a half-edge from v to v
   // once), sorted by (other end, face, corner).
   void gather_incident(std::uint32_t v) {
-    incident_.clear();
+    if (incident_.size() < 2 * corners_.degree(v)) incident_.resize(2 * corners_.degree(v));
+    n_incident_ = 0;
     const std::uint32_t* c = corners_.begin(v);
     std::uint32_t first = 0;
     for (std::uint32_t i = 0; i < corners_.degree(v); ++i) {
       const std::uint32_t f = c[i] / 3, k = c[i] % 3;
       if (i == 0 || c[i - 1] / 3 != f) first = i;  // a triangle's corners at v are adjacent
       const auto& t = triangles_[f];
-      incident_.push_back({static_cast<std::uint32_t>(t[(k + 1) % 3]), f, first, static_cast<std::uint8_t>(k)});
+      incident_[n_incident_++] = {static_cast<std::uint32_t>(t[(k + 1) % 3]), f, first, static_cast<std::uint8_t>(k)};
       const auto prev = static_cast<std::uint32_t>(t[(k + 2) % 3]);
-      if (prev != v) incident_.push_back({prev, f, first, static_cast<std::uint8_t>((k + 2) % 3)});
+      if (prev != v) incident_[n_incident_++] = {prev, f, first, static_cast<std::uint8_t>((k + 2) % 3)};
     }
-    sort_incident(incident_);
+    sort_incident(incident_.data(), n_incident_);
   }
 
   // The edge (a, b), b = incident_[i].other >= a, with half-edges incident_[i .. j).
@@ -364,7 +365,8 @@ class TopologyAnalysis {
   ParityUnionFind orient_;
   UnionFind boundary_uf_;  // boundary vertices joined along boundary edges (sized at the first one)
   LocalFans fans_;
-  std::vector<Incident> incident_;
+  std::vector<Incident> incident_;  // the first n_incident_ hold the scanned vertex's half-edges
+  std::size_t n_incident_ = 0;
   std::vector<std::uint8_t> on_boundary_, on_nonmanifold_edge_, face_bad_, vertex_bad_;
   std::vector<std::uint32_t> edges_from_, boundary_from_;  // per vertex: edges, boundary edges with it as lower end
   std::vector<std::uint32_t> contradiction_faces_;

@@ -37,8 +37,12 @@ void init_state(DenoiseState& st, const TopologyReport& b) {
   st.origin.resize(st.n_input);
   for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
   st.component.assign(st.n_input, -1);
-  for (auto f : st.mesh.faces())
-    for (auto v : st.mesh.fv_range(f)) st.component[v.idx()] = b.face_component[f.idx()];
+  for (auto v : st.mesh.vertices()) {  // the component of any face at v (a boundary vertex's outgoing halfedge has none)
+    auto h = st.mesh.halfedge_handle(v);
+    if (!h.is_valid()) continue;
+    if (st.mesh.is_boundary(h)) h = st.mesh.opposite_halfedge_handle(h);
+    st.component[v.idx()] = b.face_component[st.mesh.face_handle(h).idx()];
+  }
   for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
 }
 
