@@ -87,37 +87,6 @@ void sort_incident(Incident* inc, std::size_t n) {
   }
 }
 
-// Union-find over the corners of one vertex (joined along manifold edges: its fans), reused
-// from vertex to vertex.
-class LocalFans {
- public:
-  void reset(std::uint32_t n) {
-    parent_.resize(n);
-    std::iota(parent_.begin(), parent_.end(), 0u);
-  }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent_[x] != x) {
-      parent_[x] = parent_[parent_[x]];
-      x = parent_[x];
-    }
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[b] = a;
-  }
-  bool single() {
-    const std::uint32_t root = find(0);
-    for (std::uint32_t i = 1; i < parent_.size(); ++i)
-      if (find(i) != root) return false;
-    return true;
-  }
-
- private:
-  std::vector<std::uint32_t> parent_;
-};
-
 // The steps of analyze_topology over one triangle list, sharing their state (geometry-central
 // style: one short method per step, run in order by run()). Edges are found around each vertex
 // from its corners (one counting sort, no edge table) and classified at their lower end, in
@@ -190,11 +159,18 @@ class TopologyAnalysis {
         if (incident_[i].other >= v) classify_edge(static_cast<std::uint32_t>(v), i, j);
         i = j;
       }
-      vertex_bad_[v] = !fans_.single();
+      vertex_bad_[v] = !one_fan(degree);
       const std::uint32_t* c = corners_.begin(v);
       for (std::uint32_t i = 1; i < degree; ++i) face_uf_.unite(c[0] / 3, c[i] / 3);
     }
     r_.mean_edge_length = r_.edges ? length_sum_ / static_cast<double>(r_.edges) : 0.0;
+  }
+
+  bool one_fan(std::uint32_t degree) {
+    const std::uint32_t root = fans_.find(0);
+    for (std::uint32_t i = 1; i < degree; ++i)
+      if (fans_.find(i) != root) return false;
+    return true;
   }
 
   // The half-edges of v's corners (out of each corner and into it; a half-edge from v to v
@@ -364,7 +340,7 @@ class TopologyAnalysis {
   UnionFind face_uf_;  // triangles sharing a vertex
   ParityUnionFind orient_;
   UnionFind boundary_uf_;  // boundary vertices joined along boundary edges (sized at the first one)
-  LocalFans fans_;
+  UnionFind fans_;  // the corners of the vertex being scanned, joined along its manifold edges
   std::vector<Incident> incident_;  // the first n_incident_ hold the scanned vertex's half-edges
   std::size_t n_incident_ = 0;
   std::vector<std::uint8_t> on_boundary_, on_nonmanifold_edge_, face_bad_, vertex_bad_;
