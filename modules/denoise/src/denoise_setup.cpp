@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/huge_pages.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/face_grid.h"
@@ -12,6 +13,15 @@
 namespace cf::detail {
 
 namespace {
+
+// The arrays every search and build reads at random (connectivity, points) on huge pages.
+void mesh_on_huge_pages(const Mesh& m) {
+  if (m.n_vertices() == 0 || m.n_edges() == 0 || m.n_faces() == 0) return;
+  collapse_to_huge_pages(&m.vertex(Mesh::VertexHandle(0)), m.n_vertices() * sizeof(Mesh::Vertex));
+  collapse_to_huge_pages(&m.edge(Mesh::EdgeHandle(0)), m.n_edges() * sizeof(Mesh::Edge));
+  collapse_to_huge_pages(&m.face(Mesh::FaceHandle(0)), m.n_faces() * sizeof(Mesh::Face));
+  collapse_to_huge_pages(m.points(), m.n_vertices() * sizeof(Vec3));
+}
 
 // Whether garbage_collection() would change anything (elements marked deleted).
 bool has_garbage(const Mesh& m) {
@@ -94,6 +104,10 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
     st.mesh = input;
     if (has_garbage(st.mesh)) st.mesh.garbage_collection();
+    // The properties (points, status) were cloned at the input's size: room for surgery now,
+    // before the arrays go onto huge pages (a later growth would move them off).
+    st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
+    mesh_on_huge_pages(st.mesh);
   };
   auto analyse = [&](const Mesh& m) {
     Stopwatch sw;
