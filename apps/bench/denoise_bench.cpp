@@ -21,6 +21,8 @@
 #include <sstream>
 #include <string>
 
+#include <sys/resource.h>
+
 #include "bench_meshes.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/run_stats.h"
@@ -33,6 +35,13 @@ using namespace cf;
 
 namespace {
 
+// Minor page faults of the process so far (fresh memory touched: costly on this virtual machine).
+long minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
 void header() {
   std::printf("%-24s %8s %5s %-6s %5s %7s %9s %7s %5s %6s %7s %6s %7s %6s %8s %5s  %s\n", "mesh", "faces", "genus",
               "method", "loops", "loopvtx", "looplen", "longest", "cap_x", "hom_s", "search_s", "surg_s", "total_s",
@@ -41,22 +50,13 @@ void header() {
 
 bool g_exact_only = false;  // --exact-only: skip the paper method's rows
 
-void row(const std::string& name, const Mesh& m, const std::string& method, int max_loops = -1) {
-  if (g_exact_only && method != "exact") return;
-  DenoiseOptions o;
-  o.method = method;
-  if (const char* t = std::getenv("DENOISE_BENCH_THREADS")) o.threads = std::atoi(t);
-  const int genus = *analyze_topology(m).genus;
-  if (max_loops >= 0) o.target_genus = std::max(0, genus - max_loops);
+// One row: the result is built in place (DenoiseResult r = denoise(...)): assigning it to a
+// declared result would copy the mesh (OpenMesh meshes have no move operations) inside the timing.
+void print_row(const std::string& name, const Mesh& m, int genus, const std::string& method, int max_loops,
+               const DenoiseOptions& o) {
   Stopwatch sw;
   const std::clock_t cpu0 = std::clock();  // process CPU time (all threads): meaningful on a loaded machine
-  DenoiseResult r;
-  try {
-    r = denoise(m, o);
-  } catch (const std::exception& e) {
-    std::printf("%-24s %8zu %5d %-6s failed: %s\n", name.c_str(), m.n_faces(), genus, method.c_str(), e.what());
-    return;
-  }
+  const DenoiseResult r = denoise(m, o);
   const double t = sw.seconds();
   const double cpu = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   const auto& tot = r.report["totals"];
@@ -69,6 +69,20 @@ void row(const std::string& name, const Mesh& m, const std::string& method, int 
               r.report["genus_after"].is_null() ? "-" : r.report["genus_after"].dump().c_str(),
               max_loops >= 0 ? ("first " + std::to_string(max_loops) + " loops only").c_str() : "");
   if (std::getenv("DENOISE_BENCH_SEARCH")) std::printf("    search %s\n", r.report["search"].dump().c_str());
+}
+
+void row(const std::string& name, const Mesh& m, const std::string& method, int max_loops = -1) {
+  if (g_exact_only && method != "exact") return;
+  DenoiseOptions o;
+  o.method = method;
+  if (const char* t = std::getenv("DENOISE_BENCH_THREADS")) o.threads = std::atoi(t);
+  const int genus = *analyze_topology(m).genus;
+  if (max_loops >= 0) o.target_genus = std::max(0, genus - max_loops);
+  try {
+    print_row(name, m, genus, method, max_loops, o);
+  } catch (const std::exception& e) {
+    std::printf("%-24s %8zu %5d %-6s failed: %s\n", name.c_str(), m.n_faces(), genus, method.c_str(), e.what());
+  }
   std::fflush(stdout);
 }
 
@@ -154,11 +168,12 @@ int main(int argc, char** argv) {
     Mesh m = bench::sphere_with_handles(std::atof(argv[2]), std::atoi(argv[3]), std::atof(argv[4]));
     Stopwatch sw;
     const std::clock_t cpu0 = std::clock();
+    const long faults0 = minor_faults();
     DenoiseOptions o;
     if (const char* t = std::getenv("DENOISE_BENCH_THREADS")) o.threads = std::atoi(t);
     DenoiseResult r = denoise(m, o);
-    std::printf("wall %.2f s, cpu %.2f s, peak %.0f MiB\n", sw.seconds(), double(std::clock() - cpu0) / CLOCKS_PER_SEC,
-                peak_memory_mib());
+    std::printf("wall %.2f s, cpu %.2f s, peak %.0f MiB, %ld page faults\n", sw.seconds(),
+                double(std::clock() - cpu0) / CLOCKS_PER_SEC, peak_memory_mib(), minor_faults() - faults0);
     std::printf("faces %zu genus %s -> %s\ntotals %s\ntime %s\nsearch %s\n", m.n_faces(),
                 r.report["genus_before"].dump().c_str(), r.report["genus_after"].dump().c_str(),
                 r.report["totals"].dump().c_str(), r.report["time_s"].dump().c_str(), r.report["search"].dump().c_str());

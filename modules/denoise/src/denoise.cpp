@@ -138,7 +138,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   validate_denoise_options(o);
   Stopwatch total;
   DenoiseResult res;
-  detail::DenoiseState st;
+  detail::DenoiseState st(res.mesh);
   if (o.threads > 1) st.worker = std::make_unique<detail::SearchWorker>();
   double t_analysis = 0;
   detail::prepare_input(st, input, o, &res.before, &t_analysis);
@@ -158,7 +158,6 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   phase_done("verification");
   const nlohmann::json stumps = o.remove_stumps > 0 ? run_stumps(st, o, res.after) : nlohmann::json(nullptr);
   res.loops = st.loops;
-  res.mesh = std::move(st.mesh);
   nlohmann::json totals;
   const nlohmann::json loops = loops_report(res.loops, &totals);
   if (o.strict && totals["cap_intersections"].get<std::size_t>() > 0)

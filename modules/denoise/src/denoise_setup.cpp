@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/huge_pages.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/face_grid.h"
@@ -12,6 +13,15 @@
 namespace cf::detail {
 
 namespace {
+
+// The arrays every search and build reads at random (connectivity, points) on huge pages.
+void mesh_on_huge_pages(const Mesh& m) {
+  if (m.n_vertices() == 0 || m.n_edges() == 0 || m.n_faces() == 0) return;
+  collapse_to_huge_pages(&m.vertex(Mesh::VertexHandle(0)), m.n_vertices() * sizeof(Mesh::Vertex));
+  collapse_to_huge_pages(&m.edge(Mesh::EdgeHandle(0)), m.n_edges() * sizeof(Mesh::Edge));
+  collapse_to_huge_pages(&m.face(Mesh::FaceHandle(0)), m.n_faces() * sizeof(Mesh::Face));
+  collapse_to_huge_pages(m.points(), m.n_vertices() * sizeof(Vec3));
+}
 
 // Whether garbage_collection() would change anything (elements marked deleted).
 bool has_garbage(const Mesh& m) {
@@ -37,8 +47,12 @@ void init_state(DenoiseState& st, const TopologyReport& b) {
   st.origin.resize(st.n_input);
   for (std::size_t v = 0; v < st.n_input; ++v) st.origin[v] = static_cast<int>(v);
   st.component.assign(st.n_input, -1);
-  for (auto f : st.mesh.faces())
-    for (auto v : st.mesh.fv_range(f)) st.component[v.idx()] = b.face_component[f.idx()];
+  for (auto v : st.mesh.vertices()) {  // the component of any face at v (a boundary vertex's outgoing halfedge has none)
+    auto h = st.mesh.halfedge_handle(v);
+    if (!h.is_valid()) continue;
+    if (st.mesh.is_boundary(h)) h = st.mesh.opposite_halfedge_handle(h);
+    st.component[v.idx()] = b.face_component[st.mesh.face_handle(h).idx()];
+  }
   for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
 }
 
@@ -90,6 +104,10 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
     st.mesh = input;
     if (has_garbage(st.mesh)) st.mesh.garbage_collection();
+    // The properties (points, status) were cloned at the input's size: room for surgery now,
+    // before the arrays go onto huge pages (a later growth would move them off).
+    st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
+    mesh_on_huge_pages(st.mesh);
   };
   auto analyse = [&](const Mesh& m) {
     Stopwatch sw;

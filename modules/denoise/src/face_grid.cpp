@@ -6,14 +6,14 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "colonflat/core/huge_pages.h"
+
 namespace cf {
 
-FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) {
-  for (auto f : mesh.faces()) insert(mesh, f);
-}
+FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) { build_static(mesh, mesh.faces()); }
 
 FaceGrid::FaceGrid(const Mesh& mesh, double cell_size, const std::vector<Mesh::FaceHandle>& faces) : cell_(cell_size) {
-  for (auto f : faces) insert(mesh, f);
+  build_static(mesh, faces);
 }
 
 FaceGrid::Key FaceGrid::key(const Vec3& p) const {
@@ -42,9 +42,14 @@ void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::arr
 std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   const Key a = key(lo), b = key(hi);
   std::vector<int> cand(big_.begin(), big_.end());
+  auto add_row = [&](std::uint32_t row) {
+    for (const int* f = static_.begin(row); f != static_.end(row); ++f)
+      if (!erased(*f)) cand.push_back(*f);
+  };
   const double box_cells = double(b.x - a.x + 1) * double(b.y - a.y + 1) * double(b.z - a.z + 1);
-  if (box_cells > double(cells_.size())) {
-    for (const auto& [k, v] : cells_) {  // a query box with more cells than the grid: scan the grid
+  if (box_cells > double(cells_.size() + static_.rows())) {
+    for (std::uint32_t row = 0; row < static_.rows(); ++row) add_row(row);  // a query box with more cells than the grid
+    for (const auto& [k, v] : cells_) {
       (void)k;
       cand.insert(cand.end(), v.begin(), v.end());
     }
@@ -52,7 +57,12 @@ std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
     for (long long x = a.x; x <= b.x; ++x)
       for (long long y = a.y; y <= b.y; ++y)
         for (long long z = a.z; z <= b.z; ++z) {
-          auto it = cells_.find({x, y, z});
+          const Key k{x, y, z};
+          const std::uint64_t code = StaticCells::code(k);
+          const std::uint32_t row = code == StaticCells::kEmpty ? StaticCells::kNoRow : static_.find(code);
+          if (row != StaticCells::kNoRow) add_row(row);
+          if (cells_.empty()) continue;
+          auto it = cells_.find(k);
           if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
         }
   }
@@ -61,14 +71,113 @@ std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   return cand;
 }
 
-template <class Visit>
-bool FaceGrid::visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) {
+// ---- the constructor's faces in compressed rows per cell ----
+
+std::uint64_t FaceGrid::StaticCells::code(const Key& k) {
+  constexpr long long kHalf = 1LL << 20;
+  auto out = [&](long long c) { return c < -kHalf || c >= kHalf; };
+  if (out(k.x) || out(k.y) || out(k.z)) return kEmpty;
+  return (std::uint64_t(k.x + kHalf) << 42) | (std::uint64_t(k.y + kHalf) << 21) | std::uint64_t(k.z + kHalf);
+}
+
+namespace {
+inline std::size_t slot_hash(std::uint64_t code, std::size_t mask) {
+  std::uint64_t h = code * 0x9E3779B97F4A7C15ull;
+  return static_cast<std::size_t>(h ^ (h >> 29)) & mask;
+}
+}  // namespace
+
+std::uint32_t FaceGrid::StaticCells::find(std::uint64_t code) const {
+  if (slot_code_.empty()) return kNoRow;
+  const std::size_t mask = slot_code_.size() - 1;
+  for (std::size_t s = slot_hash(code, mask);; s = (s + 1) & mask) {
+    if (slot_code_[s] == code) return slot_row_[s];
+    if (slot_code_[s] == kEmpty) return kNoRow;
+  }
+}
+
+std::uint32_t FaceGrid::StaticCells::find_or_add(std::uint64_t code) {
+  if (2 * (count_.size() + 1) > slot_code_.size()) rehash(std::max<std::size_t>(4096, 2 * slot_code_.size()));
+  const std::size_t mask = slot_code_.size() - 1;
+  std::size_t s = slot_hash(code, mask);
+  for (; slot_code_[s] != kEmpty; s = (s + 1) & mask)
+    if (slot_code_[s] == code) return slot_row_[s];
+  slot_code_[s] = code;
+  slot_row_[s] = static_cast<std::uint32_t>(count_.size());
+  count_.push_back(0);
+  return slot_row_[s];
+}
+
+void FaceGrid::StaticCells::rehash(std::size_t slots) {
+  std::vector<std::uint64_t> old_code;
+  std::vector<std::uint32_t> old_row;
+  assign_huge(old_code, slots, kEmpty);
+  assign_huge(old_row, slots, kNoRow);
+  old_code.swap(slot_code_);
+  old_row.swap(slot_row_);
+  const std::size_t mask = slots - 1;
+  for (std::size_t i = 0; i < old_code.size(); ++i) {
+    if (old_code[i] == kEmpty) continue;
+    std::size_t s = slot_hash(old_code[i], mask);
+    while (slot_code_[s] != kEmpty) s = (s + 1) & mask;
+    slot_code_[s] = old_code[i];
+    slot_row_[s] = old_row[i];
+  }
+}
+
+void FaceGrid::StaticCells::finish_counts() {
+  start_.assign(count_.size() + 1, 0);
+  for (std::size_t r = 0; r < count_.size(); ++r) start_[r + 1] = start_[r] + count_[r];
+  resize_huge(faces_, start_.back());
+  cursor_.assign(start_.begin(), start_.end() - 1);
+}
+
+// Two passes over the faces: count the faces of each cell, then fill the rows. Faces spanning
+// more than kMaxCellsPerFace cells go to big_, faces beyond the codes' range to the dynamic cells.
+template <class Faces>
+void FaceGrid::build_static(const Mesh& mesh, const Faces& faces) {
+  erased_.assign(mesh.n_faces(), 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::uint64_t last = StaticCells::kEmpty;
+    std::uint32_t last_row = StaticCells::kNoRow;
+    for (auto f : faces) {
+      Key a, b;
+      if (!cell_range(mesh, f, a, b)) {
+        if (pass == 0 && big_set_.insert(f.idx()).second) big_.push_back(f.idx());
+        continue;
+      }
+      if (StaticCells::code(a) == StaticCells::kEmpty || StaticCells::code(b) == StaticCells::kEmpty) {
+        if (pass == 0) insert_dynamic(mesh, f);
+        continue;
+      }
+      for (long long x = a.x; x <= b.x; ++x)
+        for (long long y = a.y; y <= b.y; ++y)
+          for (long long z = a.z; z <= b.z; ++z) {
+            const std::uint64_t c = StaticCells::code(Key{x, y, z});
+            if (c != last) last = c, last_row = pass == 0 ? static_.find_or_add(c) : static_.find(c);
+            if (pass == 0) static_.count(last_row);
+            else static_.fill(last_row, f.idx());
+          }
+    }
+    if (pass == 0) static_.finish_counts();
+  }
+  static_.end_fill();
+}
+
+bool FaceGrid::cell_range(const Mesh& mesh, Mesh::FaceHandle f, Key& a, Key& b) const {
   Vec3 lo, hi;
   std::array<int, 3> ids;
   std::array<Vec3, 3> pts;
   face_box(mesh, f, lo, hi, ids, pts);
-  const Key a = key(lo), b = key(hi);
-  if ((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) > kMaxCellsPerFace) return false;
+  a = key(lo);
+  b = key(hi);
+  return (b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1) <= kMaxCellsPerFace;
+}
+
+template <class Visit>
+bool FaceGrid::visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) const {
+  Key a, b;
+  if (!cell_range(mesh, f, a, b)) return false;
   for (long long x = a.x; x <= b.x; ++x)
     for (long long y = a.y; y <= b.y; ++y)
       for (long long z = a.z; z <= b.z; ++z) visit(Key{x, y, z});
@@ -76,6 +185,11 @@ bool FaceGrid::visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) 
 }
 
 void FaceGrid::insert(const Mesh& mesh, Mesh::FaceHandle f) {
+  if (f.idx() < static_cast<int>(erased_.size())) erased_[f.idx()] = 0;
+  insert_dynamic(mesh, f);
+}
+
+void FaceGrid::insert_dynamic(const Mesh& mesh, Mesh::FaceHandle f) {
   const bool small = visit_cells(mesh, f, [&](const Key& k) {
     auto& v = cells_[k];
     if (std::find(v.begin(), v.end(), f.idx()) == v.end()) v.push_back(f.idx());
@@ -89,6 +203,7 @@ void FaceGrid::erase(const Mesh& mesh, Mesh::FaceHandle f) {
     if (it != cells_.end()) it->second.erase(std::remove(it->second.begin(), it->second.end(), f.idx()), it->second.end());
   });
   if (!small && big_set_.erase(f.idx())) big_.erase(std::find(big_.begin(), big_.end(), f.idx()));
+  if (small && f.idx() < static_cast<int>(erased_.size())) erased_[f.idx()] = 1;  // hides its static entries
 }
 
 namespace {

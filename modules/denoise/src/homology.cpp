@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/huge_pages.h"
 
 namespace cf {
 
@@ -12,12 +13,14 @@ namespace {
 struct ClosedDual {
   const Mesh& mesh;
   std::size_t real_faces;
-  std::vector<int> boundary_face;                   // per halfedge: its virtual face, or -1
+  std::vector<int> boundary_face;  // per halfedge: its virtual face, or -1 (empty on a closed mesh)
   std::vector<Mesh::HalfedgeHandle> virtual_start;  // a halfedge of each virtual face
 
-  explicit ClosedDual(const Mesh& m) : mesh(m), real_faces(m.n_faces()), boundary_face(m.n_halfedges(), -1) {
+  explicit ClosedDual(const Mesh& m) : mesh(m), real_faces(m.n_faces()) {
     for (auto h : mesh.halfedges()) {
-      if (!mesh.is_boundary(h) || boundary_face[h.idx()] >= 0) continue;
+      if (!mesh.is_boundary(h)) continue;
+      if (boundary_face.empty()) boundary_face.assign(mesh.n_halfedges(), -1);  // not on a closed mesh
+      if (boundary_face[h.idx()] >= 0) continue;
       const int id = static_cast<int>(real_faces + virtual_start.size());
       virtual_start.push_back(h);
       auto x = h;
@@ -41,9 +44,9 @@ struct ClosedDual {
 void dual_spanning_forest(const ClosedDual& dual, std::vector<int>& parent_edge, std::vector<int>& order,
                           std::vector<std::uint8_t>& in_tree) {
   const Mesh& mesh = dual.mesh;
-  parent_edge.assign(dual.faces(), -2);
+  assign_huge(parent_edge, dual.faces(), -2);
   order.clear();
-  order.reserve(dual.faces());
+  reserve_huge(order, dual.faces());
   in_tree.assign(mesh.n_edges(), 0);
   for (std::size_t root = 0; root < dual.faces(); ++root) {
     if (parent_edge[root] != -2) continue;
@@ -107,7 +110,7 @@ void HomologyBasis::build(const Mesh& mesh) {
   const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
-  row_of_.assign(mesh.n_edges(), 0);
+  assign_huge(row_of_, mesh.n_edges(), 0u);
   rows_.assign(words_, 0);  // row 0: the zero class
   std::vector<std::uint64_t> cls(words_, 0);
   for (int i = 0; i < rank_; ++i) {
@@ -138,37 +141,59 @@ void HomologyBasis::build(const Mesh& mesh) {
   prune_cut_graph(mesh);
 }
 
-// Pruned cut graph: degree-1 vertices removed recursively.
+// Pruned cut graph: degree-1 vertices removed recursively (the 2-core: the same whatever the
+// order). The cut graph's adjacency is gathered once into compressed rows, so that peeling a
+// leaf reads its few cut edges instead of circulating its mesh halfedges.
 void HomologyBasis::prune_cut_graph(const Mesh& mesh) {
   const std::size_t V = mesh.n_vertices(), E = mesh.n_edges();
   pruned_edge_ = cut_edge_;
-  std::vector<int> degree(V, 0);
-  for (std::size_t e = 0; e < E; ++e) {
-    if (!cut_edge_[e]) continue;
+  auto ends = [&](std::size_t e) {
     const auto h = mesh.halfedge_handle(Mesh::EdgeHandle(static_cast<int>(e)), 0);
-    ++degree[mesh.from_vertex_handle(h).idx()];
-    ++degree[mesh.to_vertex_handle(h).idx()];
-  }
-  std::vector<int> stack;
+    return std::pair<int, int>(mesh.from_vertex_handle(h).idx(), mesh.to_vertex_handle(h).idx());
+  };
+  std::vector<std::uint32_t> start(V + 1, 0);  // counts, then row starts
+  for (std::size_t e = 0; e < E; ++e)
+    if (cut_edge_[e]) {
+      const auto [a, b] = ends(e);
+      ++start[a + 1];
+      ++start[b + 1];
+    }
+  std::vector<int> degree(V);
+  for (std::size_t v = 0; v < V; ++v) degree[v] = static_cast<int>(start[v + 1]), start[v + 1] += start[v];
+  std::vector<std::pair<int, int>> adjacent;  // per vertex: (cut edge, other end)
+  resize_huge(adjacent, start[V]);
+  for (std::size_t e = 0; e < E; ++e)  // filled through start[v] (moved one row along), shifted back after
+    if (cut_edge_[e]) {
+      const auto [a, b] = ends(e);
+      adjacent[start[a]++] = {static_cast<int>(e), b};
+      adjacent[start[b]++] = {static_cast<int>(e), a};
+    }
+  for (std::size_t v = V; v > 0; --v) start[v] = start[v - 1];
+  start[0] = 0;
+  peel_leaves(start, adjacent, degree);
+  pruned_vertices_.clear();
   for (std::size_t v = 0; v < V; ++v)
+    if (degree[v] >= 2) pruned_vertices_.push_back(static_cast<int>(v));
+}
+
+void HomologyBasis::peel_leaves(const std::vector<std::uint32_t>& start, const std::vector<std::pair<int, int>>& adjacent,
+                                std::vector<int>& degree) {
+  std::vector<int> stack;
+  for (std::size_t v = 0; v < degree.size(); ++v)
     if (degree[v] == 1) stack.push_back(static_cast<int>(v));
   while (!stack.empty()) {
-    const auto v = Mesh::VertexHandle(stack.back());
+    const int v = stack.back();
     stack.pop_back();
-    if (degree[v.idx()] != 1) continue;
-    for (auto h : mesh.voh_range(v)) {
-      const int e = mesh.edge_handle(h).idx();
+    if (degree[v] != 1) continue;
+    for (std::uint32_t i = start[v]; i < start[v + 1]; ++i) {
+      const auto [e, w] = adjacent[i];
       if (!pruned_edge_[e]) continue;
       pruned_edge_[e] = 0;
-      --degree[v.idx()];
-      const int w = mesh.to_vertex_handle(h).idx();
+      --degree[v];
       if (--degree[w] == 1) stack.push_back(w);
       break;
     }
   }
-  pruned_vertices_.clear();
-  for (std::size_t v = 0; v < V; ++v)
-    if (degree[v] >= 2) pruned_vertices_.push_back(static_cast<int>(v));
 }
 
 std::uint32_t HomologyBasis::new_row(const std::uint64_t* cls) {

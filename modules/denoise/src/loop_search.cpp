@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "colonflat/core/huge_pages.h"
+
 namespace cf {
 
 FundamentalCycleSearch::FundamentalCycleSearch(const Mesh& mesh, const HomologyBasis& homology,
@@ -13,8 +15,9 @@ FundamentalCycleSearch::FundamentalCycleSearch(const Mesh& mesh, const HomologyB
 void FundamentalCycleSearch::grow() {
   const std::size_t n = mesh_.n_vertices();
   if (node_.size() < n) {
-    const std::size_t cap = std::max(n, node_.size() * 5 / 4);
-    node_.resize(cap);
+    // Room for what surgery adds (as the mesh copy reserves), then 25 % more at a time.
+    const std::size_t cap = node_.empty() ? n + n / 16 + 4096 : std::max(n, node_.size() * 5 / 4);
+    resize_huge(node_, cap);
     mark_.resize(cap, 0);
   }
   // Boundary flags: vertices created by surgery are interior, so only new entries are computed.

@@ -4,15 +4,16 @@
 #include <numeric>
 #include <vector>
 
+#include "colonflat/core/huge_pages.h"
 namespace cf {
 
 class UnionFind {
  public:
   explicit UnionFind(std::size_t n = 0) { reset(n); }
   void reset(std::size_t n) {
-    parent_.resize(n);
+    resize_huge(parent_, n);
     std::iota(parent_.begin(), parent_.end(), 0u);
-    size_.assign(n, 1u);
+    assign_huge(size_, n, 1u);
   }
   std::uint32_t find(std::uint32_t x) {
     while (parent_[x] != x) {

@@ -7,8 +7,12 @@
 // edge intersect when they fold flat onto each other. Faces are hashed by bounding box into cubic
 // cells of `cell_size` (mm); a face spanning more than 512 cells is checked by every query.
 // Moving a face: insert() it again at its new place (stale cells only cost time).
+// Storage: the constructor's faces in compressed rows per cell (an open-addressing table from
+// cell to row, filled in two passes: no allocation per cell; 1.56 M faces in about 0.15 s
+// instead of 0.8 s with a vector per cell), faces insert()ed later in a hash map of cells.
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -53,15 +57,48 @@ class FaceGrid {
   Key key(const Vec3& p) const;
   // Calls visit(key) for each cell of f's bounding box; false (nothing visited) when they are more
   // than kMaxCellsPerFace.
+  // The range of cells of f's bounding box; false when they are more than kMaxCellsPerFace.
+  bool cell_range(const Mesh& mesh, Mesh::FaceHandle f, Key& a, Key& b) const;
   template <class Visit>
-  bool visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit);
+  bool visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) const;
   std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
+  void insert_dynamic(const Mesh& mesh, Mesh::FaceHandle f);
+  // Faces given to the constructor, in compressed rows per cell.
+  class StaticCells {
+   public:
+    static constexpr std::uint32_t kNoRow = 0xffffffffu;
+    static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+    // The cell's code (x, y, z in 21 bits each), or kEmpty when a coordinate is out of range.
+    static std::uint64_t code(const Key& k);
+    std::uint32_t find(std::uint64_t code) const;
+    std::uint32_t find_or_add(std::uint64_t code);  // a new row counts 0 faces
+    std::size_t rows() const { return count_.size(); }
+    void count(std::uint32_t row) { ++count_[row]; }
+    void finish_counts();  // rows from counts; then fill() every counted face once
+    void fill(std::uint32_t row, int face) { faces_[cursor_[row]++] = face; }
+    void end_fill() { cursor_ = {}; }
+    const int* begin(std::uint32_t row) const { return faces_.data() + start_[row]; }
+    const int* end(std::uint32_t row) const { return faces_.data() + start_[row + 1]; }
+    const std::vector<int>& faces() const { return faces_; }
+
+   private:
+    void rehash(std::size_t slots);
+    std::vector<std::uint64_t> slot_code_;
+    std::vector<std::uint32_t> slot_row_;
+    std::vector<std::uint32_t> count_, start_, cursor_;
+    std::vector<int> faces_;
+  };
+  template <class Faces>
+  void build_static(const Mesh& mesh, const Faces& faces);
+  bool erased(int f) const { return f < static_cast<int>(erased_.size()) && erased_[f]; }
   // Grid faces that triangle (ids, p) intersects improperly (at most 1 with first_only).
   std::size_t grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
                         bool first_only) const;
   static constexpr long long kMaxCellsPerFace = 512;
   double cell_;
-  std::unordered_map<Key, std::vector<int>, KeyHash> cells_;
+  StaticCells static_;
+  std::vector<std::uint8_t> erased_;  // per face id: erase()d (its static entries hidden) until insert()ed again
+  std::unordered_map<Key, std::vector<int>, KeyHash> cells_;  // faces insert()ed after the constructor
   std::vector<int> big_;  // faces spanning more than kMaxCellsPerFace cells (each once)
   std::unordered_set<int> big_set_;
 };

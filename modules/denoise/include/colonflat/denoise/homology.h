@@ -17,6 +17,7 @@
 // near the root), so each edge holds an index into a pool of its nonzero class rows (row 0 is
 // the zero class) instead of a dense edges x words table (188 MB at 2.3 M edges and genus 300).
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
@@ -53,6 +54,10 @@ class HomologyBasis {
 
  private:
   void prune_cut_graph(const Mesh& mesh);
+  // Removes degree-1 vertices of the cut graph (rows start / adjacent: per vertex its (cut edge,
+  // other end)) until none is left; `degree` ends as each vertex's degree in the pruned graph.
+  void peel_leaves(const std::vector<std::uint32_t>& start, const std::vector<std::pair<int, int>>& adjacent,
+                   std::vector<int>& degree);
   std::uint32_t new_row(const std::uint64_t* cls);
   int rank_ = 0, words_ = 1;
   std::vector<std::uint32_t> row_of_;  // per edge: its row in rows_ (0: the zero class)
