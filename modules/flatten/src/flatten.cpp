@@ -121,7 +121,7 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
     const double scale = std::sqrt(w.seg.area_3d / h.period);
     emb = embed_conformal(s, E, h, signed_area >= 0 ? 1.0 : -1.0, scale);
-    w.seg.untangled_vertices = untangle(s, vf, emb, fixed, degenerate);
+    w.seg.untangled_vertices = w.folds_pending ? 0 : untangle(s, vf, emb, fixed, degenerate);
     w.seg.weights = h.weights;
     w.seg.dirichlet_period_ratio = h.energy_u / h.period;
     bad = count_bad(s, emb, degenerate);
@@ -259,7 +259,11 @@ struct FlattenedBranches {
 std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
   const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
-  if (cuts.empty()) return std::future<FlattenedBranches>();
+  w.folds_pending = false;
+  if (cuts.empty()) {  // this map stays: its folds are untangled now
+    w.seg.untangled_vertices = untangle(w.ann, p.vf, w.emb, p.fixed, p.degenerate);
+    return std::future<FlattenedBranches>();
+  }
   const std::size_t nf = w.ann.t.size();
   std::vector<char> keep(nf, 1);
   for (const auto& cut : cuts)
@@ -358,11 +362,14 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.cap_area = surface_area(s) - surface_area(w.ann);
   Prepared p = prepare(w, &edges);
   phase("ends opened");
+  const bool may_cut = o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth;
+  // A colon map that side branches may replace is untangled only if it stays (branch detection
+  // reads the collapse, which untangling cannot lift).
+  w.folds_pending = may_cut && !w.branch;
   conformal(w, loops, p, o);
   phase("conformal map");
   std::future<FlattenedBranches> cut;
-  if (o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth)
-    cut = cut_branches(w, loops, p, o, depth);
+  if (may_cut) cut = cut_branches(w, loops, p, o, depth);
   w.prior = PriorSolve{};  // the last factorisation's memory back
   if (cut.valid()) phase("side branches cut, conformal map again");
   const Centreline cl = centreline_step(w, loops);

@@ -267,6 +267,7 @@ struct SegmentWork {
   double cap_area = 0;        // mm^2 of wall removed to open the ends (caps)
   double lost_area = 0;       // mm^2 of wall in no band (faces dropped when a branch was cut off)
   bool branch = false;        // a side branch's band (flattened from its neck)
+  bool folds_pending = false; // the map's folds are not untangled yet (a colon map that may be re-solved)
   PriorSolve prior;           // the last conformal solve's order and factor, for the next one
 };
 
