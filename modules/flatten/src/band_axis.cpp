@@ -38,7 +38,8 @@ namespace {
 // distorts angles least is taken.
 constexpr double kAxisAreaLow = 0.15, kAxisAreaHigh = 3.5;
 
-// Distortion of the band for one axis (x = L axis(u), y scaled by yscale), on a sample of faces.
+// Distortion of the band for one axis (x = L axis(u), y scaled by yscale), on a sample of faces,
+// those out of the map left out.
 DistortionStats axis_distortion(const SegmentWork& w, const std::vector<double>& axis, double length, double yscale,
                                 const std::vector<char>& degenerate) {
   const Surface& s = w.ann;
@@ -49,8 +50,9 @@ DistortionStats axis_distortion(const SegmentWork& w, const std::vector<double>&
     const Tri& t = s.t[f];
     auto c = w.emb.corners(s, int(f));
     for (auto& q : c) q = V2(length * interpolate_axis(axis, q.x() / w.seg.length), q.y() * yscale);
-    fd.push_back(face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]));
-  }
+    const FaceDistortion d = face_distortion(s.p[t[0]], s.p[t[1]], s.p[t[2]], c[0], c[1], c[2]);
+    if (!too_small_in_map(d.area2, d.area3)) fd.push_back(d);  // as measure(): a stump's crushed faces
+  }                                                             // would swamp the qc mean (1e11)
   return stats_of(fd);
 }
 
