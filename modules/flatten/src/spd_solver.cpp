@@ -165,6 +165,7 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   given_order_.clear();
   use_huge_pages_for_cholmod();
   cholmod_start(&common_);
+  common_.print = 0;  // no warnings on stderr: a failed factorisation is reported by status and falls back
   started_ = true;
   common_.supernodal = CHOLMOD_SIMPLICIAL;
   common_.final_asis = 1;  // keep LDL^T
