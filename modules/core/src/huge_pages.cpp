@@ -22,7 +22,7 @@ HugeRange huge_range(const void* p, std::size_t bytes) {
 
 }  // namespace
 
-void advise_huge_pages(const void* p, std::size_t bytes) {
+void advise_huge_pages(void* p, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
   const HugeRange r = huge_range(p, bytes);
   if (r.last > r.first) ::madvise(reinterpret_cast<void*>(r.first), r.last - r.first, MADV_HUGEPAGE);  // advice only

@@ -4,14 +4,13 @@
 
 #include <Eigen/OrderingMethods>
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <mutex>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/huge_pages.h"
 
 namespace cf::flat_detail {
 
@@ -67,16 +66,8 @@ Eigen::MatrixXd SpdSolver::solve_leading(const Eigen::MatrixXd& b, int leading) 
 namespace {
 
 // CHOLMOD's large blocks (a colon's factor: about 300 MB) on transparent huge pages where the
-// system allows them: faulting them in as 4 KiB pages cost about a tenth of the flatten time.
-void advise_huge_pages(void* p, std::size_t bytes) {
-  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-  if (!p || bytes < 2 * kHuge) return;
-  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
-  const std::uintptr_t last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
-#ifdef MADV_HUGEPAGE
-  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // advice only
-#endif
-}
+// system allows them (core advise_huge_pages): faulting them in as 4 KiB pages cost about a tenth
+// of the flatten time.
 void* huge_malloc(std::size_t bytes) {
   void* p = std::malloc(bytes);
   advise_huge_pages(p, bytes);

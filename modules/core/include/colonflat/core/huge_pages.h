@@ -13,7 +13,7 @@ constexpr std::size_t kHugePageMinBytes = std::size_t(4) << 20;
 
 // Advises huge pages for the whole 2 MiB pages inside [p, p + bytes) (bytes >= kHugePageMinBytes).
 // Call before the memory is first written.
-void advise_huge_pages(const void* p, std::size_t bytes);
+void advise_huge_pages(void* p, std::size_t bytes);
 
 // Moves the whole 2 MiB pages inside [p, p + bytes) of memory already written onto huge pages
 // now (MADV_COLLAPSE, Linux 6.1 and later; elsewhere nothing happens). For arrays that another
