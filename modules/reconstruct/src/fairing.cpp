@@ -17,20 +17,21 @@ namespace {
 
 using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
+Points to_points(const std::vector<std::array<double, 3>>& p) {
+  Points x(Eigen::Index(p.size()), 3);
+  for (std::size_t i = 0; i < p.size(); ++i) x.row(Eigen::Index(i)) = Eigen::RowVector3d(p[i][0], p[i][1], p[i][2]);
+  return x;
+}
+
 // The state of one fairing: the vertex graph, the anchors (staircase positions) and the constraint.
 class ConstrainedFairing {
  public:
-  ConstrainedFairing(const TriangleList& surface, const std::vector<std::array<double, 3>>& anchors,
+  // start: the surface's points (#P x 3), whose cotangent weights the energy keeps.
+  ConstrainedFairing(const TriangleList& surface, const Points& start, Points anchors,
                      const Eigen::Matrix3d& lps_to_index, double radius)
-      : triangles_(surface.triangles), to_index_(lps_to_index), radius_(radius) {
+      : to_index_(lps_to_index), radius_(radius), anchors_(std::move(anchors)) {
     build_graph(surface);
-    anchors_.resize(Eigen::Index(anchors.size()), 3);
-    for (std::size_t i = 0; i < anchors.size(); ++i)
-      anchors_.row(Eigen::Index(i)) = Eigen::RowVector3d(anchors[i][0], anchors[i][1], anchors[i][2]);
-    Points x(anchors_.rows(), 3);
-    for (std::size_t i = 0; i < surface.points.size(); ++i)
-      x.row(Eigen::Index(i)) = Eigen::RowVector3d(surface.points[i][0], surface.points[i][1], surface.points[i][2]);
-    cotangent_weights(x);
+    cotangent_weights(surface.triangles, start);
   }
 
   // x (#P x 3): the start (within the radius of the anchors) and the result.
@@ -58,16 +59,17 @@ class ConstrainedFairing {
   }
 
   // weight_[k] for the k-th CSR entry: the cotangent weight of the edge on the start surface,
-  // clamped to [0, 10] (linear precision: a plane's Laplacian is 0 however it is triangulated),
-  // normalised per row so that U(x)_i is a weighted mean minus x_i.
-  void cotangent_weights(const Points& x) {
+  // clamped to [0, 10], normalised per row so that U(x)_i is a weighted mean minus x_i. Cotangent
+  // weights have linear precision (a plane's Laplacian is 0 however it is triangulated); the clamp
+  // keeps that wherever no weight is negative.
+  void cotangent_weights(const std::vector<std::array<int, 3>>& triangles, const Points& x) {
     weight_.assign(neighbours_.size(), 0.0);
     auto entry = [&](int i, int j) -> double& {
       const auto first = neighbours_.begin() + std::ptrdiff_t(start_[std::size_t(i)]);
       const auto last = neighbours_.begin() + std::ptrdiff_t(start_[std::size_t(i) + 1]);
       return weight_[std::size_t(std::lower_bound(first, last, j) - neighbours_.begin())];
     };
-    for (const auto& t : triangles_)
+    for (const auto& t : triangles)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d u = (x.row(t[(k + 1) % 3]) - x.row(t[k])).transpose();
         const Eigen::Vector3d v = (x.row(t[(k + 2) % 3]) - x.row(t[k])).transpose();
@@ -75,17 +77,17 @@ class ConstrainedFairing {
         entry(t[(k + 1) % 3], t[(k + 2) % 3]) += 0.5 * cot;
         entry(t[(k + 2) % 3], t[(k + 1) % 3]) += 0.5 * cot;
       }
-    row_weight_.assign(start_.size() - 1, 0.0);
     for (std::size_t i = 0; i + 1 < start_.size(); ++i) {
-      for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) weight_[k] = std::clamp(weight_[k], 0.0, 10.0);
-      for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) row_weight_[i] += weight_[k];
-      for (std::size_t k = start_[i]; k < start_[i + 1]; ++k)
-        weight_[k] = row_weight_[i] > 0 ? weight_[k] / row_weight_[i] : 1.0 / double(start_[i + 1] - start_[i]);
+      double row_weight = 0;
+      for (auto k = std::size_t(start_[i]); k < std::size_t(start_[i + 1]); ++k) weight_[k] = std::clamp(weight_[k], 0.0, 10.0);
+      for (auto k = std::size_t(start_[i]); k < std::size_t(start_[i + 1]); ++k) row_weight += weight_[k];
+      for (auto k = std::size_t(start_[i]); k < std::size_t(start_[i + 1]); ++k)
+        weight_[k] = row_weight > 0 ? weight_[k] / row_weight : 1.0 / double(start_[i + 1] - start_[i]);
     }
     // transpose weights: for entry k = (i, j), the weight of (j, i) in row j
     weight_t_.resize(weight_.size());
     for (std::size_t i = 0; i + 1 < start_.size(); ++i)
-      for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) weight_t_[k] = entry(neighbours_[k], int(i));
+      for (auto k = std::size_t(start_[i]); k < std::size_t(start_[i + 1]); ++k) weight_t_[k] = entry(neighbours_[k], int(i));
   }
 
   // out_i = weighted mean of the neighbours of i - x_i; 0 on the rim of an open surface (no
@@ -95,19 +97,19 @@ class ConstrainedFairing {
     vtkSMPTools::For(0, vtkIdType(start_.size() - 1), kGrain, [&](vtkIdType first, vtkIdType last) {
       for (auto i = std::size_t(first); i < std::size_t(last); ++i) {
         Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-        for (std::size_t k = start_[i]; k < start_[i + 1]; ++k) sum += weight_[k] * x.row(neighbours_[k]);
+        for (auto k = std::size_t(start_[i]); k < std::size_t(start_[i + 1]); ++k) sum += weight_[k] * x.row(neighbours_[k]);
         out.row(Eigen::Index(i)) = rim_[i] ? Eigen::RowVector3d::Zero() : Eigen::RowVector3d(sum - x.row(Eigen::Index(i)));
       }
     });
   }
 
-  // out = U^T r: (U^T r)_j = -r_j + sum over neighbours i of j of r_i / deg(i).
+  // out = U^T r: (U^T r)_j = -r_j + sum over neighbours i of j of w_ij r_i (w_ij: row i's weight of j).
   void umbrella_transpose(const Points& r, Points& out) const {
     out.resize(r.rows(), 3);
     vtkSMPTools::For(0, vtkIdType(start_.size() - 1), kGrain, [&](vtkIdType first, vtkIdType last) {
       for (auto j = std::size_t(first); j < std::size_t(last); ++j) {
         Eigen::RowVector3d sum = -r.row(Eigen::Index(j));
-        for (std::size_t k = start_[j]; k < start_[j + 1]; ++k) sum += weight_t_[k] * r.row(neighbours_[k]);
+        for (auto k = std::size_t(start_[j]); k < std::size_t(start_[j + 1]); ++k) sum += weight_t_[k] * r.row(neighbours_[k]);
         out.row(Eigen::Index(j)) = sum;
       }
     });
@@ -176,14 +178,13 @@ class ConstrainedFairing {
     return count;
   }
 
-  const std::vector<std::array<int, 3>>& triangles_;
   static constexpr vtkIdType kGrain = 16384;  // vertices per parallel chunk (vtkSMPTools)
   Eigen::Matrix3d to_index_;
   double radius_;
   std::vector<int> start_;
   std::vector<int> neighbours_;
   std::vector<char> rim_;
-  std::vector<double> weight_, weight_t_, row_weight_;
+  std::vector<double> weight_, weight_t_;
   Points anchors_, residual_;
 };
 
@@ -195,10 +196,8 @@ FairingResult fair_within_tolerance(TriangleList& surface, const std::vector<std
     throw Error("fairing: " + std::to_string(anchors.size()) + " anchors for " + std::to_string(surface.points.size()) +
                 " points");
   if (options.iterations <= 0 || surface.points.empty()) return {};
-  ConstrainedFairing fairing(surface, anchors, lps_to_index, options.radius_voxels);
-  Points x(Eigen::Index(surface.points.size()), 3);
-  for (std::size_t i = 0; i < surface.points.size(); ++i)
-    x.row(Eigen::Index(i)) = Eigen::RowVector3d(surface.points[i][0], surface.points[i][1], surface.points[i][2]);
+  Points x = to_points(surface.points);
+  ConstrainedFairing fairing(surface, x, to_points(anchors), lps_to_index, options.radius_voxels);
   const FairingResult result = fairing.run(options.iterations, x);
   for (std::size_t i = 0; i < surface.points.size(); ++i)
     for (int a = 0; a < 3; ++a) surface.points[i][std::size_t(a)] = x(Eigen::Index(i), a);
