@@ -1,5 +1,6 @@
 // Setting up a denoise run: the working copy of the input, the input's topology and, with two
 // threads, the cap guard grid and the first homology basis built at the same time.
+#include <algorithm>
 #include <exception>
 #include <iterator>
 
@@ -21,6 +22,44 @@ void mesh_on_huge_pages(const Mesh& m) {
   collapse_to_huge_pages(&m.edge(Mesh::EdgeHandle(0)), m.n_edges() * sizeof(Mesh::Edge));
   collapse_to_huge_pages(&m.face(Mesh::FaceHandle(0)), m.n_faces() * sizeof(Mesh::Face));
   collapse_to_huge_pages(m.points(), m.n_vertices() * sizeof(Vec3));
+}
+
+// Whether `m` holds only what every Mesh holds (points, connectivity, vertex/edge/face status):
+// then copy_onto_huge_pages() copies all of it.
+bool only_standard_properties(const Mesh& m) {
+  static const Mesh plain;
+  auto live = [](auto begin, auto end) { return std::count_if(begin, end, [](const auto* p) { return p != nullptr; }); };
+  return live(m.vprops_begin(), m.vprops_end()) == live(plain.vprops_begin(), plain.vprops_end()) &&
+         live(m.hprops_begin(), m.hprops_end()) == live(plain.hprops_begin(), plain.hprops_end()) &&
+         live(m.eprops_begin(), m.eprops_end()) == live(plain.eprops_begin(), plain.eprops_end()) &&
+         live(m.fprops_begin(), m.fprops_end()) == live(plain.fprops_begin(), plain.fprops_end()) &&
+         live(m.mprops_begin(), m.mprops_end()) == live(plain.mprops_begin(), plain.mprops_end()) &&
+         m.has_vertex_status() && m.has_edge_status() && m.has_face_status() && !m.has_halfedge_status();
+}
+
+// Copies `input` into the empty `out` with room for (nv, ne, nf) elements, every array advised
+// onto huge pages before the copy first writes it. A copy assignment clones the arrays into fresh
+// 4 KiB pages (1.56 M faces: 0.44 s, mostly page faults, then 0.17 s to collapse them onto huge
+// pages). Precondition: only_standard_properties(input).
+void copy_onto_huge_pages(const Mesh& input, Mesh& out, std::size_t nv, std::size_t ne, std::size_t nf) {
+  out.reserve(nv, ne, nf);
+  // One element of each kind, so that each array's first element is addressable; the copy
+  // below replaces them.
+  out.resize(1, 1, 1);
+  // The element arrays are read-only through the public interface; the mesh is ours to advise.
+  advise_huge_pages(const_cast<Mesh::Vertex*>(&out.vertex(Mesh::VertexHandle(0))), nv * sizeof(Mesh::Vertex));
+  advise_huge_pages(const_cast<Mesh::Edge*>(&out.edge(Mesh::EdgeHandle(0))), ne * sizeof(Mesh::Edge));
+  advise_huge_pages(const_cast<Mesh::Face*>(&out.face(Mesh::FaceHandle(0))), nf * sizeof(Mesh::Face));
+  advise_huge_pages(&out.point(Mesh::VertexHandle(0)), nv * sizeof(Vec3));
+  advise_huge_pages(&out.status(Mesh::VertexHandle(0)), nv * sizeof(OpenMesh::Attributes::StatusInfo));
+  advise_huge_pages(&out.status(Mesh::EdgeHandle(0)), ne * sizeof(OpenMesh::Attributes::StatusInfo));
+  advise_huge_pages(&out.status(Mesh::FaceHandle(0)), nf * sizeof(OpenMesh::Attributes::StatusInfo));
+  out.assign_connectivity(input);  // the elements, into the reserved arrays; properties resized
+  auto copy_array = [](const auto& from, auto& to) { std::copy(from.begin(), from.end(), to.begin()); };
+  copy_array(input.property(input.points_pph()).data_vector(), out.property(out.points_pph()).data_vector());
+  copy_array(input.property(input.vertex_status_pph()).data_vector(), out.property(out.vertex_status_pph()).data_vector());
+  copy_array(input.property(input.edge_status_pph()).data_vector(), out.property(out.edge_status_pph()).data_vector());
+  copy_array(input.property(input.face_status_pph()).data_vector(), out.property(out.face_status_pph()).data_vector());
 }
 
 // Whether garbage_collection() would change anything (elements marked deleted).
@@ -101,12 +140,18 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     // Room for what surgery adds: the element arrays keep their capacity through the copy
     // (doubling the 2 M-edge array at the first surgery that overflows it cost 0.3 s).
     auto grown = [](std::size_t n) { return n + n / 16 + 4096; };
-    st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
+    const std::size_t nv = grown(input.n_vertices()), ne = grown(input.n_edges()), nf = grown(input.n_faces());
+    if (only_standard_properties(input)) {
+      copy_onto_huge_pages(input, st.mesh, nv, ne, nf);
+      if (has_garbage(st.mesh)) st.mesh.garbage_collection();
+      return;
+    }
+    st.mesh.reserve(nv, ne, nf);
     st.mesh = input;
     if (has_garbage(st.mesh)) st.mesh.garbage_collection();
-    // The properties (points, status) were cloned at the input's size: room for surgery now,
-    // before the arrays go onto huge pages (a later growth would move them off).
-    st.mesh.reserve(grown(input.n_vertices()), grown(input.n_edges()), grown(input.n_faces()));
+    // The properties were cloned at the input's size: room for surgery now, before the arrays
+    // go onto huge pages (a later growth would move them off).
+    st.mesh.reserve(nv, ne, nf);
     mesh_on_huge_pages(st.mesh);
   };
   auto analyse = [&](const Mesh& m) {

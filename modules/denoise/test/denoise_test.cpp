@@ -141,6 +141,42 @@ TEST(DenoiseExact, GenusZeroAndInvalidOptions) {
   }
 }
 
+// Element-by-element equality of two meshes: points, face corners, halfedge links, status.
+void expect_same_mesh(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  ASSERT_EQ(a.n_edges(), b.n_edges());
+  ASSERT_EQ(a.n_faces(), b.n_faces());
+  for (auto v : a.vertices()) {
+    EXPECT_EQ(a.point(v), b.point(v));
+    EXPECT_EQ(a.halfedge_handle(v), b.halfedge_handle(v));
+  }
+  for (auto h : a.halfedges()) {
+    EXPECT_EQ(a.to_vertex_handle(h), b.to_vertex_handle(h));
+    EXPECT_EQ(a.next_halfedge_handle(h), b.next_halfedge_handle(h));
+    EXPECT_EQ(a.prev_halfedge_handle(h), b.prev_halfedge_handle(h));
+    EXPECT_EQ(a.face_handle(h), b.face_handle(h));
+  }
+  for (auto f : a.faces()) EXPECT_EQ(a.status(f).bits(), b.status(f).bits());
+}
+
+// The working copy is the input itself: a genus-0 input comes back identical, element by
+// element, whether it holds only the standard arrays (copied onto huge pages), an extra
+// property (copied by assignment) or deleted elements (garbage-collected like OpenMesh does).
+TEST(DenoiseExact, WorkingCopyIsTheInput) {
+  const Mesh s = to_mesh(sphere(1, 40, 20));
+  expect_same_mesh(denoise(s, DenoiseOptions{}).mesh, s);
+  Mesh tagged = s;
+  OpenMesh::VPropHandleT<int> tag;
+  tagged.add_property(tag, "tag");
+  const DenoiseResult r = denoise(tagged, DenoiseOptions{});
+  expect_same_mesh(r.mesh, s);
+  Mesh holed = s;
+  holed.delete_face(Mesh::FaceHandle(0), false);
+  Mesh expected = holed;
+  expected.garbage_collection();
+  expect_same_mesh(denoise(holed, DenoiseOptions{}).mesh, expected);
+}
+
 // The paper method refuses open meshes with an actionable message.
 TEST(DenoisePaper, RefusesOpenMesh) {
   Mesh m = to_mesh(open_cylinder(1, 3, 12, 4));
