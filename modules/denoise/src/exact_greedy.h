@@ -174,6 +174,9 @@ class ExactGreedy {
   // (about two builds' worth of CPU: a build costs about as much as settling 1.3 n vertices;
   // counted in work, not seconds, so that the result does not depend on the machine's load).
   static constexpr double kRebuildWork = 2.5;
+  // ... and per cut since the last build at least this many times the vertex count (a quarter
+  // of a build's cost: below it the searches are local and a fresh cut graph does not help).
+  static constexpr double kRebuildWorkPerCut = 0.25;
   double largest_limit_ = 0;
 };
 
