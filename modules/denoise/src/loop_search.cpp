@@ -66,8 +66,7 @@ void FundamentalCycleSearch::relax(int w, double d, int parent) {
   }
   node.dist = d;
   node.parent = parent;
-  heap_.emplace_back(d, w);
-  std::push_heap(heap_.begin(), heap_.end(), std::greater<Item>());
+  heap_.push(d, w);
 }
 
 // Marks v settled and stores the class of path(s, v) (the parent's XOR the tree edge's).
@@ -146,14 +145,13 @@ CycleCandidate FundamentalCycleSearch::run_group(const std::vector<int>& roots, 
 // half the best cycle found.
 void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool frontier, CycleCandidate& best) {
   while (!heap_.empty()) {
-    const auto [d, vi] = heap_.front();
+    const auto [d, vi] = heap_.top();
     if (d > 0.5 * std::min(limit, best.value)) {
       best.truncated = true;
       if (!best.found && frontier) best.frontier_bound = frontier_bound();
       break;
     }
-    std::pop_heap(heap_.begin(), heap_.end(), std::greater<Item>());
-    heap_.pop_back();
+    heap_.pop();
     if (node_[vi].settled || d > node_[vi].dist) continue;
     settle(vi);
     expand(vi, d, limit, accept, best);
@@ -184,7 +182,7 @@ double FundamentalCycleSearch::frontier_bound() {
   // Unsettled vertices with a tentative distance are in the heap (possibly several times).
   double bound = std::numeric_limits<double>::infinity();
   std::vector<std::uint64_t> cls(W_);
-  for (const auto& [dw, wi] : heap_) {
+  for (const auto& [dw, wi] : heap_.items()) {
     // Each unsettled vertex once: its current entry (stale duplicates carry a larger distance).
     const Node& node = node_[wi];
     if (node.settled || node.stamp != run_id_ || node.parent < 0 || dw != node.dist) continue;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "colonflat/core/mesh.h"
+#include "colonflat/core/quad_heap.h"
 #include "colonflat/denoise/homology.h"
 
 namespace cf {
@@ -118,8 +119,7 @@ class FundamentalCycleSearch {
   std::uint32_t mark_id_ = 0;
   std::size_t settled_count_ = 0;
   std::vector<int> settled_order_;
-  using Item = std::pair<double, int>;
-  std::vector<Item> heap_;  // binary min-heap (std::push_heap / pop_heap with std::greater)
+  QuadHeap heap_;  // tentative (distance, vertex) entries, stale duplicates included
 };
 
 // Edge cochain whose sum over any edge cycle C is the Z2 intersection number of C with `loop`:
