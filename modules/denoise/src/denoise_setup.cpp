@@ -111,7 +111,7 @@ void run_both(SearchWorker& worker, const std::function<void()>& mine, const std
   if (their_error) std::rethrow_exception(their_error);
 }
 
-// Mean edge length over the mesh's edges (the guard grid's cell size is twice it).
+// Mean edge length over the mesh's edges (the guard grid's cells are kGuardCellEdges of it).
 double mean_edge_length(const Mesh& mesh) {
   double sum = 0;
   for (auto e : mesh.edges()) sum += mesh.calc_edge_length(e);
@@ -123,7 +123,7 @@ double mean_edge_length(const Mesh& mesh) {
 // the homology basis. Both only read st.mesh.
 void build_ahead(DenoiseState& st, const DenoiseOptions& o) {
   Stopwatch sw;
-  if (o.check_caps) st.guard = std::make_unique<FaceGrid>(st.mesh, 2.0 * mean_edge_length(st.mesh));
+  if (o.check_caps) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * mean_edge_length(st.mesh));
   st.t.surgery += sw.seconds();  // where cut_loop() counts it when it builds the grid
   if (o.method != "exact") return;
   sw.restart();

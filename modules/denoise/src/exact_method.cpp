@@ -46,7 +46,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   so.ring_pull = o.ring_pull;
   so.cap_rings = o.method == "paper" && o.ring_pull == 0 ? 1 : so.cap_rings;
   if (o.check_caps) {
-    if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, 2.0 * st.mean_edge);
+    if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * st.mean_edge);
     so.guard = st.guard.get();
   }
   *out = cut_and_cap(st.mesh, loop, so, hb);
