@@ -20,7 +20,8 @@ class Untangler {
     if (region_.empty()) return 0;
     for (int round = 0; round < 4; ++round) {  // grow 0, 1, 2, 4 rings; the boundary stays
       for (int ring = 0; ring < (1 << round) && round > 0; ++ring) grow();
-      if (!solve(movable(false), movable(false))) return region_.size();
+      const std::vector<char> free_vertex = movable(false);
+      if (!solve(free_vertex, free_vertex)) return region_.size();
     }
     // Still folded: a fold that touches the boundary needs the boundary to give way. On the folds
     // and two rings around them (the vertices beyond hold the region in place), end-loop vertices
@@ -78,7 +79,8 @@ class Untangler {
     return free_vertex;
   }
 
-  // Tutte solve of x over `free_x` and of y over `free_y`; true while folds remain in the region.
+  // Tutte solve of x over `free_x` and of y over `free_y` (one system when they are the same);
+  // true while folds remain in the region.
   bool solve(const std::vector<char>& free_x, const std::vector<char>& free_y) {
     std::vector<int> faces;
     std::vector<char> seen(s_.t.size(), 0);
@@ -88,9 +90,10 @@ class Untangler {
           if (!seen[f]) seen[f] = 1, faces.push_back(f);
     const std::vector<std::array<double, 3>> uniform(faces.size(), {1.0, 1.0, 1.0});
     const std::vector<std::array<V2, 3>> zero(faces.size(), {V2::Zero(), V2::Zero(), V2::Zero()});
+    const bool same = free_x == free_y;
     RegionSystem sx, sy;
-    if (!sx.build(s_, free_x, faces, uniform) || !sy.build(s_, free_y, faces, uniform)) return false;
-    const std::vector<V2> px = sx.solve(s_, emb_, zero), py = free_x == free_y ? px : sy.solve(s_, emb_, zero);
+    if (!sx.build(s_, free_x, faces, uniform) || (!same && !sy.build(s_, free_y, faces, uniform))) return false;
+    const std::vector<V2> px = sx.solve(s_, emb_, zero), py = same ? px : sy.solve(s_, emb_, zero);
     for (int v : region_) emb_.pos[v] = V2(px[v].x(), py[v].y());
     return std::any_of(faces.begin(), faces.end(), [&](int f) { return folded(f); });
   }
