@@ -9,6 +9,7 @@
 
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 
 namespace fs = std::filesystem;
 
@@ -54,6 +55,7 @@ void RunContext::progress(const std::string& line) const { write_progress_line(l
 
 nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ctx, double heartbeat_s) {
   Stopwatch clock;
+  const double cpu0 = process_cpu_seconds();
   ProgressScope phases(ctx.log, stage.spec().name);
   {
     Heartbeat beat(ctx, stage.spec().name, heartbeat_s);
@@ -63,6 +65,8 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
           {"parameters", stage.params_json()},
           {"result", ctx.report},
           {"time_s", clock.seconds()},
+          {"cpu_time_s", process_cpu_seconds() - cpu0},
+          {"threads", thread_count()},
           {"phases", phases.phases()},
           {"peak_memory_mib", peak_memory_mib()},
           {"outputs", nlohmann::json::object()}};

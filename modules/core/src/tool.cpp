@@ -5,6 +5,7 @@
 #include <ostream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 
 namespace cf {
 
@@ -25,6 +26,13 @@ std::string tool_help(CLI::App& app) { return clean_help(app.help()); }
 int run_cli(CLI::App& app, const std::string& tool, const std::vector<std::string>& args, std::ostream& out,
             std::ostream& err, const std::function<int()>& body) {
   const std::string prefix = "colonflat " + tool + ": error: ";
+  // Every command takes --threads (one place): the process-wide worker count, reset per command.
+  int threads = 0;
+  if (!app.get_option_no_throw("--threads"))
+    app.add_option("--threads", threads, "worker threads (default: every core, or COLONFLAT_THREADS); results do not depend on it")
+        ->check(CLI::Range(1, 1024))
+        ->type_name("N");
+  set_thread_count(0);
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 parses from the back
     app.parse(reversed);
@@ -41,6 +49,7 @@ int run_cli(CLI::App& app, const std::string& tool, const std::vector<std::strin
     err << prefix << e.what() << " (see 'colonflat " << tool << " --help')\n";
     return kExitUsage;
   }
+  set_thread_count(threads);
   try {
     return body();
   } catch (const Error& e) {

@@ -1,0 +1,38 @@
+#pragma once
+// The number of worker threads every stage may use, and the two ways the stages split work over
+// them. One process-wide setting: `--threads N` of every command (and `colonflat run`) sets it;
+// the default is every core the machine offers (std::thread::hardware_concurrency()), or the
+// environment variable COLONFLAT_THREADS when it holds a positive integer.
+//
+// Contract for callers: results must not depend on the thread count. Split work so that each
+// piece is computed the same way whoever computes it, and combine pieces in a fixed order
+// (index order), never in completion order.
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+namespace cf {
+
+// Worker threads to use, >= 1.
+int thread_count();
+// Sets the count; n <= 0 restores the default (all cores / COLONFLAT_THREADS).
+void set_thread_count(int n);
+// The default the machine gives (>= 1): COLONFLAT_THREADS if set and positive, else all cores.
+int default_thread_count();
+
+// Calls body(begin, end) on contiguous chunks covering [0, n), one chunk per thread (at most
+// min(thread_count(), max_threads) threads; fewer when n is small). Chunk c is
+// [n*c/T, n*(c+1)/T). The calling thread runs chunk 0. An exception thrown by any chunk is
+// rethrown here after all chunks finished (the first one by chunk index).
+void parallel_for(std::size_t n, const std::function<void(std::size_t begin, std::size_t end)>& body,
+                  int max_threads = 1 << 30);
+
+// Runs every task, on up to thread_count() threads (tasks are taken in index order; the caller
+// runs some of them). Exceptions as in parallel_for (the first by task index).
+void parallel_tasks(const std::vector<std::function<void()>>& tasks);
+
+// User + system CPU seconds of this process so far, all threads (getrusage). CPU over wall time
+// of a stretch of work is the number of cores it kept busy (stage reports record both).
+double process_cpu_seconds();
+
+}  // namespace cf

@@ -1,0 +1,76 @@
+#include "colonflat/core/threads.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <exception>
+#include <string>
+#include <thread>
+
+namespace cf {
+
+namespace {
+
+std::atomic<int> g_threads{0};  // 0: the default
+
+// Runs work(i) for every i in [0, count) on `threads` threads (the caller is one of them), each
+// thread taking the next unclaimed index; rethrows the exception of the lowest index that threw.
+void run_indexed(std::size_t count, int threads, const std::function<void(std::size_t)>& work) {
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < count; i = next++) {
+      try {
+        work(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace
+
+int default_thread_count() {
+  if (const char* env = std::getenv("COLONFLAT_THREADS")) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (end != env && *end == '\0' && v > 0) return int(std::min<long>(v, 1024));
+  }
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+int thread_count() {
+  const int n = g_threads.load();
+  return n > 0 ? n : default_thread_count();
+}
+
+void set_thread_count(int n) { g_threads.store(n > 0 ? n : 0); }
+
+void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body, int max_threads) {
+  if (n == 0) return;
+  const std::size_t t = std::min<std::size_t>({std::size_t(thread_count()), std::size_t(std::max(1, max_threads)), n});
+  if (t == 1) return body(0, n);
+  run_indexed(t, int(t), [&](std::size_t c) { body(n * c / t, n * (c + 1) / t); });
+}
+
+void parallel_tasks(const std::vector<std::function<void()>>& tasks) {
+  const int t = int(std::min<std::size_t>(std::size_t(thread_count()), tasks.size()));
+  run_indexed(tasks.size(), std::max(1, t), [&](std::size_t i) { tasks[i](); });
+}
+
+double process_cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+}  // namespace cf
