@@ -245,7 +245,8 @@ LoadedMesh load_mesh(const fs::path& path, const LoadPolicy& policy) {
     if (!policy.allow_several_components && topo.components.size() > 1)
       throw PreconditionError(std::to_string(topo.components.size()) +
                               " connected components; a single connected surface is required");
-    out.mesh = triangles_to_mesh(std::move(tris), topo, policy.fix_orientation);
+    out.orientation = make_orientation_consistent(tris, topo, policy.fix_orientation);
+    out.mesh = build_mesh(tris);
     out.topology = topo.inconsistent_edges ? analyze_topology(out.mesh) : std::move(topo);
   } catch (const PreconditionError& e) {
     throw InputError(path.string(), e.what());
