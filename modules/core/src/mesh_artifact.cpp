@@ -5,6 +5,7 @@
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/orientation.h"
+#include "mesh_read.h"
 
 namespace cf {
 
@@ -13,12 +14,12 @@ const ArtifactType& mesh_artifact() {
       "mesh", "triangle mesh (" + mesh_format_list() + "), LPS mm",
       // Stage inputs are read strictly: a degenerate face (fewer than 3 vertices, a repeated
       // corner) is refused with its count and examples rather than silently dropped.
-      // Faces turned at read time (to agree with their neighbours) travel with the mesh until the
-      // stage's orient_mesh_input() reports them.
+      // Faces turned and components reversed at read time travel with the mesh until the stage's
+      // orient_mesh_input() reports them.
       [](const std::filesystem::path& p) {
         LoadPolicy strict;
         strict.drop_degenerate = false;
-        LoadedMesh l = load_mesh(p, strict);
+        LoadedMesh l = load_mesh_oriented(p, strict, true);
         if (!l.orientation.empty()) {
           OpenMesh::MPropHandleT<std::string> h;
           l.mesh.add_property(h, kReadOrientationProperty);
