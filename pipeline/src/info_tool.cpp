@@ -58,6 +58,7 @@ class InfoTool : public Tool {
         TriangleList tris = soup_to_triangles(soup, policy, diag);
         topo = analyze_topology(tris);
         add_topology_findings(*topo, allow_boundary, diag);
+        add_orientation_findings(std::move(tris), *topo, diag);
       }
       const bool ok = !diag.has_at_least(Severity::kDefect);
       if (json) {

@@ -4,6 +4,8 @@
 #include <sstream>
 
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/orientation.h"
+#include "mesh_read.h"
 
 namespace cf {
 
@@ -12,10 +14,18 @@ const ArtifactType& mesh_artifact() {
       "mesh", "triangle mesh (" + mesh_format_list() + "), LPS mm",
       // Stage inputs are read strictly: a degenerate face (fewer than 3 vertices, a repeated
       // corner) is refused with its count and examples rather than silently dropped.
+      // Faces turned and components reversed at read time travel with the mesh until the stage's
+      // orient_mesh_input() reports them.
       [](const std::filesystem::path& p) {
         LoadPolicy strict;
         strict.drop_degenerate = false;
-        return std::any(load_mesh(p, strict).mesh);
+        LoadedMesh l = load_mesh_oriented(p, strict, true);
+        if (!l.orientation.empty()) {
+          OpenMesh::MPropHandleT<std::string> h;
+          l.mesh.add_property(h, kReadOrientationProperty);
+          l.mesh.property(h) = l.orientation.to_json().dump();
+        }
+        return std::any(std::move(l.mesh));
       },
       [](const std::any& v, const std::filesystem::path& tmp, const std::filesystem::path& target) {
         // write_mesh renames atomically itself; the caller's transaction renames tmp later.
@@ -24,6 +34,22 @@ const ArtifactType& mesh_artifact() {
       },
       {".vtp", ".vtk", ".off", ".obj", ".ply", ".stl"}};
   return t;
+}
+
+nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage) {
+  // In place: the bag's value is not const (ArtifactBag::take does the same), and a copy of a
+  // 1.4 M-face mesh costs more than the check.
+  Mesh& mesh = const_cast<Mesh&>(bag.get<Mesh>(port));
+  OrientationReport r;
+  OpenMesh::MPropHandleT<std::string> h;
+  if (mesh.get_property_handle(h, kReadOrientationProperty)) {
+    r = OrientationReport::from_json(nlohmann::json::parse(mesh.property(h)));
+    mesh.remove_property(h);
+  }
+  r.append(orient_outward(mesh));
+  for (const std::string& note : r.notes()) ctx.progress(stage + ": " + port + ": " + note);
+  return r.to_json();
 }
 
 namespace {

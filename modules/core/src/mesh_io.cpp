@@ -34,6 +34,7 @@
 #include "colonflat/core/vtk_convert.h"
 #include "colonflat/core/vtk_messages.h"
 #include "mesh_header_check.h"
+#include "mesh_read.h"
 
 namespace fs = std::filesystem;
 
@@ -231,7 +232,9 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
   return soup;
 }
 
-LoadedMesh load_mesh(const fs::path& path, const LoadPolicy& policy) {
+LoadedMesh load_mesh(const fs::path& path, const LoadPolicy& policy) { return load_mesh_oriented(path, policy, false); }
+
+LoadedMesh load_mesh_oriented(const fs::path& path, const LoadPolicy& policy, bool outward) {
   PolygonSoup soup = read_polygon_soup(path);
   LoadedMesh out;
   out.diagnosis = diagnose_soup(soup);
@@ -245,7 +248,9 @@ LoadedMesh load_mesh(const fs::path& path, const LoadPolicy& policy) {
     if (!policy.allow_several_components && topo.components.size() > 1)
       throw PreconditionError(std::to_string(topo.components.size()) +
                               " connected components; a single connected surface is required");
-    out.mesh = triangles_to_mesh(std::move(tris), topo, policy.fix_orientation);
+    out.orientation = make_orientation_consistent(tris, topo, policy.fix_orientation);
+    if (outward) out.orientation.append(orient_outward(tris, topo));
+    out.mesh = build_mesh(tris);
     out.topology = topo.inconsistent_edges ? analyze_topology(out.mesh) : std::move(topo);
   } catch (const PreconditionError& e) {
     throw InputError(path.string(), e.what());

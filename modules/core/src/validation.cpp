@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/orientation.h"
 
 namespace cf {
 namespace {
@@ -238,8 +239,14 @@ void add_topology_findings(const TopologyReport& t, bool allow_boundary, MeshDia
                           "open surface: " + plural(t.boundary_edges, "boundary edge", "boundary edges") + " in " +
                               plural(t.boundary_loops, "boundary loop", "boundary loops") +
                               examples(t.example_boundary_edges, edge_str)});
-  if (!t.orientable)
-    d.findings.push_back({"non_orientable", Severity::kDefect, 1, "the surface is not orientable"});
+  if (!t.orientable) {
+    std::size_t c = 0;
+    while (c + 1 < t.components.size() && t.components[c].orientable) ++c;
+    d.findings.push_back({"non_orientable", Severity::kDefect, 1,
+                          "the surface is not orientable: component " + std::to_string(c) + " (" +
+                              std::to_string(t.components.empty() ? t.faces : t.components[c].faces) +
+                              " faces) has no inside and no outside (a Moebius-like twist)"});
+  }
   else if (t.inconsistent_edges)
     d.findings.push_back({"inconsistent_orientation", Severity::kRepaired, t.inconsistent_edges,
                           "inconsistent orientation: " +
@@ -249,6 +256,30 @@ void add_topology_findings(const TopologyReport& t, bool allow_boundary, MeshDia
   if (t.components.size() > 1)
     d.findings.push_back({"several_components", Severity::kNote, t.components.size(),
                           std::to_string(t.components.size()) + " connected components"});
+}
+
+void add_orientation_findings(TriangleList t, const TopologyReport& topo, MeshDiagnosis& d) {
+  if (!topo.manifold || !topo.orientable || topo.components.empty()) return;
+  make_consistent(t, topo);
+  const std::vector<ComponentSide> sides = component_sides(t, topo);
+  std::size_t n = 0;
+  std::string first;
+  for (std::size_t c = 0; c < sides.size(); ++c) {
+    if (!sides[c].inward()) continue;
+    if (n++ == 0) {
+      std::ostringstream s;
+      s.setf(std::ios::fixed);
+      s.precision(1);
+      s << "component " << c << " (" << sides[c].faces << " faces, signed volume " << sides[c].volume_mm3 / 1e3 << " mL"
+        << (sides[c].depth ? ", inside another component" : "") << ")";
+      first = s.str();
+    }
+  }
+  if (n)
+    d.findings.push_back({"inward_normals", Severity::kNote, n,
+                          plural(n, "closed component has", "closed components have") +
+                              " normals pointing into the lumen, e.g. " + first +
+                              "; the stages reverse them (docs/conventions.md, Orientation)"});
 }
 
 TriangleList soup_to_triangles(const PolygonSoup& soup, const LoadPolicy& policy,
@@ -290,85 +321,20 @@ TriangleList soup_to_triangles(const PolygonSoup& soup, const LoadPolicy& policy
   return t;
 }
 
-Mesh triangles_to_mesh(TriangleList t, const TopologyReport& topo, bool fix_orientation) {
+OrientationReport make_orientation_consistent(TriangleList& t, const TopologyReport& topo, bool fix_orientation) {
   if (!topo.manifold) {
     MeshDiagnosis d;
     add_topology_findings(topo, true, d);
     throw PreconditionError("not a 2-manifold: " + d.summary(Severity::kDefect));
   }
-  if (!topo.orientable) throw PreconditionError("the surface is not orientable");
-  if (topo.inconsistent_edges) {
-    if (!fix_orientation)
-      throw PreconditionError("inconsistent orientation on " + std::to_string(topo.inconsistent_edges) + " edges");
-    // Breadth-first re-orientation across manifold edges, one seed per component.
-    const std::size_t F = t.triangles.size();
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> recs;
-    recs.reserve(3 * F);
-    for (std::size_t f = 0; f < F; ++f)
-      for (int k = 0; k < 3; ++k) {
-        std::uint64_t a = t.triangles[f][k], b = t.triangles[f][(k + 1) % 3];
-        if (a > b) std::swap(a, b);
-        recs.emplace_back((a << 32) | b, static_cast<std::uint32_t>(f));
-      }
-    std::sort(recs.begin(), recs.end());
-    std::vector<std::uint32_t> adj_start(F + 1, 0), adj;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    for (std::size_t i = 0; i + 1 < recs.size(); ++i)
-      if (recs[i].first == recs[i + 1].first) pairs.emplace_back(recs[i].second, recs[i + 1].second);
-    for (auto& p : pairs) {
-      ++adj_start[p.first + 1];
-      ++adj_start[p.second + 1];
-    }
-    for (std::size_t f = 0; f < F; ++f) adj_start[f + 1] += adj_start[f];
-    adj.resize(adj_start[F]);
-    std::vector<std::uint32_t> fill(adj_start.begin(), adj_start.end() - 1);
-    for (auto& p : pairs) {
-      adj[fill[p.first]++] = p.second;
-      adj[fill[p.second]++] = p.first;
-    }
-    std::vector<std::uint8_t> seen(F, 0);
-    auto directed = [&](std::uint32_t f, int a, int b) {
-      const auto& tr = t.triangles[f];
-      for (int k = 0; k < 3; ++k)
-        if (tr[k] == a && tr[(k + 1) % 3] == b) return true;
-      return false;
-    };
-    for (std::size_t s = 0; s < F; ++s) {
-      if (seen[s]) continue;
-      seen[s] = 1;
-      std::deque<std::uint32_t> q{static_cast<std::uint32_t>(s)};
-      while (!q.empty()) {
-        const std::uint32_t f = q.front();
-        q.pop_front();
-        for (std::uint32_t i = adj_start[f]; i < adj_start[f + 1]; ++i) {
-          const std::uint32_t g = adj[i];
-          if (seen[g]) continue;
-          seen[g] = 1;
-          // Shared edge: find it and make g traverse it opposite to f.
-          const auto& tf = t.triangles[f];
-          for (int k = 0; k < 3; ++k) {
-            const int a = tf[k], b = tf[(k + 1) % 3];
-            if (directed(g, a, b)) {
-              std::swap(t.triangles[g][1], t.triangles[g][2]);
-              break;
-            }
-            if (directed(g, b, a)) break;
-          }
-          q.push_back(g);
-        }
-      }
-    }
-  }
-  Mesh mesh;
-  mesh.reserve(t.points.size(), t.triangles.size() * 3 / 2, t.triangles.size());
-  for (const auto& p : t.points) mesh.add_vertex(Vec3(p[0], p[1], p[2]));
-  for (std::size_t f = 0; f < t.triangles.size(); ++f) {
-    const auto& tr = t.triangles[f];
-    auto fh = mesh.add_face(Mesh::VertexHandle(tr[0]), Mesh::VertexHandle(tr[1]), Mesh::VertexHandle(tr[2]));
-    if (!fh.is_valid())
-      throw PreconditionError("face " + std::to_string(f) + " could not be added to the halfedge mesh");
-  }
-  return mesh;
+  if (topo.inconsistent_edges && !fix_orientation && topo.orientable)
+    throw PreconditionError("inconsistent orientation on " + std::to_string(topo.inconsistent_edges) + " edges");
+  return make_consistent(t, topo);  // refuses a non-orientable component with its size
+}
+
+Mesh triangles_to_mesh(TriangleList t, const TopologyReport& topo, bool fix_orientation) {
+  make_orientation_consistent(t, topo, fix_orientation);
+  return build_mesh(t);
 }
 
 }  // namespace cf

@@ -27,6 +27,7 @@ const ParamTable<DenoiseOptions>& denoise_param_table() {
 }
 
 void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
+  const nlohmann::json orientation = orient_mesh_input(bag, "surface", ctx, "denoise");
   const Mesh& in = bag.get<Mesh>("surface");
   int last_shown = -1;
   auto progress = [&](int removed, int total) {
@@ -55,6 +56,7 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
         << r.report["totals"]["cap_intersections"].get<std::size_t>() << " triangle pairs; --strict makes this an error)";
   ctx.progress(msg.str());
   ctx.report = r.report;
+  ctx.report["orientation"] = orientation;
   bag.put("denoised", std::move(r.mesh));
   bag.put("loops", LoopSet(std::move(r.loops)));
 }

@@ -227,6 +227,7 @@ nlohmann::json flat_report(const FlatMap& f) {
   return {{"segments", segs},
           {"segment_count", f.segments.size()},
           {"skipped_components", f.skipped_components},
+          {"skipped", f.skipped},
           {"flat_vertices", f.uv.size()},
           {"flat_triangles", f.triangles.size()},
           {"coverage", coverage_to_json(f.coverage)},

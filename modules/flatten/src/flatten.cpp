@@ -41,26 +41,6 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
   return s;
 }
 
-// Signed volume (x6) of the surface closed by cones to its centroid: > 0 when normals point out.
-double signed_volume(const Surface& s) {
-  V3 centroid = V3::Zero();
-  for (const auto& p : s.p) centroid += p;
-  centroid /= double(s.p.size());
-  double vol = 0;
-  for (const Tri& t : s.t) vol += (s.p[t[0]] - centroid).dot((s.p[t[1]] - centroid).cross(s.p[t[2]] - centroid));
-  return vol;
-}
-
-void check_component(const ComponentTopology& ct, std::size_t c) {
-  if (!ct.genus) throw PreconditionError("segment " + std::to_string(c) + " is not an orientable 2-manifold");
-  if (*ct.genus > 0)
-    throw PreconditionError("colon segment " + std::to_string(c) + " has genus " + std::to_string(*ct.genus) +
-                            " (handles); flatten needs genus 0: run denoise first");
-  if (ct.boundary_loops > 2)
-    throw PreconditionError("colon segment " + std::to_string(c) + " has " + std::to_string(ct.boundary_loops) +
-                            " boundary loops; flatten needs a closed surface or a tube with two open ends");
-}
-
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
 // smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The fill-reducing
 // order of the conformal solve (w.prior) is computed on a second thread meanwhile, on the closed
@@ -80,8 +60,9 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
   if (loops.size() != 2 || chi != 0)
-    throw Error("could not open the ends of colon segment " + std::to_string(c) + " into a tube (" +
-                std::to_string(loops.size()) + " boundary loops, Euler characteristic " + std::to_string(chi) + ")");
+    throw Error("could not open the ends of component " + std::to_string(c) + " (" + std::to_string(s.t.size()) +
+                " faces) into a tube: it is not tube-like (" + std::to_string(loops.size()) +
+                " boundary loops after opening, Euler characteristic " + std::to_string(chi) + ")");
   auto min_src = [&](const std::vector<int>& l) {
     int m = INT32_MAX;
     for (int v : l) m = std::min(m, w.ann.src[v]);
@@ -446,31 +427,21 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
   out.input_faces = topo.faces;
   if (topo.faces == 0) throw PreconditionError("the surface has no triangles");
   if (!topo.manifold) throw PreconditionError("the surface is not a 2-manifold; flatten needs a clean colon surface");
-  const std::size_t largest = topo.components[0].faces;
+  ComponentScreen screen(mesh, topo, opts);
   std::vector<SegmentWork> work;
   for (std::size_t c = 0; c < topo.components.size(); ++c) {
-    const ComponentTopology& ct = topo.components[c];
-    if (double(ct.faces) < opts.min_segment_fraction * double(largest) || ct.faces < 8) {
-      ++out.skipped_components;
-      continue;
-    }
-    check_component(ct, c);
+    if (!screen.admit(c)) continue;
     const Surface s = component_surface(mesh, topo, int(c));
-    // Normals out of the lumen (the reconstruct convention): a closed component enclosing a
-    // negative volume is the wall of a cavity (a blob floating in the lumen): skipped.
-    const double vol = signed_volume(s);
-    if (ct.boundary_loops == 0 && vol < 0) {
-      ++out.skipped_components;
-      continue;
-    }
-    auto ws = flatten_surface(s, ct.boundary_loops, c, vol >= 0 ? 1.0 : -1.0, opts, 0);
+    auto ws = flatten_surface(s, topo.components[c].boundary_loops, c, screen.lumen_sign(c), opts, 0);
     const int base = int(work.size());
     for (auto& w : ws) {
       if (w.parent >= 0) w.parent += base;
       work.push_back(std::move(w));
     }
   }
-  if (work.empty()) throw PreconditionError("no colon segment large enough to flatten");
+  out.skipped_components = screen.skipped().size();
+  out.skipped = screen.skipped();
+  if (work.empty()) screen.nothing_flattened();
   double xmin = 1e300, xmax = -1e300;
   for (const auto& p : mesh.points) xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
   const std::vector<char> reversed = label_and_order(work, 0.5 * (xmin + xmax));

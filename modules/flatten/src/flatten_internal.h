@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "colonflat/core/orientation.h"
+#include "colonflat/core/topology.h"
 #include "colonflat/flatten/flatten.h"
 
 namespace cf::flat_detail {
@@ -25,6 +27,29 @@ struct Surface {
   std::vector<V3> p;
   std::vector<Tri> t;
   std::vector<int> src;  // input vertex id of each local vertex
+};
+
+// Which components of the input are flattened (component_screen.cpp). admit() says whether
+// component c is colon wall to flatten; a component that is not is skipped with its reason (too
+// small, a cavity's wall) or refused with a PreconditionError naming it, its size and the cause
+// (not a 2-manifold, genus > 0, open in more than 2 places, normals into the lumen).
+class ComponentScreen {
+ public:
+  ComponentScreen(const TriangleList& mesh, const TopologyReport& topo, const FlattenOptions& o);
+  bool admit(std::size_t c);
+  double lumen_sign(std::size_t c) const;  // +1 when normals point out of the lumen
+  const std::vector<std::string>& skipped() const { return skipped_; }
+  // Throws the PreconditionError for an input with no component to flatten, naming each skipped one.
+  [[noreturn]] void nothing_flattened() const;
+  std::string name(std::size_t c) const;  // "component 0 (1460112 faces, 52341 mm2, encloses 3800.0 mL)"
+
+ private:
+  bool skip(std::size_t c, const std::string& why);
+  const TriangleList& mesh_;
+  const TopologyReport& topo_;
+  const FlattenOptions& o_;
+  std::vector<ComponentSide> sides_;
+  std::vector<std::string> skipped_;
 };
 
 // Edge graph: edges lo < hi, sorted by (lo, hi), their one or two faces, and the edge opposite

@@ -28,10 +28,13 @@ const ParamTable<FlattenOptions>& flatten_param_table() {
 }
 
 void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
+  const nlohmann::json orientation = orient_mesh_input(bag, "denoised", ctx, "flatten");
   const Mesh& mesh = bag.get<Mesh>("denoised");
   Stopwatch sw;
   FlatMap flat = flatten_colon(mesh, opts_);
   ctx.report = flat_report(flat);
+  ctx.report["orientation"] = orientation;
+  for (const auto& s : flat.skipped) ctx.progress("flatten: skipped " + s);
   ctx.report["flatten_time_s"] = sw.seconds();
   for (const auto& s : flat.segments) {
     std::ostringstream line;

@@ -54,6 +54,8 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   bag.put("colon_image", r.colon.image);
   bag.put("candidates", r.candidates_json);
   if (!opts_.snapshots) return;
+  for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
+    if (bag.has(port)) ctx.report["orientation"][port] = orient_mesh_input(bag, port, ctx, "render");
   try {
     // denoise's loops, in memory in `colonflat run` or read from --loops: drawn as polylines
     vtkSmartPointer<vtkPolyData> loops;

@@ -27,9 +27,12 @@ struct LoadedMesh {
   Mesh mesh;
   MeshDiagnosis diagnosis;
   TopologyReport topology;  // of `mesh` as loaded
+  OrientationReport orientation;  // faces turned to agree with their neighbours (not reversed)
 };
 
-// Reads, diagnoses and converts a file to a valid, consistently oriented triangle mesh.
+// Reads, diagnoses and converts a file to a valid, consistently oriented triangle mesh (each
+// component's minority of faces turned; whether its normals point out of the lumen is the
+// stages' business: orient_outward(), orientation.h).
 // Throws InputError with the diagnosis when the file cannot be made a 2-manifold per `policy`.
 LoadedMesh load_mesh(const std::filesystem::path& path, const LoadPolicy& policy = {});
 

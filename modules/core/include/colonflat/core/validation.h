@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "colonflat/core/orientation.h"
 #include "colonflat/core/soup.h"
 #include "colonflat/core/topology.h"
 
@@ -48,9 +49,19 @@ MeshDiagnosis diagnose_soup(const PolygonSoup& soup);
 // Adds the findings a topology report implies (boundary, non-manifold, orientation, components).
 void add_topology_findings(const TopologyReport& topo, bool allow_boundary, MeshDiagnosis& diag);
 
+// Adds a note when closed components have their normals into the lumen (orientation.h: the
+// signed volume's sign against the nesting depth; faces made consistent first on the copy `t`).
+void add_orientation_findings(TriangleList t, const TopologyReport& topo, MeshDiagnosis& diag);
+
 // Triangulates and cleans a soup per `policy`. Throws PreconditionError on fatal findings.
 TriangleList soup_to_triangles(const PolygonSoup& soup, const LoadPolicy& policy,
                                const MeshDiagnosis& diag);
+
+// Checks that `t` is a manifold and makes every component consistently oriented (see
+// orientation.h make_consistent); returns the faces turned. Throws PreconditionError naming the
+// defect (not a manifold, a non-orientable component with its size, or an inconsistent
+// orientation when !fix_orientation).
+OrientationReport make_orientation_consistent(TriangleList& t, const TopologyReport& topo, bool fix_orientation);
 
 // Makes a consistently oriented OpenMesh mesh. Preconditions: manifold, orientable triangles
 // (checked; throws PreconditionError naming the defect otherwise).

@@ -115,11 +115,15 @@ struct FlatMap {
   DistortionStats stats;                        // over all segments
   Coverage coverage;                            // over all segments
   std::size_t skipped_components = 0;           // small components and cavity walls not flattened
+  std::vector<std::string> skipped;             // each skipped component with its size and reason
   std::size_t input_vertices = 0, input_faces = 0;
 };
 
-// Flattens every colon segment of `mesh` (LPS mm). Throws PreconditionError when a segment has
-// genus > 0 ("run denoise first"), more than two boundary loops, or is not a manifold.
+// Flattens every colon segment of `mesh` (LPS mm; normals out of the lumen: the stage orients its
+// input first with core's orient_outward). Throws PreconditionError naming the component, its
+// size and the cause when a component has genus > 0 ("run denoise first"), more than two boundary
+// loops, is not a manifold or has its normals into the lumen, and when no component is left to
+// flatten (each skipped one named: too small, a cavity's wall).
 FlatMap flatten_colon(const Mesh& mesh, const FlattenOptions& opts = {});
 FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts = {});
 
