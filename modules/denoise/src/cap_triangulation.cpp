@@ -6,8 +6,15 @@
 #include <string>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 
 namespace cf {
+
+namespace {
+// Rings from this many vertices split the restricted triangulation's subproblems over the threads:
+// below, a length's subproblems take less time than handing them to threads.
+constexpr int kParallelRing = 48;
+}  // namespace
 
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
                                                         const std::function<bool(int, int, int)>& allowed) {
@@ -17,19 +24,41 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
   auto area = [&](int i, int m, int j) { return 0.5 * OpenMesh::cross(ring[m] - ring[i], ring[j] - ring[i]).norm(); };
   std::vector<double> W(static_cast<std::size_t>(n) * n, 0.0);
   std::vector<int> arg(static_cast<std::size_t>(n) * n, -1);
-  for (int len = 2; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
-      double best = std::numeric_limits<double>::infinity();
-      for (int m = i + 1; m < j; ++m) {
-        const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] + area(i, m, j);
-        if (w < best && (!allowed || allowed(i, m, j))) {
-          best = w;
-          arg[std::size_t(i) * n + j] = m;
-        }
-      }
-      W[std::size_t(i) * n + j] = best;
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  // Subproblem (i, j): the lightest triangle (i, m, j) over triangulated sides. With `allowed`
+  // (a grid query per triangle), the candidates are tried lightest first until one passes: in
+  // the order of m it ran for every m that improved on the lightest allowed one so far, which on
+  // a twisted loop whose triangles mostly cross the surface is nearly every m.
+  auto solve = [&](int i, int j, std::vector<std::pair<double, int>>& order) {
+    double best = kNone;
+    int best_m = -1;
+    order.clear();
+    for (int m = i + 1; m < j; ++m) {
+      const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] + area(i, m, j);
+      if (!(w < kNone)) continue;  // a side has no triangulation
+      if (allowed) order.push_back({w, m});
+      else if (w < best) best = w, best_m = m;
     }
+    std::sort(order.begin(), order.end());
+    for (const auto& [w, m] : order)
+      if (allowed(i, m, j)) {
+        best = w, best_m = m;
+        break;
+      }
+    W[std::size_t(i) * n + j] = best;
+    arg[std::size_t(i) * n + j] = best_m;
+  };
+  // The subproblems of one length are independent (they read shorter ones only): with `allowed`
+  // on a long ring they are split over the threads (the result does not depend on the split).
+  const bool split = allowed && n >= kParallelRing;
+  for (int len = 2; len < n; ++len) {
+    auto range = [&](std::size_t begin, std::size_t end) {
+      std::vector<std::pair<double, int>> order;
+      for (std::size_t i = begin; i < end; ++i) solve(int(i), int(i) + len, order);
+    };
+    if (split) parallel_for(std::size_t(n - len), range);
+    else range(0, std::size_t(n - len));
+  }
   std::vector<std::pair<int, int>> stack{{0, n - 1}};
   while (!stack.empty()) {
     auto [i, j] = stack.back();

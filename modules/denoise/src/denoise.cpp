@@ -6,6 +6,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/denoise/stumps.h"
 #include "denoise_internal.h"
 
@@ -139,7 +140,8 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   Stopwatch total;
   DenoiseResult res;
   detail::DenoiseState st(res.mesh);
-  if (o.threads > 1) st.worker = std::make_unique<detail::SearchWorker>();
+  const int threads = std::min(thread_count(), detail::kMaxThreads);
+  if (threads > 1) st.worker = std::make_unique<detail::SearchWorker>(threads);
   double t_analysis = 0;
   detail::prepare_input(st, input, o, &res.before, &t_analysis);
   phase_done("topology analysis");

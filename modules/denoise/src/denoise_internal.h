@@ -18,6 +18,11 @@ namespace cf::detail {
 // candidates per cap check, a small cost next to the build.
 constexpr double kGuardCellEdges = 3.0;
 
+// Threads denoise uses at most (cf::thread_count() above it is capped): a batch of group searches
+// holds at most 16 groups (ExactGreedy::batch_size()), and each thread keeps its own per-vertex
+// search state (about 40 bytes per vertex), so more threads would only hold memory.
+constexpr int kMaxThreads = 16;
+
 struct Timers {
   double homology = 0, search = 0, surgery = 0, verify = 0, stumps = 0;
 };
@@ -38,8 +43,8 @@ struct DenoiseState {
   Timers t;
   std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked (or by prepare_input())
   double mean_edge = 0;
-  std::unique_ptr<SearchWorker> worker;             // the helper thread (DenoiseOptions::threads > 1)
-  std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare_input() on two threads, taken by the exact method
+  std::unique_ptr<SearchWorker> worker;             // the helper threads (cf::thread_count() > 1), else null
+  std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare_input() with helper threads, taken by the exact method
 
   // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others
   // (caps) have no input id.

@@ -1,5 +1,5 @@
-// Setting up a denoise run: the working copy of the input, the input's topology and, with two
-// threads, the cap guard grid and the first homology basis built at the same time.
+// Setting up a denoise run: the working copy of the input, the input's topology and, with
+// helper threads, the cap guard grid and the first homology basis built at the same time.
 #include <algorithm>
 #include <exception>
 #include <iterator>

@@ -53,11 +53,12 @@ SurgeryResult ExactGreedy::cut_recorded(const std::vector<Mesh::VertexHandle>& l
   return sr;
 }
 
-// Undoes the last cut_recorded() (mesh, bookkeeping; the face grid guard is rebuilt later).
+// Undoes the last cut_recorded() (mesh, bookkeeping; the guard forgets the faces it added: a
+// rebuild of the whole grid cost 0.2-0.4 s per undo at 1.8 M faces).
 void ExactGreedy::revert_cut(const SurgeryResult& sr) {
   Stopwatch sw;
   undo_surgery(st_.mesh, sr.undo);
-  st_.guard.reset();
+  if (st_.guard) st_.guard->forget_faces_from(static_cast<int>(sr.undo.faces));
   st_.cap_rings.resize(st_.cap_rings.size() - 2);
   st_.origin.resize(st_.mesh.n_vertices());
   st_.component.resize(st_.mesh.n_vertices());
@@ -98,6 +99,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<M
   }
   search_->set_avoid(nullptr);
   st_.t.search += sw.seconds();
+  fallback_s_ += sw.seconds();
   return found;
 }
 

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/loop_search.h"
 #include "denoise_internal.h"
 #include "search_worker.h"
@@ -109,11 +110,16 @@ class ExactGreedy {
   bool near_group(int seed, const GroupRun& g) const;
   static constexpr std::size_t kMaxSkipped = 64;  // far-first entries set aside per batch, at most
   static constexpr double kGroupRadius = 0.5;  // first group radius, times the best known loop
-  // Two threads: groups are searched in batches, half on each thread, of about this many
-  // settled vertices per thread (from the last batch's mean), at most kMaxBatch groups per
-  // thread: one hand-over costs about as much as a small search.
+  // Groups are searched in batches of kBatchLanes lanes of about kBatchWork settled vertices
+  // each (from the last batch's mean), at most kMaxBatch groups per lane: one hand-over to a
+  // thread costs about as much as a small search. The lanes are a fixed number, not the thread
+  // count, so that the searches are the same for any thread count; the threads share the lanes'
+  // groups. kBatchLanes = 2: the batches the former `--threads 2` formed (measured in sessions
+  // 6-8: same loops, no loss on the 300-handle sphere), now formed for any thread count; up to
+  // 16 groups per batch when the groups are small.
   static constexpr std::size_t kBatchWork = 2000;
   static constexpr std::size_t kMaxBatch = 8;
+  static constexpr std::size_t kBatchLanes = 2;
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
                             int iteration);
@@ -130,6 +136,7 @@ class ExactGreedy {
   void cut(int slot, const CycleCandidate& c, int iteration);
   int total_genus_left() const;
   void update_crossing_wanted();
+  void debug_cut(int iteration, double surgery_s);
 
   DenoiseState& st_;
   const DenoiseOptions& opts_;
@@ -140,8 +147,8 @@ class ExactGreedy {
   HomologyBasis homology_;
   Z2Span span_;
   std::unique_ptr<FundamentalCycleSearch> search_;
-  std::unique_ptr<FundamentalCycleSearch> search2_;  // the second thread's (DenoiseOptions::threads > 1)
-  SearchWorker* worker_ = nullptr;  // DenoiseState::worker (two threads)
+  std::vector<std::unique_ptr<FundamentalCycleSearch>> searches_extra_;  // helper thread t's is [t - 1]
+  SearchWorker* worker_ = nullptr;  // DenoiseState::worker (null with one thread)
   std::size_t last_group_settled_ = 0;  // mean settled vertices per group search of the last batch
   bool crossing_wanted_ = false;  // closed, total genus 1, policy shortest: use crossing families
   int closed_ = 0;               // mesh without boundary: 1, with: -1, unknown: 0
@@ -178,6 +185,9 @@ class ExactGreedy {
   // of a build's cost: below it the searches are local and a fresh cut graph does not help).
   static constexpr double kRebuildWorkPerCut = 0.25;
   double largest_limit_ = 0;
+  Stopwatch debug_clock_;  // COLONFLAT_DENOISE_DEBUG: since the last cut
+  double debug_search_ = 0, fallback_s_ = 0;
+  long long debug_searches_ = 0, debug_settled_ = 0;
 };
 
 }  // namespace cf::detail

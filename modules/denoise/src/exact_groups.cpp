@@ -63,9 +63,9 @@ ExactGreedy::GroupRun ExactGreedy::prepare_group(int seed, double best, std::uin
   return g;
 }
 
-// One search from the group around `seed` (best = the best known loop's value) and, with two
-// threads, a batch of further groups from the next seeds of the far-first order (or far in
-// space from the seed), half of them searched on each thread. Any order of searches keeps the
+// One search from the group around `seed` (best = the best known loop's value) and a batch of
+// further groups from the next seeds of the far-first order (or far in space from the seed),
+// split over the threads. Any order of searches keeps the
 // result exact (every bound stays a valid lower bound); a group that an earlier one of its
 // batch would have certified costs one search more.
 void ExactGreedy::search_group(int seed, double best) {
@@ -92,12 +92,14 @@ void ExactGreedy::search_group(int seed, double best) {
   st_.t.search += sw.seconds();
 }
 
-// Groups in the next batch: 1 with one thread or while the Z family is being found (its first
-// loop comes from run 0's search state); else enough for kBatchWork settled vertices per thread.
+// Groups in the next batch: 1 while the Z family is being found (its first loop comes from run
+// 0's search state); else enough for kBatchWork settled vertices per lane, kBatchLanes lanes.
+// Never from the thread count: the batches, hence every search and bound, are the same whatever
+// the number of threads that runs them (identical loops and mesh for any --threads).
 std::size_t ExactGreedy::batch_size() const {
-  if (!worker_ || (crossing_ && families_.size() == 2)) return 1;
-  const std::size_t per_thread = kBatchWork / std::max<std::size_t>(1, last_group_settled_);
-  return 2 * std::clamp<std::size_t>(per_thread, 1, kMaxBatch);
+  if (crossing_ && families_.size() == 2) return 1;
+  const std::size_t per_lane = kBatchWork / std::max<std::size_t>(1, last_group_settled_);
+  return kBatchLanes * std::clamp<std::size_t>(per_lane, 1, kMaxBatch);
 }
 
 // Whether a group search from `seed` may settle a vertex that the search of g settles (their
@@ -156,15 +158,22 @@ void ExactGreedy::run_group(GroupRun& g, FundamentalCycleSearch& search) const {
   }
 }
 
-// Run 0 on this thread's search object (extract() of its result stays possible); with a batch,
-// the even runs here and the odd ones on the helper thread.
+// Run 0 on this thread's search object (extract() of its result stays possible); with T
+// threads, thread t searches runs t, t + T, ... with its own search object. A run's result does
+// not depend on the search object or thread that computes it.
 void ExactGreedy::run_groups(std::vector<GroupRun>& runs) {
-  auto run_share = [this, &runs](std::size_t parity, FundamentalCycleSearch& search) {
-    for (std::size_t i = parity; i < runs.size(); i += 2) run_group(runs[i], search);
-  };
-  if (runs.size() == 1) return run_group(runs[0], *search_);
+  const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), runs.size())) : 1;
+  if (lanes == 1) {
+    for (GroupRun& g : runs) run_group(g, *search_);
+    return;
+  }
+  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
+    searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
   parallel_pairs_ += static_cast<long long>(runs.size() / 2);
-  worker_->run_both([&] { run_share(0, *search_); }, [&] { run_share(1, *search2_); });
+  worker_->run(lanes, [&](int t) {
+    FundamentalCycleSearch& search = t == 0 ? *search_ : *searches_extra_[t - 1];
+    for (std::size_t i = t; i < runs.size(); i += lanes) run_group(runs[i], search);
+  });
 }
 
 // Bounds after a group search of value `own`: F >= own for every member, F >= own - 2d for

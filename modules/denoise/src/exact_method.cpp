@@ -3,6 +3,8 @@
 // between nearby sources (docs/denoise.md, "How it is fast").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <numeric>
 
@@ -174,7 +176,9 @@ void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   std::vector<std::uint64_t> reduced = cls;
   if (span_.reduce(reduced.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
   const int comp = st_.component[loop.front().idx()];
+  const double surgery0 = st_.t.surgery;
   const SurgeryResult sr = cut_cleanly(loop, reduced, iteration);
+  if (std::getenv("COLONFLAT_DENOISE_DEBUG")) debug_cut(iteration, st_.t.surgery - surgery0);
   span_.insert(cls.data());  // the same span whichever loop of the class was cut
   --st_.genus_left[comp];
   if (crossing_) return;  // back to the span family on the new mesh
@@ -182,6 +186,22 @@ void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   lower_bounds_near(sr);
   add_surgery_sources(sr);
   st_.t.search += sw.seconds();
+}
+
+// COLONFLAT_DENOISE_DEBUG: one stderr line per cut (what the cut and the searches before it cost).
+void ExactGreedy::debug_cut(int iteration, double surgery_s) {
+  const LoopRecord& L = st_.loops.back();
+  std::fprintf(stderr,
+               "denoise debug: cut %d: %.1f mm, %zu vertices, %zu cap pairs%s; since the last cut: %.2f s "
+               "(search %.2f s, %lld searches, %lld settled; same-class fallback %.2f s), surgery %.2f s\n",
+               iteration, L.length, L.vertex_ids.size(), L.cap_intersections,
+               L.replaced_length > 0 ? " (replaced a loop)" : "", debug_clock_.seconds(), st_.t.search - debug_search_,
+               searches_ - debug_searches_, settled_ - debug_settled_, fallback_s_, surgery_s);
+  fallback_s_ = 0;
+  debug_clock_.restart();
+  debug_search_ = st_.t.search;
+  debug_searches_ = searches_;
+  debug_settled_ = settled_;
 }
 
 void ExactGreedy::write_stats(nlohmann::json& stats) const {

@@ -28,9 +28,8 @@ void ExactGreedy::build_homology() {
   // The searches keep their per-vertex arrays (a fresh one page-faults 40 MB at 1.6 M vertices);
   // set_cochain(nullptr) takes the new class width.
   if (!search_) search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
-  if (opts_.threads > 1 && !search2_) search2_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
   search_->set_cochain(nullptr);
-  if (search2_) search2_->set_cochain(nullptr);
+  for (auto& s : searches_extra_) s->set_cochain(nullptr);
   deactivate_all_slots();
   queue_ = {};
   exact_queue_ = {};

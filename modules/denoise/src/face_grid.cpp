@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <unordered_set>
 
 #include "colonflat/core/huge_pages.h"
@@ -56,19 +58,72 @@ std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   } else {
     for (long long x = a.x; x <= b.x; ++x)
       for (long long y = a.y; y <= b.y; ++y)
-        for (long long z = a.z; z <= b.z; ++z) {
-          const Key k{x, y, z};
-          const std::uint64_t code = StaticCells::code(k);
-          const std::uint32_t row = code == StaticCells::kEmpty ? StaticCells::kNoRow : static_.find(code);
-          if (row != StaticCells::kNoRow) add_row(row);
-          if (cells_.empty()) continue;
-          auto it = cells_.find(k);
-          if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
-        }
+        for (long long z = a.z; z <= b.z; ++z) cell_faces(Key{x, y, z}, [&](int f) { return cand.push_back(f), false; });
   }
   std::sort(cand.begin(), cand.end());
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
   return cand;
+}
+
+// Calls visit(cell) for the cells that the plane of triangle p crosses inside the triangle's
+// bounding box (every cell the triangle meets is one of them) until visit returns true; returns
+// whether it did. Per column of cells along the plane's dominant normal axis, the plane spans a
+// short range of that axis: a cap triangle of a long loop (tens of mm) has 10^4-10^5 cells in its
+// bounding box, and most of the surface's faces near the loop in them, but its plane crosses
+// only a sheet of cells one or two thick. A degenerate triangle visits its whole box.
+template <class Visit>
+bool FaceGrid::triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const {
+  Vec3 lo = p[0], hi = p[0];
+  for (int i = 1; i < 3; ++i) {
+    lo.minimize(p[i]);
+    hi.maximize(p[i]);
+  }
+  const Vec3 n = OpenMesh::cross(p[1] - p[0], p[2] - p[0]);
+  int d = 0;
+  for (int a = 1; a < 3; ++a)
+    if (std::fabs(n[a]) > std::fabs(n[d])) d = a;
+  const int u = (d + 1) % 3, v = (d + 2) % 3;
+  const double c = OpenMesh::dot(n, p[0]), slack = 1e-9 * cell_;
+  const Key ka = key(lo), kb = key(hi);
+  const long long la[3] = {ka.x, ka.y, ka.z}, lb[3] = {kb.x, kb.y, kb.z};
+  long long k[3];
+  for (k[u] = la[u]; k[u] <= lb[u]; ++k[u])
+    for (k[v] = la[v]; k[v] <= lb[v]; ++k[v]) {
+      long long d0 = la[d], d1 = lb[d];
+      if (n[d] != 0) {  // the plane's range of axis d over the column's rectangle clamped to the box
+        const double u0 = std::max(k[u] * cell_, lo[u]), u1 = std::min((k[u] + 1) * cell_, hi[u]);
+        const double v0 = std::max(k[v] * cell_, lo[v]), v1 = std::min((k[v] + 1) * cell_, hi[v]);
+        double dmin = std::numeric_limits<double>::infinity(), dmax = -dmin;
+        for (double uu : {u0, u1})
+          for (double vv : {v0, v1}) {
+            const double x = (c - n[u] * uu - n[v] * vv) / n[d];
+            dmin = std::min(dmin, x);
+            dmax = std::max(dmax, x);
+          }
+        d0 = std::max(d0, static_cast<long long>(std::floor((std::max(dmin, lo[d]) - slack) / cell_)));
+        d1 = std::min(d1, static_cast<long long>(std::floor((std::min(dmax, hi[d]) + slack) / cell_)));
+      }
+      for (k[d] = d0; k[d] <= d1; ++k[d])
+        if (visit(Key{k[0], k[1], k[2]})) return true;
+    }
+  return false;
+}
+
+// Calls visit(face id) for the grid faces of cell k (a face may come again from another cell)
+// until visit returns true; returns whether it did.
+template <class Visit>
+bool FaceGrid::cell_faces(const Key& k, Visit&& visit) const {
+  const std::uint64_t code = StaticCells::code(k);
+  const std::uint32_t row = code == StaticCells::kEmpty ? StaticCells::kNoRow : static_.find(code);
+  if (row != StaticCells::kNoRow)
+    for (const int* f = static_.begin(row); f != static_.end(row); ++f)
+      if (!erased(*f) && visit(*f)) return true;
+  if (cells_.empty()) return false;
+  const auto it = cells_.find(k);
+  if (it != cells_.end())
+    for (int f : it->second)
+      if (visit(f)) return true;
+  return false;
 }
 
 // ---- the constructor's faces in compressed rows per cell ----
@@ -197,6 +252,15 @@ void FaceGrid::insert_dynamic(const Mesh& mesh, Mesh::FaceHandle f) {
   if (!small && big_set_.insert(f.idx()).second) big_.push_back(f.idx());  // checked by every query instead
 }
 
+void FaceGrid::forget_faces_from(int first) {
+  for (auto& [k, faces] : cells_) {
+    (void)k;
+    faces.erase(std::remove_if(faces.begin(), faces.end(), [first](int f) { return f >= first; }), faces.end());
+  }
+  big_.erase(std::remove_if(big_.begin(), big_.end(), [first](int f) { return f >= first; }), big_.end());
+  for (auto it = big_set_.begin(); it != big_set_.end();) it = *it >= first ? big_set_.erase(it) : std::next(it);
+}
+
 void FaceGrid::erase(const Mesh& mesh, Mesh::FaceHandle f) {
   const bool small = visit_cells(mesh, f, [&](const Key& k) {
     auto it = cells_.find(k);
@@ -292,25 +356,34 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
   return pairs;
 }
 
+// With first_only, each cell's faces are tested as the cells come (a face in several cells may be
+// tested again; the first hit ends the query): a cap triangle that crosses a wall is refused
+// after a few cells. Otherwise every face once (sorted, unique), for an exact count.
 std::size_t FaceGrid::grid_hits(const Mesh& mesh, const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
                                 bool first_only) const {
   Vec3 lo = p[0], hi = p[0];
-  for (int i = 1; i < 3; ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], p[i][a]);
-      hi[a] = std::max(hi[a], p[i][a]);
-    }
-  std::size_t count = 0;
-  for (int gi : candidates(lo, hi)) {
+  for (int i = 1; i < 3; ++i) {
+    lo.minimize(p[i]);
+    hi.maximize(p[i]);
+  }
+  auto hit = [&](int gi) {
     Vec3 glo, ghi;
     std::array<int, 3> gids;
     std::array<Vec3, 3> q;
     face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
     if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
-      continue;
-    if (improper_intersection(ids, p, gids, q) && (++count, first_only)) break;
+      return false;
+    return improper_intersection(ids, p, gids, q);
+  };
+  if (first_only) {
+    if (std::any_of(big_.begin(), big_.end(), hit)) return 1;
+    return triangle_cells(p, [&](const Key& k) { return cell_faces(k, hit); }) ? 1 : 0;
   }
-  return count;
+  std::vector<int> cand(big_.begin(), big_.end());
+  triangle_cells(p, [&](const Key& k) { return cell_faces(k, [&](int f) { return cand.push_back(f), false; }); });
+  std::sort(cand.begin(), cand.end());
+  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  return static_cast<std::size_t>(std::count_if(cand.begin(), cand.end(), hit));
 }
 
 std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const {

@@ -134,11 +134,6 @@ TEST(DenoiseExact, GenusZeroAndInvalidOptions) {
   bad.method = "paper";
   bad.policy = "fill";
   EXPECT_THROW(denoise(s, bad), UsageError);
-  for (int threads : {0, 3}) {
-    bad = DenoiseOptions{};
-    bad.threads = threads;
-    EXPECT_THROW(denoise(s, bad), UsageError) << threads;
-  }
 }
 
 // Element-by-element equality of two meshes: points, face corners, halfedge links, status.

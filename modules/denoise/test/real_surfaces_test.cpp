@@ -10,6 +10,7 @@
 
 #include "bench_meshes.h"
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/denoise/denoise.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include "colonflat/volume/volume_io.h"
@@ -88,35 +89,57 @@ TEST(DenoiseRealLike, MaxLoopLengthKeepsTheLongContactHandle) {
   EXPECT_GE(*r.after.genus, 1);
 }
 
-// Two threads (two group searches at once) cut loops of the same lengths as one thread on the
-// colon-like surface, whose long last loop needs large searches (so pairs do run).
-TEST(DenoiseRealLike, TwoThreadsCutLoopsOfTheSameLengths) {
-  const Mesh m = bench::colon_like_surface({1.0, 60, true, true, true});
-  DenoiseOptions one, two;
-  two.threads = 2;
-  const DenoiseResult a = denoise(m, one), b = denoise(m, two);
-  EXPECT_GT(b.report["search"]["parallel_search_pairs"].get<long long>(), 0);
-  ASSERT_EQ(a.loops.size(), b.loops.size());
-  for (std::size_t i = 0; i < a.loops.size(); ++i) EXPECT_NEAR(a.loops[i].length, b.loops[i].length, 1e-9) << i;
+// Denoises `m` with `threads` worker threads (cf::thread_count(), the global --threads).
+DenoiseResult denoise_with_threads(const Mesh& m, int threads) {
+  set_thread_count(threads);
+  DenoiseResult r = denoise(m, DenoiseOptions{});
+  set_thread_count(0);
+  return r;
 }
 
-// Two threads on a sphere with many handles far apart: the set-up runs on both threads and
-// batches of spatially separated group searches are split over them; the loops are the same
-// cycles (same vertices; the start and direction may differ), in the same order, as with one thread.
-TEST(DenoiseRealLike, TwoThreadsCutTheSameLoopsOnManyHandles) {
-  const Mesh m = bench::sphere_with_handles(30, 24, 0.6);
-  DenoiseOptions one, two;
-  two.threads = 2;
-  const DenoiseResult a = denoise(m, one), b = denoise(m, two);
-  EXPECT_GT(b.report["search"]["parallel_search_pairs"].get<long long>(), 0);
-  EXPECT_EQ(b.report["genus_after"], 0);
+// The same loops (vertex ids in the same order, same lengths) and the same output mesh, point by
+// point and face by face, with 1 and with `threads` threads.
+void expect_same_result(const DenoiseResult& a, const DenoiseResult& b) {
   ASSERT_EQ(a.loops.size(), b.loops.size());
   for (std::size_t i = 0; i < a.loops.size(); ++i) {
-    EXPECT_NEAR(a.loops[i].length, b.loops[i].length, 1e-9) << i;
-    std::vector<int> va = a.loops[i].vertex_ids, vb = b.loops[i].vertex_ids;
-    std::sort(va.begin(), va.end());
-    std::sort(vb.begin(), vb.end());
-    EXPECT_EQ(va, vb) << i;
+    EXPECT_EQ(a.loops[i].vertex_ids, b.loops[i].vertex_ids) << i;
+    EXPECT_EQ(a.loops[i].length, b.loops[i].length) << i;
+  }
+  ASSERT_EQ(a.mesh.n_vertices(), b.mesh.n_vertices());
+  ASSERT_EQ(a.mesh.n_faces(), b.mesh.n_faces());
+  std::size_t points_differ = 0, faces_differ = 0;
+  for (auto v : a.mesh.vertices()) points_differ += a.mesh.point(v) != b.mesh.point(v);
+  for (auto f : a.mesh.faces()) {
+    std::vector<int> fa, fb;
+    for (auto v : a.mesh.fv_range(f)) fa.push_back(v.idx());
+    for (auto v : b.mesh.fv_range(f)) fb.push_back(v.idx());
+    faces_differ += fa != fb;
+  }
+  EXPECT_EQ(points_differ, 0u);
+  EXPECT_EQ(faces_differ, 0u);
+}
+
+// A sphere with 24 handles far apart: batches of spatially separated group searches run on 2
+// threads (pairs counted), and the loops and the output mesh are identical to 1 thread's.
+TEST(DenoiseThreads, OneAndTwoThreadsGiveTheSameLoopsAndMeshOnManyHandles) {
+  const Mesh m = bench::sphere_with_handles(30, 24, 0.6);
+  const DenoiseResult a = denoise_with_threads(m, 1), b = denoise_with_threads(m, 2);
+  EXPECT_EQ(a.report["search"]["parallel_search_pairs"].get<long long>(), 0);
+  EXPECT_GT(b.report["search"]["parallel_search_pairs"].get<long long>(), 0);
+  EXPECT_EQ(b.report["genus_after"], 0);
+  EXPECT_EQ(a.loops.size(), 24u);
+  expect_same_result(a, b);
+}
+
+// The colon-like surface (long contact handle, surgery on top of surgery, crossing families for
+// the last loop): identical loops and mesh with 1, 2 and 3 threads.
+TEST(DenoiseThreads, ColonLikeSurfaceIsTheSameForAnyThreadCount) {
+  const Mesh m = bench::colon_like_surface({1.0, 60, true, true, true});
+  const DenoiseResult a = denoise_with_threads(m, 1);
+  EXPECT_EQ(a.report["genus_after"], 0);
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(threads);
+    expect_same_result(a, denoise_with_threads(m, threads));
   }
 }
 

@@ -32,6 +32,10 @@ class FaceGrid {
   void insert(const Mesh& mesh, Mesh::FaceHandle f);
   // Takes f out (f at the place where it was inserted).
   void erase(const Mesh& mesh, Mesh::FaceHandle f);
+  // Forgets every face with an id >= first that was insert()ed (faces an undone surgery added and
+  // the mesh no longer has); faces below keep their entries (moved back faces: stale cells only
+  // cost time). Costs one pass over the inserted faces' cells, not a rebuild.
+  void forget_faces_from(int first);
   // Pairs (f in `faces`, g any face) that intersect improperly; pairs inside `faces` count once.
   // Precondition: every face in `faces` was insert()ed at its current position.
   std::size_t count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
@@ -62,6 +66,10 @@ class FaceGrid {
   template <class Visit>
   bool visit_cells(const Mesh& mesh, Mesh::FaceHandle f, Visit&& visit) const;
   std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
+  template <class Visit>
+  bool triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const;  // the cells triangle p's plane crosses
+  template <class Visit>
+  bool cell_faces(const Key& k, Visit&& visit) const;  // the faces of cell k
   void insert_dynamic(const Mesh& mesh, Mesh::FaceHandle f);
   // Faces given to the constructor, in compressed rows per cell.
   class StaticCells {
