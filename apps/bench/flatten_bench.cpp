@@ -16,8 +16,12 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_cli.h"
+#include "bench_meshes.h"
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
+#include <functional>
 #include <ctime>
 #include <cstring>
 #include <sstream>
@@ -28,6 +32,8 @@
 #include <fstream>
 
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/progress.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/stage.h"
 #include "colonflat/denoise/denoise_stage.h"
@@ -35,6 +41,7 @@
 #include "colonflat/denoise/denoise.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
+#include "colonflat/testdata/synthetic.h"
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include <vtkImageData.h>
@@ -128,11 +135,12 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
               tot_p ? double(tot_f) / tot_p : 1.0, double(tot_fp) / (last - first + 1));
 }
 
-// The denoised surface of a real case, computed once and cached.
-std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache) {
+// The denoised surface of a real case, computed once and cached; `raw`: a lumen mask reconstructed
+// as its binary staircase (no sub-voxel surface, smoothing or fairing: far more handles).
+std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache, bool raw) {
   std::filesystem::create_directories(cache);
   std::string stem = in.filename().string();
-  stem = stem.substr(0, stem.find('.'));
+  stem = stem.substr(0, stem.find('.')) + (raw ? "_raw" : "");
   const auto den = cache / (stem + "_denoised.vtp");
   if (std::filesystem::exists(den)) return den;
   auto run = [](std::unique_ptr<cf::Stage> (*make)(), const std::vector<std::string>& args) {
@@ -142,56 +150,136 @@ std::filesystem::path denoised_real(const std::filesystem::path& in, const std::
   std::filesystem::path surface = in;
   if (in.string().size() > 7 && in.string().substr(in.string().size() - 7) == ".nii.gz") {
     surface = cache / (stem + "_surface.vtp");
-    run(cf::make_reconstruct_stage, {in.string(), "-o", surface.string(), "-q"});
+    std::vector<std::string> args{in.string(), "-o", surface.string(), "-q"};
+    if (raw)
+      for (const char* a : {"--subvoxel", "off", "--smoothing-iterations", "0", "--fairing-iterations", "0"})
+        args.push_back(a);
+    run(cf::make_reconstruct_stage, args);
   }
   run(cf::make_denoise_stage, {surface.string(), "-o", den.string(), "-q"});
   return den;
 }
 
-void real_table(const std::string& dir, const std::string& cache, const std::string& map, const std::string& out) {
-  std::printf("load average %.2f; map %s\n", load_average(), map.c_str());
-  std::printf("time_s = wall clock of flatten_colon, cpu_s = its CPU time (all threads), load = load average before\n");
-  std::printf("%-30s %8s %4s %8s %9s %7s %7s %7s %7s %7s %7s %8s %8s %8s %5s\n", "case", "faces", "segs", "cover%",
-              "notshown", "area05", "area95", "qc_mean", "qc_p95", "flipped", "leftout", "time_s", "cpu_s", "peak_MiB",
-              "load");
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) {
-    const std::string n = e.path().filename().string();
-    if (n.find(".nii.gz") != std::string::npos || e.path().extension() == ".vtk" || e.path().extension() == ".vtp")
-      files.push_back(e.path());
+// One surface of the stress set: its name and how to get it (genus 0, ready to flatten).
+struct StressCase {
+  std::string name;
+  std::function<cf::Mesh()> load;
+};
+
+// The generated colon-like surfaces: the 1.07 M-face synthetic colon (folds, polyps) and the
+// U-shaped colon-like mask surface with a 60 mm contact, bridges, strands and hooks (denoised once,
+// cached).
+std::vector<StressCase> generated_cases(const std::filesystem::path& cache) {
+  std::vector<StressCase> cases;
+  cases.push_back({"synthetic colon 1.5 m", [] { return cf::synthetic::to_mesh(cf::synthetic::colon(million_face_colon()).mesh); }});
+  cases.push_back({"colon-like U, contact 60 mm", [cache] {
+                     const auto den = cache / "colonlike_contact60_denoised.vtp";
+                     if (!std::filesystem::exists(den)) {
+                       std::filesystem::create_directories(cache);
+                       cf::write_mesh(cf::denoise(cf::bench::colon_like_surface({0.42, 60, true, true, true}),
+                                                  cf::DenoiseOptions{}).mesh, den);
+                     }
+                     return cf::load_mesh(den).mesh;
+                   }});
+  return cases;
+}
+
+// Peak memory from here on (Linux: writing 5 to clear_refs resets the process' VmHWM).
+void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+// One row per surface and thread count: wall and CPU time of flatten_colon, CPU use, peak memory
+// from the call on (the loaded surface included), coverage and distortion, whether the map equals
+// the first thread count's (largest coordinate difference), then the stage's phases.
+void stress_row(const std::string& name, const cf::Mesh& mesh, int threads, const cf::FlattenOptions& fo,
+                std::vector<std::array<double, 2>>& first_uv, const std::string& out) {
+  cf::set_thread_count(threads);
+  reset_peak_memory();
+  const double load = load_average(), cpu0 = cf::process_cpu_seconds();
+  cf::ProgressScope scope(nullptr, "flatten");
+  cf::Stopwatch sw;
+  const cf::FlatMap flat = cf::flatten_colon(mesh, fo);
+  const double t = sw.seconds(), cpu = cf::process_cpu_seconds() - cpu0;
+  std::size_t left_out = 0;
+  for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
+  std::string same = "-";
+  if (first_uv.empty()) {
+    first_uv = flat.uv;
+  } else if (first_uv.size() != flat.uv.size()) {
+    same = "no (size)";
+  } else {
+    double d = 0;
+    for (std::size_t i = 0; i < flat.uv.size(); ++i)
+      d = std::max({d, std::abs(flat.uv[i][0] - first_uv[i][0]), std::abs(flat.uv[i][1] - first_uv[i][1])});
+    same = d == 0 ? "bitwise" : std::to_string(d);
   }
-  std::sort(files.begin(), files.end());
-  for (const auto& in : files) {
-    const auto den = denoised_real(in, cache);
-    const cf::Mesh mesh = cf::load_mesh(den).mesh;
-    cf::FlattenOptions fo;
-    fo.map = map;
-    const double load = load_average();
-    cf::Stopwatch sw;
-    const std::clock_t c0 = std::clock();
-    const cf::FlatMap flat = cf::flatten_colon(mesh, fo);
-    const double t = sw.seconds(), cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
-    std::size_t left_out = 0;
-    for (const auto& sg : flat.segments) left_out += sg.crowded_faces;
-    const auto& st = flat.stats;
-    std::printf("%-30s %8zu %4zu %8.3f %9.0f %7.3f %7.3f %7.3f %7.3f %7zu %7zu %8.2f %8.2f %8.0f %5.2f\n",
-                in.filename().string().c_str(), mesh.n_faces(), flat.segments.size(), 100 * flat.coverage.fraction,
-                flat.coverage.wall_area_mm2 - flat.coverage.shown_area_mm2, st.area_p05, st.area_p95, st.qc_mean,
-                st.qc_p95, st.flipped, left_out, t, cpu, cf::peak_memory_mib(), load);
-    for (const auto& sg : flat.segments)
-      std::printf("    segment %d: %s -> %s, centreline %.0f mm, band %.0f x %.0f mm, balanced %zu vertices\n", sg.id,
-                  sg.x0_end.c_str(), sg.x1_end.c_str(), sg.centreline_length, sg.length, sg.period,
-                  sg.balanced_vertices);
-    std::fflush(stdout);
-    if (!out.empty()) {
-      std::filesystem::create_directories(out);
-      cf::RenderOptions ro;
-      ro.snapshots = false;
-      const cf::RenderResult rr = cf::render_flat(flat, ro);
-      std::string stem = in.filename().string();
-      cf::write_png(rr.colon.image, out + "/" + stem.substr(0, stem.find('.')) + "_colon.png");
+  const auto& st = flat.stats;
+  std::printf("%-30s %8zu %3d %4zu %8.3f %9.0f %7.3f %7.3f %7.3f %7.3f %7zu %7zu %8.2f %8.2f %5.0f %8.0f %5.2f %s\n",
+              name.c_str(), mesh.n_faces(), threads, flat.segments.size(), 100 * flat.coverage.fraction,
+              flat.coverage.wall_area_mm2 - flat.coverage.shown_area_mm2, st.area_p05, st.area_p95, st.qc_mean,
+              st.qc_p95, st.flipped, left_out, t, cpu, 100 * cpu / std::max(t, 1e-9), cf::peak_memory_mib(), load,
+              same.c_str());
+  std::string phases;
+  for (const auto& ph : scope.phases())
+    phases += " " + ph["phase"].get<std::string>() + " " + std::to_string(ph["time_s"].get<double>()).substr(0, 5) + ";";
+  std::printf("    phases:%s\n", phases.c_str());
+  for (const auto& sg : flat.segments)
+    std::printf("    segment %d (%s, %zu faces): area p05 %.3f p95 %.3f, qc %.3f, shown %.2f %%, correction steps %d\n",
+                sg.id, sg.kind.c_str(), sg.faces, sg.stats.area_p05, sg.stats.area_p95, sg.stats.qc_mean,
+                100 * sg.coverage.fraction, sg.corrected_iterations);
+  std::fflush(stdout);
+  if (!out.empty() && same == "-") {
+    std::filesystem::create_directories(out);
+    cf::RenderOptions ro;
+    ro.snapshots = false;
+    std::string stem = name;
+    std::replace(stem.begin(), stem.end(), ' ', '_');
+    cf::write_png(cf::render_flat(flat, ro).colon.image, out + "/" + stem + "_colon.png");
+  }
+}
+
+struct StressOptions {
+  std::string real, cache, map, out;
+  std::vector<std::string> surfaces;
+  bool generated = false, raw_masks = false;
+  std::vector<int> thread_counts{1, 2};
+};
+
+void stress_table(const StressOptions& so) {
+  std::vector<StressCase> cases;
+  if (!so.real.empty()) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(so.real)) {
+      const std::string n = e.path().filename().string();
+      if (n.find(".nii.gz") != std::string::npos || e.path().extension() == ".vtk" || e.path().extension() == ".vtp")
+        files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& in : files) {
+      const bool mask = in.string().find(".nii.gz") != std::string::npos;
+      for (bool raw : {false, true})
+        if (!raw || (mask && so.raw_masks))
+          cases.push_back({in.filename().string() + (raw ? " raw" : ""),
+                           [in, raw, &so] { return cf::load_mesh(denoised_real(in, so.cache, raw)).mesh; }});
     }
   }
+  for (const std::string& f : so.surfaces)
+    cases.push_back({std::filesystem::path(f).filename().string(), [f] { return cf::load_mesh(f).mesh; }});
+  if (so.generated)
+    for (auto& c : generated_cases(so.cache)) cases.push_back(std::move(c));
+  std::printf("load average %.2f; map %s; %d cores\n", load_average(), so.map.c_str(), cf::default_thread_count());
+  std::printf("time_s/cpu_s = wall/CPU time of flatten_colon, cpu%% = CPU/wall, peak_MiB = peak RSS from the call on "
+              "(surface included), same = map vs the first thread count (largest |d uv| mm)\n");
+  std::printf("%-30s %8s %3s %4s %8s %9s %7s %7s %7s %7s %7s %7s %8s %8s %5s %8s %5s %s\n", "case", "faces", "thr",
+              "segs", "cover%", "notshown", "area05", "area95", "qc_mean", "qc_p95", "flipped", "leftout", "time_s",
+              "cpu_s", "cpu%", "peak_MiB", "load", "same");
+  cf::FlattenOptions fo;
+  fo.map = so.map;
+  for (const StressCase& c : cases) {
+    const cf::Mesh mesh = c.load();
+    std::vector<std::array<double, 2>> first_uv;
+    for (int t : so.thread_counts) stress_row(c.name, mesh, t, fo, first_uv, so.out);
+  }
+  cf::set_thread_count(0);
 }
 
 void BM_FlattenColon(benchmark::State& state) {
@@ -210,23 +298,31 @@ BENCHMARK(BM_FlattenColon)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 int main(int argc, char** argv) {
   cf::bench::BenchCli cli("flatten_bench", "Flattening benchmark and acceptance table (see the file's header)");
   bool table_only = false;
-  std::string phantoms, size = "full", out, real, cache = "/tmp/flatten_bench_cache", map = "area-balanced";
+  std::string phantoms, size = "full", threads = "1,2";
+  StressOptions so{"", "/tmp/flatten_bench_cache", "area-balanced", ""};
   CLI::App& app = cli.app();
   app.add_flag("--table-only", table_only, "the table without Google Benchmark");
   app.add_option("--phantom", phantoms, "acceptance on phantom seeds N or N-M");
   app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
-  app.add_option("--out", out, "folder for the colon images and candidate JSON");
-  app.add_option("--real", real, "folder of real cases (*.nii.gz masks, *.vtk / *.vtp surfaces)");
-  app.add_option("--cache", cache, "cache of denoised real surfaces");
-  app.add_option("--map", map, "flatten map")->check(CLI::IsMember({"area-balanced", "conformal"}));
+  app.add_option("--out", so.out, "folder for the colon images (and the phantoms' candidate JSON)");
+  app.add_option("--real", so.real, "stress set: folder of real cases (*.nii.gz masks, *.vtk / *.vtp surfaces)");
+  app.add_option("--surface", so.surfaces, "stress set: a denoised (genus 0) surface, flattened as it is (repeatable)");
+  app.add_flag("--generated", so.generated, "stress set: the generated colon-like surfaces");
+  app.add_flag("--raw-masks", so.raw_masks, "stress set: also each --real mask reconstructed as its raw staircase");
+  app.add_option("--thread-counts", threads, "stress set: thread counts, one row each (e.g. 1,2)");
+  app.add_option("--cache", so.cache, "cache of denoised real and generated surfaces");
+  app.add_option("--map", so.map, "flatten map")->check(CLI::IsMember({"area-balanced", "conformal"}));
   return cli.run(argc, argv, [&] {
-    if (!real.empty()) {
-      real_table(real, cache, map, out);
+    if (!so.real.empty() || !so.surfaces.empty() || so.generated) {
+      so.thread_counts.clear();
+      std::stringstream ss(threads);
+      for (std::string t; std::getline(ss, t, ',');) so.thread_counts.push_back(std::stoi(t));
+      stress_table(so);
       return 0;
     }
     if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
-      phantom_table(first, last, size, out);
+      phantom_table(first, last, size, so.out);
       return 0;
     }
     table();

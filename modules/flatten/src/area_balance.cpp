@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "face_blocks.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
 
@@ -96,12 +97,13 @@ std::vector<std::array<V2, 3>> plane_frames(const Surface& s, const std::vector<
 struct SymmetricDirichlet {
   const Surface& s;
   const Embedding& emb;
-  const std::vector<int>& faces;
+  const std::vector<int>& faces_;
   std::vector<Eigen::Matrix2d> x_inv;  // inverse of the 3D triangle's edge matrix in its plane
   std::vector<double> area3;
 
+  const std::vector<int>& faces() const { return faces_; }
   Eigen::Matrix2d jacobian(const std::vector<V2>& pos, std::size_t i) const {
-    const int f = faces[i];
+    const int f = faces_[i];
     const Tri& t = s.t[f];
     Eigen::Matrix2d D;
     const V2 c0 = pos[t[0]] + V2(0, emb.dy[f][0]);
@@ -110,29 +112,29 @@ struct SymmetricDirichlet {
     return D * x_inv[i];
   }
   double energy(const std::vector<V2>& pos) const {
-    double e = 0;
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      const Eigen::Matrix2d J = jacobian(pos, i);
-      const double det = J.determinant();
-      if (det <= 0) return kHuge;
-      e += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
-    }
-    return e;
+    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      double part = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const Eigen::Matrix2d J = jacobian(pos, i);
+        const double det = J.determinant();
+        if (det <= 0) return kHuge;
+        part += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
+      }
+      return part;
+    });
+    return e >= kHuge ? kHuge : e;
   }
-  // Gradient with respect to the unknowns of `sys` (n x 2).
-  Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const {
-    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Eigen::Index(sys.unknowns().size()), 2);
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      const Eigen::Matrix2d J = jacobian(pos, i);
-      const double det = J.determinant(), n2 = J.squaredNorm();
-      const Eigen::Matrix2d dJ = 2 * J * (1 + 1 / (det * det)) - 2 * n2 / (det * det) * J.inverse().transpose();
-      const Eigen::Matrix2d G = area3[i] * dJ * x_inv[i].transpose();
-      const Tri& t = s.t[faces[i]];
-      const V2 grad[3] = {-(G.col(0) + G.col(1)), G.col(0), G.col(1)};
-      for (int k = 0; k < 3; ++k)
-        if (sys.index(t[k]) >= 0) g.row(sys.index(t[k])) += grad[k].transpose();
-    }
-    return g;
+  // Per face, the gradient with respect to each corner.
+  void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const Eigen::Matrix2d J = jacobian(pos, i);
+        const double det = J.determinant(), n2 = J.squaredNorm();
+        const Eigen::Matrix2d dJ = 2 * J * (1 + 1 / (det * det)) - 2 * n2 / (det * det) * J.inverse().transpose();
+        const Eigen::Matrix2d G = area3[i] * dJ * x_inv[i].transpose();
+        out[i] = {V2(-(G.col(0) + G.col(1))), V2(G.col(0)), V2(G.col(1))};
+      }
+    });
   }
   static constexpr double kHuge = 1e300;
 };
@@ -207,12 +209,16 @@ double face_step_limit(const Surface& s, const Embedding& emb, const std::vector
 // place of the one ARAP lacks), and none that is readable now can become unreadable.
 double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
                      const std::vector<double>& area3, double floor_ratio) {
-  double tmax = 1.0;
-  for (int f : faces) {
-    const double a = emb.area2(s, f);
-    if (a <= 0) continue;
-    tmax = std::min(tmax, face_step_limit(s, emb, next, f, std::min(0.5, floor_ratio * area3[f] / a)));
-  }
+  const double tmax = block_min(faces.size(), 1.0, [&](std::size_t begin, std::size_t end) {
+    double t = 1.0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const int f = faces[i];
+      const double a = emb.area2(s, f);
+      if (a <= 0) continue;
+      t = std::min(t, face_step_limit(s, emb, next, f, std::min(0.5, floor_ratio * area3[f] / a)));
+    }
+    return t;
+  });
   return std::max(0.0, tmax);
 }
 

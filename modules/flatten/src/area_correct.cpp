@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "colonflat/core/union_find.h"
+#include "face_blocks.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
 
@@ -37,39 +38,41 @@ class ConformalAreaEnergy {
   double excess(double log_ratio) const { return log_ratio - std::clamp(log_ratio, log_lo_, log_hi_); }
 
   double energy(const std::vector<V2>& pos) const {
-    double e = 0;
-    for (std::size_t i = 0; i < faces_.size(); ++i) {
-      const auto c = corners(pos, faces_[i]);
-      const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-      if (a2 <= 0) return kHuge;
-      for (int k = 0; k < 3; ++k) e += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
-      const int f = faces_[i];
-      const double x = excess(std::log(scale_ * a2 / area3_[f]));
-      e += lambda_ * area3_[f] * x * x;
-    }
-    return e;
+    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      double part = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const auto c = corners(pos, faces_[i]);
+        const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
+        if (a2 <= 0) return kHuge;
+        for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
+        const int f = faces_[i];
+        const double x = excess(std::log(scale_ * a2 / area3_[f]));
+        part += lambda_ * area3_[f] * x * x;
+      }
+      return part;
+    });
+    return e >= kHuge ? kHuge : e;
   }
 
-  // Gradient with respect to the unknowns of `sys` (n x 2).
-  Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const {
-    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Eigen::Index(sys.unknowns().size()), 2);
-    for (std::size_t i = 0; i < faces_.size(); ++i) {
-      const int f = faces_[i];
-      const auto c = corners(pos, f);
-      const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-      const double x = excess(std::log(scale_ * a2 / area3_[f]));
-      const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
-      V2 grad[3] = {V2::Zero(), V2::Zero(), V2::Zero()};
-      for (int k = 0; k < 3; ++k) {
-        const int a = (k + 1) % 3, b = (k + 2) % 3;
-        const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
-        grad[a] += e, grad[b] -= e;
-        grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
+  // Per face, the gradient with respect to each corner.
+  void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const int f = faces_[i];
+        const auto c = corners(pos, f);
+        const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
+        const double x = excess(std::log(scale_ * a2 / area3_[f]));
+        const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
+        std::array<V2, 3>& grad = out[i];
+        grad = {V2::Zero(), V2::Zero(), V2::Zero()};
+        for (int k = 0; k < 3; ++k) {
+          const int a = (k + 1) % 3, b = (k + 2) % 3;
+          const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
+          grad[a] += e, grad[b] -= e;
+          grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
+        }
       }
-      for (int k = 0; k < 3; ++k)
-        if (sys.index(s_.t[f][k]) >= 0) g.row(sys.index(s_.t[f][k])) += grad[k].transpose();
-    }
-    return g;
+    });
   }
   static constexpr double kHuge = 1e300;
 
@@ -151,6 +154,7 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
   return pieces;
 }
 
+// Newton steps on one set of faces (free vertices as given); accumulates into `res`.
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`.
 void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
               const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,

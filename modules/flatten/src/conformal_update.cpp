@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "colonflat/core/union_find.h"
 #include "conformal_factor.h"
@@ -84,6 +86,11 @@ bool same_loops(const ConformalFactor& f, const std::vector<char>& mark, const s
 
 }  // namespace
 
+// The update is used while its estimated operations stay below this share of a new
+// factorisation's: both run at about the same rate, and the estimate counts every column on each
+// term's path, though terms processed together (CHOLMOD takes up to 8 at a time) share them.
+constexpr double kUpdateShareOfFactorisation = 0.5;
+
 bool restrict_factor(ConformalFactor& f, const Edges& E, const std::vector<double>& w, const std::vector<char>& mark,
                      const std::vector<int>& new_of_old) {
   if (new_of_old.size() != f.unknown_of.size() || !same_loops(f, mark, new_of_old)) return false;
@@ -95,11 +102,17 @@ bool restrict_factor(ConformalFactor& f, const Edges& E, const std::vector<doubl
   if (!weight_changes(f, E, w, old_of, change)) return false;
   RankOneColumns grow, shrink;
   rank_one_terms(f, change, new_of_old, grow, shrink);
-  // Beyond this many terms (a cut along much of the surface) a new factorisation is cheaper.
-  const int most = std::max(2000, int(f.unknown_of.size() / 50));
-  if (grow.columns + shrink.columns > most) return false;
+  // When the terms would cost more than a share of a new factorisation (many of them, or paths
+  // through the dense columns of the loops, ordered last), a new factorisation is cheaper.
   const int n = int(f.unknown_of.size()) - 1;
-  return f.solver.modify(grow.matrix(n), true) && f.solver.modify(shrink.matrix(n), false);
+  const SpdSolver::SpMat up = grow.matrix(n), down = shrink.matrix(n);
+  const double budget = kUpdateShareOfFactorisation * f.solver.factor_flops();
+  const double cost = f.solver.modify_flops({&up, &down}, budget);
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug factor update: %d rank-one terms, about %.3g flops against %.3g for a new factorisation\n",
+                 grow.columns + shrink.columns, cost, f.solver.factor_flops());
+  if (cost > budget) return false;
+  return f.solver.modify(up, true) && f.solver.modify(down, false);
 }
 
 }  // namespace cf::flat_detail

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <future>
 #include <unordered_map>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
 #include "flatten_internal.h"
 
@@ -19,6 +21,11 @@ namespace cf {
 namespace {
 
 using namespace flat_detail;
+
+// A side job (the elimination order beside the opening of the ends, the side branches beside the
+// colon's own steps) runs on a thread of its own when the process may use more than one
+// (--threads), else when its result is needed: the same result either way.
+std::launch side_launch() { return thread_count() > 1 ? std::launch::async : std::launch::deferred; }
 
 Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, int c) {
   Surface s;
@@ -49,7 +56,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const Edges E0 = build_edges(s.t);
-    auto order = std::async(std::launch::async, [&] { return fill_reducing_vertex_order(E0, int(s.p.size())); });
+    auto order = std::async(side_launch(), [&] { return fill_reducing_vertex_order(E0, int(s.p.size())); });
     Opened op = open_ends(s, E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
@@ -276,7 +283,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
   w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factorisation
   w.ann = std::move(rest);
   const double cut_area = annulus_area - surface_area(w.ann);
-  auto flattened = std::async(std::launch::async, [pieces = std::move(pieces), component = w.seg.component,
+  auto flattened = std::async(side_launch(), [pieces = std::move(pieces), component = w.seg.component,
                                                    lumen_sign = w.lumen_sign, o, depth, cut_area] {
     FlattenedBranches b;
     double placed = 0;
@@ -378,36 +385,33 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   return out;
 }
 
-// Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
-// their parent and their neck's position on it, labelled "neck" -> "tip".
-std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x) {
-  std::vector<int> colon;
-  std::vector<FlatSegment> segs;
-  for (std::size_t i = 0; i < work.size(); ++i)
-    if (work[i].parent < 0) colon.push_back(int(i)), segs.push_back(work[i].seg);
-  std::vector<char> rev_colon, reversed(work.size(), 0);
-  label_ends(segs, midline_x, rev_colon);
-  for (std::size_t k = 0; k < colon.size(); ++k) work[colon[k]].seg = segs[k], reversed[colon[k]] = rev_colon[k];
-  auto root_order = [&](int i) {
-    while (work[i].parent >= 0) i = work[i].parent;
-    return work[i].seg.order;
-  };
-  std::vector<int> branch;
-  for (std::size_t i = 0; i < work.size(); ++i) {
-    SegmentWork& b = work[i];
-    if (b.parent < 0) continue;
-    const SegmentWork& parent = work[b.parent];
-    if (reversed[b.parent]) b.seg.attach_mm = parent.seg.centreline_length - b.seg.attach_mm;
-    b.seg.kind = "branch";
-    b.seg.x0_end = "neck";
-    b.seg.x1_end = "tip";
-    branch.push_back(int(i));
+// One colon segment to flatten: its surface, boundary loops, component id and lumen side.
+struct SegmentJob {
+  Surface surface;
+  std::size_t loops = 0, component = 0;
+  double lumen_sign = 1;
+  std::vector<SegmentWork> works;  // the result: the segment's work, then its branches
+};
+
+// The segments flattened side by side on the worker threads (each on its own: the results do not
+// depend on which thread or in which order), their works gathered in segment order.
+std::vector<SegmentWork> flatten_segments(std::vector<SegmentJob>& jobs, const FlattenOptions& o) {
+  std::vector<std::function<void()>> tasks;
+  for (SegmentJob& j : jobs)
+    tasks.push_back([&j, &o] {
+      j.works = flatten_surface(j.surface, j.loops, j.component, j.lumen_sign, o, 0);
+      j.surface = Surface{};  // its memory back
+    });
+  parallel_tasks(tasks);
+  std::vector<SegmentWork> work;
+  for (SegmentJob& j : jobs) {
+    const int base = int(work.size());
+    for (auto& w : j.works) {
+      if (w.parent >= 0) w.parent += base;
+      work.push_back(std::move(w));
+    }
   }
-  std::stable_sort(branch.begin(), branch.end(), [&](int a, int b) {
-    return std::make_pair(root_order(a), work[a].seg.attach_mm) < std::make_pair(root_order(b), work[b].seg.attach_mm);
-  });
-  for (std::size_t k = 0; k < branch.size(); ++k) work[branch[k]].seg.order = int(colon.size() + k);
-  return reversed;
+  return work;
 }
 
 }  // namespace
@@ -428,20 +432,15 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
   if (topo.faces == 0) throw PreconditionError("the surface has no triangles");
   if (!topo.manifold) throw PreconditionError("the surface is not a 2-manifold; flatten needs a clean colon surface");
   ComponentScreen screen(mesh, topo, opts);
-  std::vector<SegmentWork> work;
+  std::vector<SegmentJob> jobs;
   for (std::size_t c = 0; c < topo.components.size(); ++c) {
     if (!screen.admit(c)) continue;
-    const Surface s = component_surface(mesh, topo, int(c));
-    auto ws = flatten_surface(s, topo.components[c].boundary_loops, c, screen.lumen_sign(c), opts, 0);
-    const int base = int(work.size());
-    for (auto& w : ws) {
-      if (w.parent >= 0) w.parent += base;
-      work.push_back(std::move(w));
-    }
+    jobs.push_back({component_surface(mesh, topo, int(c)), topo.components[c].boundary_loops, c, screen.lumen_sign(c), {}});
   }
   out.skipped_components = screen.skipped().size();
   out.skipped = screen.skipped();
-  if (work.empty()) screen.nothing_flattened();
+  if (jobs.empty()) screen.nothing_flattened();
+  std::vector<SegmentWork> work = flatten_segments(jobs, opts);
   double xmin = 1e300, xmax = -1e300;
   for (const auto& p : mesh.points) xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
   const std::vector<char> reversed = label_and_order(work, 0.5 * (xmin + xmax));

@@ -299,6 +299,11 @@ struct SegmentWork {
 // Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.
 std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate);
 
+// Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
+// their parent and their neck's position on it, labelled "neck" -> "tip". Returns per work whether
+// its band is reversed (flatten_layout.cpp).
+std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x);
+
 // Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those
 // flagged (x -> L - x, y -> P - y), and writes vertices (one per vertex and sheet), triangles,
 // per-vertex data, overall distortion and coverage into `out`.

@@ -76,6 +76,38 @@ Coverage total_coverage(const std::vector<FlatSegment>& segs) {
 
 }  // namespace
 
+// Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
+// their parent and their neck's position on it, labelled "neck" -> "tip".
+std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x) {
+  std::vector<int> colon;
+  std::vector<FlatSegment> segs;
+  for (std::size_t i = 0; i < work.size(); ++i)
+    if (work[i].parent < 0) colon.push_back(int(i)), segs.push_back(work[i].seg);
+  std::vector<char> rev_colon, reversed(work.size(), 0);
+  label_ends(segs, midline_x, rev_colon);
+  for (std::size_t k = 0; k < colon.size(); ++k) work[colon[k]].seg = segs[k], reversed[colon[k]] = rev_colon[k];
+  auto root_order = [&](int i) {
+    while (work[i].parent >= 0) i = work[i].parent;
+    return work[i].seg.order;
+  };
+  std::vector<int> branch;
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    SegmentWork& b = work[i];
+    if (b.parent < 0) continue;
+    const SegmentWork& parent = work[b.parent];
+    if (reversed[b.parent]) b.seg.attach_mm = parent.seg.centreline_length - b.seg.attach_mm;
+    b.seg.kind = "branch";
+    b.seg.x0_end = "neck";
+    b.seg.x1_end = "tip";
+    branch.push_back(int(i));
+  }
+  std::stable_sort(branch.begin(), branch.end(), [&](int a, int b) {
+    return std::make_pair(root_order(a), work[a].seg.attach_mm) < std::make_pair(root_order(b), work[b].seg.attach_mm);
+  });
+  for (std::size_t k = 0; k < branch.size(); ++k) work[branch[k]].seg.order = int(colon.size() + k);
+  return reversed;
+}
+
 void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reversed, const FlattenOptions& o,
                    FlatMap& out) {
   std::vector<int> order(work.size());

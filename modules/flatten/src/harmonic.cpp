@@ -9,6 +9,7 @@
 #include <queue>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 #include "conformal_factor.h"
 #include "spd_solver.h"
@@ -212,8 +213,9 @@ void solve_with(const ConformalFactor& f, const Edges& E, const std::vector<doub
                 const std::vector<signed char>& eta, const std::vector<char>& mark,
                 const std::vector<int>& unknown_of, UvSolution& sol) {
   const int n = int(f.unknown_of.size()) - 1;
-  const Eigen::VectorXd xv = f.solver.solve(v_rhs(E, w, eta, unknown_of, n));
-  const Eigen::VectorXd xu = f.solver.solve_leading(u_rhs(E, w, mark, unknown_of, n), f.leading);
+  Eigen::VectorXd xv, xu;  // two solves with one factorisation, side by side
+  parallel_tasks({[&] { xv = f.solver.solve(v_rhs(E, w, eta, unknown_of, n)); },
+                  [&] { xu = f.solver.solve_leading(u_rhs(E, w, mark, unknown_of, n), f.leading); }});
   const std::size_t nv = mark.size();
   sol.u.resize(Eigen::Index(nv));
   sol.v.resize(Eigen::Index(nv));

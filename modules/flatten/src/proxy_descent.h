@@ -5,10 +5,15 @@
 // appear), halved until the Armijo condition holds (after 30 halvings the last trial is kept if it
 // still lowers E). Shared by the symmetric-Dirichlet balancing (area_balance.cpp) and the area
 // correction (area_correct.cpp).
-// Energy: double energy(const std::vector<V2>& pos) const (>= Energy::kHuge: not injective);
-//         Eigen::MatrixXd gradient(const std::vector<V2>& pos, const RegionSystem& sys) const (n x 2).
+// Energy: const std::vector<int>& faces() const (the faces it sums over);
+//         double energy(const std::vector<V2>& pos) const (>= Energy::kHuge: not injective);
+//         void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& g) const
+//           (per face of faces(), the gradient with respect to each corner).
+// Every per-face loop runs on all worker threads in fixed blocks (face_blocks.h): the steps are
+// the same for any thread count.
 #include <algorithm>
 
+#include "face_blocks.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -16,6 +21,18 @@ namespace cf::flat_detail {
 struct DescentResult {
   int steps = 0;                                // steps taken (the last one, below min_gain, not counted)
   double energy_before = 0, energy_after = 0;
+};
+
+// The gradient over the unknowns of a region system from per-face corner gradients: each unknown
+// sums the corners it is, in face order (the order a sequential scatter over the faces adds them).
+class CornerGather {
+ public:
+  CornerGather(const Surface& s, const std::vector<int>& faces, const RegionSystem& sys);
+  // n x 2 (n = unknowns of sys).
+  Eigen::MatrixXd sum(const std::vector<std::array<V2, 3>>& face_gradients) const;
+
+ private:
+  std::vector<int> start_, corner_;  // unknown u's corners (3 i + k): corner_[start_[u] .. start_[u + 1])
 };
 
 // At most `max_steps` steps moving the unknowns of `sys` in emb.pos; stops when E gains less than
@@ -28,12 +45,17 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
   if (e0 >= Energy::kHuge) return res;  // the region is not injective: leave it
   const std::vector<int>& unknowns = sys.unknowns();
+  const CornerGather gather(s, energy.faces(), sys);
+  std::vector<std::array<V2, 3>> face_gradients(energy.faces().size());
   std::vector<V2> trial = emb.pos;  // emb.pos with the unknowns moved (nothing else ever differs)
   auto move_to = [&](const Eigen::MatrixXd& d, double t) {
-    for (std::size_t i = 0; i < unknowns.size(); ++i) trial[unknowns[i]] = emb.pos[unknowns[i]] + t * V2(d(i, 0), d(i, 1));
+    for_each_block(unknowns.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) trial[unknowns[i]] = emb.pos[unknowns[i]] + t * V2(d(i, 0), d(i, 1));
+    });
   };
   for (; res.steps < max_steps; ++res.steps) {
-    const Eigen::MatrixXd g = energy.gradient(emb.pos, sys);
+    energy.face_gradients(emb.pos, face_gradients);
+    const Eigen::MatrixXd g = gather.sum(face_gradients);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
     const double slope = (g.array() * d.array()).sum();
     if (!(slope < 0)) break;

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "flatten_internal.h"
+#include "proxy_descent.h"
 #include "spd_solver.h"
 
 namespace cf::flat_detail {
@@ -76,6 +77,36 @@ std::vector<V2> RegionSystem::solve(const Surface& s, const Embedding& emb,
 Eigen::MatrixXd RegionSystem::solve_raw(const Eigen::MatrixXd& b) const {
   if (vars_.empty()) return b;
   return impl_->solver.solve(b);
+}
+
+CornerGather::CornerGather(const Surface& s, const std::vector<int>& faces, const RegionSystem& sys) {
+  const std::size_t n = sys.unknowns().size();
+  start_.assign(n + 1, 0);
+  for (int f : faces)
+    for (int v : s.t[f])
+      if (sys.index(v) >= 0) ++start_[std::size_t(sys.index(v)) + 1];
+  for (std::size_t u = 0; u < n; ++u) start_[u + 1] += start_[u];
+  corner_.resize(std::size_t(start_[n]));
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < faces.size(); ++i)  // face order: each unknown's corners come in face order
+    for (int k = 0; k < 3; ++k)
+      if (const int u = sys.index(s.t[faces[i]][k]); u >= 0) corner_[std::size_t(fill[u]++)] = int(3 * i) + k;
+}
+
+Eigen::MatrixXd CornerGather::sum(const std::vector<std::array<V2, 3>>& face_gradients) const {
+  const std::size_t n = start_.size() - 1;
+  Eigen::MatrixXd g(Eigen::Index(n), 2);
+  for_each_block(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t u = begin; u < end; ++u) {
+      double gx = 0, gy = 0;
+      for (int c = start_[u]; c < start_[u + 1]; ++c) {
+        const V2& q = face_gradients[std::size_t(corner_[c] / 3)][std::size_t(corner_[c] % 3)];
+        gx += q.x(), gy += q.y();
+      }
+      g(Eigen::Index(u), 0) = gx, g(Eigen::Index(u), 1) = gy;
+    }
+  });
+  return g;
 }
 
 }  // namespace cf::flat_detail

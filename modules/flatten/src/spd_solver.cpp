@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <mutex>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/huge_pages.h"
+#include "colonflat/core/threads.h"
 
 namespace cf::flat_detail {
 
@@ -182,29 +184,52 @@ bool SpdSolver::factorize(const SpMat& A) {
   return fall_back(A);
 }
 
+// A cholmod_common of the calling thread's own for solves with a finished factor (CHOLMOD's
+// statistics and workspace live there): solves may then run at the same time on several threads.
+struct SolveCommon {
+  cholmod_common c{};
+  SolveCommon() {
+    cholmod_start(&c);
+    c.print = 0;
+  }
+  ~SolveCommon() { cholmod_finish(&c); }
+};
+
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   if (!cholmod_ok_) return fallback_->solve(b);
-  cholmod_dense rhs = view_dense(b);
-  cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common_);
-  if (!x) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common_.status) + ")");
-  return take_dense(x, common_);
+  // Column by column, the columns on the worker threads: each column's arithmetic is the same
+  // whoever solves it, so the result does not depend on the thread count.
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  std::vector<std::function<void()>> columns;
+  for (Eigen::Index c = 0; c < b.cols(); ++c)
+    columns.push_back([&, c] {
+      SolveCommon common;
+      const Eigen::MatrixXd column = b.col(c);
+      cholmod_dense rhs = view_dense(column);
+      cholmod_dense* xc = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common.c);
+      if (!xc) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.c.status) + ")");
+      x.col(c) = take_dense(xc, common.c);
+    });
+  parallel_tasks(columns);
+  return x;
 }
 
 // P, L, (the rows past the leading block zeroed), D, L^T, P^T: one step at a time.
 Eigen::MatrixXd SpdSolver::cholmod_leading(const Eigen::MatrixXd& b, int leading) const {
+  SolveCommon common;
   cholmod_dense rhs = view_dense(b);
-  cholmod_dense* y = cholmod_solve(CHOLMOD_P, factor_, &rhs, &common_);
+  cholmod_dense* y = cholmod_solve(CHOLMOD_P, factor_, &rhs, &common.c);
   for (int system : {CHOLMOD_L, CHOLMOD_D, CHOLMOD_Lt, CHOLMOD_Pt}) {
     if (!y) break;
     if (system == CHOLMOD_D)
       for (std::size_t c = 0; c < y->ncol; ++c)
         std::fill(static_cast<double*>(y->x) + c * y->d + leading, static_cast<double*>(y->x) + c * y->d + y->nrow, 0.0);
-    cholmod_dense* next = cholmod_solve(system, factor_, y, &common_);
-    cholmod_free_dense(&y, &common_);
+    cholmod_dense* next = cholmod_solve(system, factor_, y, &common.c);
+    cholmod_free_dense(&y, &common.c);
     y = next;
   }
-  if (!y) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common_.status) + ")");
-  return take_dense(y, common_);
+  if (!y) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.c.status) + ")");
+  return take_dense(y, common.c);
 }
 
 bool SpdSolver::modify(const SpMat& C, bool update) {
@@ -225,6 +250,33 @@ bool SpdSolver::modify(const SpMat& C, bool update) {
   cholmod_updown(update ? 1 : 0, &view, factor_, &common_);
   cholmod_ok_ = common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
   return cholmod_ok_;
+}
+
+double SpdSolver::factor_flops() const { return factor_ ? common_.fl : 0.0; }
+
+double SpdSolver::modify_flops(const std::vector<const SpMat*>& terms, double limit) const {
+  if (!cholmod_ok_ || factor_->is_super) return 0.0;
+  const std::size_t n = factor_->n;
+  const int* Lp = static_cast<const int*>(factor_->p);
+  const int* Li = static_cast<const int*>(factor_->i);
+  const int* Lnz = static_cast<const int*>(factor_->nz);
+  std::vector<int> parent(n, -1), place(n);  // elimination tree: the first row below the diagonal
+  for (std::size_t j = 0; j < n; ++j) {
+    int first = -1;
+    for (int k = Lp[j]; k < Lp[j] + Lnz[j]; ++k)
+      if (Li[k] > int(j) && (first < 0 || Li[k] < first)) first = Li[k];
+    parent[j] = first;
+  }
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  for (std::size_t k = 0; k < n; ++k) place[perm[k]] = int(k);
+  double flops = 0;
+  for (const SpMat* C : terms)
+    for (int c = 0; c < C->outerSize() && flops <= limit; ++c) {
+      int j = int(n);
+      for (SpMat::InnerIterator it(*C, c); it; ++it) j = std::min(j, place[it.row()]);
+      for (; j >= 0 && j < int(n); j = parent[j]) flops += 4.0 * Lnz[j];
+    }
+  return flops;
 }
 
 std::vector<int> SpdSolver::order() const {
@@ -250,6 +302,10 @@ bool SpdSolver::factorize(const SpMat& A) { return fall_back(A); }
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const { return fallback_->solve(b); }
 
 bool SpdSolver::modify(const SpMat&, bool) { return false; }
+
+double SpdSolver::factor_flops() const { return 0.0; }
+
+double SpdSolver::modify_flops(const std::vector<const SpMat*>&, double) const { return 0.0; }
 
 std::vector<int> SpdSolver::order() const { return {}; }
 

@@ -60,6 +60,13 @@ class SpdSolver {
   // factorisation). False without CHOLMOD or when the result is not positive definite; the solver
   // is then unusable until factorize().
   bool modify(const SpMat& C, bool update);
+  // Floating-point operations of the numeric factorisation (CHOLMOD's count from the analysis; 0
+  // without CHOLMOD or before analyze()).
+  double factor_flops() const;
+  // Estimated operations of modify() with the columns of each matrix of `terms`: per column, 4 x the
+  // entries of L on the elimination-tree path from its first row (in the factor's order) to the
+  // root (the columns a rank-one update changes; Davis & Hager 1999). Counting stops past `limit`.
+  double modify_flops(const std::vector<const SpMat*>& terms, double limit) const;
   // The elimination order of the analysis (empty without CHOLMOD or before analyze()).
   std::vector<int> order() const;
 
