@@ -35,6 +35,10 @@ void validate(const PhantomOptions& o) {
     throw UsageError("--fully-tagged-segments must be in [0, 3] (got " + std::to_string(o.fully_tagged_segments) + ")");
 }
 
+}  // namespace
+
+namespace phantom_detail {
+
 template <class TImage>
 typename TImage::Pointer image_on(const Grid& g) {
   auto im = TImage::New();
@@ -70,8 +74,8 @@ CtImage::Pointer materials_to_images(const Model& md, std::vector<unsigned char>
 }
 
 // Partial-volume blur (Gaussian) and noise (per-slice deterministic streams), rounded and clamped.
-CtImage::Pointer blur_and_noise(CtImage::Pointer sharp, const PhantomOptions& o, const Grid& g) {
-  const double blur = o.blur_mm > 0 ? o.blur_mm : std::max(0.45, 0.6 * std::min(g.sp[0], g.sp[1]));
+CtImage::Pointer blur_and_noise(CtImage::Pointer sharp, double noise_hu, double blur_mm, std::uint64_t seed, const Grid& g) {
+  const double blur = blur_mm > 0 ? blur_mm : std::max(0.45, 0.6 * std::min(g.sp[0], g.sp[1]));
   using Smooth = itk::SmoothingRecursiveGaussianImageFilter<CtImage, CtImage>;
   auto sm = Smooth::New();
   sm->SetInput(sharp);
@@ -85,15 +89,19 @@ CtImage::Pointer blur_and_noise(CtImage::Pointer sharp, const PhantomOptions& o,
   const std::size_t slice = std::size_t(g.n[0]) * g.n[1];
   parallel_for(g.n[2], [&](int k0, int k1) {
     for (int k = k0; k < k1; ++k) {
-      Rng r(o.seed * 1000003ull + std::uint64_t(k) * 7919ull + 17);
+      Rng r(seed * 1000003ull + std::uint64_t(k) * 7919ull + 17);
       for (std::size_t q = std::size_t(k) * slice; q < std::size_t(k + 1) * slice; ++q) {
-        const double v = hu[q] + (o.noise_hu > 0 ? o.noise_hu * r.normal() : 0.0);
+        const double v = hu[q] + (noise_hu > 0 ? noise_hu * r.normal() : 0.0);
         hu[q] = float(std::clamp(std::nearbyint(v), -1024.0, 3071.0)) + 0.0f;  // no -0
       }
     }
   });
   return ct;
 }
+
+}  // namespace phantom_detail
+
+namespace {
 
 // Arc length along this case's centreline at material position s.
 double true_arc(const Path& P, double s) {
@@ -116,7 +124,7 @@ Phantom generate_phantom(const PhantomOptions& o) {
   Phantom out;
   VolumeCounts counts;
   CtImage::Pointer sharp = materials_to_images(md, mat, out, counts);
-  out.ct = blur_and_noise(sharp, o, md.g);
+  out.ct = blur_and_noise(sharp, o.noise_hu, o.blur_mm, o.seed, md.g);
   phase_done("CT with blur and noise");
   out.patient_position = md.gravity > 0 ? "HFS" : "HFP";
   set_patient_position(out.ct.GetPointer(), out.patient_position);

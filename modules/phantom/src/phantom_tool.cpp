@@ -4,12 +4,75 @@
 #include <ostream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/output_check.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/phantom/mask_phantom.h"
 #include "colonflat/phantom/phantom.h"
 
 namespace cf {
 namespace {
+
+// Options of `--from-mask` and the options that do not apply to it.
+struct MaskCli {
+  std::string mask;
+  bool no_header = false, no_bladder = false;
+  int bowel_loops = 4;
+};
+const char* const kSyntheticOnly[] = {"--size", "--format", "--collapsed", "--polyps", "--topological-noise",
+                                      "--oral-contrast", "--excreted-contrast", "--enhanced-vessels", "--rectal-tube",
+                                      "--realistic"};
+
+void add_mask_options(CLI::App& app, MaskCli& m) {
+  app.add_option("--from-mask", m.mask,
+                 "paint the CT around this real lumen mask (0/1, any volume format; LPS geometry kept) instead of the "
+                 "synthetic colon: body, colon wall, bone, pools, fully tagged stretches, small bowel, bladder "
+                 "(docs/phantom.md)")
+      ->type_name("MASK");
+  app.add_flag("--no-position-header", m.no_header, "with --from-mask: no PatientPosition in ct.nrrd");
+  app.add_option("--bowel-loops", m.bowel_loops, "with --from-mask: small-bowel loops with oral contrast (default 4; range [0, 8])")
+      ->type_name("N");
+  app.add_flag("--no-bladder", m.no_bladder, "with --from-mask: no bladder");
+}
+
+// colonflat phantom --from-mask MASK -o DIR: checks, paints and writes (all files or none).
+int run_from_mask(CLI::App& app, const MaskCli& m, const PhantomOptions& o, const std::string& dir, bool quiet,
+                  std::ostream& err) {
+  for (const char* opt : kSyntheticOnly)
+    if (app.count(opt) > 0) throw UsageError(std::string(opt) + " does not apply with --from-mask");
+  MaskPhantomOptions mo;
+  mo.seed = o.seed;
+  mo.position = o.position;
+  mo.position_header = !m.no_header;
+  mo.noise_hu = o.noise_hu;
+  mo.blur_mm = o.blur_mm;
+  mo.fully_tagged = app.count("--fully-tagged-segments") ? o.fully_tagged_segments : 1;
+  mo.bowel_loops = m.bowel_loops;
+  mo.bladder = !m.no_bladder;
+  mo.pools = o.tagged_fluid;
+  gravity_of_position(mo.position);
+  PathPlan plan;
+  plan.input(m.mask);
+  for (const char* f : {"ct.nrrd", "lumen_mask.nrrd", "labels.nrrd", "phantom.json", "polyps.json", "centerline.json", "noise_sites.json"})
+    plan.output(std::filesystem::path(dir) / f, "-o");
+  plan.check();
+  Stopwatch t;
+  ProgressScope phases(quiet ? nullptr : &err, "phantom");
+  MaskImage::Pointer mask = read_binary_mask(m.mask);
+  MaskPhantom p = paint_phantom_from_mask(mask, mo);
+  p.phantom.description["files"]["mask"] = m.mask;
+  write_phantom(p.phantom, dir, "nrrd");
+  phase_done("written");
+  if (!quiet) {
+    const auto& v = p.phantom.description["volumes_ml"];
+    err << std::fixed << std::setprecision(1) << "phantom: from " << m.mask << ": lumen " << v["lumen"].get<double>()
+        << " mL, colon fluid " << v["colon_fluid"].get<double>() << " mL (" << p.phantom.description["pools"]["count"].get<int>()
+        << " pools), small bowel " << v["small_bowel"].get<double>() << " mL, bladder " << v["bladder"].get<double>()
+        << " mL, " << o.position << (m.no_header ? " (no position header)" : "") << "; " << std::setprecision(2)
+        << t.seconds() << " s, peak " << std::setprecision(0) << peak_memory_mib() << " MiB -> " << dir << "\n";
+  }
+  return kExitOk;
+}
 
 class PhantomTool : public Tool {
  public:
@@ -46,9 +109,10 @@ class PhantomTool : public Tool {
     app.add_option("--blur", o.blur_mm, "partial-volume blur sigma [mm] (default 0 = automatic; range [0, 5])")
         ->type_name("MM");
     app.add_option("--position", o.position, "patient position: supine (posterior down, DICOM HFS) or prone (anterior "
-                                             "down, HFP; same colon and polyps as supine, mobile colon displaced) "
+                                             "down, HFP; same colon and polyps as supine, mobile colon displaced); "
+                                             "with --from-mask also left-down (HFDL) or right-down (HFDR) "
                                              "(default supine)")
-        ->type_name("supine|prone");
+        ->type_name("supine|prone|left-down|right-down");
     app.add_option("--fully-tagged-segments", o.fully_tagged_segments,
                    "colon stretches completely filled with tagged fluid, between collapsed necks (default 0; range [0, 3])")
         ->type_name("K");
@@ -61,7 +125,12 @@ class PhantomTool : public Tool {
                  "all of the above: oral and excreted contrast, enhanced aorta, rectal tube and (unless given) 2 fully "
                  "tagged stretches");
     app.add_flag("-q,--quiet", quiet, "no progress output");
+    MaskCli mask;
+    add_mask_options(app, mask);
     return run_cli(app, name(), args, out, err, [&]() -> int {
+      if (!mask.mask.empty()) return run_from_mask(app, mask, o, dir, quiet, err);
+      for (const char* opt : {"--no-position-header", "--bowel-loops", "--no-bladder"})
+        if (app.count(opt) > 0) throw UsageError(std::string(opt) + " needs --from-mask");
       if (format != "nrrd" && format != "dicom") throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
       if (realistic) {
         o.oral_contrast = o.excreted_contrast = o.enhanced_vessels = o.rectal_tube = true;

@@ -92,18 +92,14 @@ PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<do
   return sample_plane(ct, plane, lps[a.fixed_axis], u0, v0, pixels, pixels, pix);
 }
 
-void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
+void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels, const fs::path& path) {
+  if (pixels.size() != std::size_t(w) * h * components) throw Error(path.string() + ": PNG pixel count does not match its size");
   vtkNew<vtkImageData> img;
-  img->SetDimensions(im.w, im.h, 1);
-  img->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  img->SetDimensions(w, h, 1);
+  img->AllocateScalars(VTK_UNSIGNED_CHAR, components);
   auto* px = static_cast<unsigned char*>(img->GetScalarPointer());
-  const double lo = win.level - 0.5 * win.width;
-  for (int r = 0; r < im.h; ++r)
-    for (int c = 0; c < im.w; ++c) {
-      const double v = (im.hu[std::size_t(r) * im.w + c] - lo) / win.width;
-      // VTK rows count from the bottom
-      px[std::size_t(im.h - 1 - r) * im.w + c] = static_cast<unsigned char>(std::lround(255 * std::clamp(v, 0.0, 1.0)));
-    }
+  const std::size_t row = std::size_t(w) * components;
+  for (int r = 0; r < h; ++r) std::copy_n(pixels.data() + r * row, row, px + std::size_t(h - 1 - r) * row);  // VTK rows count from the bottom
   write_atomically(path, [&](const fs::path& tmp) {
     vtkNew<vtkPNGWriter> writer;
     writer->SetInputData(img);
@@ -112,6 +108,17 @@ void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::pat
     writer->Write();
     if (writer->GetErrorCode() != 0) throw Error(path.string() + ": cannot write PNG");
   });
+}
+
+unsigned char window_grey(float hu, const CtWindow& win) {
+  const double v = (hu - (win.level - 0.5 * win.width)) / win.width;
+  return static_cast<unsigned char>(std::lround(255 * std::clamp(v, 0.0, 1.0)));
+}
+
+void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
+  std::vector<unsigned char> grey(im.hu.size());
+  std::transform(im.hu.begin(), im.hu.end(), grey.begin(), [&](float v) { return window_grey(v, win); });
+  write_png_pixels(im.w, im.h, 1, grey, path);
 }
 
 template <class Image>

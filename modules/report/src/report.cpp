@@ -18,6 +18,7 @@
 #include "colonflat/report/ct_views.h"
 #include "colonflat/report/report_data.h"
 #include "colonflat/report/resources.h"
+#include "colonflat/report/segmentation_qc.h"
 #include "colonflat/report/slicer_markups.h"
 
 namespace fs = std::filesystem;
@@ -83,6 +84,20 @@ struct Builder {
                                              : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
       result.images += int(data["stacks"][plane_name(p)]["files"].size());
     }
+  }
+
+  // The Segmentation section: montages with the lumen and the bodies segment rejected.
+  void add_segmentation() {
+    if (!run.ct || !run.lumen) {
+      data["segmentation"] = {{"missing", run.volume_is_mask ? "the run started from a lumen mask (no segmentation)"
+                                                             : "no CT or no lumen_mask.nrrd in the run folder"}};
+      return;
+    }
+    nlohmann::json seg = nlohmann::json::object();
+    for (const auto& s : run.run_report.value("stages", nlohmann::json::array()))
+      if (s.value("stage", "") == "segment") seg = s.value("result", nlohmann::json::object());
+    data["segmentation"] = write_segmentation_qc(run.ct.GetPointer(), run.lumen.GetPointer(), seg, files_dir,
+                                                 "report_files/", &result.images);
   }
 
   void add_findings() {
@@ -197,6 +212,9 @@ ReportResult build_review_report(const RunData& run, const ReportOptions& opts, 
   phase_done("colon image and lookup grid");
   b.add_ct();
   phase_done(std::string(b.run.volume_is_mask ? "mask" : "CT") + " planes (" + std::to_string(b.result.images) + " images)");
+  const int before = b.result.images;
+  b.add_segmentation();
+  phase_done("segmentation montages (" + std::to_string(b.result.images - before) + " images)");
   b.add_findings();
   phase_done(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
              " known-polyp cards");

@@ -171,6 +171,7 @@ RunData load_run(const fs::path& dir, const RunLoadOptions& opts) {
     if (run.volume_is_mask) run.mask = read_mask(run.ct_path);
     else run.ct = read_ct_volume(run.ct_path);
   }
+  if (run.ct && fs::exists(dir / "lumen_mask.nrrd")) run.lumen = read_mask(dir / "lumen_mask.nrrd");
   complete_run(run, opts);
   return run;
 }
@@ -200,6 +201,7 @@ RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann
     run.ct_path = input;
     run.volume_is_mask = true;
   }
+  if (run.ct && bag.has("mask")) run.lumen = bag.get<MaskImage::Pointer>("mask");
   complete_run(run, opts);
   return run;
 }

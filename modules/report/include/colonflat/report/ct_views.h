@@ -50,6 +50,11 @@ template <class Image>
 PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<double, 3>& lps, double fov_mm,
                                int pixels);
 
+// 8-bit grey value of `hu` through `window` (0 below, 255 above).
+unsigned char window_grey(float hu, const CtWindow& window);
+// Writes w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, as a PNG (atomic).
+void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels,
+                      const std::filesystem::path& path);
 // Writes `image` through `window` as an 8-bit grey PNG (atomic).
 void write_windowed_png(const PlaneImage& image, const CtWindow& window, const std::filesystem::path& path);
 

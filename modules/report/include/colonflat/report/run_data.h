@@ -52,6 +52,7 @@ struct RunData {
   CtImage::Pointer ct;                         // null when no CT was found
   MaskImage::Pointer mask;                     // without a CT: the lumen mask the run started from
   bool volume_is_mask = false;                 // the views show `mask` (0/1), not a CT
+  MaskImage::Pointer lumen;                    // with a CT: the run's lumen mask (segment's output), else null
   ImagePtr colon_image;                        // colon.png in memory; null: read from the run folder
   std::filesystem::path ct_path, truth_path;
   std::vector<std::string> warnings;           // what is missing or inconsistent, for the page

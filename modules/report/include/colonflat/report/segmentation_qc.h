@@ -1,0 +1,34 @@
+#pragma once
+// The report's "Segmentation" section (docs/report.md): coronal, axial and sagittal montages of the
+// CT with the lumen outlined and every body the segment stage rejected (>= min_body_ml) outlined in
+// another colour, plus the tables of kept and rejected bodies. Segment's internals are not used:
+// a rejected body is the connected set of gas or tagged-fluid voxels outside the lumen found from
+// the position of segment's decision (run_report.json, stage "segment", result.decisions:
+// what, volume_ml, position_lps_mm, decision, reason), grown to at most 3x its volume.
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+
+struct SegmentationQcOptions {
+  double min_body_ml = 5;     // rejected bodies outlined from this volume on
+  int slices = 6;             // per plane (at least 4)
+  int max_pixels = 360;       // longest side of a montage image
+  double margin_mm = 15;      // around the lumen and the bodies
+  double search_mm = 25;      // a body's voxels are looked for this far from its decision's position
+};
+
+// Writes the montage PNGs `<dir>/seg_<plane>_<n>.png` and returns the section's data:
+// {planes: {axial|coronal|sagittal: [{file, position_mm, axis, w, h, labels: [{id, col, row}]}]},
+//  bodies: [{id, what, reason, volume_ml, position_lps_mm, outlined, measured_ml, colour}], kept: [...],
+//  lumen_ml, thresholds_hu}. `segment_result` is the segment stage's result object (may be empty).
+// The lumen must be on the CT's grid (else: {"missing": why}). `images` += PNGs written.
+nlohmann::json write_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                                     const std::filesystem::path& dir, const std::string& rel_prefix, int* images,
+                                     const SegmentationQcOptions& opts = {});
+
+}  // namespace cf

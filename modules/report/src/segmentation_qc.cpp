@@ -1,0 +1,329 @@
+// The report's Segmentation section: scan the lumen (volume, box, where it lies along each axis),
+// find the bodies segment rejected (from each decision's position: the gas or tagged-fluid voxels
+// outside the lumen connected to the nearest such voxel), choose slices through the bodies and the
+// lumen, draw the montages (CT in the lung window, lumen outline green, rejected bodies tinted and
+// outlined red) and list the kept and rejected bodies.
+#include "colonflat/report/segmentation_qc.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "colonflat/report/ct_views.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+namespace {
+
+constexpr unsigned char kLumenRgb[3] = {40, 230, 90};
+constexpr unsigned char kBodyRgb[3] = {255, 50, 30};
+
+struct QcBody {
+  int id = 0;
+  nlohmann::json decision;
+  std::vector<std::size_t> voxels;  // sorted
+  int cls = -1;                     // 0 gas, 1 tagged fluid
+  bool truncated = false, too_large = false;
+};
+
+class SegmentationQc {
+ public:
+  SegmentationQc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& result, const SegmentationQcOptions& o)
+      : ct_(ct), lumen_(lumen), result_(result), o_(o), hu_(ct->GetBufferPointer()), m_(lumen->GetBufferPointer()) {
+    const auto sz = ct->GetLargestPossibleRegion().GetSize();
+    for (int d = 0; d < 3; ++d) n_[d] = sz[d];
+    voxel_ml_ = ct->GetSpacing()[0] * ct->GetSpacing()[1] * ct->GetSpacing()[2] / 1000.0;
+  }
+  nlohmann::json run(const fs::path& dir, const std::string& prefix, int* images);
+
+ private:
+  void thresholds();
+  void scan_lumen();
+  void find_bodies();
+  bool seed_of(const std::array<double, 3>& lps, int cls, std::size_t& seed) const;
+  void flood(QcBody& b, std::size_t seed, std::size_t cap);
+  int voxel_class(std::size_t q) const {
+    if (m_[q]) return -1;
+    return hu_[q] < gas_thr_ ? 0 : hu_[q] > fluid_thr_ ? 1 : -1;
+  }
+  std::array<double, 3> lps_of(std::size_t q) const {
+    CtImage::IndexType i = {{long(q % n_[0]), long((q / n_[0]) % n_[1]), long(q / (n_[0] * n_[1]))}};
+    CtImage::PointType p;
+    ct_->TransformIndexToPhysicalPoint(i, p);
+    return {p[0], p[1], p[2]};
+  }
+  void grow_box(const std::array<double, 3>& p) {
+    for (int d = 0; d < 3; ++d) lo_[d] = std::min(lo_[d], p[d]), hi_[d] = std::max(hi_[d], p[d]);
+  }
+  std::vector<double> slice_positions(Plane p) const;
+  nlohmann::json draw(Plane p, double fixed, int n, const fs::path& dir, const std::string& prefix);
+  nlohmann::json tables() const;
+
+  const CtImage* ct_;
+  const MaskImage* lumen_;
+  const nlohmann::json& result_;
+  const SegmentationQcOptions& o_;
+  const float* hu_;
+  const unsigned char* m_;
+  std::size_t n_[3];
+  double voxel_ml_ = 0, gas_thr_ = -500, fluid_thr_ = 200, lumen_ml_ = 0, pix_ = 1;
+  std::array<double, 3> lo_{1e300, 1e300, 1e300}, hi_{-1e300, -1e300, -1e300}, hist_lo_{};
+  std::array<std::vector<double>, 3> hist_;  // lumen voxels per 1 mm along each LPS axis from hist_lo_
+  std::vector<QcBody> bodies_;
+  std::vector<bool> taken_;
+  std::vector<std::pair<std::size_t, int>> body_voxels_;  // (voxel, body index + 1), sorted
+};
+
+// Gas below the midpoint of segment's air and tissue means, tagged fluid above the midpoint of its
+// tissue and fluid means (its own classes); -500 / +200 HU when the run did not report them.
+void SegmentationQc::thresholds() {
+  const auto m = result_.value("class_means_hu", nlohmann::json::object());
+  const double air = m.value("air", 0.0), tissue = m.value("tissue", 0.0), fluid = m.value("fluid", 0.0);
+  if (air < tissue && tissue < fluid && air < -300 && fluid > 100) gas_thr_ = 0.5 * (air + tissue), fluid_thr_ = 0.5 * (tissue + fluid);
+}
+
+// Lumen volume, LPS box, and per-axis histograms (1 mm bins over the volume's LPS box).
+void SegmentationQc::scan_lumen() {
+  std::array<double, 3> vlo{1e300, 1e300, 1e300}, vhi{-1e300, -1e300, -1e300};
+  for (int c = 0; c < 8; ++c) {
+    const std::size_t q = ((c & 1) ? n_[0] - 1 : 0) + n_[0] * (((c & 2) ? n_[1] - 1 : 0) + n_[1] * ((c & 4) ? n_[2] - 1 : 0));
+    const auto p = lps_of(q);
+    for (int d = 0; d < 3; ++d) vlo[d] = std::min(vlo[d], p[d]), vhi[d] = std::max(vhi[d], p[d]);
+  }
+  for (int d = 0; d < 3; ++d) hist_lo_[d] = vlo[d], hist_[d].assign(std::size_t(vhi[d] - vlo[d]) + 2, 0.0);
+  const std::size_t n = n_[0] * n_[1] * n_[2];
+  std::size_t count = 0;
+  for (std::size_t q = 0; q < n; ++q) {
+    if (!m_[q]) continue;
+    ++count;
+    const auto p = lps_of(q);
+    grow_box(p);
+    for (int d = 0; d < 3; ++d) hist_[d][std::size_t(p[d] - hist_lo_[d])] += 1;
+  }
+  lumen_ml_ = count * voxel_ml_;
+}
+
+// The voxel of class `cls` (or either, -1) outside the lumen and not yet in a body nearest to `lps`,
+// within search_mm.
+bool SegmentationQc::seed_of(const std::array<double, 3>& lps, int cls, std::size_t& seed) const {
+  CtImage::PointType p;
+  for (int d = 0; d < 3; ++d) p[d] = lps[d];
+  itk::ContinuousIndex<double, 3> c;
+  ct_->TransformPhysicalPointToContinuousIndex(p, c);
+  long lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    const double r = o_.search_mm / ct_->GetSpacing()[d];
+    lo[d] = std::max(0L, long(std::floor(c[d] - r))), hi[d] = std::min(long(n_[d]) - 1, long(std::ceil(c[d] + r)));
+  }
+  double best = o_.search_mm * o_.search_mm;
+  bool found = false;
+  for (long k = lo[2]; k <= hi[2]; ++k)
+    for (long j = lo[1]; j <= hi[1]; ++j)
+      for (long i = lo[0]; i <= hi[0]; ++i) {
+        const std::size_t q = std::size_t(i) + n_[0] * (std::size_t(j) + n_[1] * std::size_t(k));
+        const int vc = voxel_class(q);
+        if (vc < 0 || (cls >= 0 && vc != cls) || taken_[q]) continue;
+        const auto x = lps_of(q);
+        const double d2 = (x[0] - lps[0]) * (x[0] - lps[0]) + (x[1] - lps[1]) * (x[1] - lps[1]) + (x[2] - lps[2]) * (x[2] - lps[2]);
+        if (d2 <= best) best = d2, seed = q, found = true;
+      }
+  return found;
+}
+
+// 6-connected voxels of the seed's class outside the lumen, at most `cap`.
+void SegmentationQc::flood(QcBody& b, std::size_t seed, std::size_t cap) {
+  b.cls = voxel_class(seed);
+  std::vector<std::size_t> stack{seed};
+  taken_[seed] = true;
+  const long nx = long(n_[0]), ny = long(n_[1]), nz = long(n_[2]);
+  while (!stack.empty()) {
+    const std::size_t q = stack.back();
+    stack.pop_back();
+    b.voxels.push_back(q);
+    if (b.voxels.size() >= cap) {
+      b.truncated = true;
+      break;
+    }
+    const long i = long(q % n_[0]), j = long((q / n_[0]) % n_[1]), k = long(q / (n_[0] * n_[1]));
+    const long nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+    for (const auto& x : nb) {
+      if (x[0] < 0 || x[1] < 0 || x[2] < 0 || x[0] >= nx || x[1] >= ny || x[2] >= nz) continue;
+      const std::size_t r = std::size_t(x[0] + nx * (x[1] + ny * x[2]));
+      if (taken_[r] || voxel_class(r) != b.cls) continue;
+      taken_[r] = true;
+      stack.push_back(r);
+    }
+  }
+  std::sort(b.voxels.begin(), b.voxels.end());
+}
+
+// Every rejected decision of at least min_body_ml: its body, grown from the nearest voxel of its kind.
+void SegmentationQc::find_bodies() {
+  taken_.assign(n_[0] * n_[1] * n_[2], false);
+  for (const auto& d : result_.value("decisions", nlohmann::json::array())) {
+    const bool kept = d.value("decision", std::string()) == "kept" || d.value("kept", false);
+    const double ml = d.value("volume_ml", 0.0);
+    if (kept || ml < o_.min_body_ml || !d.contains("position_lps_mm")) continue;
+    QcBody b;
+    b.id = int(bodies_.size()) + 1;
+    b.decision = d;
+    const std::string what = d.value("what", std::string());
+    const int cls = what.find("gas") != std::string::npos ? 0 : what.find("fluid") != std::string::npos ? 1 : -1;
+    std::size_t seed = 0;
+    b.too_large = ml > 2 * lumen_ml_;  // outside air: larger than twice the whole lumen, not colon
+    if (!b.too_large && seed_of(d["position_lps_mm"].get<std::array<double, 3>>(), cls, seed))
+      flood(b, seed, std::max<std::size_t>(1000, std::size_t(3 * ml / voxel_ml_)));
+    for (std::size_t q : b.voxels) {
+      grow_box(lps_of(q));
+      body_voxels_.push_back({q, b.id});
+    }
+    bodies_.push_back(std::move(b));
+  }
+  std::sort(body_voxels_.begin(), body_voxels_.end());
+}
+
+nlohmann::json SegmentationQc::run(const fs::path& dir, const std::string& prefix, int* images) {
+  thresholds();
+  scan_lumen();
+  find_bodies();
+  if (lo_[0] > hi_[0]) return {{"missing", "the lumen mask is empty and no rejected body was found"}};
+  double ext = 0;
+  for (int d = 0; d < 3; ++d) ext = std::max(ext, hi_[d] - lo_[d] + 2 * o_.margin_mm);
+  pix_ = std::max({ext / o_.max_pixels, ct_->GetSpacing()[0], ct_->GetSpacing()[1]});
+  nlohmann::json j = tables();
+  for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) {
+    nlohmann::json list = nlohmann::json::array();
+    int n = 0;
+    for (double f : slice_positions(p)) list.push_back(draw(p, f, n++, dir, prefix));
+    *images += n;
+    j["planes"][plane_name(p)] = list;
+  }
+  return j;
+}
+
+// Slices through the largest bodies (where each has most voxels along the axis) and through the
+// lumen (its 20-80 % quantiles along the axis), at least 8 mm apart, sorted.
+std::vector<double> SegmentationQc::slice_positions(Plane p) const {
+  const int a = plane_axes(p).fixed_axis;
+  std::vector<double> pos;
+  const auto add = [&](double x) {
+    for (double y : pos)
+      if (std::abs(x - y) < 8) return;
+    pos.push_back(x);
+  };
+  for (const QcBody& b : bodies_) {
+    if (b.voxels.empty() || int(pos.size()) >= o_.slices - 2) continue;
+    std::vector<int> h(hist_[a].size() / 2 + 2, 0);
+    for (std::size_t q : b.voxels) {
+      const double x = lps_of(q)[a] - hist_lo_[a];
+      if (x >= 0 && std::size_t(x / 2) < h.size()) ++h[std::size_t(x / 2)];
+    }
+    add(hist_lo_[a] + 2.0 * double(std::max_element(h.begin(), h.end()) - h.begin()) + 1.0);
+  }
+  double total = 0;
+  for (double c : hist_[a]) total += c;
+  for (double f : {0.5, 0.2, 0.8, 0.35, 0.65, 0.1, 0.9}) {
+    if (int(pos.size()) >= o_.slices || total <= 0) break;
+    double acc = 0;
+    std::size_t i = 0;
+    while (i + 1 < hist_[a].size() && acc + hist_[a][i] < f * total) acc += hist_[a][i++];
+    add(hist_lo_[a] + double(i) + 0.5);
+  }
+  std::sort(pos.begin(), pos.end());
+  return pos;
+}
+
+// One montage image: the CT plane (lung window), rejected bodies tinted and outlined red, the lumen
+// outlined green; a label per body where it shows (its pixels' centre).
+nlohmann::json SegmentationQc::draw(Plane p, double fixed, int n, const fs::path& dir, const std::string& prefix) {
+  const PlaneAxes a = plane_axes(p);
+  const auto range = [&](int axis, int sign) {
+    const double x = sign * lo_[axis], y = sign * hi_[axis];
+    return std::array<double, 2>{std::min(x, y) - o_.margin_mm, std::max(x, y) + o_.margin_mm};
+  };
+  const auto ur = range(a.u_axis, a.u_sign), vr = range(a.v_axis, a.v_sign);
+  const int w = std::max(1, int(std::ceil((ur[1] - ur[0]) / pix_))), h = std::max(1, int(std::ceil((vr[1] - vr[0]) / pix_)));
+  const PlaneImage im = sample_plane(ct_, p, fixed, ur[0], vr[0], w, h, pix_);
+  std::vector<unsigned char> lum(std::size_t(w) * h, 0), rgb(std::size_t(w) * h * 3);
+  std::vector<int> body(std::size_t(w) * h, 0);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      CtImage::PointType pt;
+      pt[a.fixed_axis] = fixed;
+      pt[a.u_axis] = a.u_sign * (ur[0] + c * pix_);
+      pt[a.v_axis] = a.v_sign * (vr[0] + r * pix_);
+      CtImage::IndexType idx;
+      const std::size_t px = std::size_t(r) * w + c;
+      const unsigned char g = window_grey(im.hu[px], lung_window());
+      for (int k = 0; k < 3; ++k) rgb[3 * px + k] = g;
+      if (!ct_->TransformPhysicalPointToIndex(pt, idx)) continue;
+      const std::size_t q = std::size_t(idx[0]) + n_[0] * (std::size_t(idx[1]) + n_[1] * std::size_t(idx[2]));
+      lum[px] = m_[q];
+      const auto it = std::lower_bound(body_voxels_.begin(), body_voxels_.end(), std::make_pair(q, 0));
+      if (it != body_voxels_.end() && it->first == q) body[px] = it->second;
+      if (body[px])
+        for (int k = 0; k < 3; ++k) rgb[3 * px + k] = static_cast<unsigned char>(0.65 * g + 0.35 * kBodyRgb[k]);
+    }
+  std::vector<std::array<double, 3>> centre(bodies_.size() + 1, {0, 0, 0});  // sum col, sum row, count
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      const std::size_t px = std::size_t(r) * w + c;
+      bool lum_edge = false, body_edge = false;
+      for (const auto& [dr, dc] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const int rr = r + dr, cc = c + dc;
+        if (rr < 0 || cc < 0 || rr >= h || cc >= w) continue;
+        const std::size_t o = std::size_t(rr) * w + cc;
+        lum_edge = lum_edge || (lum[px] && !lum[o]);
+        body_edge = body_edge || (body[px] && body[o] != body[px]);
+      }
+      if (lum_edge) std::copy_n(kLumenRgb, 3, &rgb[3 * px]);
+      if (body_edge) std::copy_n(kBodyRgb, 3, &rgb[3 * px]);
+      if (body[px]) centre[std::size_t(body[px])][0] += c, centre[std::size_t(body[px])][1] += r, centre[std::size_t(body[px])][2] += 1;
+    }
+  const std::string name = std::string("seg_") + plane_name(p) + "_" + std::to_string(n) + ".png";
+  write_png_pixels(w, h, 3, rgb, dir / name);
+  nlohmann::json labels = nlohmann::json::array();
+  for (std::size_t b = 1; b < centre.size(); ++b)
+    if (centre[b][2] > 0)
+      labels.push_back({{"id", int(b)}, {"col", centre[b][0] / centre[b][2]}, {"row", centre[b][1] / centre[b][2]}, {"pixels", centre[b][2]}});
+  return {{"file", prefix + name}, {"position_mm", std::round(fixed * 10) / 10}, {"axis", std::string(1, "LPS"[a.fixed_axis])},
+          {"w", w}, {"h", h}, {"pixel_mm", pix_}, {"labels", labels}};
+}
+
+// The kept and rejected bodies of segment's decisions, the lumen volume and the thresholds used.
+nlohmann::json SegmentationQc::tables() const {
+  nlohmann::json bodies = nlohmann::json::array(), kept = nlohmann::json::array();
+  for (const QcBody& b : bodies_)
+    bodies.push_back({{"id", b.id}, {"what", b.decision.value("what", "")}, {"reason", b.decision.value("reason", "")},
+                      {"volume_ml", b.decision.value("volume_ml", 0.0)}, {"position_lps_mm", b.decision["position_lps_mm"]},
+                      {"outlined", !b.voxels.empty()}, {"measured_ml", b.voxels.size() * voxel_ml_}, {"truncated", b.truncated},
+                      {"too_large", b.too_large},
+                      {"kind", b.cls == 0 ? "gas" : b.cls == 1 ? "tagged fluid" : "not found"}});
+  double small_ml = 0;
+  int small = 0;
+  for (const auto& d : result_.value("decisions", nlohmann::json::array())) {
+    const bool is_kept = d.value("decision", std::string()) == "kept" || d.value("kept", false);
+    if (is_kept) kept.push_back({{"what", d.value("what", "")}, {"volume_ml", d.value("volume_ml", 0.0)}, {"reason", d.value("reason", "")}});
+    else if (d.value("volume_ml", 0.0) < o_.min_body_ml) small_ml += d.value("volume_ml", 0.0), ++small;
+  }
+  return {{"bodies", bodies}, {"kept", kept}, {"segment_volumes_ml", result_.value("segment_volumes_ml", nlohmann::json::array())},
+          {"lumen_ml", lumen_ml_}, {"min_body_ml", o_.min_body_ml}, {"small_rejected", {{"count", small}, {"volume_ml", small_ml}}},
+          {"thresholds_hu", {{"gas_below", gas_thr_}, {"fluid_above", fluid_thr_}}},
+          {"colours", {{"lumen", "rgb(40,230,90)"}, {"rejected", "rgb(255,50,30)"}}}};
+}
+
+}  // namespace
+
+nlohmann::json write_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                                     const fs::path& dir, const std::string& rel_prefix, int* images,
+                                     const SegmentationQcOptions& opts) {
+  if (!ct || !lumen) return {{"missing", "no CT or no lumen mask in the run folder"}};
+  if (ct->GetLargestPossibleRegion().GetSize() != lumen->GetLargestPossibleRegion().GetSize())
+    return {{"missing", "the lumen mask is not on the CT's grid"}};
+  for (int d = 0; d < 3; ++d)
+    if (std::abs(ct->GetOrigin()[d] - lumen->GetOrigin()[d]) > 1e-3 || std::abs(ct->GetSpacing()[d] - lumen->GetSpacing()[d]) > 1e-6)
+      return {{"missing", "the lumen mask is not on the CT's grid"}};
+  return SegmentationQc(ct, lumen, segment_result, opts).run(dir, rel_prefix, images);
+}
+
+}  // namespace cf
