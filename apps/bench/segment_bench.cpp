@@ -12,6 +12,9 @@
 //                                     of the inferior slice (pelvic floor, thighs' soft tissue, the rectal
 //                                     tube's channel) below the volume so the scan has N slices (the 512 x 512
 //                                     x 450 case of issue 13: --pad-to 450); Dice on the original slices.
+//   segment_bench --real CT [--pad-to N]  a CT file without ground truth (e.g. ../shared/real/ctc_prone_a.nrrd):
+//                                     read and segmentation time, CPU, peak memory, lumen / fluid / fully
+//                                     tagged mL kept, segments (issue 25).
 // Peak memory: the process's peak resident set is reset (/proc/self/clear_refs) before each step,
 // so "peak" is the high-water mark of that step alone (segmentation: reading ct.nrrd included).
 #include <benchmark/benchmark.h>
@@ -322,6 +325,27 @@ void realistic_table(const std::string& size, const std::vector<int>& seeds, int
               "ao_vox, tube = segmented voxels that are small bowel (contrast or gas), bladder, aorta, rectal tube\n");
 }
 
+// One CT without ground truth: time, memory and what was kept.
+void real_table(const std::string& path, int pad_to) {
+  std::printf("segment_bench --real %s%s\n", path.c_str(), pad_to > 0 ? (" padded to " + std::to_string(pad_to) + " slices").c_str() : "");
+  std::printf("%7s %7s %7s %7s %5s %8s %9s %9s %7s %9s %s\n", "slices", "read_s", "seg_s", "seg_cpu", "load", "peak_MiB", "lumen_mL",
+              "fluid_mL", "segs", "tagged_mL", "gravity");
+  reset_peak_memory();
+  cf::Stopwatch t;
+  cf::CtImage::Pointer ct = cf::read_ct_volume(path);
+  if (pad_to > 0) ct = pad_inferior(ct, pad_to);
+  const double read_s = t.seconds(), load = load_average();
+  cf::SegmentStats st;
+  t.restart();
+  cf::MaskImage::Pointer mask = cf::segment_colon(ct, {}, &st);
+  const double seg_s = t.seconds();
+  std::printf("%7zu %7.2f %7.2f %7.2f %5.1f %8.0f %9.1f %9.1f %7d %9.1f %s (%s)\n", ct->GetLargestPossibleRegion().GetSize()[2],
+              read_s, seg_s, st.cpu_time_s, load, cf::peak_memory_mib(), st.lumen_volume_ml, st.fluid_volume_ml, st.segments,
+              st.tagged_stretch_volume_ml, st.gravity.c_str(), st.gravity_source.c_str());
+  std::printf("columns: peak_MiB = peak resident memory of reading (and padding) + segmentation; fluid_mL = kept voxels >= "
+              "--fluid-threshold; tagged_mL = fully tagged stretches kept by linking\n");
+}
+
 void BM_SegmentSmallPhantom(benchmark::State& state) {
   cf::PhantomOptions o;
   o.size = "small";
@@ -349,7 +373,7 @@ BENCHMARK(BM_GenerateSmallPhantom)->Unit(benchmark::kMillisecond);
 int main(int argc, char** argv) {
   bool table_only = false, dicom = true, collapsed = false, realistic = false;
   int pad_to = 0;
-  std::string size = "full";
+  std::string size = "full", real;
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
@@ -358,6 +382,7 @@ int main(int argc, char** argv) {
     else if (a == "--no-dicom") dicom = false;
     else if (a == "--collapsed") collapsed = true;
     else if (a == "--realistic") realistic = true;
+    else if (a == "--real" && i + 1 < argc) real = argv[++i];
     else if (a == "--pad-to" && i + 1 < argc) pad_to = std::stoi(argv[++i]);
     else if (a == "--size" && i + 1 < argc) size = argv[++i];
     else if (a == "--seeds" && i + 1 < argc) {
@@ -366,7 +391,8 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  if (realistic) realistic_table(size, seeds, pad_to);
+  if (!real.empty()) real_table(real, pad_to);
+  else if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);
   if (table_only) return 0;
   int n = int(rest.size());
