@@ -3,6 +3,9 @@
 // not give it, the pools kept (gas above them along one level) and the partial-volume layer.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
 #include <sstream>
 
 #include "segment_internal.h"
@@ -12,24 +15,39 @@ namespace {
 constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExcluded = 5;
 }
 
+// Bright voxels (3 x 3 x 3 mean in [fluid-threshold, fluid-max]) split into one piece per lumen
+// (segment_split.cpp), and the gas components of the crop for the level test.
 void ColonSegmenter::find_fluid_bodies() {
-  RunLabels fl;
-  {
-    Bytes bright(d_.total);
-    const std::size_t plane = d_.n[0] * d_.n[1];
-    box_mean3_slices(hu_.data(), d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
-      for (std::size_t t = 0, q = k * plane; t < plane; ++t, ++q) {
-        bright[q] = !lab_[q] && mean[t] >= opts_.fluid_threshold && mean[t] <= opts_.fluid_max;
-        if (bright[q]) lab_[q] = kCandidate;
-      }
-    });
-    fl = component_runs(bright.data(), d_);
-  }
-  fluid_count_ = fl.count();
-  fluid_label_.assign(d_.total, 0);
-  for (std::uint32_t l = 1; l <= fluid_count_; ++l)
-    for (const Run* r = fl.begin(l); r != fl.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, l);
+  Bytes bright(d_.total);
+  const std::size_t plane = d_.n[0] * d_.n[1];
+  box_mean3_slices(hu_.data(), d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
+    for (std::size_t t = 0, q = k * plane; t < plane; ++t, ++q) {
+      bright[q] = !lab_[q] && mean[t] >= opts_.fluid_threshold && mean[t] <= opts_.fluid_max;
+      if (bright[q]) lab_[q] = kCandidate;
+    }
+  });
+  split_fluid_bodies(bright);
   pool_.assign(fluid_count_ + 1, 0);
+  Bytes gas(d_.total);
+  for (std::size_t q = 0; q < d_.total; ++q) gas[q] = lab_[q] == kGas;
+  const RunLabels gl = component_runs(gas.data(), d_);
+  gas_runs_.clear();
+  gas_run_len_.clear();
+  gas_voxels_.assign(gl.count() + 1, 0);
+  for (std::uint32_t l = 1; l <= gl.count(); ++l)
+    for (const Run* r = gl.begin(l); r != gl.end(l); ++r) gas_voxels_[l] += r->length;
+  for (const auto& [run, label] : gl.raster(std::vector<unsigned char>(gl.count() + 1, 1))) {
+    gas_runs_.emplace_back(run.start, label);
+    gas_run_len_.push_back(run.length);
+  }
+}
+
+// The gas component holding crop voxel q (0: not gas).
+std::uint32_t ColonSegmenter::gas_label_at(std::size_t q) const {
+  auto it = std::upper_bound(gas_runs_.begin(), gas_runs_.end(), std::make_pair(q, UINT32_MAX));
+  if (it == gas_runs_.begin()) return 0;
+  --it;
+  return q < it->first + gas_run_len_[std::size_t(it - gas_runs_.begin())] ? it->second : 0;
 }
 
 // Scans every line along `axis` for gas and fluid at most interface-width apart. contact: 1 where
@@ -64,29 +82,39 @@ void ColonSegmenter::scan_contacts(int axis, Bytes* contact, bool layer) {
 }
 
 // Per fluid body and side (0: gas at lower index, 1: at higher index) along `axis`: the number of
-// contact columns when they lie at one height (spread <= level-tolerance), else 0.
-std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis) {
+// contact columns it shares with gas bodies along which they lie at one height (per gas body: a
+// gas body and a fluid body in one lumen meet at one level, since each has one pressure; one fluid
+// body may meet several gas bodies at different heights). A pair counts when its contacts cover
+// >= 1 cm^2 and their heights spread (10th-90th percentile) <= level-tolerance, and the gas body
+// holds at least min_gas_voxels.
+std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis, std::size_t min_gas_voxels) {
   Bytes contact(d_.total, 0);
   scan_contacts(axis, &contact, false);
-  std::vector<std::vector<float>> heights[2];
-  heights[0].resize(fluid_count_ + 1);
-  heights[1].resize(fluid_count_ + 1);
-  for (std::size_t q = 0; q < d_.total; ++q)
-    if (contact[q]) {
-      std::size_t c[3];
-      d_.coords(q, c[0], c[1], c[2]);
-      heights[contact[q] - 1][fluid_label_[q]].push_back(float(double(c[axis]) * d_.sp[axis]));
+  const int wvox = int(std::ceil(opts_.interface_width / d_.sp[axis]));
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> heights[2];  // (fluid, gas) -> heights
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    if (!contact[q]) continue;
+    std::size_t c[3];
+    d_.coords(q, c[0], c[1], c[2]);
+    const int side = contact[q] - 1;
+    std::uint32_t g = 0;  // the gas voxel the contact faces, at most interface-width + 1 voxels away
+    for (long t = 1; t <= wvox + 1 && !g; ++t) {
+      const long p = side == 0 ? long(c[axis]) - t : long(c[axis]) + t;
+      if (p < 0 || p >= long(d_.n[axis])) break;
+      const std::size_t r = side == 0 ? q - std::size_t(t) * d_.stride[axis] : q + std::size_t(t) * d_.stride[axis];
+      if (lab_[r] == kGas) g = gas_label_at(r);
     }
+    heights[side][{fluid_label_[q], g}].push_back(float(double(c[axis]) * d_.sp[axis]));
+  }
   const double pixel_mm2 = d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[axis];
   const std::size_t min_columns = std::max<std::size_t>(8, std::size_t(std::ceil(100.0 / pixel_mm2)));  // 1 cm^2
   std::vector<std::array<std::size_t, 2>> out(fluid_count_ + 1, {0, 0});
-  for (std::uint32_t l = 1; l <= fluid_count_; ++l)
-    for (int side = 0; side < 2; ++side) {
-      auto& v = heights[side][l];
-      if (v.size() < min_columns) continue;
+  for (int side = 0; side < 2; ++side)
+    for (auto& [key, v] : heights[side]) {
+      if (v.size() < min_columns || gas_voxels_[key.second] < min_gas_voxels) continue;
       std::sort(v.begin(), v.end());
       const double spread = v[v.size() * 9 / 10] - v[v.size() / 10];
-      if (spread <= std::max(opts_.level_tolerance, 1.5 * d_.sp[axis])) out[l][side] = v.size();
+      if (spread <= std::max(opts_.level_tolerance, 1.5 * d_.sp[axis])) out[key.first][side] += v.size();
     }
   return out;
 }
@@ -96,7 +124,7 @@ void ColonSegmenter::gravity_from_levels() {
   double best_area = 0;
   int best_axis = -1, best_side = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    const auto lv = level_contacts(axis);
+    const auto lv = level_contacts(axis, 0);  // any gas: small-bowel bubbles show gravity too
     const double pixel_mm2 = d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[axis];
     for (int side = 0; side < 2; ++side) {
       double area = 0;
@@ -121,10 +149,12 @@ void ColonSegmenter::gravity_from_levels() {
   gravity_source_ = gravity_source_.empty() ? s.str() : gravity_source_ + "; " + s.str();
 }
 
-// A fluid body is a pool when gas lies above it (against gravity) along a level surface; bone
-// touching gas here and there has no level surface. Pools become lumen; other bodies stay candidates.
+// A fluid piece is a pool when insufflated colon gas (a gas body of at least min-segment-volume)
+// lies above it (against gravity) along a level surface; bone touching gas here and there has no
+// level surface, and small bowel holds only small bubbles of swallowed gas. Pools become lumen;
+// other pieces stay candidates.
 void ColonSegmenter::keep_level_pools() {
-  const auto lv = level_contacts(grav_axis_);
+  const auto lv = level_contacts(grav_axis_, std::size_t(std::ceil(opts_.min_segment_volume / voxel_ml_)));
   const int side = grav_sign_ > 0 ? 0 : 1;
   for (std::uint32_t l = 1; l <= fluid_count_; ++l) pool_[l] = lv[l][side] > 0;
   double sum = 0;
@@ -136,6 +166,27 @@ void ColonSegmenter::keep_level_pools() {
       ++n;
     }
   st_.fluid_hu = n ? sum / double(n) : 0.0;
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_pieces(lv, side);
+}
+
+// Every fluid piece of >= 3 mL: volume, centroid (LPS), mean HU, level contacts, pool or not.
+void ColonSegmenter::debug_pieces(const std::vector<std::array<std::size_t, 2>>& lv, int side) const {
+  std::vector<std::array<double, 5>> acc(fluid_count_ + 1, {0, 0, 0, 0, 0});
+  for (std::size_t q = 0; q < d_.total; ++q) {
+    const std::uint32_t l = fluid_label_[q];
+    if (!l) continue;
+    std::size_t c[3];
+    d_.coords(q, c[0], c[1], c[2]);
+    acc[l][0] += 1, acc[l][1] += double(c[0]), acc[l][2] += double(c[1]), acc[l][3] += double(c[2]), acc[l][4] += hu_[q];
+  }
+  for (std::uint32_t l = 1; l <= fluid_count_; ++l) {
+    const double n = acc[l][0];
+    if (n * voxel_ml_ < 3) continue;
+    const double c[3] = {acc[l][1] / n, acc[l][2] / n, acc[l][3] / n};
+    const auto p = lps_of(c);
+    std::fprintf(stderr, "piece %u %.1f mL at LPS (%.0f %.0f %.0f) crop (%.0f %.0f %.0f) HU %.0f level %zu %s\n", l, n * voxel_ml_, p[0], p[1], p[2],
+                 c[0], c[1], c[2], acc[l][4] / n, lv[l][side], pool_[l] ? "POOL" : "-");
+  }
 }
 
 void ColonSegmenter::mark_layer() { scan_contacts(grav_axis_, nullptr, true); }

@@ -85,6 +85,8 @@ RunLabels component_runs(const unsigned char* mask, const Dims& d);
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
+// Erosion of `m` (0/1) by a ball of radius r_mm (voxels outside the volume count as set).
+Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
 // slice(k, mean of slice k) for every k, from two workers (each slice once, slices of one worker
 // in order); only a few slices are held in memory.
@@ -152,10 +154,13 @@ class ColonSegmenter {
   MaskImage::Pointer paste() const;
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
+  void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
+  std::uint32_t gas_label_at(std::size_t q) const;
   void scan_contacts(int axis, Bytes* contact, bool layer);
-  std::vector<std::array<std::size_t, 2>> level_contacts(int axis);
+  std::vector<std::array<std::size_t, 2>> level_contacts(int axis, std::size_t min_gas_voxels);
   void gravity_from_levels();
   void keep_level_pools();
+  void debug_pieces(const std::vector<std::array<std::size_t, 2>>& lv, int side) const;
   void mark_layer();
   // Segments and fully tagged stretches (segment_link.cpp).
   void select_segments();
@@ -195,6 +200,9 @@ class ColonSegmenter {
   Buffer<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
+  std::vector<std::pair<std::size_t, std::uint32_t>> gas_runs_;  // crop gas components: (run start, label) in raster order
+  std::vector<std::size_t> gas_run_len_;
+  std::vector<std::size_t> gas_voxels_;  // per crop gas component: its voxels
   std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
   std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   Bytes state_;                        // crop: final 0/1 (after the graph cut)

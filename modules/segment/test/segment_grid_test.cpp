@@ -78,6 +78,34 @@ TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
   }
 }
 
+// Ball erosion (anisotropic voxels 0.75 x 0.75 x 1.5 mm, radius 3 mm) equals the brute-force
+// minimum over the ellipsoid of voxels within 3 mm, on a mask with holes and thin bridges.
+TEST(SegmentGrid, BallErosionMatchesBruteForce) {
+  const std::size_t n[3] = {34, 30, 22};
+  const double sp[3] = {0.75, 0.75, 1.5};
+  const Dims d = make_dims(n, sp);
+  const Bytes m = random_mask(d, 0.985, 21);
+  const Bytes e = erode_ball(m, d, 3.0);
+  std::size_t set = 0;
+  for (std::size_t q = 0; q < d.total; ++q) {
+    std::size_t c[3];
+    d.coords(q, c[0], c[1], c[2]);
+    bool all = m[q] != 0;
+    for (long dk = -2; dk <= 2; ++dk)
+      for (long dj = -4; dj <= 4; ++dj)
+        for (long di = -4; di <= 4; ++di) {
+          const long i = long(c[0]) + di, j = long(c[1]) + dj, k = long(c[2]) + dk;
+          if (i < 0 || j < 0 || k < 0 || i >= long(d.n[0]) || j >= long(d.n[1]) || k >= long(d.n[2])) continue;
+          const double r2 = std::pow(di * 0.75, 2) + std::pow(dj * 0.75, 2) + std::pow(dk * 1.5, 2);
+          if (r2 <= 9.0 + 1e-9) all = all && m[d.idx(i, j, k)];
+        }
+    ASSERT_EQ(bool(e[q]), all) << "voxel " << q;
+    set += all;
+  }
+  EXPECT_GT(set, 20u);           // some voxels pass,
+  EXPECT_LT(set, d.total / 2);  // most are within 3 mm of a hole
+}
+
 // The streamed 3 x 3 x 3 mean equals the brute-force mean with clamped edges, every slice once.
 TEST(SegmentGrid, StreamedBoxMeanMatchesBruteForce) {
   const Dims d = dims(17, 13, 11);

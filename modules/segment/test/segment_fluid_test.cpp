@@ -1,0 +1,97 @@
+// Tagged fluid that belongs to the colon wherever it touches it (issue 25): fluid bodies are split at
+// the narrow partial-volume bridges where bowel loops touch, and a fluid body is a pool when it meets
+// one gas body along one level (a fluid body may meet several gas pockets at different heights).
+// Tiny synthetic volumes, 1 mm voxels, no PatientPosition (gravity from the levels: +y).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "colonflat/segment/segment.h"
+#include "segment_volumes.h"
+
+namespace cf {
+namespace {
+
+double radial(double y, double z, double cy, double cz) { return std::sqrt((y - cy) * (y - cy) + (z - cz) * (z - cz)); }
+
+SegmentOptions fluid_options() {
+  SegmentOptions o = small_volume_options();
+  o.min_tagged_volume = 1;
+  return o;
+}
+
+// Voxels of the box [x0,x1] x [y0,y1] x [z0,z1] satisfying `inside`, and how many of them the mask holds.
+std::pair<std::size_t, std::size_t> kept_in(const MaskImage* m, int x0, int x1, int y0, int y1, int z0, int z1,
+                                            const std::function<bool(int, int, int)>& inside) {
+  std::size_t n = 0, kept = 0;
+  for (int x = x0; x <= x1; ++x)
+    for (int y = y0; y <= y1; ++y)
+      for (int z = z0; z <= z1; ++z)
+        if (inside(x, y, z)) ++n, kept += at(m, x, y, z);
+  return {n, kept};
+}
+
+bool has_reason(const SegmentStats& st, const std::string& decision, const std::string& part) {
+  for (const auto& d : st.decisions)
+    if (d["decision"] == decision && d["reason"].get<std::string>().find(part) != std::string::npos) return true;
+  return false;
+}
+
+// A colon tube with dependent fluid along its whole side (level at its axis) and a thinner loop of
+// oral contrast (300 HU, radius 5 mm) pressed against the pool's bottom across a 1.5 mm wall (one
+// bright body in the 3 x 3 x 3 mean): the pool is kept along the whole side, the loop is not.
+TEST(SegmentFluid, SideFluidKeptLoopAcrossWallRejected) {
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (x >= 10 && x <= 85 && radial(y, z, 34, 48) < 10) return y < 34 ? -1000.0 : 450.0;  // colon: gas over fluid
+    if (x >= 20 && x <= 75 && radial(y, z, 50.5, 48) < 5) return 300.0;                   // small-bowel loop
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_colon(ct, fluid_options(), &st);
+  const auto pool = kept_in(m, 14, 81, 36, 42, 42, 54, [](int, int y, int z) { return radial(y, z, 34, 48) < 8; });
+  EXPECT_EQ(pool.second, pool.first) << st.to_json()["decisions"].dump(1);
+  const auto loop = kept_in(m, 22, 73, 47, 54, 45, 51, [](int, int y, int z) { return radial(y, z, 50.5, 48) < 3; });
+  EXPECT_GT(loop.first, 500u);
+  EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
+  EXPECT_TRUE(has_reason(st, "rejected", "")) << st.to_json()["decisions"].dump(1);
+}
+
+// One colon tube: a gas pocket with a shallow level (4 mm of fluid), a fully tagged middle stretch
+// and a second gas pocket whose level lies 10 mm higher (the pockets' gas pressures differ). The
+// fluid body meets each gas body along a level of its own: the whole tube is lumen, one segment.
+TEST(SegmentFluid, FluidBetweenGasPocketsAtDifferentLevelsKept) {
+  auto ct = make_volume(100, [&](double x, double y, double z) {
+    if (x < 8 || x > 92 || radial(y, z, 40, 50) >= 9) return kKeep;
+    if (x < 35) return y < 44 ? -1000.0 : 450.0;
+    if (x > 65) return y < 34 ? -1000.0 : 450.0;
+    return 450.0;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_colon(ct, fluid_options(), &st);
+  const auto tube = kept_in(m, 10, 90, 32, 48, 42, 58, [](int, int y, int z) { return radial(y, z, 40, 50) < 7; });
+  EXPECT_GE(double(tube.second), 0.98 * double(tube.first)) << st.to_json()["decisions"].dump(1);
+  const auto middle = kept_in(m, 40, 60, 32, 48, 42, 58, [](int, int y, int z) { return radial(y, z, 40, 50) < 7; });
+  EXPECT_EQ(middle.second, middle.first);  // the fully tagged middle stretch, whole
+  EXPECT_EQ(components(m), 1u);
+}
+
+// A dense bright blob (900 HU, like a vertebral body) 3 mm beside the colon's gas: it has no level
+// under gas and does not continue the colon; it is not kept.
+TEST(SegmentFluid, BoneLikeBlobsRejected) {
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (x >= 10 && x <= 85 && radial(y, z, 40, 40) < 9) return -1000.0;       // gas-filled colon
+    if (std::sqrt((x - 48) * (x - 48) + (y - 40) * (y - 40) + (z - 61) * (z - 61)) < 9) return 900.0;  // blob beside
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_colon(ct, fluid_options(), &st);
+  EXPECT_TRUE(at(m, 48, 40, 40));
+  const auto blob = kept_in(m, 40, 56, 32, 48, 54, 68, [](int x, int y, int z) {
+    return std::sqrt((x - 48) * (x - 48) + (y - 40) * (y - 40) + (z - 61) * (z - 61)) < 7;
+  });
+  EXPECT_GT(blob.first, 1000u);
+  EXPECT_EQ(blob.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
+}  // namespace
+}  // namespace cf
