@@ -226,11 +226,11 @@ ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<doub
   c.s = std::move(s);
   c.axial_source = source;
   c.from_rectum = from_rectum;
-  double max_s = 0;
+  double max_s = 0, min_s = std::numeric_limits<double>::max();
   for (double x : c.s)
-    if (!std::isnan(x)) max_s = std::max(max_s, x);
-  if (max_s < 20 * o.bin_mm)
-    throw PreconditionError(scan.name + ": colon map too short to register (" + std::to_string(int(max_s)) + " mm)");
+    if (!std::isnan(x)) max_s = std::max(max_s, x), min_s = std::min(min_s, x);
+  if (max_s - std::min(min_s, max_s) < 20 * o.bin_mm)
+    throw PreconditionError(scan.name + ": colon map too short to register (" + std::to_string(int(std::max(0.0, max_s - min_s))) + " mm)");
   fill_profile(scan, o, int(std::ceil(std::max(max_s, min_length_mm) / o.bin_mm)), c);
   return c;
 }

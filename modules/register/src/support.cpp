@@ -7,6 +7,9 @@ namespace cf {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Largest local length change between the scans the map may show where it is supported: a stretch
+// of colon between two folds does not halve or double its length between supine and prone.
+constexpr double kMaxStretch = 2.0;
 
 // Highest present bin on one side of the midline that is a turning point of the course, or -1.
 int flexure_bin(const LengthProfile& p, double midline, int side, const LandmarkOptions& o) {
@@ -82,16 +85,23 @@ AlignmentSupport alignment_support(const LengthProfile& a, const LengthProfile& 
   s.supine_supported.assign(size_t(a.bins()), 0);
   s.prone_supported.assign(size_t(b.bins()), 0);
   int with_wall = 0, supported = 0;
+  // Local slope of the length map: where the warping stretches one colon over a stretch missing
+  // in the other (slope near 0 or very large) the map is not supported, even next to wall.
+  auto slope_ok = [&](double s, bool forward) {
+    const double h = a.bin_mm;
+    const double d = forward ? length.a_to_b(s + h) - length.a_to_b(s - h) : length.b_to_a(s + h) - length.b_to_a(s - h);
+    return d >= 2 * h / kMaxStretch && d <= 2 * h * kMaxStretch;
+  };
   for (int i = 0; i < a.bins(); ++i) {
     const int j = b.bin_of(length.a_to_b((i + 0.5) * a.bin_mm));
-    const bool ok = a.count[size_t(i)] > 0 && b.count[size_t(j)] > 0 &&
+    const bool ok = a.count[size_t(i)] > 0 && b.count[size_t(j)] > 0 && slope_ok((i + 0.5) * a.bin_mm, true) &&
                     (a.centre[size_t(i)] - b.centre[size_t(j)] - b_to_a).norm() <= radius;
     s.supine_supported[size_t(i)] = ok;
     with_wall += a.count[size_t(i)] > 0, supported += ok;
   }
   for (int j = 0; j < b.bins(); ++j) {
     const int i = a.bin_of(length.b_to_a((j + 0.5) * b.bin_mm));
-    s.prone_supported[size_t(j)] = b.count[size_t(j)] > 0 && a.count[size_t(i)] > 0 &&
+    s.prone_supported[size_t(j)] = b.count[size_t(j)] > 0 && a.count[size_t(i)] > 0 && slope_ok((j + 0.5) * b.bin_mm, false) &&
                                    (a.centre[size_t(i)] - b.centre[size_t(j)] - b_to_a).norm() <= radius;
   }
   s.supported_fraction = with_wall > 0 ? double(supported) / with_wall : 0.0;

@@ -19,7 +19,7 @@ struct AlignOptions {
   double warp_smooth_mm = 15;  // mm; Gaussian smoothing of the warping path
   // With AlignContext::use_position (both colons laid out as pieces on one axis, pieces.h):
   double position_weight = 1.0;     // weight of the centre lines' distance term
-  double position_sigma_mm = 25;    // mm; organ motion between supine and prone (docs)
+  double position_sigma_mm = 60;    // mm; organ motion between supine and prone (docs)
   double position_cap = 9;          // the distance term saturates at (3 sigma)^2: any mismatch costs the same
   double empty_cost = 4;            // a bin without wall in either scan (a gap between pieces): (2 sigma)^2
 };
