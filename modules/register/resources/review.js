@@ -39,7 +39,8 @@
       el("span", { class: "title", text: "supine " + p.supine.key + " \u2194 prone " + p.prone.key }),
       el("span", { class: "badge hit", text: "seen in both scans" }),
       el("span", { text: "pair score " + fix(p.score, 2) + " (supine " + fix(p.supine.score, 2) + ", prone " + fix(p.prone.score, 2) + ")" }),
-      el("span", { text: "after registration " + fix(p.along_mm) + " mm apart along the colon, " + fix(p.around_deg, 0) + "° around; size ratio " + fix(p.size_ratio, 2) })]);
+      el("span", { text: "after registration " + fix(p.along_mm) + " mm apart along the colon, " + fix(p.around_deg, 0) + "° around; size ratio " + fix(p.size_ratio, 2) }),
+      el("span", { class: "dim", text: "alignment supported here" + (p.anchor_mm === null || p.anchor_mm === undefined ? "" : "; nearest shared landmark or anchor " + fix(p.anchor_mm / 10, 1) + " cm along") })]);
     const body = el("div", { class: "pair-body" }, [
       C.supine.card(p.supine, { head: headOf(p.supine), facts: registeredFacts(p.supine, p.prone.key) }),
       C.prone.card(p.prone, { head: headOf(p.prone), facts: registeredFacts(p.prone, p.supine.key) })]);
@@ -49,7 +50,8 @@
     const pr = s.probe, where = other(s.scan);
     if (pr.not_registered) return el("p", { class: "dim", text: "This point is outside the registered part of the colon: no " + where + " view." });
     const head = [el("span", { class: "scan", text: where }),
-                  el("span", { class: "badge check", text: "not found in " + where + " - check here" })];
+                  s.unaligned ? el("span", { class: "badge unaligned", text: "not aligned here - position uncertain" })
+                              : el("span", { class: "badge check", text: "not found in " + where + " - check here" })];
     if (pr.match) head.push(el("span", { class: "badge hit", text: "known polyp " + pr.match.key + " " + fix(pr.match.distance_mm) + " mm from here" }));
     const facts = [["shows", where + " at the registered position of " + s.scan + " " + s.finding.key]].concat(registeredFacts(pr, null));
     const n = pr.nearest_candidate;
@@ -60,7 +62,8 @@
     const f = s.finding;
     const head = el("div", { class: "pair-head" }, [
       el("span", { class: "title", text: s.scan + " " + f.key + " \u2014 not found in " + other(s.scan) }),
-      el("span", { class: "dim", text: "polyps stay on the wall in both positions; stool and fluid move" })]);
+      s.unaligned ? el("span", { class: "badge unaligned", text: "the two scans could not be aligned here (" + other(s.scan) + " colon missing, collapsed or too far away): never paired" })
+                  : el("span", { class: "dim", text: "polyps stay on the wall in both positions; stool and fluid move" })]);
     const body = el("div", { class: "pair-body" }, [C[s.scan].card(f, { head: headOf(f), facts: registeredFacts(f, null) }), probeCard(s)]);
     return el("div", { class: "pair single", id: rowId(s.scan, f.key) }, [head, body]);
   }
@@ -93,6 +96,18 @@
       m.appendChild(c);
     }
   }
+  // Where the two scans could not be aligned (the striped stretches of the image).
+  function alignmentNote() {
+    const a = R.alignment;
+    if (!a) return null;
+    const gaps = (a.unaligned_mm || []).map((g) => fix(g[0] / 10, 1) + "\u2013" + fix(g[1] / 10, 1) + " cm");
+    const text = "Alignment: " + fix(100 * (a.supported_fraction || 0), 0) + " % of the supine colon supported; pieces: supine " +
+      a.pieces.supine + ", prone " + a.pieces.prone + "; shared landmarks: " + ((a.shared_landmarks || []).join(", ") || "none") +
+      "; " + a.candidate_anchors + " candidate pairs used as anchors. " +
+      (gaps.length ? "Could not be aligned (violet stripes; no pair is made there): " + gaps.join(", ") + " on the supine axis."
+                   : "Aligned along the whole supine colon.");
+    return el("p", { id: "alignment-note", class: gaps.length ? "unaligned-note" : "dim", text: text });
+  }
   function indexTable() {
     const rows = [];
     const tr = (cells, id) => {
@@ -121,6 +136,8 @@
     }
     for (const w of R.warnings || []) $("warnings").appendChild(el("p", { class: "warning", text: "Warning: " + w }));
     sideBySide();
+    const note = alignmentNote();
+    if (note) $("review-index").appendChild(note);
     $("review-index").appendChild(indexTable());
     for (const p of R.pairs || []) $("pair-list").appendChild(pairRow(p));
     if (!(R.pairs || []).length) $("pair-list").appendChild(el("p", { class: "dim", text: "No candidate was paired between the scans." }));

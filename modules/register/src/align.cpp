@@ -13,21 +13,24 @@ namespace {
 constexpr double kInfCost = std::numeric_limits<double>::infinity();
 constexpr double kTwoPi = 6.283185307179586;
 
-std::vector<double> zscore(std::vector<double> v) {
-  double mean = 0, sq = 0;
-  for (double x : v) mean += x;
-  mean /= double(v.size());
-  for (double x : v) sq += (x - mean) * (x - mean);
-  const double sd = std::sqrt(sq / double(v.size()));
-  for (double& x : v) x = sd > 1e-12 ? (x - mean) / sd : 0.0;
+// Z-score over the bins that hold wall (`count` > 0); empty bins get 0.
+std::vector<double> zscore(std::vector<double> v, const std::vector<int>& count) {
+  double mean = 0, sq = 0, n = 0;
+  for (size_t k = 0; k < v.size(); ++k)
+    if (count[k] > 0) mean += v[k], n += 1;
+  mean /= std::max(1.0, n);
+  for (size_t k = 0; k < v.size(); ++k)
+    if (count[k] > 0) sq += (v[k] - mean) * (v[k] - mean);
+  const double sd = std::sqrt(sq / std::max(1.0, n));
+  for (size_t k = 0; k < v.size(); ++k) v[k] = sd > 1e-12 && count[k] > 0 ? (v[k] - mean) / sd : 0.0;
   return v;
 }
 
 // Weighted, z-scored features per bin: [fold, smoothed calibre, curvature].
 std::vector<std::array<double, 3>> features(const LengthProfile& p, const AlignOptions& o) {
-  const auto fold = zscore(p.fold);
-  const auto calibre = zscore(gaussian_smooth(p.radius, 10.0 / p.bin_mm));
-  const auto curv = zscore(gaussian_smooth(p.curvature, 5.0 / p.bin_mm));
+  const auto fold = zscore(p.fold, p.count);
+  const auto calibre = zscore(gaussian_smooth(p.radius, 10.0 / p.bin_mm), p.count);
+  const auto curv = zscore(gaussian_smooth(p.curvature, 5.0 / p.bin_mm), p.count);
   std::vector<std::array<double, 3>> f(fold.size());
   for (size_t k = 0; k < f.size(); ++k)
     f[k] = {std::sqrt(o.fold_weight) * fold[k], std::sqrt(o.calibre_weight) * calibre[k],
@@ -72,23 +75,65 @@ LengthProfile reversed_profile(const LengthProfile& p) {
   return r;
 }
 
-LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, const AlignOptions& o) {
-  const auto fa = features(a, o), fb = features(b, o);
-  const int na = int(fa.size()), nb = int(fb.size());
-  const double ratio = double(nb - 1) / double(std::max(1, na - 1));
-  const double band = std::max(o.band_mm / b.bin_mm, 2.0 + std::abs(nb - na * ratio));
+namespace {
+
+// Cost of pairing bin i of A with bin j of B: feature distance, the distance of the two centre
+// lines (capped: beyond it every mismatch is as bad), a bin without wall in either scan a fixed
+// cost (nothing to compare: the path crosses it at the cost of an unsupported stretch), the
+// proportional prior, and anchors (a row of an anchor is open only within its tolerance).
+class LocalCost {
+ public:
+  LocalCost(const LengthProfile& a, const LengthProfile& b, const AlignOptions& o, const AlignContext& ctx)
+      : a_(a), b_(b), o_(o), ctx_(ctx), fa_(features(a, o)), fb_(features(b, o)) {
+    na_ = int(fa_.size()), nb_ = int(fb_.size());
+    ratio_ = double(nb_ - 1) / double(std::max(1, na_ - 1));
+    band_ = std::max(o.band_mm / b.bin_mm, 2.0 + std::abs(nb_ - na_ * ratio_));
+    anchor_.assign(size_t(na_), {-1, 0});
+    double last_b = -1;
+    for (const auto& an : ctx.anchors) {  // sorted by a; an anchor out of order with the previous is dropped
+      if (an.b_mm <= last_b) continue;
+      last_b = an.b_mm;
+      anchor_[size_t(a.bin_of(an.a_mm))] = {b.bin_of(an.b_mm), std::max(1, int(std::ceil(an.tolerance_mm / b.bin_mm)))};
+    }
+  }
+  int na() const { return na_; }
+  int nb() const { return nb_; }
+  int lo(int i) const { return std::max(0, int(std::floor(i * ratio_ - band_))); }
+  int hi(int i) const { return std::min(nb_ - 1, int(std::ceil(i * ratio_ + band_))); }
+  double operator()(int i, int j) const {
+    const double off = (j - i * ratio_) / band_;
+    double d = o_.prior_weight * off * off;
+    if (const auto& [aj, tol] = anchor_[size_t(i)]; aj >= 0 && std::abs(j - aj) > tol) d += 1e6;
+    if (ctx_.use_position && (a_.count[size_t(i)] == 0 || b_.count[size_t(j)] == 0)) return d + o_.empty_cost;
+    for (int c = 0; c < 3; ++c) d += (fa_[size_t(i)][c] - fb_[size_t(j)][c]) * (fa_[size_t(i)][c] - fb_[size_t(j)][c]);
+    if (ctx_.use_position) {
+      const double e = (a_.centre[size_t(i)] - b_.centre[size_t(j)] - ctx_.b_to_a).norm() / o_.position_sigma_mm;
+      d += o_.position_weight * std::min(e * e, o_.position_cap);
+    }
+    return d;
+  }
+
+ private:
+  const LengthProfile &a_, &b_;
+  const AlignOptions& o_;
+  const AlignContext& ctx_;
+  std::vector<std::array<double, 3>> fa_, fb_;
+  std::vector<std::pair<int, int>> anchor_;  // per A bin: (B bin, tolerance in bins), -1 = none
+  int na_ = 0, nb_ = 0;
+  double ratio_ = 1, band_ = 1;
+};
+
+}  // namespace
+
+LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, const AlignOptions& o,
+                             const AlignContext& ctx) {
+  const LocalCost local(a, b, o, ctx);
+  const int na = local.na(), nb = local.nb();
   std::vector<double> cost(size_t(na) * size_t(nb), kInfCost);
   std::vector<std::uint8_t> step(cost.size(), 0);
-  auto local = [&](int i, int j) {
-    double d = 0;
-    for (int c = 0; c < 3; ++c) d += (fa[size_t(i)][c] - fb[size_t(j)][c]) * (fa[size_t(i)][c] - fb[size_t(j)][c]);
-    const double off = (j - i * ratio) / band;
-    return d + o.prior_weight * off * off;
-  };
   auto at = [&](int i, int j) -> double& { return cost[size_t(i) * size_t(nb) + size_t(j)]; };
   for (int i = 0; i < na; ++i) {
-    const int lo = std::max(0, int(std::floor(i * ratio - band))), hi = std::min(nb - 1, int(std::ceil(i * ratio + band)));
-    for (int j = lo; j <= hi; ++j) {
+    for (int j = local.lo(i); j <= local.hi(i); ++j) {
       const double d = local(i, j);
       if (i == 0 && j == 0) { at(i, j) = d; continue; }
       double best = kInfCost;

@@ -216,6 +216,26 @@ ScanCoordinates colon_coordinates(const ColonScan& scan, const ProfileOptions& o
     c.reversed = true;
     c.from_rectum = false;
   }
+  fill_profile(scan, o, bins, c);
+  return c;
+}
+
+ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<double> s, const ProfileOptions& o,
+                                         double min_length_mm, const std::string& source, bool from_rectum) {
+  ScanCoordinates c;
+  c.s = std::move(s);
+  c.axial_source = source;
+  c.from_rectum = from_rectum;
+  double max_s = 0, min_s = std::numeric_limits<double>::max();
+  for (double x : c.s)
+    if (!std::isnan(x)) max_s = std::max(max_s, x), min_s = std::min(min_s, x);
+  if (max_s - std::min(min_s, max_s) < 20 * o.bin_mm)
+    throw PreconditionError(scan.name + ": colon map too short to register (" + std::to_string(int(std::max(0.0, max_s - min_s))) + " mm)");
+  fill_profile(scan, o, int(std::ceil(std::max(max_s, min_length_mm) / o.bin_mm)), c);
+  return c;
+}
+
+void fill_profile(const ColonScan& scan, const ProfileOptions& o, int bins, ScanCoordinates& c) {
   LengthProfile& p = c.profile;
   p.bin_mm = o.bin_mm;
   p.centre = smooth_points(bin_centroids(c.s, scan.lps, o.bin_mm, bins, p.count), o.smooth_mm / o.bin_mm);
@@ -245,7 +265,6 @@ ScanCoordinates colon_coordinates(const ColonScan& scan, const ProfileOptions& o
   const auto trend = gaussian_smooth(p.radius, o.fold_band_mm / o.bin_mm);
   p.fold.resize(size_t(bins));
   for (int k = 0; k < bins; ++k) p.fold[size_t(k)] = p.radius[size_t(k)] - trend[size_t(k)];
-  return c;
 }
 
 }  // namespace cf

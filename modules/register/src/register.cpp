@@ -5,6 +5,7 @@
 #include <vtkPolyData.h>
 #include <vtkStaticPointLocator.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <thread>
@@ -73,27 +74,114 @@ void ColonRegistration::run() {
   align_along();
   timing_["length_alignment_s"] = t.seconds() - timing_["coordinates_s"].get<double>();
   align_around();
+  assess_support();
   const double before = t.seconds();
   correspond_vertices();
   timing_["vertex_correspondence_s"] = t.seconds() - before;
   match_candidates();
+  anchor_on_candidates();
+  if (!anchors_.empty()) {  // second pass through the matched candidates
+    const double again = t.seconds();
+    align_along();
+    align_around();
+    assess_support();
+    correspond_vertices();
+    match_candidates();
+    timing_["anchored_pass_s"] = t.seconds() - again;
+  }
   timing_["total_s"] = t.seconds();
 }
 
-void ColonRegistration::compute_coordinates() {
-  sup_ = colon_coordinates(supine_, opts_.profile);
-  pro_ = colon_coordinates(prone_, opts_.profile, opts_.orientation == "reverse");
-  const bool labelled = sup_.from_rectum && pro_.from_rectum;
-  if (opts_.orientation == "auto" && !labelled) {
-    const double same = align_length(sup_.profile, pro_.profile, opts_.align).cost;
-    const double reverse = align_length(sup_.profile, reversed_profile(pro_.profile), opts_.align).cost;
-    if (reverse < same) pro_ = colon_coordinates(prone_, opts_.profile, true);
+namespace {
+// Centres of the bins that hold wall.
+std::vector<Eigen::Vector3d> present_centres(const LengthProfile& p) {
+  std::vector<Eigen::Vector3d> out;
+  for (int k = 0; k < p.bins(); ++k)
+    if (p.count[size_t(k)] > 0) out.push_back(p.centre[size_t(k)]);
+  return out;
+}
+
+// s of the rectal / cecal end of a laid-out scan (NaN when its end band is not labelled so).
+double end_s(const std::vector<ColonPiece>& pieces, const std::string& name) {
+  for (const auto& p : pieces) {
+    if (!p.registered) continue;
+    if (p.x0_end == name) return p.s_of(0);
+    if (p.x1_end == name) return p.s_of(p.length_mm);
   }
+  return kNaN;
+}
+}  // namespace
+
+void ColonRegistration::compute_coordinates() {
+  piecewise_ = has_pieces(supine_) && has_pieces(prone_);
+  if (piecewise_) {
+    opts_.pieces.bin_mm = opts_.profile.bin_mm;
+    layout_ = layout_pieces(supine_, prone_, opts_.pieces);
+    auto s_sup = common_s(supine_, layout_.supine), s_pro = common_s(prone_, layout_.prone);
+    double extent = 0;
+    for (const auto* v : {&s_sup, &s_pro})
+      for (double x : *v)
+        if (!std::isnan(x)) extent = std::max(extent, x);
+    const bool rectum = !std::isnan(end_s(layout_.supine, "rectum")) || !std::isnan(end_s(layout_.prone, "rectum"));
+    sup_ = colon_coordinates_from_s(supine_, std::move(s_sup), opts_.profile, extent, "pieces (centreline_mm)", rectum);
+    pro_ = colon_coordinates_from_s(prone_, std::move(s_pro), opts_.profile, extent, "pieces (centreline_mm)", rectum);
+    b_to_a_ = layout_.prone_to_supine;
+  } else {
+    sup_ = colon_coordinates(supine_, opts_.profile);
+    pro_ = colon_coordinates(prone_, opts_.profile, opts_.orientation == "reverse");
+    const bool labelled = sup_.from_rectum && pro_.from_rectum;
+    if (opts_.orientation == "auto" && !labelled) {
+      const double same = align_length(sup_.profile, pro_.profile, opts_.align).cost;
+      const double reverse = align_length(sup_.profile, reversed_profile(pro_.profile), opts_.align).cost;
+      if (reverse < same) pro_ = colon_coordinates(prone_, opts_.profile, true);
+    }
+    b_to_a_ = fit_shift(present_centres(sup_.profile), present_centres(pro_.profile));
+  }
+  anchors_.clear();
   sup_index_ = std::make_unique<Index>(supine_, sup_);
   pro_index_ = std::make_unique<Index>(prone_, pro_);
 }
 
-void ColonRegistration::align_along() { length_ = align_length(sup_.profile, pro_.profile, opts_.align); }
+void ColonRegistration::align_along() {
+  AlignContext ctx;
+  ctx.use_position = piecewise_;
+  ctx.b_to_a = b_to_a_;
+  ctx.anchors = anchors_;
+  length_ = align_length(sup_.profile, pro_.profile, opts_.align, ctx);
+}
+
+void ColonRegistration::assess_support() {
+  sup_marks_ = find_landmarks(sup_.profile, end_s(layout_.supine, "rectum"), end_s(layout_.supine, "cecum"), opts_.landmarks);
+  pro_marks_ = find_landmarks(pro_.profile, end_s(layout_.prone, "rectum"), end_s(layout_.prone, "cecum"), opts_.landmarks);
+  shared_ = share_landmarks(sup_marks_, pro_marks_, length_, opts_.landmark_tolerance_mm);
+  std::vector<double> at;
+  for (const auto& l : shared_)
+    if (l.consistent) at.push_back(l.supine_mm);
+  for (const auto& a : anchors_) at.push_back(a.a_mm);
+  support_ = alignment_support(sup_.profile, pro_.profile, length_, b_to_a_, opts_.support_radius_mm, at);
+}
+
+double ColonRegistration::support_gap_mm(bool supine_scan, double s) const {
+  if (std::isnan(s)) return std::numeric_limits<double>::infinity();
+  const auto& gap = supine_scan ? support_.supine_gap_mm : support_.prone_gap_mm;
+  if (gap.empty()) return 0;
+  return gap[size_t((supine_scan ? sup_ : pro_).profile.bin_of(s))];
+}
+
+void ColonRegistration::anchor_on_candidates() {
+  std::vector<AlignAnchor> found;
+  for (const auto& m : matching_.pairs) {
+    if (!m.unique || m.along_mm > opts_.anchor_along_mm || m.around_deg > opts_.anchor_around_deg) continue;
+    if (m.supine_gap_mm > 0 || m.prone_gap_mm > 0) continue;
+    const ScanCandidate *a = nullptr, *b = nullptr;
+    for (const auto& c : supine_.candidates) if (c.id == m.supine_id) a = &c;
+    for (const auto& c : prone_.candidates) if (c.id == m.prone_id) b = &c;
+    const double sa = locate(a->lps, Direction::kSupineToProne).first, sb = locate(b->lps, Direction::kProneToSupine).first;
+    found.push_back({sa, sb, opts_.anchor_tolerance_mm, "candidate"});
+  }
+  std::sort(found.begin(), found.end(), [](const AlignAnchor& x, const AlignAnchor& y) { return x.a_mm < y.a_mm; });
+  anchors_ = found;
+}
 
 void ColonRegistration::align_around() {
   twist_ = estimate_twist(sup_, pro_, length_, opts_.twist, &twist_windows_);

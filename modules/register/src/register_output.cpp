@@ -61,6 +61,7 @@ vtkSmartPointer<vtkPolyData> correspondence_polydata(const ColonRegistration& re
   vertex->SetNumberOfTuples(n);
   auto flat = double_array(other + "_flat_mm", 3, n), lps = double_array(other + "_position_lps_mm", 3, n);
   auto s = double_array("register_s_mm", 1, n), theta = double_array("register_angle_rad", 1, n);
+  auto gap = double_array("register_gap_mm", 1, n);  // mm along to supported alignment (0 = supported)
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (vtkIdType v = 0; v < n; ++v) {
     const int w = map[size_t(v)];
@@ -74,8 +75,9 @@ vtkSmartPointer<vtkPolyData> correspondence_polydata(const ColonRegistration& re
     }
     s->SetValue(v, c.s[size_t(v)]);
     theta->SetValue(v, c.theta[size_t(v)]);
+    gap->SetValue(v, reg.support_gap_mm(forward, c.s[size_t(v)]));
   }
-  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{vertex, flat, lps, s, theta})
+  for (vtkAbstractArray* a : std::initializer_list<vtkAbstractArray*>{vertex, flat, lps, s, theta, gap})
     pd->GetPointData()->AddArray(a);
   vtkNew<vtkStringArray> note;
   note->SetName("Registration");

@@ -33,6 +33,10 @@ const ParamTable<RegisterParams>& register_param_table() {
         .real("match-along-mm", &P::match_along_mm, "mm", "largest distance along the colon of a candidate pair", 0, 500)
         .real("match-around-deg", &P::match_around_deg, "deg", "largest angle around the colon of a candidate pair", 0, 180)
         .real("match-size-ratio", &P::match_size_ratio, "", "largest size ratio of a candidate pair", 1, 100)
+        .real("position-sigma-mm", &P::position_sigma_mm, "mm", "organ motion between the scans: scale of the centre lines' distance in the length alignment", 1, 500)
+        .real("support-radius-mm", &P::support_radius_mm, "mm", "centre points of the two scans farther apart than this (after the table shift) do not support the alignment", 1, 1000)
+        .real("max-unsupported-mm", &P::max_unsupported_mm, "mm", "a candidate farther than this along the colon from supported alignment is never paired", 0, 1000)
+        .real("match-3d-mm", &P::match_3d_mm, "mm", "largest LPS distance of a candidate pair after the table shift", 1, 2000)
         .real("pixel-mm", &P::pixel_mm, "mm", "pixel size of the side-by-side image", 0.1, 10)
         .flag("review", &P::review,
               "supine-prone review page OUT/report.html + OUT/report_files/: per candidate both scans' views, or the "
@@ -55,6 +59,10 @@ RegisterOptions register_options(const RegisterParams& p) {
   o.match_along_mm = p.match_along_mm;
   o.match_around_deg = p.match_around_deg;
   o.match_size_ratio = p.match_size_ratio;
+  o.align.position_sigma_mm = p.position_sigma_mm;
+  o.support_radius_mm = p.support_radius_mm;
+  o.max_unsupported_mm = p.max_unsupported_mm;
+  o.match_3d_mm = p.match_3d_mm;
   return o;
 }
 

@@ -86,6 +86,25 @@ class ReviewBuilder {
                              {"prone_reversed", reg_.prone_reversed()},
                              {"along_from", c.from_rectum ? "rectum" : "start of the supine map"},
                              {"file", "registration.json"}};
+    data_["alignment"] = alignment_json();
+  }
+
+  // Where the two colons could be aligned: pieces per scan, shared landmarks, anchors, and the
+  // stretches of the supine axis without support (shown striped on the side-by-side image).
+  nlohmann::json alignment_json() const {
+    const AlignmentSupport& s = reg_.support();
+    nlohmann::json gaps = nlohmann::json::array(), marks = nlohmann::json::array();
+    for (const auto& [a, b] : s.unsupported) gaps.push_back({round1(a), round1(b)});
+    for (const auto& l : reg_.shared_landmarks())
+      if (l.consistent) marks.push_back(l.name);
+    int candidate_anchors = 0;
+    for (const auto& a : reg_.anchors()) candidate_anchors += a.kind == "candidate";
+    return {{"supported_fraction", std::round(s.supported_fraction * 1000) / 1000},
+            {"unaligned_mm", gaps},
+            {"pieces", {{"supine", reg_.pieces().supine.size()}, {"prone", reg_.pieces().prone.size()}}},
+            {"shared_landmarks", marks},
+            {"candidate_anchors", candidate_anchors},
+            {"max_unsupported_mm", reg_.options().max_unsupported_mm}};
   }
 
   // One row per candidate pair: both scans' cards with registered positions and the pair's figures.
@@ -98,7 +117,8 @@ class ReviewBuilder {
                                 std::to_string(m.prone_id) + " is not in the runs' candidate lists");
       rows.push_back({{"supine", own_card(scans_[0], *a)}, {"prone", own_card(scans_[1], *b)},
                       {"along_mm", round1(m.along_mm)}, {"around_deg", round1(m.around_deg)},
-                      {"size_ratio", std::round(m.size_ratio * 100) / 100}, {"score", std::round(m.score * 1000) / 1000}});
+                      {"size_ratio", std::round(m.size_ratio * 100) / 100}, {"score", std::round(m.score * 1000) / 1000},
+                      {"anchor_mm", std::isfinite(m.anchor_mm) ? nlohmann::json(round1(m.anchor_mm)) : nlohmann::json(nullptr)}});
     }
     data_["pairs"] = rows;
     result.pairs = int(rows.size());
@@ -107,15 +127,17 @@ class ReviewBuilder {
   // One row per candidate seen in one scan only: its card and the other scan's views where it maps.
   void add_singles() {
     nlohmann::json rows = nlohmann::json::array();
-    const auto add = [&](ReviewScan& own, ReviewScan& other, const std::vector<int>& ids) {
+    const auto add = [&](ReviewScan& own, ReviewScan& other, const std::vector<int>& ids, const std::vector<int>& unaligned) {
       for (int id : ids) {
         const ReportFinding* f = candidate(own, id);
         if (!f) throw Error("review: " + own.name + " candidate P" + std::to_string(id) + " is not in its run's list");
-        rows.push_back({{"scan", own.name}, {"finding", own_card(own, *f)}, {"probe", probe_card(own, other, *f)}});
+        const bool no_support = std::find(unaligned.begin(), unaligned.end(), id) != unaligned.end();
+        rows.push_back({{"scan", own.name}, {"finding", own_card(own, *f)}, {"probe", probe_card(own, other, *f)},
+                        {"unaligned", no_support}});
       }
     };
-    add(scans_[0], scans_[1], reg_.matching().supine_only);
-    add(scans_[1], scans_[0], reg_.matching().prone_only);
+    add(scans_[0], scans_[1], reg_.matching().supine_only, reg_.matching().supine_unaligned);
+    add(scans_[1], scans_[0], reg_.matching().prone_only, reg_.matching().prone_unaligned);
     data_["singles"] = rows;
     result.singles = int(rows.size());
   }

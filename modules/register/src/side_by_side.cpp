@@ -49,11 +49,23 @@ double shade(const ColonScan& scan, const ScanCoordinates& c, int v) {
   return 0.25 + 0.75 * std::max(0.0, -n.dot(light));
 }
 
+constexpr double kWall[3] = {235, 170, 150}, kUnaligned[3] = {170, 90, 230};
+
+// Per image column: the alignment has support there (the supine bin is within
+// max_unsupported_mm of a supported bin, support.h).
+std::vector<char> aligned_columns(const ColonRegistration& reg, const Layout& l) {
+  std::vector<char> out(size_t(l.band_cols), 1);
+  for (int col = 0; col < l.band_cols; ++col)
+    out[size_t(col)] = reg.support_gap_mm(true, (col + 0.5) * l.pixel) <= reg.options().max_unsupported_mm;
+  return out;
+}
+
 void paint_bands(const ColonRegistration& reg, const Layout& l, vtkImageData* img) {
   auto* px = static_cast<unsigned char*>(img->GetScalarPointer());
   const auto& cs = reg.supine_coordinates();
   const auto& cp = reg.prone_coordinates();
   const double tolerance = 2 * l.pixel + 3;
+  const std::vector<char> aligned = aligned_columns(reg, l);
   for (int col = 0; col < l.band_cols; ++col)
     for (int r = 0; r < l.band; ++r) {
       const double s = (col + 0.5) * l.pixel, theta = (r + 0.5) * kTwoPi / l.band;
@@ -62,12 +74,15 @@ void paint_bands(const ColonRegistration& reg, const Layout& l, vtkImageData* im
       const int vs = reg.vertex_at(true, s, theta), vp = reg.vertex_at(false, s2, t2);
       const double gs = vs >= 0 && std::abs(cs.s[size_t(vs)] - s) < tolerance ? shade(reg.supine(), cs, vs) : -1;
       const double gp = vp >= 0 && std::abs(cp.s[size_t(vp)] - s2) < tolerance ? shade(reg.prone(), cp, vp) : -1;
+      // Where the alignment has no support: wall tinted violet with diagonal stripes, in both bands.
+      const bool hatch = !aligned[size_t(col)] && (col + r) % 14 < 4;
       for (int band = 0; band < 2; ++band) {
         const double g = band == 0 ? gs : gp;
         const int row = (band == 0 ? l.supine_top : l.prone_top) + r;
         unsigned char* d = px + (size_t(l.height - 1 - row) * size_t(l.width) + size_t(kLeft + col)) * 3;
-        const double rgb[3] = {235, 170, 150};
-        for (int c = 0; c < 3; ++c) d[c] = g < 0 ? 70 : (unsigned char)std::lround(std::clamp(g, 0.0, 1.0) * rgb[c]);
+        const double* rgb = aligned[size_t(col)] ? kWall : kUnaligned;
+        for (int c = 0; c < 3; ++c)
+          d[c] = hatch ? (unsigned char)kUnaligned[c] : g < 0 ? 70 : (unsigned char)std::lround(std::clamp(g, 0.0, 1.0) * rgb[c]);
       }
     }
 }
@@ -144,6 +159,16 @@ void write_text(vtkImageData* out, const ColonRegistration& reg, const Layout& l
   legend << reg.matching().pairs.size() << " matched pairs (green), " << reg.matching().supine_only.size()
          << " supine-only and " << reg.matching().prone_only.size() << " prone-only candidates (orange)";
   draw_text(out, legend.str(), kLeft, l.prone_top - kGap / 2 - 8, 13, orange);
+  const auto& gaps = reg.support().unsupported;
+  if (!gaps.empty()) {
+    const double violet[3] = {0.75, 0.5, 1.0};
+    std::ostringstream text;
+    text << "violet, striped: not aligned (no wall of the other scan there, or the colons too far apart): ";
+    for (size_t k = 0; k < gaps.size() && k < 6; ++k)
+      text << (k ? ", " : "") << std::lround(gaps[k].first) << "-" << std::lround(gaps[k].second) << " mm";
+    if (gaps.size() > 6) text << " ...";
+    draw_text(out, text.str(), kLeft, l.prone_top - kGap / 2 + 10, 12, violet);
+  }
 }
 
 }  // namespace

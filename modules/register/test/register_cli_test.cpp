@@ -202,3 +202,54 @@ TEST(RegisterReview, FailingReviewLeavesNoOutput) {
 
 }  // namespace
 }  // namespace cf
+
+namespace cf {
+namespace {
+
+// Pixels of the side-by-side image's violet "not aligned" stripes in image columns [c0, c1).
+int violet_pixels(vtkImageData* img, int c0, int c1) {
+  int dims[3];
+  img->GetDimensions(dims);
+  int n = 0;
+  for (int y = 0; y < dims[1]; ++y)
+    for (int x = std::max(0, c0); x < std::min(dims[0], c1); ++x) {
+      const auto* p = static_cast<unsigned char*>(img->GetScalarPointer(x, y, 0));
+      n += p[0] == 170 && p[1] == 90 && p[2] == 230;
+    }
+  return n;
+}
+
+// A quarter of the colon (125 of 500 mm) left out of the prone map: the review page names the
+// stretch that could not be aligned and marks the supine polyps there as unaligned (never paired),
+// and the side-by-side image stripes those columns violet and no column of the aligned rectal part.
+TEST(RegisterReview, UnalignedStretchIsShownOnPageAndImage) {
+  testing::TempDir tmp;
+  SyntheticPairOptions o;
+  o.prone_removed = {{150, 275}};
+  const SyntheticPair pair = make_synthetic_pair(o);
+  write_run_dir(pair.supine, tmp / "supine");
+  write_run_dir(pair.prone, tmp / "prone");
+  const Result r = run_register({tmp.str("supine"), tmp.str("prone"), "-o", tmp.str("out"), "-q"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json page = report_page_data(tmp / "out/report.html");
+  const auto& gaps = page["alignment"]["unaligned_mm"];
+  double covered = 0;
+  for (const auto& g : gaps) covered += std::max(0.0, std::min(g[1].get<double>(), 275.0) - std::max(g[0].get<double>(), 150.0));
+  EXPECT_GT(covered, 100.0) << gaps.dump();
+  int unaligned = 0;
+  for (const auto& s : page["singles"]) unaligned += s["unaligned"].get<bool>();
+  int inside = 0;
+  for (const auto& q : pair.polyps) inside += !q.in_prone;
+  EXPECT_GE(unaligned, inside);
+  EXPECT_GT(inside, 0);
+  for (const auto& p : page["pairs"]) EXPECT_EQ(p["supine"]["key"], p["prone"]["key"]);
+  vtkNew<vtkPNGReader> png;
+  png->SetFileName((tmp / "out/supine_prone.png").c_str());
+  png->Update();
+  const int left = 90;  // image margin left of s = 0 (side_by_side.cpp), 1 mm per pixel
+  EXPECT_GT(violet_pixels(png->GetOutput(), left + 170, left + 255), 500);
+  EXPECT_EQ(violet_pixels(png->GetOutput(), left + 10, left + 120), 0);
+}
+
+}  // namespace
+}  // namespace cf

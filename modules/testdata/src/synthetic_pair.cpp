@@ -111,37 +111,86 @@ Eigen::Vector3d wall_normal(const Tube& tube, const Placement& pl, double s, dou
   return normal.normalized();
 }
 
+bool removed(const std::vector<std::pair<double, double>>& cuts, double sigma) {
+  for (const auto& [a, b] : cuts)
+    if (sigma >= a && sigma < b) return true;
+  return false;
+}
+
+// The kept rings in runs (a stretch left out of the segmentation splits the colon): run id per ring, -1 = left out.
+std::vector<int> ring_runs(const Grid& g, const std::vector<std::pair<double, double>>& cuts, int& runs) {
+  std::vector<int> run(size_t(g.rings), -1);
+  runs = 0;
+  for (int r = 0; r < g.rings; ++r) {
+    if (removed(cuts, g.sigma[size_t(r * g.around)])) continue;
+    if (r == 0 || run[size_t(r - 1)] < 0) ++runs;
+    run[size_t(r)] = runs - 1;
+  }
+  return run;
+}
+
+// One band per run of kept rings, in order, ends labelled as flatten labels them (rectum on the
+// first, cecum on the last, end A / end B where the colon was cut), `order` reversed among the
+// middle bands when `shuffle` (the placement must not rely on flatten's chain).
+void add_segments(FlatMap& flat, const Tube& tube, const Placement& pl, const Grid& g, const std::vector<int>& run,
+                  int runs, bool with_arc, bool shuffle) {
+  double offset = 0;
+  for (int k = 0; k < runs; ++k) {
+    int r0 = -1, r1 = -1;
+    for (int r = 0; r < g.rings; ++r)
+      if (run[size_t(r)] == k) r1 = r, r0 = r0 < 0 ? r : r0;
+    FlatSegment seg;
+    seg.id = k;
+    seg.period = kTwoPi * tube.o.radius_mm;
+    seg.length = g.sigma[size_t(r1 * g.around)] - g.sigma[size_t(r0 * g.around)];
+    seg.order = shuffle && k > 0 && k + 1 < runs ? runs - 1 - k : k;
+    if (with_arc) {  // contract 1: a map along the centreline, ends named
+      seg.map = "area-balanced";
+      seg.centreline_length = pl.arc_of_sigma(g.sigma[size_t(r1 * g.around)]) - pl.arc_of_sigma(g.sigma[size_t(r0 * g.around)]);
+      seg.centreline_offset = offset;
+      offset += seg.centreline_length;
+      seg.x0_end = k == 0 ? "rectum" : "end A";
+      seg.x1_end = k + 1 == runs ? "cecum" : "end B";
+    }
+    flat.segments.push_back(seg);
+  }
+}
+
 // One scan's flat map: the grid at flat x = flat_x(sigma), y = radius x angle from the cut; with
-// `with_arc`, centreline_mm (and angle_rad) per vertex and the ends labelled rectum / cecum.
+// `with_arc`, centreline_mm (from each band's x0 end) and angle_rad per vertex and the ends
+// labelled. Rings in `cuts` are left out (the colon then has several bands).
 FlatMap grid_flat_map(const Tube& tube, const Placement& pl, const Grid& g, const std::function<double(double)>& flat_x,
-                      double cut, double length, bool with_arc) {
+                      double cut, bool with_arc, const std::vector<std::pair<double, double>>& cuts, bool shuffle) {
   FlatMap flat;
+  int runs = 0;
+  const std::vector<int> run = ring_runs(g, cuts, runs);
+  std::vector<double> run_start(size_t(runs), -1);
+  std::vector<int> index(g.sigma.size(), -1);
   for (size_t v = 0; v < g.sigma.size(); ++v) {
+    const int k = run[v / size_t(g.around)];
+    if (k < 0) continue;
     const double s = g.sigma[v], f = g.phi[v];
+    if (run_start[size_t(k)] < 0) run_start[size_t(k)] = s;
     const double angle = std::fmod(f - cut + 2 * kTwoPi, kTwoPi);
     const Eigen::Vector3d p = wall_point(tube, pl, s, f), n = wall_normal(tube, pl, s, f);
+    index[v] = int(flat.uv.size());
     flat.uv.push_back({flat_x(s), tube.o.radius_mm * angle});
     flat.position.push_back({p.x(), p.y(), p.z()});
     flat.normal.push_back({n.x(), n.y(), n.z()});
-    flat.segment.push_back(0);
+    flat.segment.push_back(k);
     flat.source_vertex.push_back(int(v));
-    if (with_arc) flat.centreline_mm.push_back(pl.arc_of_sigma(s)), flat.angle_rad.push_back(angle);
+    if (with_arc)
+      flat.centreline_mm.push_back(pl.arc_of_sigma(s) - pl.arc_of_sigma(run_start[size_t(k)])), flat.angle_rad.push_back(angle);
   }
   for (int r = 0; r + 1 < g.rings; ++r)
     for (int a = 0; a + 1 < g.around; ++a) {
       const int v = r * g.around + a;
-      flat.triangles.push_back({v, v + g.around, v + 1});
-      flat.triangles.push_back({v + 1, v + g.around, v + g.around + 1});
+      if (index[size_t(v)] < 0 || index[size_t(v + g.around)] < 0) continue;
+      const int w = index[size_t(v)], up = index[size_t(v + g.around)];
+      flat.triangles.push_back({w, up, w + 1});
+      flat.triangles.push_back({w + 1, up, up + 1});
     }
-  FlatSegment seg;
-  seg.length = length;
-  seg.period = kTwoPi * tube.o.radius_mm;
-  if (with_arc) {  // contract 1: a map along the centreline, ends named
-    seg.map = "area-balanced";
-    seg.centreline_length = pl.arc_of_sigma(g.sigma.back());
-    seg.x0_end = "rectum", seg.x1_end = "cecum";
-  }
-  flat.segments.push_back(seg);
+  add_segments(flat, tube, pl, g, run, runs, with_arc, shuffle);
   return flat;
 }
 
@@ -178,8 +227,10 @@ SyntheticPair make_synthetic_pair(const SyntheticPairOptions& o) {
   const Grid gs = make_grid(L, o.spacing_mm, o.radius_mm, 0.0), gp = make_grid(L, 1.1 * o.spacing_mm, o.radius_mm, 0.37);
   const double pro_len = pro.arc_of_sigma(L);
   auto pro_x = [&](double s) { return o.reverse_prone ? pro_len - 0.95 * pro.arc_of_sigma(s) : 0.95 * pro.arc_of_sigma(s); };
-  const FlatMap sup_flat = grid_flat_map(tube, sup, gs, [](double s) { return s; }, 0.3, L, o.centreline);
-  const FlatMap pro_flat = grid_flat_map(tube, pro, gp, pro_x, 2.0, 0.95 * pro_len, o.centreline && !o.reverse_prone);
+  const FlatMap sup_flat = grid_flat_map(tube, sup, gs, [](double s) { return s; }, 0.3, o.centreline,
+                                         o.supine_removed, o.shuffle_pieces);
+  const FlatMap pro_flat = grid_flat_map(tube, pro, gp, pro_x, 2.0, o.centreline && !o.reverse_prone, o.prone_removed,
+                                         o.shuffle_pieces);
   out.supine = scan_from_polydata(flat_to_polydata(sup_flat), "synthetic supine");
   out.prone = scan_from_polydata(flat_to_polydata(pro_flat), "synthetic prone");
   out.supine_sigma = gs.sigma, out.supine_phi = gs.phi, out.prone_sigma = gp.sigma, out.prone_phi = gp.phi;
@@ -188,12 +239,16 @@ SyntheticPair make_synthetic_pair(const SyntheticPairOptions& o) {
   for (auto& q : tube.polyps) {
     q.supine_lps = wall_point(tube, sup, q.sigma_mm, q.phi_rad);
     q.prone_lps = wall_point(tube, pro, q.sigma_mm, q.phi_rad);
-    out.supine.candidates.push_back({q.id, q.supine_lps, q.size_mm * (0.9 + 0.2 * u(rng)), 0.7});
-    out.prone.candidates.push_back({q.id, q.prone_lps, q.size_mm * (0.9 + 0.2 * u(rng)), 0.7});
+    q.in_supine = !removed(o.supine_removed, q.sigma_mm);
+    q.in_prone = !removed(o.prone_removed, q.sigma_mm);
+    const double size_s = q.size_mm * (0.9 + 0.2 * u(rng)), size_p = q.size_mm * (0.9 + 0.2 * u(rng));
+    if (q.in_supine) out.supine.candidates.push_back({q.id, q.supine_lps, size_s, 0.7});
+    if (q.in_prone) out.prone.candidates.push_back({q.id, q.prone_lps, size_p, 0.7});
   }
   for (int k = 0; k < o.extra_candidates; ++k) {  // stool or noise: seen in one scan only
-    out.supine.candidates.push_back({100 + k, wall_point(tube, sup, L * (0.2 + 0.6 * u(rng)), kTwoPi * u(rng)), 7, 0.6});
-    out.prone.candidates.push_back({200 + k, wall_point(tube, pro, L * (0.2 + 0.6 * u(rng)), kTwoPi * u(rng)), 7, 0.6});
+    const double ss = L * (0.2 + 0.6 * u(rng)), fs = kTwoPi * u(rng), sp = L * (0.2 + 0.6 * u(rng)), fp = kTwoPi * u(rng);
+    if (!removed(o.supine_removed, ss)) out.supine.candidates.push_back({100 + k, wall_point(tube, sup, ss, fs), 7, 0.6});
+    if (!removed(o.prone_removed, sp)) out.prone.candidates.push_back({200 + k, wall_point(tube, pro, sp, fp), 7, 0.6});
   }
   out.polyps = tube.polyps;
   return out;

@@ -1,7 +1,10 @@
 #pragma once
 // Alignment of two colons along their length (dynamic time warping of per-bin profiles) and
 // around their circumference (circular cross-correlation of the wall's radial relief).
+#include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "colonflat/register/profile.h"
 
@@ -14,6 +17,25 @@ struct AlignOptions {
   double calibre_weight = 0.5;
   double curvature_weight = 0.0;  // off: mobile segments bend differently in the two scans (docs)
   double warp_smooth_mm = 15;  // mm; Gaussian smoothing of the warping path
+  // With AlignContext::use_position (both colons laid out as pieces on one axis, pieces.h):
+  double position_weight = 1.0;     // weight of the centre lines' distance term
+  double position_sigma_mm = 60;    // mm; organ motion between supine and prone (docs)
+  double position_cap = 9;          // the distance term saturates at (3 sigma)^2: any mismatch costs the same
+  double empty_cost = 4;            // a bin without wall in either scan (a gap between pieces): (2 sigma)^2
+};
+
+// A position known in both colons (a shared landmark or a matched candidate pair): the warping
+// path passes within `tolerance_mm` of it.
+struct AlignAnchor {
+  double a_mm = 0, b_mm = 0;
+  double tolerance_mm = 10;
+  std::string kind;  // "flexure", "candidate"
+};
+
+struct AlignContext {
+  bool use_position = false;           // add the centre lines' distance; empty bins cost empty_cost
+  Eigen::Vector3d b_to_a{0, 0, 0};     // LPS mm: a point of B + this ~ the same point of A
+  std::vector<AlignAnchor> anchors;    // sorted by a_mm
 };
 
 // A monotone map between positions along colon A and colon B (mm), piecewise linear through
@@ -26,7 +48,8 @@ struct LengthAlignment {
 };
 
 // Aligns profile b to profile a (both from s = 0). Precondition: both have >= 2 bins.
-LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, const AlignOptions& opts);
+LengthAlignment align_length(const LengthProfile& a, const LengthProfile& b, const AlignOptions& opts,
+                             const AlignContext& ctx = {});
 
 // The profile with its bins in reverse order (for trying the other orientation).
 LengthProfile reversed_profile(const LengthProfile& p);

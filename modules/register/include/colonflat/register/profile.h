@@ -53,6 +53,15 @@ struct ScanCoordinates {
 // Throws PreconditionError(scan.name + ...) when the colon is shorter than 20 bins.
 ScanCoordinates colon_coordinates(const ColonScan& scan, const ProfileOptions& opts, bool reverse = false);
 
+// Coordinates from a given s per vertex (NaN = not registered; e.g. the common s of the pieces,
+// pieces.h), the profile at least `min_length_mm` long (bins beyond the colon are empty).
+// Throws PreconditionError when the colon is shorter than 20 bins.
+ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<double> s, const ProfileOptions& opts,
+                                         double min_length_mm, const std::string& source, bool from_rectum);
+
+// The profile, theta and radial of `c` from its s (`bins` bins of opts.bin_mm).
+void fill_profile(const ColonScan& scan, const ProfileOptions& opts, int bins, ScanCoordinates& c);
+
 // Gaussian smoothing of a sampled signal (sigma in samples), edges by renormalisation.
 std::vector<double> gaussian_smooth(const std::vector<double>& v, double sigma_samples);
 

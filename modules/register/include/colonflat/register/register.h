@@ -19,8 +19,10 @@
 #include <nlohmann/json.hpp>
 
 #include "colonflat/register/align.h"
+#include "colonflat/register/pieces.h"
 #include "colonflat/register/profile.h"
 #include "colonflat/register/scan.h"
+#include "colonflat/register/support.h"
 
 namespace cf {
 
@@ -32,6 +34,15 @@ struct RegisterOptions {
   double match_along_mm = 30;        // mm; largest distance along the colon of a candidate pair
   double match_around_deg = 45;      // degrees; largest angle around the colon of a pair
   double match_size_ratio = 2.0;     // largest size ratio of a pair (larger / smaller)
+  PieceOptions pieces;               // colons with centreline_mm: laid out piece by piece (pieces.h)
+  LandmarkOptions landmarks;
+  double support_radius_mm = 50;     // mm; centre points farther apart after the shift do not support the map
+  double max_unsupported_mm = 10;    // mm; a candidate farther along from a supported bin is never paired
+  double match_3d_mm = 80;           // mm; largest LPS distance of a pair after the rigid shift (organ motion)
+  double anchor_along_mm = 10;       // a pair this close (along, around), alone within the match limits,
+  double anchor_around_deg = 30;     //   becomes an anchor of a second alignment pass
+  double anchor_tolerance_mm = 6;    // mm; the second pass passes this close to each anchor
+  double landmark_tolerance_mm = 60; // mm; a shared landmark counts when the map agrees with it this well
 };
 
 enum class Direction { kSupineToProne, kProneToSupine };
@@ -42,11 +53,16 @@ struct CandidateMatch {
   double around_deg = 0;    // |theta difference| after registration
   double size_ratio = 1;    // larger / smaller (1 when a size is unknown)
   double score = 0;         // raised: 1 - (1 - score_supine)(1 - score_prone)
+  double distance_3d_mm = 0;  // LPS distance after the rigid shift between the scans
+  double supine_gap_mm = 0, prone_gap_mm = 0;  // mm along to the nearest supported bin (0: supported)
+  double anchor_mm = 0;     // mm along (supine) to the nearest shared landmark or other anchor pair
+  bool unique = true;       // no other partner within the match limits for either candidate
 };
 
 struct CandidateMatching {
   std::vector<CandidateMatch> pairs;
   std::vector<int> supine_only, prone_only;  // candidate ids
+  std::vector<int> supine_unaligned, prone_unaligned;  // of those, ids where the alignment has no support
 };
 
 class ColonRegistration {
@@ -56,13 +72,17 @@ class ColonRegistration {
   void run();  // all steps below, in order
 
   void compute_coordinates();   // (1) + orientation choice (2)
-  void align_along();           // (2)
+  void align_along();           // (2) with the anchors found so far
+  void assess_support();        // landmarks, shared landmarks, support of the length map
+  void anchor_on_candidates();  // unique close candidate pairs become anchors (returns via anchors())
   void align_around();          // (3)
   void correspond_vertices();   // (4)
   void match_candidates();      // (5) the scans' own candidates
   // Matches any two candidate lists (e.g. ground-truth polyps) with the registration's map.
   CandidateMatching match(const std::vector<ScanCandidate>& supine, const std::vector<ScanCandidate>& prone) const;
 
+  // mm along from a scan's s to the nearest supported bin (0 = supported; infinity: none).
+  double support_gap_mm(bool supine_scan, double s) const;
   // Position of a scan's point (s, theta) in the other scan.
   void map_coordinates(Direction d, double s, double theta, double& s_out, double& theta_out) const;
   // Nearest wall vertex of the target scan to the image of a point (-1 when not registered).
@@ -85,7 +105,16 @@ class ColonRegistration {
   const ColonScan& supine() const { return supine_; }
   const ColonScan& prone() const { return prone_; }
   bool prone_reversed() const { return pro_.reversed; }
+  bool piecewise() const { return piecewise_; }
+  const RegisterOptions& options() const { return opts_; }
+  const PieceLayout& pieces() const { return layout_; }
+  const AlignmentSupport& support() const { return support_; }
+  const std::vector<AlignAnchor>& anchors() const { return anchors_; }
+  const std::vector<SharedLandmark>& shared_landmarks() const { return shared_; }
+  const Eigen::Vector3d& prone_to_supine_shift() const { return b_to_a_; }
   nlohmann::json summary() const;  // the JSON written to registration.json (without inputs)
+  nlohmann::json pieces_json() const;     // the layout of both scans' pieces
+  nlohmann::json landmarks_json() const;  // landmarks per scan, shared ones, anchors
 
  private:
   struct Index;
@@ -94,6 +123,13 @@ class ColonRegistration {
   RegisterOptions opts_;
   ScanCoordinates sup_, pro_;
   LengthAlignment length_;
+  bool piecewise_ = false;
+  PieceLayout layout_;
+  Eigen::Vector3d b_to_a_{0, 0, 0};
+  std::vector<Landmark> sup_marks_, pro_marks_;
+  std::vector<SharedLandmark> shared_;
+  std::vector<AlignAnchor> anchors_;
+  AlignmentSupport support_;
   std::vector<double> twist_;
   int twist_windows_ = 0;
   std::vector<int> sup_to_pro_, pro_to_sup_;

@@ -21,7 +21,8 @@ class OutputTransaction;
 namespace cf {
 
 // The source scan's flat map with point data "<other>_vertex" (int, -1 = none),
-// "<other>_flat_mm" (x, y, 0), "<other>_position_lps_mm", "register_s_mm", "register_angle_rad".
+// "<other>_flat_mm" (x, y, 0), "<other>_position_lps_mm", "register_s_mm", "register_angle_rad",
+// "register_gap_mm" (mm along to the nearest supported alignment; 0 = supported, support.h).
 vtkSmartPointer<vtkPolyData> correspondence_polydata(const ColonRegistration& reg, Direction d);
 
 // Stages the four files for `dir` in `tx` (the caller commits; `dir` must exist or be staged).

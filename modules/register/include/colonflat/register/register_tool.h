@@ -22,6 +22,10 @@ struct RegisterParams {
   double match_along_mm = RegisterOptions{}.match_along_mm;
   double match_around_deg = RegisterOptions{}.match_around_deg;
   double match_size_ratio = RegisterOptions{}.match_size_ratio;
+  double position_sigma_mm = AlignOptions{}.position_sigma_mm;
+  double support_radius_mm = RegisterOptions{}.support_radius_mm;
+  double max_unsupported_mm = RegisterOptions{}.max_unsupported_mm;
+  double match_3d_mm = RegisterOptions{}.match_3d_mm;
   double pixel_mm = SideBySideOptions{}.pixel_mm;
   bool review = true;  // the supine-prone review page OUT/report.html (+ report_files/)
 };

@@ -9,6 +9,7 @@
 // material coordinates, so the registration error of any vertex is known.
 #include <cstdint>
 #include <filesystem>
+#include <utility>
 #include <vector>
 
 #include "colonflat/register/scan.h"
@@ -27,12 +28,18 @@ struct SyntheticPairOptions {
   bool reverse_prone = false;// prone flat x (and centreline_mm) starts at the other end
   int polyps = 6;            // polyps 6-12 mm, seen in both scans
   int extra_candidates = 1;  // false candidates per scan seen in that scan only
+  // Stretches [from, to) of material sigma (mm) left out of that scan's segmentation (a collapse,
+  // a fully tagged stretch, the rectum cut short by the catheter): the colon is then several bands,
+  // each with its own centreline_mm from its x0 end, as flatten writes them.
+  std::vector<std::pair<double, double>> supine_removed, prone_removed;
+  bool shuffle_pieces = false;  // FlatSegments "order" of the middle bands reversed
 };
 
 struct SyntheticPolyp {
   int id = 0;
   double sigma_mm = 0, phi_rad = 0, size_mm = 0;
   Eigen::Vector3d supine_lps{0, 0, 0}, prone_lps{0, 0, 0};
+  bool in_supine = true, in_prone = true;  // not in a stretch left out of that scan (then no candidate)
 };
 
 struct SyntheticPair {

@@ -1,0 +1,70 @@
+#pragma once
+// The colon of a scan as pieces (docs/register.md, "Pieces"): each colon band of the flat map
+// (segment_id, its own centreline_mm from its x0 end, FlatSegments order) is a piece; a collapse
+// splits the colon into several, a stretch left out of the segmentation (fully tagged fluid, the
+// rectum cut short by the catheter) is missing from one scan. The two scans' pieces are put on one
+// axis along the colon ("common s"):
+//   1. the scan with fewer pieces is the reference: its pieces in the flat map's order, each gap
+//      as long as the straight line between the ends it joins (a lower bound of the missing colon);
+//   2. the rigid shift between the two scans (patient on the table) by trimmed nearest-point fits
+//      of the pieces' centre lines (LPS is patient-fixed: only the table position differs);
+//   3. every piece of the other scan is placed by projecting its centre line onto the reference's
+//      (the nearest reference point within `place_radius_mm` gives its common s): its start and
+//      direction come from these projections, so a missing, split or merged piece needs no rule
+//      of its own; a piece with no counterpart (small bowel, a stretch present in one scan only)
+//      is left unregistered.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "colonflat/register/scan.h"
+
+namespace cf {
+
+struct PieceOptions {
+  double bin_mm = 2.0;            // mm; sampling of each piece's centre line
+  double place_radius_mm = 50;    // mm; a centre point with a reference point this close projects onto it
+  double min_placed_fraction = 0.3;  // a piece with fewer projecting centre points has no counterpart
+};
+
+struct ColonPiece {
+  int segment = 0;                // segment_id of the band
+  double length_mm = 0;           // centre-line length (largest centreline_mm of its vertices)
+  double start_mm = 0;            // common s of its x0 end (flipped: of its x1 end)
+  bool flipped = false;           // its centreline_mm runs against the common s
+  bool registered = true;         // false: no counterpart in the other scan
+  double placed_fraction = 1;     // share of its centre points that projected onto the reference
+  std::string x0_end, x1_end;     // FlatSegments labels ("" when absent)
+  std::vector<Eigen::Vector3d> centre;  // LPS mm, centroid per bin of its own centreline_mm
+  double s_of(double local_mm) const { return flipped ? start_mm + length_mm - local_mm : start_mm + local_mm; }
+  double end_mm() const { return start_mm + length_mm; }
+};
+
+struct PieceLayout {
+  std::vector<ColonPiece> supine, prone;  // in order along the common s
+  bool supine_is_reference = true;
+  Eigen::Vector3d prone_to_supine{0, 0, 0};  // LPS mm: prone point + this ~ the supine point
+  double fit_residual_mm = 0;                // trimmed mean distance after the shift
+};
+
+// True when the scan can be laid out as pieces (per-vertex centreline_mm present).
+bool has_pieces(const ColonScan& scan);
+
+// The colon bands of a scan in the flat map's order (FlatSegments "order", else segment id),
+// side-branch bands excluded. Precondition: has_pieces(scan).
+std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& opts);
+
+// Both scans' pieces on the common axis (steps 1-3 above).
+PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const PieceOptions& opts);
+
+// Common s per vertex of a scan laid out as `pieces` (NaN: unregistered piece or no centreline);
+// side-branch vertices sit at their neck on the parent band (FlatSegments attach_mm).
+std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces);
+
+// Rigid shift t with b + t ~ a by trimmed nearest-point iterations (the better of starting at 0 and
+// at the centroid difference). `residual` receives the trimmed mean distance.
+Eigen::Vector3d fit_shift(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
+                          double* residual = nullptr);
+
+}  // namespace cf

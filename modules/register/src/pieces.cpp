@@ -1,0 +1,278 @@
+#include "colonflat/register/pieces.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+
+namespace cf {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const nlohmann::json* segment_entry(const ColonScan& scan, int id) {
+  for (const auto& seg : scan.segments)
+    if (seg.value("id", -1) == id) return &seg;
+  return nullptr;
+}
+
+bool is_branch(const ColonScan& scan, int id) {
+  const auto* e = segment_entry(scan, id);
+  return e && e->value("kind", std::string("colon")) == "branch";
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + long(m), v.end());
+  return v[m];
+}
+
+// Centroid of the piece's vertices per bin of their own centreline mm; empty bins interpolated.
+std::vector<Eigen::Vector3d> piece_centre(const ColonScan& scan, int seg, double length, double bin) {
+  const int bins = std::max(1, int(std::ceil(length / bin)));
+  std::vector<Eigen::Vector3d> sum(size_t(bins), Eigen::Vector3d::Zero());
+  std::vector<int> n(size_t(bins), 0);
+  for (size_t v = 0; v < scan.lps.size(); ++v) {
+    const double c = scan.centreline_mm[v];
+    if (scan.segment[v] != seg || !std::isfinite(c) || c < 0) continue;
+    const int k = std::clamp(int(c / bin), 0, bins - 1);
+    sum[size_t(k)] += scan.lps[v], ++n[size_t(k)];
+  }
+  int last = -1;
+  for (int k = 0; k < bins; ++k) {
+    if (n[size_t(k)] == 0) continue;
+    sum[size_t(k)] /= n[size_t(k)];
+    for (int j = last + 1; j < k; ++j)  // fill the empty bins before k
+      sum[size_t(j)] = last < 0 ? sum[size_t(k)] : sum[size_t(last)] + (sum[size_t(k)] - sum[size_t(last)]) * double(j - last) / double(k - last);
+    last = k;
+  }
+  for (int j = last + 1; j < bins && last >= 0; ++j) sum[size_t(j)] = sum[size_t(last)];
+  return sum;
+}
+
+// Reference pieces: in their order, each gap the straight line between the ends it joins.
+void chain(std::vector<ColonPiece>& ref) {
+  double at = 0;
+  for (size_t k = 0; k < ref.size(); ++k) {
+    if (k > 0) at += (ref[k].centre.front() - ref[k - 1].centre.back()).norm();
+    ref[k].start_mm = at, ref[k].flipped = false;
+    at += ref[k].length_mm;
+  }
+}
+
+struct RefPoint {
+  Eigen::Vector3d p;
+  double s;
+  int piece;  // index of the reference piece
+};
+
+// Centre points of a piece that project onto the reference: own mm, reference s, reference piece.
+struct Projection {
+  std::vector<double> local, sref;
+  std::vector<int> ref_piece;
+};
+
+std::vector<RefPoint> ref_points(const std::vector<ColonPiece>& ref, double bin) {
+  std::vector<RefPoint> pts;
+  for (size_t i = 0; i < ref.size(); ++i)
+    for (size_t k = 0; k < ref[i].centre.size(); ++k)
+      pts.push_back({ref[i].centre[k], ref[i].s_of((double(k) + 0.5) * bin), int(i)});
+  return pts;
+}
+
+// Places `piece` on the reference axis from the projections of its (shifted) centre points.
+Projection place(ColonPiece& piece, const std::vector<RefPoint>& ref, const Eigen::Vector3d& shift, double bin,
+                 const PieceOptions& o) {
+  Projection pr;
+  std::vector<double>& local = pr.local;
+  std::vector<double>& sref = pr.sref;
+  for (size_t k = 0; k < piece.centre.size(); ++k) {
+    const Eigen::Vector3d q = piece.centre[k] + shift;
+    double best = o.place_radius_mm * o.place_radius_mm, s = kNaN;
+    int from = -1;
+    for (const auto& r : ref)
+      if (const double d = (r.p - q).squaredNorm(); d <= best) best = d, s = r.s, from = r.piece;
+    if (!std::isnan(s)) local.push_back((double(k) + 0.5) * bin), sref.push_back(s), pr.ref_piece.push_back(from);
+  }
+  piece.placed_fraction = piece.centre.empty() ? 0.0 : double(local.size()) / double(piece.centre.size());
+  piece.registered = local.size() >= 3 && piece.placed_fraction >= o.min_placed_fraction;
+  if (!piece.registered) return pr;
+  const double ml = std::accumulate(local.begin(), local.end(), 0.0) / double(local.size());
+  const double ms = std::accumulate(sref.begin(), sref.end(), 0.0) / double(sref.size());
+  double cov = 0;
+  for (size_t i = 0; i < local.size(); ++i) cov += (local[i] - ml) * (sref[i] - ms);
+  piece.flipped = cov < 0;
+  std::vector<double> start(local.size());
+  for (size_t i = 0; i < local.size(); ++i)
+    start[i] = piece.flipped ? sref[i] + local[i] - piece.length_mm : sref[i] - local[i];
+  piece.start_mm = median(start);
+  return pr;
+}
+
+// A reference gap is the straight line between the ends it joins, shorter than the colon missing
+// there. A piece of the other scan that projects onto both sides of the gap measures it: the extra
+// length (its own mm between the two sides minus the reference's) per gap k (before reference piece k).
+std::vector<double> gap_extensions(const std::vector<ColonPiece>& other, const std::vector<Projection>& proj,
+                                   size_t ref_pieces) {
+  std::vector<double> ext(ref_pieces, 0.0);
+  for (size_t p = 0; p < other.size(); ++p) {
+    if (!other[p].registered) continue;
+    const Projection& pr = proj[p];
+    for (size_t k = 1; k < ref_pieces; ++k) {
+      std::vector<double> before, after;  // own mm - reference s (flipped: own mm + reference s)
+      for (size_t i = 0; i < pr.local.size(); ++i) {
+        const double v = other[p].flipped ? pr.local[i] + pr.sref[i] : pr.local[i] - pr.sref[i];
+        if (pr.ref_piece[i] == int(k) - 1) before.push_back(v);
+        if (pr.ref_piece[i] == int(k)) after.push_back(v);
+      }
+      if (before.size() < 3 || after.size() < 3) continue;
+      const double e = other[p].flipped ? median(before) - median(after) : median(after) - median(before);
+      ext[k] = std::max(ext[k], e);
+    }
+  }
+  return ext;
+}
+
+std::vector<Eigen::Vector3d> all_centres(const std::vector<ColonPiece>& pieces) {
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& p : pieces) out.insert(out.end(), p.centre.begin(), p.centre.end());
+  return out;
+}
+
+// Trimmed nearest-point iterations from `t`; returns the trimmed mean distance.
+double refine_shift(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, Eigen::Vector3d& t) {
+  double residual = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < 10; ++it) {
+    std::vector<std::pair<double, Eigen::Vector3d>> r;
+    for (const auto& q : b) {
+      const Eigen::Vector3d x = q + t;
+      double best = std::numeric_limits<double>::infinity();
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      for (const auto& p : a)
+        if (const double e = (p - x).squaredNorm(); e < best) best = e, d = p - x;
+      r.push_back({std::sqrt(best), d});
+    }
+    std::sort(r.begin(), r.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    const size_t keep = std::max<size_t>(1, r.size() * 6 / 10);  // the best 60 %: pieces missing in one scan
+    std::vector<double> c[3];
+    residual = 0;
+    for (size_t i = 0; i < keep; ++i) {
+      residual += r[i].first / double(keep);
+      for (int k = 0; k < 3; ++k) c[k].push_back(r[i].second[k]);
+    }
+    const Eigen::Vector3d step(median(c[0]), median(c[1]), median(c[2]));
+    t += step;
+    if (step.norm() < 0.1) break;
+  }
+  return residual;
+}
+
+}  // namespace
+
+bool has_pieces(const ColonScan& scan) {
+  if (scan.centreline_mm.size() != scan.lps.size()) return false;
+  for (size_t v = 0; v < scan.lps.size(); ++v)
+    if (std::isfinite(scan.centreline_mm[v]) && scan.centreline_mm[v] >= 0 && !is_branch(scan, scan.segment[v])) return true;
+  return false;
+}
+
+std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& o) {
+  std::map<int, double> length;
+  for (size_t v = 0; v < scan.lps.size(); ++v) {
+    const double c = scan.centreline_mm[v];
+    if (!std::isfinite(c) || c < 0) continue;
+    double& l = length[scan.segment[v]];
+    l = std::max(l, c);
+  }
+  std::vector<std::pair<int, ColonPiece>> keyed;
+  for (const auto& [seg, len] : length) {
+    if (is_branch(scan, seg)) continue;
+    ColonPiece p;
+    p.segment = seg;
+    p.length_mm = std::max(len, o.bin_mm);
+    int order = seg;
+    if (const auto* e = segment_entry(scan, seg)) {
+      order = e->value("order", seg);
+      if (e->contains("x0_end") && (*e)["x0_end"].is_string()) p.x0_end = (*e)["x0_end"];
+      if (e->contains("x1_end") && (*e)["x1_end"].is_string()) p.x1_end = (*e)["x1_end"];
+    }
+    p.centre = piece_centre(scan, seg, p.length_mm, o.bin_mm);
+    keyed.push_back({order, p});
+  }
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<ColonPiece> out;
+  for (auto& [k, p] : keyed) out.push_back(std::move(p));
+  return out;
+}
+
+Eigen::Vector3d fit_shift(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double* residual) {
+  if (a.empty() || b.empty()) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d ca = Eigen::Vector3d::Zero(), cb = Eigen::Vector3d::Zero();
+  for (const auto& p : a) ca += p / double(a.size());
+  for (const auto& p : b) cb += p / double(b.size());
+  Eigen::Vector3d t0 = Eigen::Vector3d::Zero(), t1 = ca - cb;
+  const double r0 = refine_shift(a, b, t0), r1 = refine_shift(a, b, t1);
+  if (residual) *residual = std::min(r0, r1);
+  return r0 <= r1 ? t0 : t1;
+}
+
+PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const PieceOptions& o) {
+  PieceLayout L;
+  L.supine = colon_pieces(supine, o);
+  L.prone = colon_pieces(prone, o);
+  L.supine_is_reference = L.supine.size() <= L.prone.size();
+  L.prone_to_supine = fit_shift(all_centres(L.supine), all_centres(L.prone), &L.fit_residual_mm);
+  auto& ref = L.supine_is_reference ? L.supine : L.prone;
+  auto& other = L.supine_is_reference ? L.prone : L.supine;
+  const Eigen::Vector3d shift = L.supine_is_reference ? L.prone_to_supine : Eigen::Vector3d(-L.prone_to_supine);
+  chain(ref);
+  for (int pass = 0;; ++pass) {  // place, lengthen the reference gaps the other scan spans, again
+    const std::vector<RefPoint> pts = ref_points(ref, o.bin_mm);
+    std::vector<Projection> proj;
+    for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
+    if (pass == 3) break;
+    const std::vector<double> ext = gap_extensions(other, proj, ref.size());
+    double added = 0, largest = 0;
+    for (size_t k = 0; k < ref.size(); ++k) added += ext[k], largest = std::max(largest, ext[k]), ref[k].start_mm += added;
+    if (largest < 2 * o.bin_mm) break;
+  }
+  std::stable_sort(other.begin(), other.end(), [](const ColonPiece& x, const ColonPiece& y) {
+    return x.registered != y.registered ? x.registered : x.start_mm < y.start_mm;
+  });
+  double lo = 0;  // the other scan may reach beyond the reference's first end (rectum cut short)
+  for (const auto& p : other)
+    if (p.registered) lo = std::min(lo, p.start_mm);
+  for (auto* side : {&ref, &other})
+    for (auto& p : *side) p.start_mm -= lo;
+  return L;
+}
+
+std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
+  std::map<int, const ColonPiece*> by_segment;
+  for (const auto& p : pieces) by_segment[p.segment] = &p;
+  std::map<int, std::pair<int, double>> neck;  // branch band -> (colon band, attach mm on it)
+  for (const auto& seg : scan.segments) {
+    if (seg.value("kind", std::string("colon")) != "branch") continue;
+    int parent = seg.value("parent", -1);
+    double attach = seg.value("attach_mm", 0.0);
+    for (int guard = 0; guard < 16 && is_branch(scan, parent); ++guard) {  // branch of a branch
+      const auto* e = segment_entry(scan, parent);
+      attach = e->value("attach_mm", 0.0), parent = e->value("parent", -1);
+    }
+    neck[seg.value("id", -1)] = {parent, attach};
+  }
+  std::vector<double> s(scan.lps.size(), kNaN);
+  for (size_t v = 0; v < s.size(); ++v) {
+    int seg = scan.segment[v];
+    double local = scan.centreline_mm[v];
+    if (auto it = neck.find(seg); it != neck.end()) seg = it->second.first, local = it->second.second;
+    const auto p = by_segment.find(seg);
+    if (p == by_segment.end() || !p->second->registered || !std::isfinite(local) || local < 0) continue;
+    s[v] = p->second->s_of(std::min(local, p->second->length_mm));
+  }
+  return s;
+}
+
+}  // namespace cf
