@@ -371,6 +371,8 @@ void painted_table(const std::string& mask_file, int downsample) {
   fs::remove_all(tmp);
   std::printf("columns: fluid_mL = the painted colon fluid (pools + fully tagged stretch); kept_%% = its share segmented; out_mL = "
               "segmented volume more than 2 mm from the true lumen; sb_mL, bl_mL = segmented small bowel, bladder\n");
+}
+
 // One CT without ground truth: time, memory and what was kept.
 void real_table(const std::string& path, int pad_to) {
   std::printf("segment_bench --real %s%s\n", path.c_str(), pad_to > 0 ? (" padded to " + std::to_string(pad_to) + " slices").c_str() : "");
