@@ -18,7 +18,10 @@ BUILD_PKGS=(
   libcli11-dev           # command-line parsing
   nlohmann-json3-dev     # JSON reports
   libcgal-dev            # tests only: independent self-intersection check
-  libdcmtk-dev           # tests only: a second DICOM reader checks the series we write
+  libdcmtk-dev           # DICOM exams and results (modules/dicom); in tests a second reader of the series we write
+  dicom3tools            # tests only: dciodvfy checks the DICOM objects we write against their IOD
+  orthanc                # tests only: a real PACS (started by the tests on loopback ports they choose)
+  python3-pydicom        # tests only: an independent reader of the SEG we write
   xvfb xauth             # off-screen rendering where there is no display
   python3                # small test helpers
   snakemake              # cohort processing (workflow/Snakefile) and its ctest test
@@ -28,7 +31,7 @@ BUILD_PKGS=(
 # it loads comes with these packages' dependencies). libgl1-mesa-dri: the software OpenGL driver
 # that Xvfb-based 3D snapshots use (ldd cannot see it: it is loaded at run time).
 RUNTIME_PKGS=(
-  libvtk9.1 libinsighttoolkit5.2 libopenmesh1 libcholmod3 libgl1-mesa-dri xvfb xauth
+  libvtk9.1 libinsighttoolkit5.2 libopenmesh1 libcholmod3 libdcmtk17 libgl1-mesa-dri xvfb xauth
 )
 
 SUDO=""

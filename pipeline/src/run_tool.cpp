@@ -36,23 +36,32 @@ class RunTool : public Tool {
     RunOptions o;
     add_options(app, o, all);
     return run_cli(app, name(), args, out, err, [&]() -> int {
-      if (!o.prone.empty()) return run_two_scans(o, out, err);
-      RunPlan plan = plan_run(o);
       std::ostream* log = o.quiet ? nullptr : &err;
-      if (plan.generate_input) o.input = generate_default_input(o.outdir, err, log);
-      ArtifactBag bag;
-      OutputTransaction tx;
-      const nlohmann::json report = execute(plan, o, log, bag, tx);
-      tx.commit();
-      if (!o.quiet) out << run_summary_text(report, o.outdir);
-      return kExitOk;
+      const PacsSession pacs(o, log);  // --pacs: the study retrieved into a temporary exam folder
+      if (o.prone.empty()) resolve_exam_input(o, log, pacs.active());
+      const int rc = o.prone.empty() ? run_one_scan(o, out, err) : run_two_scans(o, out, err);
+      pacs.store_results(o, out);  // --store: only after the whole run succeeded
+      return rc;
     });
   }
 
  private:
+  static int run_one_scan(RunOptions& o, std::ostream& out, std::ostream& err) {
+    RunPlan plan = plan_run(o);
+    std::ostream* log = o.quiet ? nullptr : &err;
+    if (plan.generate_input) o.input = generate_default_input(o.outdir, err, log);
+    ArtifactBag bag;
+    OutputTransaction tx;
+    const nlohmann::json report = execute(plan, o, log, bag, tx);
+    tx.commit();
+    if (!o.quiet) out << run_summary_text(report, o.outdir);
+    return kExitOk;
+  }
+
   static void add_options(CLI::App& app, RunOptions& o, const std::string& all) {
     app.add_option("input", o.input,
-                   "input of the first stage run (a CT volume, or with --from the file that stage reads)")
+                   "input of the first stage run (a CT volume, or with --from the file that stage reads); a DICOM "
+                   "exam (folder of series as a PACS exports it, or its DICOMDIR): its supine and prone CT scans")
         ->type_name("FILE");
     app.add_option("-o,--output", o.outdir,
                    "output folder (default colonflat_out); refused when it holds the input or a phantom")
@@ -69,6 +78,12 @@ class RunTool : public Tool {
                    "two-scan mode: the prone scan of the same patient (INPUT is the supine one); both are run "
                    "into OUTDIR/supine and OUTDIR/prone, then registered into OUTDIR/registration")
         ->type_name("FILE");
+    app.add_option("--pacs", o.pacs,
+                   "retrieve the study from this PACS (C-GET) instead of INPUT, then run on it as on an exam folder")
+        ->type_name("AET@HOST:PORT");
+    app.add_option("--study", o.study, "with --pacs: the StudyInstanceUID to retrieve")->type_name("UID");
+    app.add_flag("--store", o.store, "with --pacs: send the DICOM results (SEG, SR, SC) back (C-STORE) after the run");
+    app.add_option("--aet", o.aet, "with --pacs: our own AE title (default COLONFLAT)")->type_name("AET");
     app.add_flag("-q,--quiet", o.quiet, "print nothing but errors");
   }
 
@@ -114,6 +129,9 @@ class RunTool : public Tool {
     FinishedRun sup_run{sup.outdir, sup.input, {}, &sup_report, &sup_bag, log};
     FinishedRun pro_run{pro.outdir, pro.input, {}, &pro_report, &pro_bag, log};
     const nlohmann::json record = pair->finish_pair(sup_run, pro_run, regdir, tx);
+    for (auto& t : tools)  // the other pair steps (the DICOM results' pairing) after the registration
+      if (auto* other = dynamic_cast<PairFinisher*>(t.get()); other && other != pair)
+        other->finish_pair(sup_run, pro_run, regdir, tx);
     tx.commit();
     if (!o.quiet) {
       for (const auto& w : record.value("warnings", nlohmann::json::array()))
@@ -143,6 +161,7 @@ class RunTool : public Tool {
     std::string rest;
     for (const auto& s : plan.not_run) rest += (rest.empty() ? "" : ", ") + s;
     if (!rest.empty()) report["not_run"] = rest;
+    if (!o.exam.is_null()) report["exam"] = o.exam;
     report["stages_time_s"] = report["total_time_s"] = total.seconds();
     report["peak_memory_mib"] = peak_memory_mib();
     run_finishers(plan, o, bag, tx, report, log);

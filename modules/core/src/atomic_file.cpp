@@ -1,6 +1,8 @@
 #include "colonflat/core/atomic_file.h"
+#include "colonflat/core/write_errors.h"
 
 #include <signal.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -59,7 +61,30 @@ long temporary_owner(const std::string& name) {
 
 bool process_gone(long pid) { return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH; }
 
+// A write that failed, or may have been cut short by a stream that fails silently (an unchecked
+// std::ofstream), on a file system that says why: the error in its words.
+void throw_if_file_system_refuses(const fs::path& written, const fs::path& target) {
+  const std::string why = file_system_problem(written);
+  if (!why.empty()) throw Error(target.string() + ": cannot write: " + why);
+}
+
 }  // namespace
+
+std::string file_system_problem(const fs::path& path) {
+  std::error_code ec;
+  fs::path p = path;
+  while (!p.empty() && !fs::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
+  if (p.empty()) p = ".";
+  struct statvfs s {};
+  if (::statvfs(p.c_str(), &s) != 0) return "";
+  if (s.f_flag & ST_RDONLY) return "read-only file system";
+  // root may use the blocks reserved for it; everyone else only the available ones.
+  const bool root = ::geteuid() == 0;
+  const auto blocks = root ? s.f_bfree : s.f_bavail;
+  const auto inodes = root ? s.f_ffree : s.f_favail;
+  if (blocks == 0 || (s.f_files > 0 && inodes == 0)) return "no space left on device";
+  return "";
+}
 
 fs::path temp_sibling(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
@@ -87,8 +112,14 @@ void write_atomically(const fs::path& target, const std::function<void(const fs:
   const fs::path tmp = temp_sibling(target);
   register_for_cleanup(tmp);
   try {
-    write(tmp);
+    try {
+      write(tmp);
+    } catch (const Error&) {
+      throw_if_file_system_refuses(tmp, target);  // the library's words replaced by the system's
+      throw;
+    }
     if (!fs::exists(tmp)) throw Error(target.string() + ": the writer produced no file");
+    throw_if_file_system_refuses(tmp, target);
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);
@@ -169,6 +200,9 @@ void OutputTransaction::rollback(std::size_t renamed) {
 void OutputTransaction::commit() {
   for (auto& [tmp, target] : staged_)
     if (!fs::exists(tmp)) throw Error(target.string() + ": the writer produced no file");
+  // A file system that filled up while the outputs were written may hold cut files (a stream
+  // that failed stays silent): nothing is committed then.
+  for (auto& [tmp, target] : staged_) throw_if_file_system_refuses(tmp, target);
   std::size_t renamed = 0;
   try {
     for (auto& [tmp, target] : staged_) {

@@ -103,7 +103,7 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
   w->SetDataModeToAppended();
   w->SetCompressorTypeToZLib();
   if (!w->Write() || !capture.errors().empty())
-    throw Error(target.string() + ": cannot write loops: " + capture.first_problem());
+    throw Error(target.string() + ": cannot write loops: " + capture.write_problem(w, file.string()));
 }
 
 // Declared sizes agree with the data: one value per point and per line, line ids within the

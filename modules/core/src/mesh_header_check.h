@@ -12,4 +12,9 @@ namespace cf {
 // declares or when it would exceed the memory budget.
 void check_declared_mesh_size(const std::filesystem::path& path, MeshFormat format);
 
+// Text meshes (ASCII OFF, OBJ, ASCII PLY; other formats are skipped): throws InputError naming
+// the first vertex with a coordinate that is not a finite number ("vertex 3 has a coordinate that
+// is not a finite number: y = nan"). Parses the file only when it mentions "nan" or "inf".
+void check_text_vertex_coordinates(const std::filesystem::path& path, MeshFormat format);
+
 }  // namespace cf

@@ -23,11 +23,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "colonflat/core/atomic_file.h"
+#include "colonflat/core/write_errors.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/library_output.h"
 #include "colonflat/core/memory_budget.h"
@@ -194,6 +196,8 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
   if (*fmt == MeshFormat::kVTP || *fmt == MeshFormat::kVTK) {
     soup = read_vtk_polydata(path, *fmt);
   } else {
+    // A "nan" or "inf" coordinate derails OpenMesh's parsers: named before their consequences.
+    check_text_vertex_coordinates(path, *fmt);
     SoupImporter importer(soup, path);
     OpenMesh::IO::Options opt;
     // OpenMesh prints parse problems to its own error stream; capture them for the message.
@@ -269,8 +273,10 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
       tag_polydata_space(pd, wo.units, wo.space);
       VtkMessageCapture vtk_messages;
       int ok = 0;
+      vtkSmartPointer<vtkAlgorithm> writer;
       if (*fmt == MeshFormat::kVTP) {
         vtkNew<vtkXMLPolyDataWriter> w;
+        writer = w.GetPointer();
         w->SetFileName(tmp.c_str());
         w->SetInputData(pd);
         w->SetDataModeToAppended();
@@ -278,6 +284,7 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
         ok = w->Write();
       } else {
         vtkNew<vtkPolyDataWriter> w;
+        writer = w.GetPointer();
         w->SetFileName(tmp.c_str());
         w->SetInputData(pd);
         if (wo.binary) w->SetFileTypeToBinary();
@@ -285,14 +292,16 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
         ok = w->Write();
       }
       if (!ok || !vtk_messages.errors().empty())
-        throw Error(path.string() + ": cannot write: " + vtk_messages.first_problem());
+        throw Error(path.string() + ": cannot write: " + vtk_messages.write_problem(writer, tmp.string()));
       return;
     }
     OpenMesh::IO::Options opt;
     if (wo.binary && (*fmt == MeshFormat::kPLY || *fmt == MeshFormat::kSTL)) opt += OpenMesh::IO::Options::Binary;
     LibraryOutputCapture printed;  // OpenMesh's writers log "[OBJWriter] : write file"
-    if (!OpenMesh::IO::write_mesh(mesh, tmp.string(), opt, static_cast<std::streamsize>(wo.ascii_precision)))
-      throw Error(path.string() + ": cannot write mesh");
+    if (!OpenMesh::IO::write_mesh(mesh, tmp.string(), opt, static_cast<std::streamsize>(wo.ascii_precision))) {
+      const std::string why = file_system_problem(tmp);
+      throw Error(path.string() + ": cannot write mesh" + (why.empty() ? "" : ": " + why));
+    }
   });
 }
 

@@ -59,20 +59,31 @@ namespace {
 
 // diagnose_soup's checks, one per function, each adding at most one finding per defect kind.
 
+// "vertex 3: y = nan": the vertex and its first coordinate that is not a finite number.
+std::string nonfinite_vertex_words(std::size_t v, const std::array<double, 3>& p) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(p[k])) {
+      std::ostringstream s;
+      s << "vertex " << v << ": " << "xyz"[k] << " = " << p[k];  // prints nan, inf or -inf
+      return s.str();
+    }
+  return "vertex " + std::to_string(v);
+}
+
 void check_nonfinite_coordinates(const PolygonSoup& soup, MeshDiagnosis& d) {
-  std::vector<std::size_t> bad;
+  std::vector<std::string> bad;
   std::size_t n = 0;
   for (std::size_t v = 0; v < soup.points.size(); ++v) {
     const auto& p = soup.points[v];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
       ++n;
-      if (bad.size() < 5) bad.push_back(v);
+      if (bad.size() < 5) bad.push_back(nonfinite_vertex_words(v, p));
     }
   }
   if (n)
     d.findings.push_back({"nonfinite_coordinates", Severity::kFatal, n,
                           plural(n, "vertex", "vertices") + " with NaN or infinite coordinates" +
-                              examples(bad, [](std::size_t v) { return "v" + std::to_string(v); })});
+                              examples(bad, [](const std::string& s) { return s; })});
 }
 
 std::string listed(const std::vector<std::string>& v) {

@@ -141,6 +141,43 @@ TEST_F(MeshIo, OutOfRangeIndexInFile) {
   }
 }
 
+// A vertex with a nan or inf coordinate in a text mesh (OFF, OBJ, ASCII PLY) is named with its
+// coordinate, not reported through what the parser read out of step after it (faces out of range).
+TEST_F(MeshIo, NonFiniteVertexInTextFileIsNamed) {
+  const std::string tet_faces = "3 0 1 2\n3 0 3 1\n3 1 3 2\n3 2 3 0\n";
+  write_text("nan.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 nan 1\n" + tet_faces);
+  write_text("inf.off", "OFF 4 4 0\n0 0 0\n1 0 -inf\n0 1 0\n0 0 1\n" + tet_faces);
+  write_text("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 NaN\nf 1 2 3\nf 1 4 2\nf 2 4 3\nf 3 4 1\n");
+  write_text("nan.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                        "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                        "0 0 0\n1 0 0\ninf 1 0\n0 0 1\n" + tet_faces);
+  for (const auto& [name, words] : std::vector<std::pair<std::string, std::string>>{
+           {"nan.off", "vertex 3 has a coordinate that is not a finite number: y = nan"},
+           {"inf.off", "vertex 1 has a coordinate that is not a finite number: z = -inf"},
+           {"nan.obj", "vertex 3 has a coordinate that is not a finite number: z = NaN"},
+           {"nan.ply", "vertex 2 has a coordinate that is not a finite number: x = inf"}}) {
+    try {
+      load_mesh(file(name));
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), file(name).string() + ": " + words);
+    }
+  }
+}
+
+// A VTK file (binary doubles) holding a NaN vertex names the vertex and the coordinate too.
+TEST_F(MeshIo, NonFiniteVertexInVtpIsNamed) {
+  Mesh m = synthetic::to_mesh(synthetic::sphere(1, 8, 4));
+  m.set_point(Mesh::VertexHandle(5), Mesh::Point(0, std::numeric_limits<double>::quiet_NaN(), 0));
+  write_mesh(m, file("nan.vtp"));
+  try {
+    load_mesh(file("nan.vtp"));
+    FAIL() << "read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 5: y = nan"), std::string::npos) << e.what();
+  }
+}
+
 // A failed write leaves an existing target untouched and no temporary behind.
 TEST_F(MeshIo, FailedWriteLeavesTargetUntouched) {
   write_text("keep.off", "original");

@@ -36,7 +36,7 @@ TEST(Validation, EmptyIsFatal) {
   EXPECT_TRUE(d.has_at_least(Severity::kFatal));
 }
 
-// NaN coordinates are fatal and named by vertex id.
+// NaN coordinates are fatal and named by vertex id and the bad coordinate.
 TEST(Validation, NonFiniteCoordinatesAreFatal) {
   auto s = soup_of(synthetic::sphere(1, 8, 4));
   s.points[7][1] = std::numeric_limits<double>::quiet_NaN();
@@ -45,7 +45,8 @@ TEST(Validation, NonFiniteCoordinatesAreFatal) {
   const Finding* f = d.find("nonfinite_coordinates");
   ASSERT_NE(f, nullptr);
   EXPECT_EQ(f->count, 2u);
-  EXPECT_NE(f->message.find("v7"), std::string::npos);
+  EXPECT_NE(f->message.find("vertex 7: y = nan"), std::string::npos) << f->message;
+  EXPECT_NE(f->message.find("vertex 9: x = inf"), std::string::npos) << f->message;
   EXPECT_THROW(soup_to_triangles(s, LoadPolicy{}, d), PreconditionError);
 }
 

@@ -171,8 +171,10 @@ nlohmann::json noise_sites_json(const Phantom& p) {
   return a;
 }
 
+// format "truth" (write_phantom_exam): every file but the CT, which the exam holds.
 void write_phantom(const Phantom& p, const fs::path& dir, const std::string& format) {
-  if (format != "nrrd" && format != "dicom") throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
+  if (format != "nrrd" && format != "dicom" && format != "truth")
+    throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
   if (!p.ct || !p.lumen) throw Error("write_phantom: empty phantom");
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -190,7 +192,7 @@ void write_phantom(const Phantom& p, const fs::path& dir, const std::string& for
   put_json("centerline.json", centerline_json(p));
   put_json("noise_sites.json", noise_sites_json(p));
   nlohmann::json d = p.description;
-  d["files"]["ct"] = format == "nrrd" ? "ct.nrrd" : "dicom/";
+  d["files"]["ct"] = format == "nrrd" ? "ct.nrrd" : format == "dicom" ? "dicom/" : "../exam/";
   put_json("phantom.json", d);
   if (format == "dicom") {
     const fs::path dd = dir / "dicom";

@@ -9,6 +9,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/phantom/mask_phantom.h"
 #include "colonflat/phantom/phantom.h"
+#include "colonflat/phantom/phantom_exam.h"
 
 namespace cf {
 namespace {
@@ -124,6 +125,12 @@ class PhantomTool : public Tool {
     app.add_flag("--realistic", realistic,
                  "all of the above: oral and excreted contrast, enhanced aorta, rectal tube and (unless given) 2 fully "
                  "tagged stretches");
+    bool exam = false;
+    app.add_flag("--exam", exam,
+                 "a DICOM exam as a PACS exports it: DIR/exam/ST0/SE1 (localizer), SE2 (supine), SE3 (prone) of one "
+                 "patient and study, and each scan's ground truth in DIR/supine/ and DIR/prone/")
+        ->excludes(app.get_option("--position"))
+        ->excludes(app.get_option("--format"));
     app.add_flag("-q,--quiet", quiet, "no progress output");
     MaskCli mask;
     add_mask_options(app, mask);
@@ -140,7 +147,8 @@ class PhantomTool : public Tool {
       ProgressScope phases(quiet ? nullptr : &err, "phantom");
       Phantom p = generate_phantom(o);
       const double gen = t.seconds();
-      write_phantom(p, dir, format);
+      if (exam) write_exam(o, p, dir);
+      else write_phantom(p, dir, format);
       phase_done("written");
       if (!quiet) {
         err << std::fixed << std::setprecision(2) << "phantom: colon "
@@ -151,6 +159,14 @@ class PhantomTool : public Tool {
       }
       return kExitOk;
     });
+  }
+
+ private:
+  // --exam: the prone scan of the same patient too, then the study as a PACS exports it.
+  static void write_exam(PhantomOptions o, const Phantom& supine, const std::string& dir) {
+    o.position = "prone";
+    const Phantom prone = generate_phantom(o);
+    write_phantom_exam(supine, prone, dir);
   }
 };
 

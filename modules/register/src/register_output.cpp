@@ -41,7 +41,7 @@ void write_vtp(vtkPolyData* pd, const fs::path& tmp, const fs::path& target) {
   w->SetCompressorTypeToNone();  // raw binary: compressing doubles costs seconds per file for a few % of size
   w->EncodeAppendedDataOff();
   if (!w->Write() || !msgs.first_problem().empty())
-    throw Error(target.string() + ": cannot write: " + msgs.first_problem());
+    throw Error(target.string() + ": cannot write: " + msgs.write_problem(w, tmp.string()));
 }
 
 }  // namespace

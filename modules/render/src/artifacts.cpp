@@ -22,7 +22,7 @@ void write_png(vtkImageData* image, const std::filesystem::path& path) {
     w->SetInputData(image);
     w->Write();
     if (!msgs.first_problem().empty() || w->GetErrorCode() != 0 || !std::filesystem::exists(tmp))
-      throw Error(path.string() + ": cannot write PNG: " + msgs.first_problem());
+      throw Error(path.string() + ": cannot write PNG: " + msgs.write_problem(w, tmp.string()));
   });
 }
 

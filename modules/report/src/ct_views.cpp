@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "colonflat/core/atomic_file.h"
+#include "colonflat/core/vtk_messages.h"
 #include "colonflat/core/error.h"
 
 namespace fs = std::filesystem;
@@ -105,8 +106,10 @@ void write_png_pixels(int w, int h, int components, const std::vector<unsigned c
     writer->SetInputData(img);
     writer->SetFileName(tmp.c_str());
     writer->SetCompressionLevel(1);  // fast; these images are small
+    VtkMessageCapture msgs;
     writer->Write();
-    if (writer->GetErrorCode() != 0) throw Error(path.string() + ": cannot write PNG");
+    if (writer->GetErrorCode() != 0 || !msgs.errors().empty())
+      throw Error(path.string() + ": cannot write PNG: " + msgs.write_problem(writer, tmp.string()));
   });
 }
 

@@ -25,6 +25,7 @@
 #include <sstream>
 
 #include "colonflat/core/atomic_file.h"
+#include "colonflat/core/write_errors.h"
 #include "colonflat/core/error.h"
 
 #include "volume_internal.h"
@@ -56,9 +57,10 @@ void write_image_file(const TImage* img, const fs::path& tmp, const fs::path& ta
   try {
     writer->Update();
   } catch (const itk::ExceptionObject& e) {
+    const std::string full = file_system_problem(w);  // before the cut file goes: ITK's words name no cause
     std::error_code ec;
     fs::remove(w, ec);
-    throw Error(target.string() + ": cannot write: " + itk_message(e));
+    throw Error(target.string() + ": cannot write: " + (full.empty() ? itk_message(e) : full));
   }
   if (w != tmp) {
     std::error_code ec;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+class vtkAlgorithm;
 class vtkOutputWindow;
 
 namespace cf {
@@ -18,12 +19,17 @@ class VtkMessageCapture {
   // Errors and warnings seen so far, each reduced to its text (no file/line prefix).
   const std::vector<std::string>& errors() const;
   const std::vector<std::string>& warnings() const;
-  // The first error, else the first warning, else "".
+  // The first error, else the first warning, else "". VTK's pipeline dump ("Algorithm X returned
+  // failure for request: vtkInformation ... Debug: Off ...") comes last, reduced to "X failed".
   std::string first_problem() const;
+  // Why `writer` failed, in words: "no space left on device" (VTK's out-of-disk-space error code,
+  // or a full file system at `file`), else first_problem(), else VTK's name of its error code.
+  std::string write_problem(vtkAlgorithm* writer, const std::string& file) const;
 
  private:
   vtkOutputWindow* previous_;
   vtkOutputWindow* window_;
+  int saved_verbosity_;  // vtkLogger's stderr cutoff before the capture
 };
 
 }  // namespace cf
