@@ -159,7 +159,6 @@ void SegmentationQc::flood(QcBody& b, std::size_t seed, std::size_t cap) {
       stack.push_back(r);
     }
   }
-  std::sort(b.voxels.begin(), b.voxels.end());
 }
 
 // Every rejected decision of at least min_body_ml: its body, grown from the nearest voxel of its kind.
@@ -176,8 +175,14 @@ void SegmentationQc::find_bodies() {
     const int cls = what.find("gas") != std::string::npos ? 0 : what.find("fluid") != std::string::npos ? 1 : -1;
     std::size_t seed = 0;
     b.too_large = ml > 2 * lumen_ml_;  // outside air: larger than twice the whole lumen, not colon
-    if (!b.too_large && seed_of(d["position_lps_mm"].get<std::array<double, 3>>(), cls, seed))
-      flood(b, seed, std::max<std::size_t>(1000, std::size_t(3 * ml / voxel_ml_)));
+    // Pieces nearest first until half the decision's volume is found (segment's body may be split
+    // here by the lumen or noise), at most 10.
+    const std::size_t cap = std::max<std::size_t>(1000, std::size_t(3 * ml / voxel_ml_));
+    for (int piece = 0; piece < 10 && !b.too_large && !b.truncated && b.voxels.size() * voxel_ml_ < 0.5 * ml; ++piece) {
+      if (!seed_of(d["position_lps_mm"].get<std::array<double, 3>>(), b.cls >= 0 ? b.cls : cls, seed)) break;
+      flood(b, seed, cap);
+    }
+    std::sort(b.voxels.begin(), b.voxels.end());
     for (std::size_t q : b.voxels) {
       grow_box(lps_of(q));
       body_voxels_.push_back({q, b.id});
