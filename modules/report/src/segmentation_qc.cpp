@@ -103,8 +103,8 @@ void SegmentationQc::scan_lumen() {
   lumen_ml_ = count * voxel_ml_;
 }
 
-// The voxel of class `cls` (or either, -1) outside the lumen and not yet in a body nearest to `lps`,
-// within search_mm.
+// The voxel of class `cls` (or either, -1) outside the lumen, not yet in a body, whose six
+// neighbours are of its class too (no noise speck), nearest to `lps` within search_mm.
 bool SegmentationQc::seed_of(const std::array<double, 3>& lps, int cls, std::size_t& seed) const {
   CtImage::PointType p;
   for (int d = 0; d < 3; ++d) p[d] = lps[d];
@@ -123,6 +123,11 @@ bool SegmentationQc::seed_of(const std::array<double, 3>& lps, int cls, std::siz
         const std::size_t q = std::size_t(i) + n_[0] * (std::size_t(j) + n_[1] * std::size_t(k));
         const int vc = voxel_class(q);
         if (vc < 0 || (cls >= 0 && vc != cls) || taken_[q]) continue;
+        bool interior = i > 0 && j > 0 && k > 0 && i + 1 < long(n_[0]) && j + 1 < long(n_[1]) && k + 1 < long(n_[2]);
+        const std::size_t sx = 1, sy = n_[0], sz = n_[0] * n_[1];
+        for (std::size_t o : {sx, sy, sz})  // six neighbours of its kind: not a speck of noise
+          interior = interior && voxel_class(q - o) == vc && voxel_class(q + o) == vc;
+        if (!interior) continue;
         const auto x = lps_of(q);
         const double d2 = (x[0] - lps[0]) * (x[0] - lps[0]) + (x[1] - lps[1]) * (x[1] - lps[1]) + (x[2] - lps[2]) * (x[2] - lps[2]);
         if (d2 <= best) best = d2, seed = q, found = true;
@@ -154,7 +159,6 @@ void SegmentationQc::flood(QcBody& b, std::size_t seed, std::size_t cap) {
       stack.push_back(r);
     }
   }
-  std::sort(b.voxels.begin(), b.voxels.end());
 }
 
 // Every rejected decision of at least min_body_ml: its body, grown from the nearest voxel of its kind.
@@ -171,8 +175,14 @@ void SegmentationQc::find_bodies() {
     const int cls = what.find("gas") != std::string::npos ? 0 : what.find("fluid") != std::string::npos ? 1 : -1;
     std::size_t seed = 0;
     b.too_large = ml > 2 * lumen_ml_;  // outside air: larger than twice the whole lumen, not colon
-    if (!b.too_large && seed_of(d["position_lps_mm"].get<std::array<double, 3>>(), cls, seed))
-      flood(b, seed, std::max<std::size_t>(1000, std::size_t(3 * ml / voxel_ml_)));
+    // Pieces nearest first until half the decision's volume is found (segment's body may be split
+    // here by the lumen or noise), at most 10.
+    const std::size_t cap = std::max<std::size_t>(1000, std::size_t(3 * ml / voxel_ml_));
+    for (int piece = 0; piece < 10 && !b.too_large && !b.truncated && b.voxels.size() * voxel_ml_ < 0.5 * ml; ++piece) {
+      if (!seed_of(d["position_lps_mm"].get<std::array<double, 3>>(), b.cls >= 0 ? b.cls : cls, seed)) break;
+      flood(b, seed, cap);
+    }
+    std::sort(b.voxels.begin(), b.voxels.end());
     for (std::size_t q : b.voxels) {
       grow_box(lps_of(q));
       body_voxels_.push_back({q, b.id});
@@ -202,7 +212,7 @@ nlohmann::json SegmentationQc::run(const fs::path& dir, const std::string& prefi
 }
 
 // Slices through the largest bodies (where each has most voxels along the axis) and through the
-// lumen (its 20-80 % quantiles along the axis), at least 8 mm apart, sorted.
+// lumen (its 20-80 % quantiles along the axis), at least 8 mm apart, at least 4, sorted.
 std::vector<double> SegmentationQc::slice_positions(Plane p) const {
   const int a = plane_axes(p).fixed_axis;
   std::vector<double> pos;
@@ -228,6 +238,11 @@ std::vector<double> SegmentationQc::slice_positions(Plane p) const {
     std::size_t i = 0;
     while (i + 1 < hist_[a].size() && acc + hist_[a][i] < f * total) acc += hist_[a][i++];
     add(hist_lo_[a] + double(i) + 0.5);
+  }
+  // A thin lumen along this axis: fill up to 4 slices evenly over the box, 2 mm apart at least.
+  for (int t = 1; t <= 8 && pos.size() < 4; ++t) {
+    const double x = lo_[a] + (hi_[a] - lo_[a]) * t / 9.0;
+    if (std::none_of(pos.begin(), pos.end(), [&](double y) { return std::abs(x - y) < 2; })) pos.push_back(x);
   }
   std::sort(pos.begin(), pos.end());
   return pos;
