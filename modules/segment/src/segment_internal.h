@@ -91,6 +91,17 @@ Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // slice(k, mean of slice k) for every k, from two workers (each slice once, slices of one worker
 // in order); only a few slices are held in memory.
 void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
+// Calls f(r) for each face neighbour r of voxel q (inside the volume).
+template <class F>
+void for_face_neighbours(const Dims& d, std::size_t q, F&& f) {
+  std::size_t c[3];
+  d.coords(q, c[0], c[1], c[2]);
+  for (int a = 0; a < 3; ++a)
+    for (int dir = -1; dir <= 1; dir += 2) {
+      if ((dir < 0 && c[a] == 0) || (dir > 0 && c[a] + 1 == d.n[a])) continue;
+      f(dir < 0 ? q - d.stride[a] : q + d.stride[a]);
+    }
+}
 // Base index of line `l` along axis `ax` (lines enumerate the other two axes).
 std::size_t line_base(const Dims& d, int ax, std::size_t l);
 

@@ -46,24 +46,18 @@ void LinkGrid::grow(std::vector<std::uint32_t>& source, std::vector<Contact>& fo
   }
   for (int step = 1; step <= max_steps && !front.empty(); ++step) {
     next.clear();
-    for (std::size_t q : front) {
-      std::size_t c[3];
-      d_.coords(q, c[0], c[1], c[2]);
-      for (int a = 0; a < 3; ++a)
-        for (int dir = -1; dir <= 1; dir += 2) {
-          if ((dir < 0 && c[a] == 0) || (dir > 0 && c[a] + 1 == d_.n[a])) continue;
-          const std::size_t r = dir < 0 ? q - d_.stride[a] : q + d_.stride[a];
-          if (source[r] != UINT32_MAX) continue;
-          source[r] = source[q];
-          const std::uint32_t l = cand_[r];
-          if (l && eligible[l]) {
-            const double gap = (mm(r) - mm(source[r])).norm();
-            if (gap <= reach) found.push_back({l, seg_[source[r]], r, source[r], gap});
-            continue;  // not through a candidate
-          }
-          next.push_back(r);
+    for (std::size_t q : front)
+      for_face_neighbours(d_, q, [&](std::size_t r) {
+        if (source[r] != UINT32_MAX) return;
+        source[r] = source[q];
+        const std::uint32_t l = cand_[r];
+        if (l && eligible[l]) {
+          const double gap = (mm(r) - mm(source[r])).norm();
+          if (gap <= reach) found.push_back({l, seg_[source[r]], r, source[r], gap});
+          return;  // not through a candidate
         }
-    }
+        next.push_back(r);
+      });
     front.swap(next);
   }
 }

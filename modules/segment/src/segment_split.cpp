@@ -78,16 +78,11 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   }
   for (std::size_t head = 0; head < queue.size(); ++head) {  // breadth-first: the nearest core along the mask
     const std::size_t q = queue[head];
-    std::size_t c[3];
-    d_.coords(q, c[0], c[1], c[2]);
-    for (int a = 0; a < 3; ++a)
-      for (int dir = -1; dir <= 1; dir += 2) {
-        if ((dir < 0 && c[a] == 0) || (dir > 0 && c[a] + 1 == d_.n[a])) continue;
-        const std::size_t r = dir < 0 ? q - d_.stride[a] : q + d_.stride[a];
-        if (!bright[r] || fluid_label_[r]) continue;
-        fluid_label_[r] = fluid_label_[q];
-        queue.push_back(r);
-      }
+    for_face_neighbours(d_, q, [&](std::size_t r) {
+      if (!bright[r] || fluid_label_[r]) return;
+      fluid_label_[r] = fluid_label_[q];
+      queue.push_back(r);
+    });
   }
   std::vector<std::size_t>().swap(queue);
   Bytes rest(d_.total);
