@@ -23,6 +23,7 @@
 #include "colonflat/pipeline/registry.h"
 #include "colonflat/testing/command.h"
 #include "colonflat/testing/files.h"
+#include "colonflat/testing/shell.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -32,15 +33,7 @@ namespace {
 
 constexpr const char* kOrthanc = "/usr/sbin/Orthanc";
 
-std::pair<int, std::string> shell(const std::string& command) {
-  std::string out;
-  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (!p) return {-1, ""};
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), p)) > 0;) out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using testing::shell;
 
 // A TCP port on the loopback that nothing listens on now (the kernel's choice).
 int free_port() {

@@ -14,6 +14,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/dicom/results.h"
+#include "colonflat/testing/shell.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
 
@@ -22,16 +23,7 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-// Runs a shell command, returns its exit status and output (stdout and stderr).
-std::pair<int, std::string> shell(const std::string& command) {
-  std::string out;
-  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (!p) return {-1, ""};
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), p)) > 0;) out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using testing::shell;
 
 // dciodvfy's lines that report errors ("Error - ...").
 std::string dciodvfy_errors(const fs::path& file) {

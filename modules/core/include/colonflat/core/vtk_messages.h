@@ -23,7 +23,7 @@ class VtkMessageCapture {
   // failure for request: vtkInformation ... Debug: Off ...") comes last, reduced to "X failed".
   std::string first_problem() const;
   // Why `writer` failed, in words: "no space left on device" (VTK's out-of-disk-space error code,
-  // or a full file system at `file`), else first_problem(), else VTK's name of its error code.
+  // or a full file system at `file`), else first_problem(), else "VTK error code N".
   std::string write_problem(vtkAlgorithm* writer, const std::string& file) const;
 
  private:
