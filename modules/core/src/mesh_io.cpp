@@ -211,6 +211,9 @@ PolygonSoup read_polygon_soup(const fs::path& path) {
       omerr().connect(std::cerr);
     };
     try {
+      // OpenMesh's PLY reader prints "Unsupported keyword : obj_info" straight to the terminal for
+      // the comment lines VTK's PLY writer adds: nothing of that reaches the user.
+      LibraryOutputCapture printed;
       ok = OpenMesh::IO::IOManager().read(path.string(), importer, opt);
     } catch (const InputError&) {
       restore();

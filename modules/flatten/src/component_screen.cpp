@@ -2,7 +2,7 @@
 // rejected component is named with its size and the cause (see docs/flatten.md, "Input").
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/orientation.h"
@@ -12,11 +12,9 @@ namespace cf::flat_detail {
 namespace {
 
 std::string fixed(double x, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << x;
-  return s.str();
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, x);
+  return text;
 }
 
 // Signed volume (x6) of the surface closed by cones to its centroid: > 0 when normals point out

@@ -12,8 +12,8 @@
 namespace cf {
 
 // Reads any supported mesh file through load_mesh() (boundaries and several components
-// accepted, polygons triangulated, orientation made consistent: the faces turned are kept in the
-// mesh property kReadOrientationProperty); writes via write_mesh().
+// accepted, polygons triangulated, orientation made consistent and outward: what was turned or
+// reversed is kept in the mesh property kReadOrientationProperty); writes via write_mesh().
 const ArtifactType& mesh_artifact();
 
 // Name of the mesh property in which mesh_artifact()'s reader leaves the faces it turned (an
@@ -21,8 +21,8 @@ const ArtifactType& mesh_artifact();
 inline constexpr const char* kReadOrientationProperty = "colonflat:read_orientation";
 
 // A stage's first step on an input mesh `port` of `bag` (the one place stages orient meshes):
-// reports the faces the reader turned, reverses every closed component whose normals point into
-// the lumen (orient_outward, orientation.h) in the bag, prints one progress line per changed
+// reports what the reader turned or reversed, reverses every closed component whose normals still
+// point into the lumen (orient_outward, orientation.h: a mesh not read from a file) in the bag, prints one progress line per changed
 // component ("<stage>: <port>: component 0 (...): normals pointed into the lumen; reversed")
 // and returns the report entry (OrientationReport::to_json()).
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
