@@ -63,12 +63,6 @@ MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, 
 
 namespace segment_detail {
 
-double process_cpu_seconds() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
 MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
   cpu_start_ = cpu_lap_ = process_cpu_seconds();
   check_input();

@@ -12,6 +12,7 @@
 
 #include <sys/mman.h>
 
+#include "colonflat/core/threads.h"
 #include "segment_internal.h"
 
 namespace cf::segment_detail {
@@ -52,11 +53,8 @@ Dims make_dims(const std::size_t n[3], const double sp[3]) {
 }
 
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body) {
-  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(2, std::thread::hardware_concurrency()));
-  if (threads == 1 || n < 2) return body(0, n);
-  std::vector<std::thread> ts;
-  for (std::size_t t = 0; t < threads; ++t) ts.emplace_back([&, t] { body(n * t / threads, n * (t + 1) / threads); });
-  for (auto& t : ts) t.join();
+  // Two chunks at most: the voxel passes are memory-bound, a third thread gains nothing on them.
+  cf::parallel_for(n, body, 2);
 }
 
 RunLabels component_runs(const unsigned char* mask, const Dims& d) {

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/segment/segment.h"
 
 namespace cf::segment_detail {
@@ -60,8 +61,8 @@ struct Dims {
 };
 
 Dims make_dims(const std::size_t n[3], const double sp[3]);
-// User + system CPU seconds of this process so far (all threads; getrusage).
-double process_cpu_seconds();
+using cf::process_cpu_seconds;  // core/threads.h
+// Splits [0, n) into at most 2 chunks on cf::thread_count() threads (core parallel_for).
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
 // A run of voxels along axis 0: linear index of its first voxel and its length.
 struct Run {
