@@ -241,6 +241,16 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
   std::stable_sort(other.begin(), other.end(), [](const ColonPiece& x, const ColonPiece& y) {
     return x.registered != y.registered ? x.registered : x.start_mm < y.start_mm;
   });
+  const ColonPiece* prev = nullptr;  // pieces of one colon do not overlap: at least the straight gap apart
+  for (auto& p : other) {
+    if (!p.registered) continue;
+    if (prev) {
+      const Eigen::Vector3d& end = prev->flipped ? prev->centre.front() : prev->centre.back();
+      const Eigen::Vector3d& begin = p.flipped ? p.centre.back() : p.centre.front();
+      p.start_mm = std::max(p.start_mm, prev->end_mm() + (begin - end).norm());
+    }
+    prev = &p;
+  }
   double lo = 0;  // the other scan may reach beyond the reference's first end (rectum cut short)
   for (const auto& p : other)
     if (p.registered) lo = std::min(lo, p.start_mm);

@@ -220,7 +220,8 @@ int violet_pixels(vtkImageData* img, int c0, int c1) {
 }
 
 // A quarter of the colon (125 of 500 mm) left out of the prone map: the review page names the
-// stretch that could not be aligned and marks the supine polyps there as unaligned (never paired),
+// stretch that could not be aligned (70 % of it or more), marks the supine polyps 20 mm or more
+// inside as unaligned and pairs none of the polyps there,
 // and the side-by-side image stripes those columns violet and no column of the aligned rectal part.
 TEST(RegisterReview, UnalignedStretchIsShownOnPageAndImage) {
   testing::TempDir tmp;
@@ -235,13 +236,15 @@ TEST(RegisterReview, UnalignedStretchIsShownOnPageAndImage) {
   const auto& gaps = page["alignment"]["unaligned_mm"];
   double covered = 0;
   for (const auto& g : gaps) covered += std::max(0.0, std::min(g[1].get<double>(), 275.0) - std::max(g[0].get<double>(), 150.0));
-  EXPECT_GT(covered, 100.0) << gaps.dump();
+  EXPECT_GT(covered, 0.7 * 125) << gaps.dump();
   int unaligned = 0;
   for (const auto& s : page["singles"]) unaligned += s["unaligned"].get<bool>();
-  int inside = 0;
-  for (const auto& q : pair.polyps) inside += !q.in_prone;
+  int inside = 0;  // polyps 20 mm or more inside the dropped stretch
+  for (const auto& q : pair.polyps) inside += q.sigma_mm > 170 && q.sigma_mm < 255;
   EXPECT_GE(unaligned, inside);
-  EXPECT_GT(inside, 0);
+  for (const auto& q : pair.polyps)
+    for (const auto& p : page["pairs"])
+      if (!q.in_prone) EXPECT_NE(p["supine"]["key"], "P" + std::to_string(q.id));
   for (const auto& p : page["pairs"]) EXPECT_EQ(p["supine"]["key"], p["prone"]["key"]);
   vtkNew<vtkPNGReader> png;
   png->SetFileName((tmp / "out/supine_prone.png").c_str());

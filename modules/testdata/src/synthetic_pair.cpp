@@ -233,7 +233,13 @@ SyntheticPair make_synthetic_pair(const SyntheticPairOptions& o) {
                                          o.shuffle_pieces);
   out.supine = scan_from_polydata(flat_to_polydata(sup_flat), "synthetic supine");
   out.prone = scan_from_polydata(flat_to_polydata(pro_flat), "synthetic prone");
-  out.supine_sigma = gs.sigma, out.supine_phi = gs.phi, out.prone_sigma = gp.sigma, out.prone_phi = gp.phi;
+  auto kept = [](const Grid& g, const std::vector<std::pair<double, double>>& cuts, std::vector<double>& sigma,
+                 std::vector<double>& phi) {  // material coordinates of the flat vertices (rings left out skipped)
+    for (size_t v = 0; v < g.sigma.size(); ++v)
+      if (!removed(cuts, g.sigma[v])) sigma.push_back(g.sigma[v]), phi.push_back(g.phi[v]);
+  };
+  kept(gs, o.supine_removed, out.supine_sigma, out.supine_phi);
+  kept(gp, o.prone_removed, out.prone_sigma, out.prone_phi);
   std::mt19937_64 rng(o.seed + 17);
   std::uniform_real_distribution<double> u(0, 1);
   for (auto& q : tube.polyps) {

@@ -21,7 +21,8 @@ struct AlignOptions {
   double position_weight = 1.0;     // weight of the centre lines' distance term
   double position_sigma_mm = 60;    // mm; organ motion between supine and prone (docs)
   double position_cap = 9;          // the distance term saturates at (3 sigma)^2: any mismatch costs the same
-  double empty_cost = 4;            // a bin without wall in either scan (a gap between pieces): (2 sigma)^2
+  double empty_cost = 2;            // a bin without wall in either scan (a gap between pieces): below the
+                                    // feature cost of two unrelated bins (3), above a matching pair's (docs)
 };
 
 // A position known in both colons (a shared landmark or a matched candidate pair): the warping

@@ -36,9 +36,9 @@ struct RegisterOptions {
   double match_size_ratio = 2.0;     // largest size ratio of a pair (larger / smaller)
   PieceOptions pieces;               // colons with centreline_mm: laid out piece by piece (pieces.h)
   LandmarkOptions landmarks;
-  double support_radius_mm = 50;     // mm; centre points farther apart after the shift do not support the map
+  double support_radius_mm = 100;    // mm; centre points farther apart after the shift do not support the map
   double max_unsupported_mm = 10;    // mm; a candidate farther along from a supported bin is never paired
-  double match_3d_mm = 80;           // mm; largest LPS distance of a pair after the rigid shift (organ motion)
+  double match_3d_mm = 120;          // mm; largest LPS distance of a pair after the rigid shift (organ motion)
   double anchor_along_mm = 10;       // a pair this close (along, around), alone within the match limits,
   double anchor_around_deg = 30;     //   becomes an anchor of a second alignment pass
   double anchor_tolerance_mm = 6;    // mm; the second pass passes this close to each anchor
