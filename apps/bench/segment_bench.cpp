@@ -422,9 +422,6 @@ int main(int argc, char** argv) {
   bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false;
   int pad_to = 0, downsample = 1;
   std::string mask_file = std::string(COLONFLAT_SHARED_DIR) + "/real/ctc_lumen_mask_a.nii.gz";
-  std::string size = "full";
-  bool table_only = false, dicom = true, collapsed = false, realistic = false;
-  int pad_to = 0;
   std::string size = "full", real;
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
@@ -447,7 +444,7 @@ int main(int argc, char** argv) {
     } else rest.push_back(argv[i]);
   }
   if (painted) painted_table(mask_file, downsample);
-  if (!real.empty()) real_table(real, pad_to);
+  else if (!real.empty()) real_table(real, pad_to);
   else if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);
   if (table_only) return 0;
