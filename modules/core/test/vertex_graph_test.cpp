@@ -1,8 +1,10 @@
 // vertex_graph (core/vertex_graph.h): neighbours and boundary vertices against brute force.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
+#include "colonflat/core/threads.h"
 #include "colonflat/core/vertex_graph.h"
 
 namespace cf {
@@ -62,6 +64,22 @@ TEST(VertexGraph, ClosedSurfaceAndIsolatedPoint) {
     EXPECT_EQ(g.on_boundary[v], 0);
   }
   EXPECT_EQ(g.degree(4), 0u);
+}
+
+// Rows are ascending and the graph is the same, array for array, with 1 and 3 threads (a grid
+// large enough to be split into several chunks, with holes).
+TEST(VertexGraph, RowsAscendingAndSameForAnyThreadCount) {
+  const TriangleList t = grid(40, {41, 42, 300, 777, 1200});
+  set_thread_count(1);
+  const VertexGraph one = vertex_graph(t);
+  set_thread_count(3);
+  const VertexGraph three = vertex_graph(t);
+  set_thread_count(0);
+  EXPECT_EQ(one.start, three.start);
+  EXPECT_EQ(one.neighbours, three.neighbours);
+  EXPECT_EQ(one.on_boundary, three.on_boundary);
+  for (std::size_t v = 0; v < t.points.size(); ++v)
+    EXPECT_TRUE(std::is_sorted(one.neighbours.begin() + one.start[v], one.neighbours.begin() + one.start[v + 1])) << v;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/stage.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/vertex_graph.h"
 
 namespace cf {
@@ -49,51 +50,67 @@ void neighbourhood(const VertexGraph& g, const TriangleList& s, int c, double r,
   }
 }
 
-}  // namespace
+// Shape index and curvedness of vertex i from a weighted quadric fit of its neighbourhood `nb`
+// in its tangent frame (normal into the lumen); false when fewer than 5 neighbours.
+bool fit_vertex(const TriangleList& s, const std::array<double, 3>& normal, int i, const std::vector<int>& nb,
+                double fit_radius, Curvature& c) {
+  const V3 n = -V3(normal[0], normal[1], normal[2]).normalized();  // into the lumen
+  const V3 t1 = (std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY()).cross(n).normalized();
+  const V3 t2 = n.cross(t1);
+  const V3 pc = P(s, i);
+  Eigen::Matrix<double, 5, 5> A = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
+  int used = 0;
+  for (int j : nb) {
+    if (j == i) continue;
+    const V3 d = P(s, j) - pc;
+    const double x = d.dot(t1), y = d.dot(t2), h = d.dot(n);
+    const double w = std::exp(-d.squaredNorm() / (fit_radius * fit_radius));
+    Eigen::Matrix<double, 5, 1> r;
+    r << 0.5 * x * x, x * y, 0.5 * y * y, x, y;
+    A += w * r * r.transpose();
+    b += w * h * r;
+    ++used;
+  }
+  if (used < 5) return false;
+  A.diagonal().array() += 1e-12 * (A.trace() + 1e-30);
+  const Eigen::Matrix<double, 5, 1> q = A.ldlt().solve(b);
+  Eigen::Matrix2d H;
+  H << q[0], q[1], q[1], q[2];
+  const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(-H).eigenvalues();  // ascending
+  const double k1 = ev[1], k2 = ev[0];
+  c.k1[i] = k1;
+  c.k2[i] = k2;
+  c.si[i] = k1 - k2 > 1e-12 ? 2 / M_PI * std::atan((k1 + k2) / (k1 - k2)) : (k1 > 0 ? 1.0 : k1 < 0 ? -1.0 : 0.0);
+  c.cv[i] = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+  return true;
+}
 
-Curvature surface_curvature(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
-                            double fit_radius) {
-  const int nv = int(s.points.size());
-  const VertexGraph g = vertex_graph(s);
+// surface_curvature() over a given vertex graph: each vertex on its own (contiguous chunks of
+// vertices over the threads, each with its own visit stamps), so any thread count gives the same.
+Curvature curvature_on_graph(const TriangleList& s, const VertexGraph& g,
+                             const std::vector<std::array<double, 3>>& normals, double fit_radius) {
+  const std::size_t nv = s.points.size();
   Curvature c;
   c.k1.assign(nv, 0);
   c.k2.assign(nv, 0);
   c.si.assign(nv, 0);
   c.cv.assign(nv, 0);
-  std::vector<int> stamp(nv, -1), nb;
-  for (int i = 0; i < nv; ++i) {
-    neighbourhood(g, s, i, fit_radius, stamp, i, nb);
-    const V3 n = -V3(normals[i][0], normals[i][1], normals[i][2]).normalized();  // into the lumen
-    const V3 t1 = (std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY()).cross(n).normalized();
-    const V3 t2 = n.cross(t1);
-    const V3 pc = P(s, i);
-    Eigen::Matrix<double, 5, 5> A = Eigen::Matrix<double, 5, 5>::Zero();
-    Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
-    int used = 0;
-    for (int j : nb) {
-      if (j == i) continue;
-      const V3 d = P(s, j) - pc;
-      const double x = d.dot(t1), y = d.dot(t2), h = d.dot(n);
-      const double w = std::exp(-d.squaredNorm() / (fit_radius * fit_radius));
-      Eigen::Matrix<double, 5, 1> r;
-      r << 0.5 * x * x, x * y, 0.5 * y * y, x, y;
-      A += w * r * r.transpose();
-      b += w * h * r;
-      ++used;
+  parallel_for(nv, [&](std::size_t begin, std::size_t end) {
+    std::vector<int> stamp(nv, -1), nb;
+    for (std::size_t i = begin; i < end; ++i) {
+      neighbourhood(g, s, int(i), fit_radius, stamp, int(i), nb);
+      fit_vertex(s, normals[i], int(i), nb, fit_radius, c);
     }
-    if (used < 5) continue;
-    A.diagonal().array() += 1e-12 * (A.trace() + 1e-30);
-    const Eigen::Matrix<double, 5, 1> q = A.ldlt().solve(b);
-    Eigen::Matrix2d H;
-    H << q[0], q[1], q[1], q[2];
-    const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(-H).eigenvalues();  // ascending
-    const double k1 = ev[1], k2 = ev[0];
-    c.k1[i] = k1;
-    c.k2[i] = k2;
-    c.si[i] = k1 - k2 > 1e-12 ? 2 / M_PI * std::atan((k1 + k2) / (k1 - k2)) : (k1 > 0 ? 1.0 : k1 < 0 ? -1.0 : 0.0);
-    c.cv[i] = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
-  }
+  });
   return c;
+}
+
+}  // namespace
+
+Curvature surface_curvature(const TriangleList& s, const std::vector<std::array<double, 3>>& normals,
+                            double fit_radius) {
+  return curvature_on_graph(s, vertex_graph(s), normals, fit_radius);
 }
 
 namespace {
@@ -103,7 +120,7 @@ namespace {
 class PolypDetector {
  public:
   PolypDetector(const TriangleList& s, const std::vector<std::array<double, 3>>& normals, const PolypOptions& o)
-      : s_(s), o_(o), c_(surface_curvature(s, normals, o.fit_radius)), g_(vertex_graph(s)), area_(vertex_areas(s)),
+      : s_(s), o_(o), g_(vertex_graph(s)), c_(curvature_on_graph(s, g_, normals, o.fit_radius)), area_(vertex_areas(s)),
         region_(s.points.size(), -1), footprint_stamp_(s.points.size(), -1) {}
   std::vector<PolypCandidate> run(Curvature* curvature_out);
 
@@ -121,8 +138,8 @@ class PolypDetector {
 
   const TriangleList& s_;
   const PolypOptions& o_;
-  Curvature c_;
   const VertexGraph g_;
+  Curvature c_;  // after g_: computed on it
   const std::vector<double> area_;  // per vertex, a third of its triangles' area (mm^2)
   std::vector<int> region_;         // cap region of each vertex, -1 when none
   std::vector<int> footprint_stamp_;

@@ -16,7 +16,8 @@ struct VertexGraph {
 };
 
 // surface: #P points, #T triangles with ids in [0, #P). Each undirected edge appears in the rows of
-// both its ends, once. Isolated points have no neighbours. O(T log T).
+// both its ends, once. Isolated points have no neighbours. O(T) (one counting sort of the corners,
+// each vertex's short row sorted), split over cf::thread_count() threads; the same for any count.
 VertexGraph vertex_graph(const TriangleList& surface);
 
 }  // namespace cf
