@@ -9,8 +9,9 @@
 #include <cmath>
 
 #include "colonflat/core/atomic_file.h"
-#include "colonflat/core/vtk_messages.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
+#include "colonflat/core/vtk_messages.h"
 
 namespace fs = std::filesystem;
 
@@ -142,11 +143,17 @@ nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<
                       {"v_axis", a.v_axis}, {"v_sign", a.v_sign}, {"fixed_axis", a.fixed_axis},
                       {"u0", ur[0]}, {"v0", vr[0]}, {"pixel_mm", o.pixel_mm}, {"w", w}, {"h", h},
                       {"positions", nlohmann::json::array()}, {"files", nlohmann::json::array()}};
+  auto fixed_of = [&](int i) { return f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm; };
+  // The planes are sampled on the threads; the PNGs are written in order on this one (VTK's
+  // message capture around each writer is process-wide).
+  std::vector<PlaneImage> planes(static_cast<std::size_t>(n));
+  parallel_for(planes.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) planes[i] = sample_plane(ct, plane, fixed_of(int(i)), ur[0], vr[0], w, h, o.pixel_mm);
+  });
   for (int i = 0; i < n; ++i) {
-    const double fixed = f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm;
-    const PlaneImage im = sample_plane(ct, plane, fixed, ur[0], vr[0], w, h, o.pixel_mm);
+    const double fixed = fixed_of(i);
     const std::string name = std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png";
-    write_windowed_png(im, o.window ? *o.window : lung_window(), dir / name);
+    write_windowed_png(planes[std::size_t(i)], o.window ? *o.window : lung_window(), dir / name);
     j["positions"].push_back(std::round(fixed * 100) / 100);
     j["files"].push_back(rel_prefix + name);
   }
