@@ -179,6 +179,9 @@ class RunTool : public Tool {
                                    nlohmann::json& report, std::ostream* log) {
     const fs::path outdir(o.outdir);
     nlohmann::json all_params = nlohmann::json::object();
+    // Each stage's files are written on a second thread while the next stage runs (the
+    // artifacts stay in the bag unchanged); all are written before the finishers, which may take them.
+    BackgroundOutputWriter writer;
     for (std::size_t i = 0; i < plan.stages.size(); ++i) {
       Stage& st = *plan.stages[i];
       if (log) *log << "[" << (i + 1) << "/" << plan.stages.size() << "] " << st.spec().name << ": " << st.spec().summary << "\n";
@@ -187,13 +190,16 @@ class RunTool : public Tool {
       nlohmann::json record = run_stage_recorded(st, bag, ctx);
       std::map<std::string, fs::path> targets;
       for (const Port& p : st.spec().outputs) targets[p.name] = outdir / p.file_name;
-      write_stage_outputs(st, bag, targets, tx, record);
+      PendingOutputs outputs = stage_outputs(st, bag, targets, tx);
+      record["outputs"] = outputs.files;
+      writer.submit(std::move(outputs));
       if (!o.debug_dir.empty()) write_debug(st, bag, record, fs::path(o.debug_dir) / (std::to_string(plan.first_index + i + 1) + "_" + st.spec().name), tx);
       all_params[st.spec().name] = st.params_json();
       if (log) *log << "    done in " << std::fixed << std::setprecision(2) << record["time_s"].get<double>()
                     << " s, peak " << std::setprecision(0) << peak_memory_mib() << " MiB\n";
       report["stages"].push_back(record);
     }
+    writer.wait();
     return all_params;
   }
 

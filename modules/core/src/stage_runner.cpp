@@ -72,8 +72,9 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
           {"outputs", nlohmann::json::object()}};
 }
 
-void write_stage_outputs(const Stage& stage, const ArtifactBag& bag, const std::map<std::string, fs::path>& targets,
-                         OutputTransaction& tx, nlohmann::json& record) {
+PendingOutputs stage_outputs(const Stage& stage, const ArtifactBag& bag, const std::map<std::string, fs::path>& targets,
+                             OutputTransaction& tx) {
+  PendingOutputs out;
   for (const Port& p : stage.spec().outputs) {
     auto it = targets.find(p.name);
     if (it == targets.end() || it->second.empty()) continue;
@@ -81,9 +82,36 @@ void write_stage_outputs(const Stage& stage, const ArtifactBag& bag, const std::
       if (p.required) throw Error("stage " + stage.spec().name + " produced no '" + p.name + "' output");
       continue;
     }
-    p.type->write(bag.raw(p.name), tx.stage(it->second), it->second);
-    record["outputs"][p.name] = it->second.filename().string();
+    const std::any* value = &bag.raw(p.name);
+    const fs::path tmp = tx.stage(it->second), target = it->second;
+    const ArtifactType* type = p.type;
+    out.writes.push_back([type, value, tmp, target] { type->write(*value, tmp, target); });
+    out.files[p.name] = target.filename().string();
   }
+  return out;
+}
+
+void write_stage_outputs(const Stage& stage, const ArtifactBag& bag, const std::map<std::string, fs::path>& targets,
+                         OutputTransaction& tx, nlohmann::json& record) {
+  const PendingOutputs out = stage_outputs(stage, bag, targets, tx);
+  out.write();
+  for (const auto& [port, file] : out.files.items()) record["outputs"][port] = file;
+}
+
+BackgroundOutputWriter::~BackgroundOutputWriter() {
+  try {
+    wait();
+  } catch (...) {
+  }
+}
+
+void BackgroundOutputWriter::submit(PendingOutputs outputs) {
+  wait();
+  job_ = std::async(std::launch::async, [o = std::move(outputs)] { o.write(); });
+}
+
+void BackgroundOutputWriter::wait() {
+  if (job_.valid()) job_.get();
 }
 
 void plan_port_output(PathPlan& plan, const Port& port, const fs::path& file, const std::string& option) {

@@ -7,6 +7,7 @@
 #include <vtkOutputWindow.h>
 
 #include <algorithm>
+#include <mutex>
 
 #include "colonflat/core/write_errors.h"
 
@@ -46,36 +47,104 @@ std::string clean(const char* text) {
   return s;
 }
 
+// One capture's messages (a vtkOutputWindow only to be deleted like one; never installed).
 class CapturingWindow : public vtkOutputWindow {
  public:
   static CapturingWindow* New();
   vtkTypeMacro(CapturingWindow, vtkOutputWindow);
-  void DisplayText(const char*) override {}
-  void DisplayErrorText(const char* t) override { errors.push_back(clean(t)); }
-  void DisplayWarningText(const char* t) override { warnings.push_back(clean(t)); }
-  void DisplayGenericWarningText(const char* t) override { warnings.push_back(clean(t)); }
-  void DisplayDebugText(const char*) override {}
   std::vector<std::string> errors, warnings;
 };
 vtkStandardNewMacro(CapturingWindow);
 
+// The process-wide state of the captures, under one mutex: the captures alive (in creation
+// order), VTK's own window (kept, and given every message while no capture lives: the router
+// is installed once and never removed, so no thread can be left holding a deleted window), and
+// vtkLogger's stderr cutoff before the first of the captures alive.
+struct Captures {
+  std::mutex mutex;
+  std::vector<CapturingWindow*> alive;
+  vtkOutputWindow* previous = nullptr;
+  bool routed = false;
+  int saved_verbosity = 0;
+};
+Captures& captures() {
+  static Captures c;
+  return c;
+}
+thread_local std::vector<CapturingWindow*> tl_captures;  // this thread's captures, innermost last
+
+// Installed at the first capture: each message goes to the calling thread's innermost capture,
+// else to the capture created last, else (no capture alive) to VTK's own window.
+class RoutingWindow : public vtkOutputWindow {
+ public:
+  static RoutingWindow* New();
+  vtkTypeMacro(RoutingWindow, vtkOutputWindow);
+  void DisplayText(const char* t) override { forward(t, &vtkOutputWindow::DisplayText); }
+  void DisplayErrorText(const char* t) override {
+    if (!add(t, true)) forward(t, &vtkOutputWindow::DisplayErrorText);
+  }
+  void DisplayWarningText(const char* t) override {
+    if (!add(t, false)) forward(t, &vtkOutputWindow::DisplayWarningText);
+  }
+  void DisplayGenericWarningText(const char* t) override {
+    if (!add(t, false)) forward(t, &vtkOutputWindow::DisplayGenericWarningText);
+  }
+  void DisplayDebugText(const char* t) override { forward(t, &vtkOutputWindow::DisplayDebugText); }
+
+ private:
+  // Stores the message in a capture; false when none is alive.
+  static bool add(const char* t, bool error) {
+    std::lock_guard<std::mutex> lock(captures().mutex);
+    CapturingWindow* w = !tl_captures.empty() ? tl_captures.back()
+                         : !captures().alive.empty() ? captures().alive.back() : nullptr;
+    if (w) (error ? w->errors : w->warnings).push_back(clean(t));
+    return w != nullptr;
+  }
+  // Text and debug lines while a capture lives are dropped (as before); otherwise VTK's window shows them.
+  static void forward(const char* t, void (vtkOutputWindow::*show)(const char*)) {
+    vtkOutputWindow* previous = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(captures().mutex);
+      if (captures().alive.empty()) previous = captures().previous;
+    }
+    if (previous) (previous->*show)(t);
+  }
+};
+vtkStandardNewMacro(RoutingWindow);
+
 }  // namespace
 
-VtkMessageCapture::VtkMessageCapture() {
-  // VTK's logger prints its own coloured copy of errors to stderr: off while capturing.
-  saved_verbosity_ = static_cast<int>(vtkLogger::GetCurrentVerbosityCutoff());
-  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-  previous_ = vtkOutputWindow::GetInstance();
-  if (previous_) previous_->Register(nullptr);
-  window_ = CapturingWindow::New();
-  vtkOutputWindow::SetInstance(window_);
+VtkMessageCapture::VtkMessageCapture() : window_(CapturingWindow::New()) {
+  auto* w = static_cast<CapturingWindow*>(window_);
+  Captures& c = captures();
+  std::lock_guard<std::mutex> lock(c.mutex);
+  if (!c.routed) {
+    c.previous = vtkOutputWindow::GetInstance();
+    if (c.previous) c.previous->Register(nullptr);  // kept for the process's life
+    RoutingWindow* router = RoutingWindow::New();
+    vtkOutputWindow::SetInstance(router);
+    router->Delete();  // the instance slot holds it
+    c.routed = true;
+  }
+  if (c.alive.empty()) {
+    // VTK's logger prints its own coloured copy of errors to stderr: off while capturing.
+    c.saved_verbosity = static_cast<int>(vtkLogger::GetCurrentVerbosityCutoff());
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+  }
+  c.alive.push_back(w);
+  tl_captures.push_back(w);
 }
 
 VtkMessageCapture::~VtkMessageCapture() {
-  vtkOutputWindow::SetInstance(previous_);
-  if (previous_) previous_->UnRegister(nullptr);
+  auto* w = static_cast<CapturingWindow*>(window_);
+  Captures& c = captures();
+  {
+    std::lock_guard<std::mutex> lock(c.mutex);
+    c.alive.erase(std::find(c.alive.begin(), c.alive.end(), w));
+    tl_captures.erase(std::find(tl_captures.begin(), tl_captures.end(), w));
+    if (c.alive.empty()) vtkLogger::SetStderrVerbosity(static_cast<vtkLogger::Verbosity>(c.saved_verbosity));
+  }
   window_->Delete();
-  vtkLogger::SetStderrVerbosity(static_cast<vtkLogger::Verbosity>(saved_verbosity_));
 }
 
 const std::vector<std::string>& VtkMessageCapture::errors() const {

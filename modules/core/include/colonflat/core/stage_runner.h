@@ -8,8 +8,11 @@
 //    "time_s": 1.23, "phases": [{"phase": "loop search", "time_s": 0.8}, ...],
 //    "peak_memory_mib": 456, "outputs": {"denoised": "denoised.vtp", ...}}
 #include <filesystem>
+#include <functional>
+#include <future>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -30,6 +33,35 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
 void write_stage_outputs(const Stage& stage, const ArtifactBag& bag,
                          const std::map<std::string, std::filesystem::path>& targets, OutputTransaction& tx,
                          nlohmann::json& record);
+
+// The outputs of one stage, staged in `tx` (on the calling thread) but not yet written: `write`
+// writes each file (safe on another thread while later stages run, as long as the artifacts stay
+// in the bag unchanged); `files` is what write_stage_outputs adds to the record's "outputs".
+struct PendingOutputs {
+  std::vector<std::function<void()>> writes;
+  nlohmann::json files = nlohmann::json::object();
+  void write() const {
+    for (const auto& w : writes) w();
+  }
+};
+PendingOutputs stage_outputs(const Stage& stage, const ArtifactBag& bag,
+                             const std::map<std::string, std::filesystem::path>& targets, OutputTransaction& tx);
+
+// Writes one stage's outputs on a background thread while the next stage runs (`colonflat run`):
+// one write job at a time, in stage order; a failed write is rethrown by the next submit() or by
+// wait(). The destructor waits too (ignoring the error: the run is failing already).
+class BackgroundOutputWriter {
+ public:
+  BackgroundOutputWriter() = default;
+  BackgroundOutputWriter(const BackgroundOutputWriter&) = delete;
+  BackgroundOutputWriter& operator=(const BackgroundOutputWriter&) = delete;
+  ~BackgroundOutputWriter();
+  void submit(PendingOutputs outputs);
+  void wait();
+
+ private:
+  std::future<void> job_;
+};
 
 // Adds an output port's file to `plan`, with the extensions its type declares.
 void plan_port_output(PathPlan& plan, const Port& port, const std::filesystem::path& file, const std::string& option);

@@ -2,6 +2,9 @@
 // VTK reports problems by printing through its output window and carrying on. While a
 // VtkMessageCapture lives, those messages are collected instead of printed, so callers can turn
 // them into one clear error (and nothing VTK says leaks onto the user's terminal).
+// Thread-safe: captures on different threads (a stage running while another thread writes the
+// previous stage's files) each get their own thread's messages; a message from a thread without a
+// capture (a VTK worker thread) goes to the capture created last.
 #include <string>
 #include <vector>
 
@@ -27,9 +30,7 @@ class VtkMessageCapture {
   std::string write_problem(vtkAlgorithm* writer, const std::string& file) const;
 
  private:
-  vtkOutputWindow* previous_;
-  vtkOutputWindow* window_;
-  int saved_verbosity_;  // vtkLogger's stderr cutoff before the capture
+  vtkOutputWindow* window_;  // this capture's messages (never installed: the shared router feeds it)
 };
 
 }  // namespace cf
