@@ -1,0 +1,102 @@
+// VtkMessageCapture on several threads and BackgroundOutputWriter (core vtk_messages.h,
+// stage_runner.h): what `colonflat run` relies on to write a stage's files while the next runs.
+#include <gtest/gtest.h>
+
+#include <vtkNew.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "colonflat/core/stage_runner.h"
+#include "colonflat/core/vtk_messages.h"
+
+namespace cf {
+namespace {
+
+// Reads a file that does not exist: VTK reports an error naming it through its output window.
+void read_missing(const std::string& name) {
+  vtkNew<vtkXMLPolyDataReader> r;
+  r->SetFileName(name.c_str());
+  r->Update();
+}
+
+bool mentions(const std::vector<std::string>& lines, const std::string& what) {
+  for (const auto& l : lines)
+    if (l.find(what) != std::string::npos) return true;
+  return false;
+}
+
+// Two threads, each with its own capture alive at the same time, each get exactly their own
+// thread's VTK errors (the file each one read), never the other's.
+TEST(CoreVtkMessages, CapturesOnTwoThreadsGetTheirOwnMessages) {
+  std::atomic<int> ready{0};
+  std::vector<std::string> errors[2];
+  auto worker = [&](int t) {
+    VtkMessageCapture capture;
+    ++ready;
+    while (ready < 2) std::this_thread::yield();  // both captures alive
+    for (int k = 0; k < 20; ++k) read_missing("/nonexistent/thread_" + std::to_string(t) + ".vtp");
+    ++ready;
+    while (ready < 4) std::this_thread::yield();  // neither ends before the other read
+    errors[t] = capture.errors();
+  };
+  std::thread a(worker, 0), b(worker, 1);
+  a.join();
+  b.join();
+  for (int t = 0; t < 2; ++t) {
+    EXPECT_TRUE(mentions(errors[t], "thread_" + std::to_string(t))) << t;
+    EXPECT_FALSE(mentions(errors[t], "thread_" + std::to_string(1 - t))) << t;
+  }
+}
+
+// A capture nested in another on one thread gets the messages while it lives; the outer one
+// gets those before and after.
+TEST(CoreVtkMessages, InnermostCaptureOfAThreadGetsItsMessages) {
+  VtkMessageCapture outer;
+  read_missing("/nonexistent/before.vtp");
+  {
+    VtkMessageCapture inner;
+    read_missing("/nonexistent/inner.vtp");
+    EXPECT_TRUE(mentions(inner.errors(), "inner.vtp"));
+    EXPECT_FALSE(mentions(inner.errors(), "before.vtp"));
+  }
+  read_missing("/nonexistent/after.vtp");
+  EXPECT_TRUE(mentions(outer.errors(), "before.vtp"));
+  EXPECT_TRUE(mentions(outer.errors(), "after.vtp"));
+  EXPECT_FALSE(mentions(outer.errors(), "inner.vtp"));
+}
+
+// Jobs run one after the other in submission order, and a failed job's error reaches the next
+// submit() or wait() (the run fails with the write's message).
+TEST(CoreBackgroundOutputWriter, RunsJobsInOrderAndRethrowsAFailedWrite) {
+  std::vector<int> order;
+  BackgroundOutputWriter writer;
+  for (int i = 0; i < 3; ++i) {
+    PendingOutputs job;
+    job.writes.push_back([&order, i] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5 * (3 - i)));
+      order.push_back(i);
+    });
+    writer.submit(std::move(job));
+  }
+  writer.wait();
+  EXPECT_EQ(order, (std::vector<int>{0, 1, 2}));
+  PendingOutputs failing;
+  failing.writes.push_back([] { throw std::runtime_error("cannot write: no space left on device"); });
+  writer.submit(std::move(failing));
+  try {
+    writer.wait();
+    FAIL() << "the failed write was not rethrown";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write: no space left on device");
+  }
+  writer.wait();  // the error is reported once
+}
+
+}  // namespace
+}  // namespace cf
