@@ -31,9 +31,9 @@ SurgeryResult Surgery::run() {
   const bool triangulated = try_triangulated_caps();
   const double t_tri = sw.seconds();
   if (!triangulated) concentric_caps();
-  if (std::getenv("COLONFLAT_DENOISE_DEBUG") && (sw.seconds() > 0.2 || !triangulated || cap_kind_[0] == 's'))
-    std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s (sheet %.2f s), concentric %.2f s\n",
-                 k_, cap_kind_, result_.intersections, t_tri, sheet_s_, sw.seconds() - t_tri);
+  if (std::getenv("COLONFLAT_DENOISE_DEBUG") && (sw.seconds() > 0.2 || !triangulated))
+    std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s, concentric %.2f s\n",
+                 k_, cap_kind_, result_.intersections, t_tri, sw.seconds() - t_tri);
   return result_;
 }
 

@@ -5,7 +5,6 @@
 #include <unordered_set>
 
 #include "colonflat/core/error.h"
-#include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/cap_triangulation.h"
 #include "colonflat/denoise/face_grid.h"
 #include "surgery_steps.h"
@@ -178,11 +177,11 @@ bool Surgery::mirror_cap(const std::vector<std::array<int, 3>>& right, std::vect
 
 // 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area
 //     triangulations of the pulled rings (no interior vertex: on an elongated loop around a thin
-//     curved band they join opposite sides and follow the band) in every placement; then sheet
-//     caps (7b, surgery_sheet.cpp); then, in every placement, minimum-area triangulations
-//     restricted to triangles that intersect nothing (a grid query per candidate triangle: the
-//     expensive step, so it comes last). Kept when neither the caps nor the faces around the
-//     pulled rings intersect anything.
+//     curved band they join opposite sides and follow the band) in every placement; then, in
+//     every placement, minimum-area triangulations restricted to triangles that intersect
+//     nothing (a grid query per candidate triangle: the expensive step, so it comes last, within
+//     kMaxGridQueries, and stops once the right ring has none). Kept when neither the caps nor
+//     the faces around the pulled rings intersect anything.
 bool Surgery::try_triangulated_caps() {
   if (!opts_.guard || k_ > kMaxTriangulatedLoop) return false;
   edge_left_ = edge_targets(result_.left_ring);
@@ -197,10 +196,7 @@ bool Surgery::try_triangulated_caps() {
         cap_kind_ = avoid ? "restricted" : "plain";
         return true;
       }
-  Stopwatch sw;
-  const bool sheet = try_sheet_caps();
-  sheet_s_ = sw.seconds();
-  return sheet && (cap_kind_ = "sheet");
+  return false;
 }
 
 void Surgery::add_triangulated_caps(const std::vector<std::array<int, 3>>& right,
@@ -268,6 +264,35 @@ ConcentricCap Surgery::make_concentric_cap(const std::vector<Mesh::HalfedgeHandl
   for (std::size_t i = 0; i < n; ++i) add(cap.rings[m - 1][i], cap.rings[m - 1][(i + 1) % n], cap.centre);
   set_concentric_classes(cap, ring_halfedges);
   return cap;
+}
+
+// Classes of a cap's new edges: ring vertex i gets the potential P_i (prefix XOR of the ring's
+// edge classes), interior vertices 0, and each new edge (a, b) the class P(a) ^ P(b), so every
+// cap triangle sums to zero (the closing one to the loop's class, which the caller quotients
+// out). Every new edge has an interior end.
+void Surgery::set_cap_classes(const std::vector<Mesh::VertexHandle>& ring,
+                              const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
+                              const std::vector<Mesh::VertexHandle>& inner) {
+  if (!homology_) return;
+  std::unordered_map<int, std::vector<std::uint64_t>> potential;
+  std::vector<std::uint64_t> acc(words_, 0);
+  for (std::size_t i = 0; i < ring_halfedges.size(); ++i) {
+    potential[ring[i].idx()] = acc;
+    xor_into(acc.data(), homology_->edge_class(mesh_.edge_handle(ring_halfedges[i])), words_);
+  }
+  const std::vector<std::uint64_t> zero(words_, 0);
+  auto pot = [&](Mesh::VertexHandle v) -> const std::vector<std::uint64_t>& {
+    auto it = potential.find(v.idx());
+    return it == potential.end() ? zero : it->second;
+  };
+  std::vector<std::uint64_t> cls(words_);
+  for (auto v : inner)
+    for (auto he : mesh_.voh_range(v)) {
+      const auto& q0 = pot(v);
+      const auto& q1 = pot(mesh_.to_vertex_handle(he));
+      for (int i = 0; i < words_; ++i) cls[i] = q0[i] ^ q1[i];
+      homology_->set_edge_class(mesh_.edge_handle(he), cls.data());
+    }
 }
 
 void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "colonflat/denoise/homology.h"
-#include "colonflat/denoise/spanning_disk.h"
 #include "colonflat/denoise/surgery.h"
 
 namespace cf::detail {
@@ -50,13 +49,6 @@ class Surgery {
   bool try_triangulated_caps();
   bool mirror_cap(const std::vector<std::array<int, 3>>& right, std::vector<std::array<int, 3>>* left);
   void add_triangulated_caps(const std::vector<std::array<int, 3>>& right, const std::vector<std::array<int, 3>>& left);
-  // Sheet caps (surgery_sheet.cpp).
-  bool try_sheet_caps();
-  bool sheet_search(const SpanningDisk& disk, double edge, const std::vector<Mesh::FaceHandle>& moving);
-  void sheet_lift_setup(const SpanningDisk& disk);
-  void position_sheet(const SpanningDisk& disk, double lift, double scale);
-  void debug_sheet(const SpanningDisk& disk, std::size_t first_cap_face, const std::vector<Mesh::FaceHandle>& moving);
-  void remove_caps(std::size_t vertices, std::size_t edges, std::size_t faces);
   void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
                        const std::vector<Mesh::VertexHandle>& inner);
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
@@ -83,14 +75,10 @@ class Surgery {
   std::vector<Vec3> original_;                               // loop positions before any move
   std::vector<Vec3> target_left_, target_right_, edge_left_, edge_right_;
   std::vector<Mesh::FaceHandle> ring_faces_;                 // faces around the two rings
-  std::vector<Mesh::VertexHandle> sheet_right_, sheet_left_;  // sheet caps: disk vertex -> mesh vertex
-  std::vector<int> sheet_hops_, sheet_nearest_;               // per disk point: edges to the ring, nearest ring vertex
-  std::vector<Vec3> sheet_normal_;                            // per ring vertex: surface normal
   ConcentricCap cap_left_, cap_right_;
   SurgeryResult result_;
   bool gave_up_ = false;                // no more restricted triangulations (budget spent, or the right ring has none)
   long long query_budget_ = 0;          // grid queries left for them (kMaxGridQueries per surgery)
-  double sheet_s_ = 0;                  // time of step 7b (COLONFLAT_DENOISE_DEBUG)
   const char* cap_kind_ = "concentric";  // which step made the caps (COLONFLAT_DENOISE_DEBUG)
 };
 
