@@ -1,6 +1,8 @@
 #include "colonflat/denoise/cap_triangulation.h"
 
 #include <algorithm>
+#include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string>
@@ -17,7 +19,8 @@ constexpr int kParallelRing = 48;
 }  // namespace
 
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
-                                                        const std::function<bool(int, int, int)>& allowed) {
+                                                        const std::function<bool(int, int, int)>& allowed,
+                                                        const std::function<bool()>& give_up) {
   const int n = static_cast<int>(ring.size());
   std::vector<std::array<int, 3>> tris;
   if (n < 3) return tris;
@@ -58,6 +61,7 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
     };
     if (split) parallel_for(std::size_t(n - len), range);
     else range(0, std::size_t(n - len));
+    if (give_up && give_up()) return {};  // between lengths: the same for any thread count
   }
   std::vector<std::pair<int, int>> stack{{0, n - 1}};
   while (!stack.empty()) {
@@ -77,8 +81,9 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid,
-    const std::vector<std::array<int, 3>>& others) {
+    const std::vector<std::array<int, 3>>& others, long long* budget) {
   const int n = static_cast<int>(ring.size());
+  std::atomic<long long> queries{0};
   std::vector<Vec3> pts;
   for (auto v : ring) pts.push_back(mesh.point(v));
   auto diagonal_ok = [&](int a, int b) {
@@ -91,9 +96,15 @@ std::vector<std::array<int, 3>> triangulate_ring(
     if (OpenMesh::cross(b - a, c - a).norm() < 1e-4 * longest) return false;
     if (!grid) return true;  // diagonals are checked on the result: cheaper than here
     if (!diagonal_ok(i, m) || !diagonal_ok(m, j) || !diagonal_ok(i, j)) return false;
+    ++queries;
     return !grid->hits(mesh, {ring[i].idx(), ring[m].idx(), ring[j].idx()}, others);
   };
-  std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed);
+  auto give_up = [&] { return budget && queries.load() > *budget; };
+  std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed, give_up);
+  if (grid && std::getenv("COLONFLAT_DENOISE_DEBUG") && n >= 48)
+    std::fprintf(stderr, "denoise debug: restricted triangulation of %d vertices: %lld grid queries, %s\n", n,
+                 queries.load(), t.empty() ? "none" : "found");
+  if (budget) *budget -= queries.load();
   for (auto& tri : t) {
     for (int e = 0; e < 3; ++e)
       if (!diagonal_ok(tri[e], tri[(e + 1) % 3])) return {};

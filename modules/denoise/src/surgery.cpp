@@ -1,10 +1,13 @@
 #include "colonflat/denoise/surgery.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <unordered_set>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/run_stats.h"
 #include "surgery_steps.h"
 
 namespace cf {
@@ -24,8 +27,13 @@ SurgeryResult Surgery::run() {
   original_.resize(k_);
   for (std::size_t i = 0; i < k_; ++i) original_[i] = mesh_.point(loop_[i]);
   copy_loop_classes();
-  if (try_triangulated_caps()) return result_;
-  concentric_caps();
+  Stopwatch sw;
+  const bool triangulated = try_triangulated_caps();
+  const double t_tri = sw.seconds();
+  if (!triangulated) concentric_caps();
+  if (std::getenv("COLONFLAT_DENOISE_DEBUG") && (sw.seconds() > 0.2 || !triangulated))
+    std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s, concentric %.2f s\n",
+                 k_, cap_kind_, result_.intersections, t_tri, sw.seconds() - t_tri);
   return result_;
 }
 

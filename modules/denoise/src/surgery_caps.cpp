@@ -15,6 +15,14 @@ namespace {
 // Loops up to this many vertices get triangulated caps (O(k^3) time, O(k^2) memory: about 10 s
 // and 0.7 GB at 2000 vertices); longer ones get concentric-ring caps in one placement.
 constexpr std::size_t kMaxTriangulatedLoop = 2000;
+// Grid queries (candidate triangles tested against the surface) the restricted triangulations of
+// one surgery may make in all: each costs 0.1-0.3 ms on long rings (their triangles span many
+// grid cells), so this bounds a surgery's restricted triangulations to about 20-60 s of CPU,
+// where they used to take up to 96 s (issue 26). A ring that needs more has had most of its
+// triangles refused: it crosses the surface nearly everywhere. On the real CT surface a
+// successful 96-vertex cap took 76,000 queries over 5 placements, a failing 211-vertex pair
+// 120,000 per placement.
+constexpr long long kMaxGridQueries = 200000;
 
 Vec3 area_normal(const Mesh& mesh, Mesh::FaceHandle f) {
   auto it = mesh.cfv_iter(f);
@@ -112,44 +120,89 @@ bool Surgery::triangulate_both(bool avoid, std::vector<std::array<int, 3>>* righ
   // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
   auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
   const FaceGrid* grid = avoid ? opts_.guard : nullptr;
-  *right = triangulate_ring(mesh_, result_.right_ring, chord, grid, {});
-  if (right->empty()) return false;
-  *left = triangulate_ring(mesh_, order_left, chord, grid, *right);
+  *right = triangulate_ring(mesh_, result_.right_ring, chord, grid, {}, &query_budget_);
+  // Fail fast: the placements move the ring by fractions of an edge; a right ring with no clean
+  // triangulation in one placement had none in any other on the real CT surface (issue 26).
+  if (right->empty()) {
+    gave_up_ = gave_up_ || avoid;  // also when the budget ran out
+    return false;
+  }
+  if (avoid && mirror_cap(*right, left)) return true;
+  *left = triangulate_ring(mesh_, order_left, chord, grid, *right, &query_budget_);
+  gave_up_ = gave_up_ || query_budget_ <= 0;
   if (left->empty()) return false;
   std::vector<std::array<int, 3>> all = *right;
   all.insert(all.end(), left->begin(), left->end());
   return opts_.guard->count_triangles(mesh_, all) == 0;
 }
 
+// The ring placements tried, in order: pulls 0.25 (ring-pull), 0.4 and 0.15 towards the side
+// targets and along a side edge each, then 0.08 along the edge.
+std::vector<Surgery::Placement> Surgery::placements() const {
+  std::vector<Placement> out;
+  for (const Placement tr : {Placement{opts_.ring_pull, false}, Placement{opts_.ring_pull, true}, Placement{0.4, false},
+                             Placement{0.4, true}, Placement{0.15, false}, Placement{0.15, true}, Placement{0.08, true}})
+    if (tr.pull > 0) out.push_back(tr);
+  return out;
+}
+
+// Moves the rings to placement `tr`; true when the faces around them then intersect nothing.
+bool Surgery::place_checked(const Placement& tr) {
+  place_rings(tr.pull, tr.along_edge ? edge_left_ : target_left_, tr.along_edge ? edge_right_ : target_right_);
+  for (auto f : ring_faces_) opts_.guard->insert(mesh_, f);
+  return opts_.guard->count_intersections(mesh_, ring_faces_) == 0;
+}
+
+// The left cap as the right one's mirror: the same triangles on the left copies, reversed (the
+// rings are a fraction of an edge apart, so the two caps are nearly parallel); kept when no
+// diagonal is a mesh edge on the left side and both caps together intersect nothing. Restricting
+// the left ring's own triangulation to avoid the right cap failed where the mirror is clean.
+bool Surgery::mirror_cap(const std::vector<std::array<int, 3>>& right, std::vector<std::array<int, 3>>* left) {
+  std::unordered_map<int, std::size_t> index;
+  for (std::size_t i = 0; i < k_; ++i) index[result_.right_ring[i].idx()] = i;
+  left->clear();
+  for (const auto& t : right) {
+    std::array<std::size_t, 3> r = {index.at(t[0]), index.at(t[2]), index.at(t[1])};
+    for (int e = 0; e < 3; ++e) {
+      const std::size_t a = r[e], b = r[(e + 1) % 3];
+      const bool ring_edge = (a + 1) % k_ == b || (b + 1) % k_ == a;
+      if (!ring_edge && mesh_.find_halfedge(result_.left_ring[a], result_.left_ring[b]).is_valid()) return false;
+    }
+    left->push_back({result_.left_ring[r[0]].idx(), result_.left_ring[r[1]].idx(), result_.left_ring[r[2]].idx()});
+  }
+  std::vector<std::array<int, 3>> all = right;
+  all.insert(all.end(), left->begin(), left->end());
+  return opts_.guard->count_triangles(mesh_, all) == 0;
+}
+
 // 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area
 //     triangulations of the pulled rings (no interior vertex: on an elongated loop around a thin
-//     curved band they join opposite sides and follow the band), plain first, then restricted to
-//     triangles that intersect nothing; kept when neither the caps nor the faces around the
-//     pulled rings intersect anything; tried for several ring placements.
+//     curved band they join opposite sides and follow the band) in every placement; then, in
+//     every placement, minimum-area triangulations restricted to triangles that intersect
+//     nothing (a grid query per candidate triangle: the expensive step, so it comes last, within
+//     kMaxGridQueries, and stops once the right ring has none). Kept when neither the caps nor
+//     the faces around the pulled rings intersect anything.
 bool Surgery::try_triangulated_caps() {
   if (!opts_.guard || k_ > kMaxTriangulatedLoop) return false;
-  const std::vector<Vec3> edge_left = edge_targets(result_.left_ring), edge_right = edge_targets(result_.right_ring);
-  const std::vector<Mesh::FaceHandle> ring_faces = faces_around_rings();
-  struct Try {
-    double pull;
-    bool along_edge;
-  };
-  const double p1 = opts_.ring_pull;
+  edge_left_ = edge_targets(result_.left_ring);
+  edge_right_ = edge_targets(result_.right_ring);
+  ring_faces_ = faces_around_rings();
+  query_budget_ = kMaxGridQueries;
   std::vector<std::array<int, 3>> tri_right, tri_left;
-  bool found = false;
-  for (const Try tr : {Try{p1, false}, Try{p1, true}, Try{0.4, false}, Try{0.4, true}, Try{0.15, false},
-                       Try{0.15, true}, Try{0.08, true}}) {
-    if (tr.pull <= 0) continue;
-    place_rings(tr.pull, tr.along_edge ? edge_left : target_left_, tr.along_edge ? edge_right : target_right_);
-    for (auto f : ring_faces) opts_.guard->insert(mesh_, f);
-    if (opts_.guard->count_intersections(mesh_, ring_faces) != 0) continue;
-    for (bool avoid : {false, true})
-      if ((found = triangulate_both(avoid, &tri_right, &tri_left))) break;
-    if (found) break;
-  }
-  if (!found) return false;
-  add_cap(mesh_, tri_right, opts_.guard, "surgery");  // ear order: each face joins the hole's boundary
-  add_cap(mesh_, tri_left, opts_.guard, "surgery");
+  for (bool avoid : {false, true})
+    for (const Placement& tr : placements())
+      if (!gave_up_ && place_checked(tr) && triangulate_both(avoid, &tri_right, &tri_left)) {
+        add_triangulated_caps(tri_right, tri_left);
+        cap_kind_ = avoid ? "restricted" : "plain";
+        return true;
+      }
+  return false;
+}
+
+void Surgery::add_triangulated_caps(const std::vector<std::array<int, 3>>& right,
+                                    const std::vector<std::array<int, 3>>& left) {
+  add_cap(mesh_, right, opts_.guard, "surgery");  // ear order: each face joins the hole's boundary
+  add_cap(mesh_, left, opts_.guard, "surgery");
   std::vector<Mesh::VertexHandle> order_left{result_.left_ring[0]};
   for (std::size_t i = k_ - 1; i >= 1; --i) order_left.push_back(result_.left_ring[i]);
   set_chord_classes(result_.right_ring);
@@ -157,7 +210,6 @@ bool Surgery::try_triangulated_caps() {
   result_.right_cap = result_.right_ring[0];
   result_.left_cap = result_.left_ring[0];
   result_.intersections = 0;
-  return true;
 }
 
 // Classes of a triangulated cap's chords: ring vertex i gets the potential P_i (prefix XOR of
@@ -214,15 +266,18 @@ ConcentricCap Surgery::make_concentric_cap(const std::vector<Mesh::HalfedgeHandl
   return cap;
 }
 
-// Classes: ring vertex i gets the potential P_i (prefix XOR of the ring's edge classes),
-// interior vertices 0, and each new edge (a, b) the class P(a) ^ P(b), so every cap triangle
-// sums to zero (the closing one to the loop's class, which the caller quotients out).
-void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {
+// Classes of a cap's new edges: ring vertex i gets the potential P_i (prefix XOR of the ring's
+// edge classes), interior vertices 0, and each new edge (a, b) the class P(a) ^ P(b), so every
+// cap triangle sums to zero (the closing one to the loop's class, which the caller quotients
+// out). Every new edge has an interior end.
+void Surgery::set_cap_classes(const std::vector<Mesh::VertexHandle>& ring,
+                              const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
+                              const std::vector<Mesh::VertexHandle>& inner) {
   if (!homology_) return;
   std::unordered_map<int, std::vector<std::uint64_t>> potential;
   std::vector<std::uint64_t> acc(words_, 0);
   for (std::size_t i = 0; i < ring_halfedges.size(); ++i) {
-    potential[cap.rings[0][i].idx()] = acc;
+    potential[ring[i].idx()] = acc;
     xor_into(acc.data(), homology_->edge_class(mesh_.edge_handle(ring_halfedges[i])), words_);
   }
   const std::vector<std::uint64_t> zero(words_, 0);
@@ -231,16 +286,20 @@ void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector
     return it == potential.end() ? zero : it->second;
   };
   std::vector<std::uint64_t> cls(words_);
-  std::vector<Mesh::VertexHandle> inner;
-  for (std::size_t j = 1; j < cap.rings.size(); ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
-  inner.push_back(cap.centre);
-  for (auto v : inner)  // every new edge has an interior endpoint
+  for (auto v : inner)
     for (auto he : mesh_.voh_range(v)) {
       const auto& q0 = pot(v);
       const auto& q1 = pot(mesh_.to_vertex_handle(he));
       for (int i = 0; i < words_; ++i) cls[i] = q0[i] ^ q1[i];
       homology_->set_edge_class(mesh_.edge_handle(he), cls.data());
     }
+}
+
+void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges) {
+  std::vector<Mesh::VertexHandle> inner;
+  for (std::size_t j = 1; j < cap.rings.size(); ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
+  inner.push_back(cap.centre);
+  set_cap_classes(cap.rings[0], ring_halfedges, inner);
 }
 
 // 8. Geometry of one concentric cap: interior rings interpolated towards the ring centroid and

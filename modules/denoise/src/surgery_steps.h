@@ -40,7 +40,17 @@ class Surgery {
   std::vector<Vec3> edge_targets(const std::vector<Mesh::VertexHandle>& ring) const;
   void place_rings(double pull, const std::vector<Vec3>& left_target, const std::vector<Vec3>& right_target);
   std::vector<Mesh::FaceHandle> faces_around_rings() const;
+  struct Placement {
+    double pull;
+    bool along_edge;
+  };
+  std::vector<Placement> placements() const;
+  bool place_checked(const Placement& tr);
   bool try_triangulated_caps();
+  bool mirror_cap(const std::vector<std::array<int, 3>>& right, std::vector<std::array<int, 3>>* left);
+  void add_triangulated_caps(const std::vector<std::array<int, 3>>& right, const std::vector<std::array<int, 3>>& left);
+  void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
+                       const std::vector<Mesh::VertexHandle>& inner);
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
   ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
@@ -63,9 +73,13 @@ class Surgery {
   std::vector<Mesh::HalfedgeHandle> new_halfedges_, new_opposites_;  // y_i (copies of h_i) and x_i = opp(y_i)
   std::unordered_map<int, Mesh::HalfedgeHandle> replaced_;  // h_i -> y_i
   std::vector<Vec3> original_;                               // loop positions before any move
-  std::vector<Vec3> target_left_, target_right_;
+  std::vector<Vec3> target_left_, target_right_, edge_left_, edge_right_;
+  std::vector<Mesh::FaceHandle> ring_faces_;                 // faces around the two rings
   ConcentricCap cap_left_, cap_right_;
   SurgeryResult result_;
+  bool gave_up_ = false;                // no more restricted triangulations (budget spent, or the right ring has none)
+  long long query_budget_ = 0;          // grid queries left for them (kMaxGridQueries per surgery)
+  const char* cap_kind_ = "concentric";  // which step made the caps (COLONFLAT_DENOISE_DEBUG)
 };
 
 }  // namespace cf::detail

@@ -72,5 +72,49 @@ TEST(DenoiseCapTriangulation, MinAreaTriangulationRespectsAllowed) {
   EXPECT_TRUE(min_area_triangulation(hexagon, [](int, int, int) { return false; }).empty());
 }
 
+// A planar ring of 40 vertices (radius 10) with a wall (two triangles, 6 x 10) standing across
+// its centre: every triangulation of the ring covers the centre and crosses the wall.
+Mesh pierced_ring(std::vector<Mesh::VertexHandle>* ring) {
+  Mesh m;
+  for (int i = 0; i < 40; ++i) {  // no ring vertex in the wall's plane y = 0
+    const double t = (i + 0.5) * M_PI / 20;
+    ring->push_back(m.add_vertex(Vec3(10 * std::cos(t), 10 * std::sin(t), 0)));
+  }
+  const auto a = m.add_vertex(Vec3(-3, 0, -5)), b = m.add_vertex(Vec3(3, 0, -5)), c = m.add_vertex(Vec3(3, 0, 5)),
+             d = m.add_vertex(Vec3(-3, 0, 5));
+  m.add_face(a, b, c);
+  m.add_face(a, c, d);
+  return m;
+}
+
+// The restricted triangulation stops once its grid queries exceed the budget (surgery's fail-fast,
+// issue 26): on a ring no clean triangulation exists for, the unbounded search finds none after
+// thousands of queries; with a budget of 100 it also returns none, after at most one more
+// subproblem length (at most 40 x 40 queries), and the budget comes back spent.
+TEST(DenoiseCapTriangulation, RestrictedTriangulationStopsAtItsBudget) {
+  std::vector<Mesh::VertexHandle> ring;
+  const Mesh m = pierced_ring(&ring);
+  const FaceGrid grid(m, 1.0);
+  auto never = [](Mesh::VertexHandle, Mesh::VertexHandle) { return false; };
+  long long unbounded = 1LL << 60;
+  EXPECT_TRUE(triangulate_ring(m, ring, never, &grid, {}, &unbounded).empty());
+  const long long spent_unbounded = (1LL << 60) - unbounded;
+  long long budget = 100;
+  EXPECT_TRUE(triangulate_ring(m, ring, never, &grid, {}, &budget).empty());
+  const long long spent = 100 - budget;
+  EXPECT_GT(spent, 100);
+  EXPECT_LE(spent, 100 + 40 * 40);
+  EXPECT_GT(spent_unbounded, 2 * spent);
+  // Without the wall the same ring triangulates within the budget's scale: the refusal is the wall's.
+  Mesh free_ring;
+  std::vector<Mesh::VertexHandle> ring2;
+  for (const auto v : ring) ring2.push_back(free_ring.add_vertex(m.point(v)));
+  const auto f = free_ring.add_vertex(Vec3(50, 50, 50));
+  free_ring.add_face(f, free_ring.add_vertex(Vec3(51, 50, 50)), free_ring.add_vertex(Vec3(50, 51, 50)));
+  const FaceGrid far_grid(free_ring, 1.0);
+  long long enough = 100000;
+  EXPECT_EQ(triangulate_ring(free_ring, ring2, never, &far_grid, {}, &enough).size(), 38u);
+}
+
 }  // namespace
 }  // namespace cf

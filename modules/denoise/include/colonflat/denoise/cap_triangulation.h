@@ -13,9 +13,11 @@ namespace cf {
 // (i, m, j) with i < m < j index `ring` and are oriented like the polygon, listed as ears: each
 // triangle has two edges on the polygon left by removing the ones before it. With `allowed`, only
 // triangles it accepts are used (called for the candidates of each subproblem in order of weight until one passes);
-// empty result when no triangulation consists of allowed triangles.
+// empty result when no triangulation consists of allowed triangles, or when give_up() (asked after
+// each subproblem length) says so.
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
-                                                        const std::function<bool(int, int, int)>& allowed = {});
+                                                        const std::function<bool(int, int, int)>& allowed = {},
+                                                        const std::function<bool()>& give_up = {});
 
 // A cap for the closed ring `ring` (mesh vertices in boundary order; the triangles are oriented
 // like it): its minimum-area triangulation without near-collinear triangles (height below 1e-4
@@ -23,11 +25,12 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
 // diagonal (a, b) for which blocked(a, b) holds. With `grid`, only triangles that intersect none
 // of its faces and none of `others` (slower; for when the plain one intersects something).
 // Returns mesh vertex ids in ear order (ready for add_face one by one), or nothing if no such
-// triangulation exists.
+// triangulation exists or (with `grid` and `budget`) it took more grid queries (triangles
+// tested) than *budget; *budget is lowered by the queries made.
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid = nullptr,
-    const std::vector<std::array<int, 3>>& others = {});
+    const std::vector<std::array<int, 3>>& others = {}, long long* budget = nullptr);
 
 // Adds the triangles of triangulate_ring (in its ear order) to the mesh, and to `grid` when given.
 // Throws cf::Error naming `what` if OpenMesh refuses one (the ring was not a hole's boundary).
