@@ -352,17 +352,18 @@ const PaintedCase kPaintedCases[] = {
     {"bowel", "supine", true, 0, false, true, 0},       {"hard", "supine", true, 200, true, true, 0.6},
     {"hard", "prone", false, 200, true, true, 1.5},     {"hard", "left-down", false, 200, true, true, 1.0}};
 
+
 double long_stretch_kept(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
   if (p.bodies.empty() || p.bodies[0].kind != "stretch" || p.bodies[0].to_mm - p.bodies[0].from_mm < 150) return -1;
   return 100 * cf::score_fluid_bodies(seg, p).at(0).kept;
 }
 
-// Every colon fluid body of >= 5 mL kept less than 95 %: kind, mL, share kept, centroid (LPS).
+// Every colon fluid body of >= 5 mL kept less than 95 % (and the long stretch): kind, mL, share kept, centroid (LPS).
 void print_lost_bodies(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
   for (const cf::MaskBodyScore& b : cf::score_fluid_bodies(seg, p))
-    if (b.ml >= 5 && b.kept < 0.95)
-      std::printf("   lost: %s %zu, %.1f mL, %.1f %% kept, LPS (%.0f %.0f %.0f)\n", p.bodies[b.body - 1].kind.c_str(), b.body, b.ml,
-                  100 * b.kept, b.centroid_lps[0], b.centroid_lps[1], b.centroid_lps[2]);
+    if ((b.ml >= 5 && b.kept < 0.95) || (b.body == 1 && long_stretch_kept(p, seg) >= 0))
+      std::printf("   %s: %s %zu, %.1f mL, %.1f %% kept, LPS (%.0f %.0f %.0f)\n", b.kept < 0.95 ? "lost" : "long", p.bodies[b.body - 1].kind.c_str(),
+                  b.body, b.ml, 100 * b.kept, b.centroid_lps[0], b.centroid_lps[1], b.centroid_lps[2]);
 }
 
 void painted_table(const std::string& mask_file, int downsample, const std::string& only) {

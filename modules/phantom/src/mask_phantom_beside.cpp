@@ -24,6 +24,11 @@ constexpr double kBesideMm = 12.0;
 constexpr double kOtherPartMm = 150.0;
 // The stretch's ends stay this far (path mm) from the parts it lies beside (so the ends meet gas).
 constexpr double kEndClearMm = 20.0;
+// A window holding more lumen than len x kMaxSectionMm2 is not one stretch of tube: where the mask's
+// segments touch, path distances from the rectum shortcut through the contact, and a window of path
+// then holds several segments. 5000 mm^2 is the cross-section of an 80 mm wide colon, the widest
+// (a distended caecum); on the shared real mask a 200 mm window held 2 L without this.
+constexpr double kMaxSectionMm2 = 5000.0;
 // Windows are tried every kWindowStepMm of path; any window scoring >= 70 % of the best may be
 // drawn, so seeds give different stretches of the same kind.
 constexpr double kWindowStepMm = 5.0, kGoodShare = 0.7;
@@ -66,11 +71,15 @@ std::pair<double, double> MaskPainter::beside_range(const std::vector<float>& di
               a.lo = std::min(a.lo, s[u].d), a.hi = std::max(a.hi, s[u].d);
         }
   std::vector<std::pair<double, int>> score;  // (s0, samples beside other parts)
+  const double sample_mm3 = double(st[0]) * g_.sp[0] * double(st[1]) * g_.sp[1] * double(st[2]) * g_.sp[2];
   for (double s0 = 0.15 * D; s0 + len <= 0.85 * D; s0 += kWindowStepMm) {
-    int n = 0;
-    for (const Sample& a : s)
-      n += a.d >= s0 && a.d <= s0 + len && (a.lo < s0 - kEndClearMm || a.hi > s0 + len + kEndClearMm);
-    score.push_back({s0, n});
+    int n = 0, all = 0;
+    for (const Sample& a : s) {
+      const bool in = a.d >= s0 && a.d <= s0 + len;
+      all += in;
+      n += in && (a.lo < s0 - kEndClearMm || a.hi > s0 + len + kEndClearMm);
+    }
+    if (all * sample_mm3 <= kMaxSectionMm2 * len) score.push_back({s0, n});  // else: not one stretch of tube
   }
   int best = 0;
   for (const auto& w : score) best = std::max(best, w.second);
