@@ -12,12 +12,13 @@
 //                                     of the inferior slice (pelvic floor, thighs' soft tissue, the rectal
 //                                     tube's channel) below the volume so the scan has N slices (the 512 x 512
 //                                     x 450 case of issue 13: --pad-to 450); Dice on the original slices.
-//   segment_bench --painted [--mask FILE] [--downsample N]   issue 25: CTs painted around a real lumen mask
-//                                     (colonflat phantom --from-mask; default ../shared/real/ctc_lumen_mask_a.nii.gz,
-//                                     full resolution unless --downsample N (N x N in-plane)): supine, prone,
-//                                     prone without PatientPosition, left side down; Dice, colon fluid kept,
-//                                     mL segmented outside the colon (> 2 mm from the true lumen), small bowel
-//                                     and bladder kept.
+//   segment_bench --painted [--mask FILE] [--downsample N] [--cases easy,stretch,pools,bowel,hard]
+//                                     issue 25: CTs painted around a real lumen mask (colonflat phantom
+//                                     --from-mask; default ../shared/real/ctc_lumen_mask_a.nii.gz, full resolution
+//                                     unless --downsample N (N x N in-plane)): easy and hard cases (a 200-250 mm
+//                                     stretch filled beside other segments, pools over the folds, loops pressed
+//                                     against the colon, slices 0.6-1.5 mm), supine / prone / left-down, with and
+//                                     without PatientPosition; Dice, colon fluid kept, mL outside the colon.
 //   segment_bench --real CT [--pad-to N]  a CT file without ground truth (e.g. ../shared/real/ctc_prone_a.nrrd):
 //                                     read and segmentation time, CPU, peak memory, lumen / fluid / fully
 //                                     tagged mL kept, segments (issue 25).
@@ -332,25 +333,60 @@ void realistic_table(const std::string& size, const std::vector<int>& seeds, int
               "ao_vox, tube = segmented voxels that are small bowel (contrast or gas), bladder, aorta, rectal tube\n");
 }
 
-// Issue 25: segmentation of CTs painted around a real lumen mask (ground truth = the mask).
-void painted_table(const std::string& mask_file, int downsample) {
+// Issue 25: segmentation of CTs painted around a real lumen mask (ground truth = the mask). "easy":
+// pools in each pocket and one 60-120 mm stretch; "stretch": + a 200 mm stretch filled where the colon
+// lies beside other parts of itself; "pools": pools over the folds (30-50 % of the pocket); "bowel":
+// loops pressed against the colon wall; "hard": all three; slice spacing resampled where given.
+struct PaintedCase {
+  const char* name;
+  const char* position;
+  bool header;
+  double long_mm;
+  bool deep, pressed;
+  double slice_mm;  // 0: the mask's own
+};
+const PaintedCase kPaintedCases[] = {
+    {"easy", "supine", true, 0, false, false, 0},       {"easy", "prone", false, 0, false, false, 0},
+    {"stretch", "supine", true, 200, false, false, 0},  {"stretch", "prone", false, 250, false, false, 0},
+    {"pools", "supine", true, 0, true, false, 0},       {"pools", "prone", false, 0, true, false, 0},
+    {"bowel", "supine", true, 0, false, true, 0},       {"hard", "supine", true, 200, true, true, 0.6},
+    {"hard", "prone", false, 200, true, true, 1.5},     {"hard", "left-down", false, 200, true, true, 1.0}};
+
+
+double long_stretch_kept(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
+  if (p.bodies.empty() || p.bodies[0].kind != "stretch" || p.bodies[0].to_mm - p.bodies[0].from_mm < 150) return -1;
+  return 100 * cf::score_fluid_bodies(seg, p).at(0).kept;
+}
+
+// Every colon fluid body of >= 5 mL kept less than 95 % (and the long stretch): kind, mL, share kept, centroid (LPS).
+void print_lost_bodies(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
+  for (const cf::MaskBodyScore& b : cf::score_fluid_bodies(seg, p))
+    if ((b.ml >= 5 && b.kept < 0.95) || (b.body == 1 && long_stretch_kept(p, seg) >= 0))
+      std::printf("   %s: %s %zu, %.1f mL, %.1f %% kept, LPS (%.0f %.0f %.0f)\n", b.kept < 0.95 ? "lost" : "long", p.bodies[b.body - 1].kind.c_str(),
+                  b.body, b.ml, 100 * b.kept, b.centroid_lps[0], b.centroid_lps[1], b.centroid_lps[2]);
+}
+
+void painted_table(const std::string& mask_file, int downsample, const std::string& only) {
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_p" + std::to_string(::getpid()));
   cf::MaskImage::Pointer mask = cf::read_binary_mask(mask_file);
   if (downsample > 1) mask = cf::downsample_mask(mask, {downsample, downsample, 1});
   const auto sz = mask->GetLargestPossibleRegion().GetSize();
-  std::printf("segment_bench --painted: %s, %zu x %zu x %zu at %.2f x %.2f x %.2f mm; fully tagged stretch, pools, 4 small-bowel "
-              "loops, bladder\n", mask_file.c_str(), sz[0], sz[1], sz[2], mask->GetSpacing()[0], mask->GetSpacing()[1],
-              mask->GetSpacing()[2]);
-  std::printf("%-11s %6s %7s %7s %7s %5s %8s %7s %9s %8s %8s %7s %7s %s\n", "position", "header", "paint_s", "seg_s", "seg_cpu",
-              "load", "seg_MiB", "dice", "fluid_mL", "kept_%", "out_mL", "sb_mL", "bl_mL", "gravity");
-  const std::pair<const char*, bool> cases[] = {{"supine", true}, {"prone", true}, {"prone", false}, {"left-down", true}};
-  for (const auto& [pos, header] : cases) {
+  std::printf("segment_bench --painted: %s, %zu x %zu x %zu at %.2f x %.2f x %.2f mm; pools, 4 small-bowel loops, bladder\n",
+              mask_file.c_str(), sz[0], sz[1], sz[2], mask->GetSpacing()[0], mask->GetSpacing()[1], mask->GetSpacing()[2]);
+  std::printf("%-8s %-10s %4s %5s %7s %7s %7s %5s %7s %7s %8s %7s %7s %7s %6s %s\n", "case", "position", "hdr", "dz", "paint_s",
+              "seg_s", "seg_cpu", "load", "seg_MiB", "dice", "fluid_mL", "kept_%", "long_%", "out_mL", "sb_mL", "gravity");
+  for (const PaintedCase& c : kPaintedCases) {
+    if (!only.empty() && only.find(c.name) == std::string::npos) continue;
     fs::remove_all(tmp);
     cf::Stopwatch t;
     cf::MaskPhantomOptions o;
-    o.position = pos;
-    o.position_header = header;
-    cf::MaskPhantom p = cf::paint_phantom_from_mask(mask, o);
+    o.position = c.position;
+    o.position_header = c.header;
+    o.long_stretch_mm = c.long_mm;
+    o.deep_pools = c.deep;
+    o.pressed_bowel = c.pressed;
+    cf::MaskImage::Pointer m = c.slice_mm > 0 ? cf::resample_mask_slices(mask, c.slice_mm) : mask;
+    cf::MaskPhantom p = cf::paint_phantom_from_mask(m, o);
     const double paint_s = t.seconds();
     cf::write_phantom(p.phantom, tmp, "nrrd");
     p.phantom.ct = nullptr;
@@ -363,14 +399,17 @@ void painted_table(const std::string& mask_file, int downsample) {
     const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
     ct = nullptr;
     const cf::MaskSegmentationScore s = cf::score_segmentation(seg, p.phantom);
-    std::printf("%-11s %6s %7.2f %7.2f %7.2f %5.1f %8.0f %7.4f %9.1f %8.1f %8.1f %7.1f %7.1f %s (%s)\n", pos, header ? "yes" : "no",
-                paint_s, seg_s, st.cpu_time_s, load, seg_mib, s.dice, s.fluid_ml, 100 * s.fluid_kept, s.outside_ml,
-                s.small_bowel_ml, s.bladder_ml, st.gravity.c_str(), st.gravity_source.c_str());
+    std::printf("%-8s %-10s %4s %5.2f %7.2f %7.2f %7.2f %5.1f %7.0f %7.4f %8.1f %7.1f %7.1f %7.1f %6.1f %s (%s)\n", c.name, c.position,
+                c.header ? "yes" : "no", m->GetSpacing()[2], paint_s, seg_s, st.cpu_time_s, load, seg_mib, s.dice, s.fluid_ml,
+                100 * s.fluid_kept, long_stretch_kept(p, seg), s.outside_ml, s.small_bowel_ml, st.gravity.c_str(),
+                st.gravity_source.c_str());
+    print_lost_bodies(p, seg);
     std::fflush(stdout);
   }
   fs::remove_all(tmp);
-  std::printf("columns: fluid_mL = the painted colon fluid (pools + fully tagged stretch); kept_%% = its share segmented; out_mL = "
-              "segmented volume more than 2 mm from the true lumen; sb_mL, bl_mL = segmented small bowel, bladder\n");
+  std::printf("columns: dz = slice spacing (mm); fluid_mL = the painted colon fluid; kept_%% = its share segmented; long_%% = share "
+              "of the long stretch segmented (-1: none); out_mL = segmented volume more than 2 mm from the true lumen; sb_mL = "
+              "segmented small bowel\n");
 }
 
 // One CT without ground truth: time, memory and what was kept.
@@ -422,7 +461,7 @@ int main(int argc, char** argv) {
   bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false;
   int pad_to = 0, downsample = 1;
   std::string mask_file = std::string(COLONFLAT_SHARED_DIR) + "/real/ctc_lumen_mask_a.nii.gz";
-  std::string size = "full", real;
+  std::string size = "full", real, cases;
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
@@ -433,6 +472,7 @@ int main(int argc, char** argv) {
     else if (a == "--realistic") realistic = true;
     else if (a == "--painted") painted = true;
     else if (a == "--mask" && i + 1 < argc) mask_file = argv[++i];
+    else if (a == "--cases" && i + 1 < argc) cases = argv[++i];
     else if (a == "--downsample" && i + 1 < argc) downsample = std::stoi(argv[++i]);
     else if (a == "--real" && i + 1 < argc) real = argv[++i];
     else if (a == "--pad-to" && i + 1 < argc) pad_to = std::stoi(argv[++i]);
@@ -443,7 +483,7 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  if (painted) painted_table(mask_file, downsample);
+  if (painted) painted_table(mask_file, downsample, cases);
   else if (!real.empty()) real_table(real, pad_to);
   else if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);

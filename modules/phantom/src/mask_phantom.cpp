@@ -53,6 +53,8 @@ MaskPhantom paint_phantom_from_mask(const MaskImage* mask, const MaskPhantomOpti
   if (!(o.blur_mm >= 0 && o.blur_mm <= 5)) throw UsageError("--blur must be in [0, 5] mm");
   if (o.fully_tagged < 0 || o.fully_tagged > 3) throw UsageError("--fully-tagged-segments must be in [0, 3]");
   if (o.bowel_loops < 0 || o.bowel_loops > 8) throw UsageError("--bowel-loops must be in [0, 8]");
+  if (o.long_stretch_mm != 0 && !(o.long_stretch_mm >= 100 && o.long_stretch_mm <= 400))
+    throw UsageError("--long-stretch must be 0 or in [100, 400] mm");
   MaskPhantom out;
   MaskPainter(mask, o, out).run();
   return out;

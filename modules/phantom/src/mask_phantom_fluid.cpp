@@ -14,6 +14,16 @@ namespace cf::phantom_detail {
 namespace {
 // Pool depth as a fraction of the pocket's height (docs/phantom.md: 10-30 % of each haustral pocket).
 constexpr double kPoolMinFraction = 0.10, kPoolMaxFraction = 0.30;
+// Deep pools (--deep-pools): 30-50 % of the pocket's height, above the folds between haustral
+// pockets (fold height 10-30 % of the lumen), so one level runs along a whole dependent segment.
+constexpr double kDeepMinFraction = 0.30, kDeepMaxFraction = 0.50;
+// ... of at most a colon's width (mm): through a vertical stretch the lumen's height along gravity is
+// its length, and a level at 30-50 % of it would fill the whole colon below.
+constexpr double kDeepHeightCapMm = 50;
+// Deep pools are the deepest pockets' (the dependent segment's: the transverse colon prone, the
+// sigmoid or descending colon supine); the others stay 10-30 %: a scan holds a few hundred mL of
+// tagged fluid, not a colon filled to a third everywhere.
+constexpr int kDeepPools = 2;
 // Fully tagged stretch length along the colon (mm) and where it may lie (fraction of the path from
 // the rectal end): the example is 90 mm of descending colon.
 constexpr double kStretchMinMm = 60, kStretchMaxMm = 120, kStretchGapMm = 40;
@@ -52,15 +62,20 @@ std::vector<float> MaskPainter::path_distance(std::size_t start) const {
   return dist;
 }
 
-// K stretches of 60-120 mm of path, 15-85 % of the way from the rectal end, 40 mm apart: every lumen
-// voxel there becomes tagged fluid (500-900 HU).
+// K stretches of 60-120 mm of path, 15-85 % of the way from the rectal end, 40 mm apart (and first,
+// with --long-stretch, one of that length lying beside other parts of the colon): every lumen voxel
+// there becomes tagged fluid (500-900 HU).
 void MaskPainter::place_stretches() {
-  if (o_.fully_tagged == 0) return;
+  if (o_.fully_tagged == 0 && o_.long_stretch_mm <= 0) return;
   const std::vector<float> dist = path_distance(rectum_);
   double D = 0;
   for (float d : dist)
     if (std::isfinite(d)) D = std::max(D, double(d));
   std::vector<std::pair<double, double>> ranges;
+  if (o_.long_stretch_mm > 0 && o_.long_stretch_mm < 0.7 * D) {
+    const auto r = beside_range(dist, D, o_.long_stretch_mm);
+    if (r.first >= 0) ranges.push_back(r);
+  }
   for (int t = 0; t < o_.fully_tagged; ++t)
     for (int attempt = 0; attempt < 100; ++attempt) {
       const double len = rng_.uniform(kStretchMinMm, kStretchMaxMm);
@@ -172,13 +187,16 @@ void MaskPainter::place_pools() {
   for (int d = 1; d < 3; ++d)
     if (std::abs(down_[d]) > std::abs(down_[a])) a = d;
   const double step = g_.sp[a] * std::abs(down_[a]);
+  int deep_left = o_.deep_pools ? kDeepPools : 0;
   for (const Basin& b : basins) {
-    const double f = rng_.uniform(kPoolMinFraction, kPoolMaxFraction);
+    const bool deep = deep_left > 0;
+    const double f = deep ? rng_.uniform(kDeepMinFraction, kDeepMaxFraction) : rng_.uniform(kPoolMinFraction, kPoolMaxFraction);
     if (mat_[b.bottom] != kColonGas) continue;  // under an earlier pool
+    deep_left -= deep;
     int i, j, k;
     ijk(b.bottom, i, j, k);
-    const double H = pocket_height(i, j, k);
-    const bool spills = !std::isnan(b.spill) && f * H >= b.d0 - b.spill;
+    const double H = deep ? std::min(kDeepHeightCapMm, pocket_height(i, j, k)) : pocket_height(i, j, k);
+    const bool spills = !deep && !std::isnan(b.spill) && f * H >= b.d0 - b.spill;
     const double level = spills ? b.spill : b.d0 - f * H;
     const double frac = (b.d0 - level) / H;
     if (frac < kPoolMinFraction || b.d0 - level < step) continue;

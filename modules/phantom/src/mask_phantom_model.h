@@ -38,6 +38,8 @@ class MaskPainter {
   // mask_phantom_fluid.cpp: fully tagged stretches and pools
   void place_stretches();
   std::vector<float> path_distance(std::size_t start) const;
+  // mask_phantom_beside.cpp: where a long stretch lies beside other parts of the colon
+  std::pair<double, double> beside_range(const std::vector<float>& dist, double D, double len);
   void place_pools();
   void fill_pocket(std::size_t bottom, double level, int body);
   double pocket_height(int i, int j, int k) const;

@@ -16,6 +16,9 @@ constexpr double kBowelWallMm = 2.0;
 // A loop's centreline keeps this far from the lumen beyond its radius: colon wall + bowel wall, so
 // the walls touch but never overlap; a "touching" loop comes within 2 mm more of that somewhere.
 constexpr double kBowelGapMm = kMaskWallMm + kBowelWallMm, kTouchSlackMm = 2.0;
+// A pressed loop (--pressed-bowel) comes within 1 mm of the colon wall: its contrast lies against
+// the colon wall (the two walls pressed into one of ~3 mm), as loops packed against the colon do.
+constexpr double kPressedSlackMm = 1.0;
 }  // namespace
 
 // One C-shaped loop in the middle 60 % of the lumen box: every centreline point in visceral fat,
@@ -40,14 +43,14 @@ bool MaskPainter::try_bowel_loop(bool touching, BowelLoop& loop) {
     }
     if (mat_[g_.index(ix[0], ix[1], ix[2])] != kVisceralFat) return false;
     const double cl = clearance(p);
-    if (cl < r + kBowelGapMm) return false;
+    if (cl < r + (touching && o_.pressed_bowel ? kMaskWallMm : kBowelGapMm)) return false;
     minc = std::min(minc, cl);
     for (const BowelLoop& o : md_.bowel)
       for (const V3& q : o.pts)
         if ((p - q).norm() < r + o.r + 2 * kBowelWallMm) return false;
     loop.pts.push_back(p);
   }
-  if (touching && minc > r + kBowelGapMm + kTouchSlackMm) return false;
+  if (touching && minc > r + (o_.pressed_bowel ? kMaskWallMm + kPressedSlackMm : kBowelGapMm + kTouchSlackMm)) return false;
   loop_clearance_.push_back(minc - r);
   return true;
 }
@@ -164,7 +167,8 @@ nlohmann::json MaskPainter::describe() const {
       {"bladder", {{"present", bladder_r_.x() > 0}, {"centre_lps_mm", {bladder_c_.x(), bladder_c_.y(), bladder_c_.z()}},
                    {"radii_mm", {bladder_r_.x(), bladder_r_.y(), bladder_r_.z()}}}},
       {"options", {{"noise_hu", o_.noise_hu}, {"blur_mm", o_.blur_mm}, {"fully_tagged", o_.fully_tagged},
-                   {"bowel_loops", o_.bowel_loops}, {"bladder", o_.bladder}, {"pools", o_.pools}}}};
+                   {"bowel_loops", o_.bowel_loops}, {"bladder", o_.bladder}, {"pools", o_.pools},
+                   {"long_stretch_mm", o_.long_stretch_mm}, {"deep_pools", o_.deep_pools}, {"pressed_bowel", o_.pressed_bowel}}}};
   return d;
 }
 

@@ -1,8 +1,9 @@
 // Scoring a segmentation against a painted case (Dice, colon fluid kept, volume outside the colon)
-// and block-majority downsampling of a mask.
+// block-majority downsampling of a mask and its resampling to another slice spacing.
 #include <itkSignedMaurerDistanceMapImageFilter.h>
 
 #include <algorithm>
+#include <array>
 
 #include "colonflat/core/error.h"
 #include "colonflat/phantom/mask_phantom.h"
@@ -43,6 +44,56 @@ MaskSegmentationScore score_segmentation(const MaskImage* seg, const Phantom& tr
   s.small_bowel_ml = bowel * ml;
   s.bladder_ml = bladder * ml;
   return s;
+}
+
+std::vector<MaskBodyScore> score_fluid_bodies(const MaskImage* seg, const MaskPhantom& truth) {
+  std::vector<std::array<double, 5>> acc(truth.bodies.size() + 1, {0, 0, 0, 0, 0});
+  const unsigned char* m = seg->GetBufferPointer();
+  const auto n = seg->GetLargestPossibleRegion().GetSize();
+  if (truth.fluid_id.size() != n[0] * n[1] * n[2]) throw PreconditionError("score_fluid_bodies: the segmentation is not on the truth's grid");
+  for (std::size_t q = 0; q < truth.fluid_id.size(); ++q)
+    if (truth.fluid_id[q]) {
+      auto& a = acc[truth.fluid_id[q]];
+      a[0] += 1, a[1] += m[q] != 0, a[2] += double(q % n[0]), a[3] += double(q / n[0] % n[1]), a[4] += double(q / n[0] / n[1]);
+    }
+  const auto sp = seg->GetSpacing();
+  std::vector<MaskBodyScore> out;
+  for (std::size_t b = 1; b < acc.size(); ++b) {
+    MaskBodyScore s;
+    s.body = b;
+    s.ml = acc[b][0] * sp[0] * sp[1] * sp[2] / 1000;
+    s.kept = acc[b][1] / std::max(1.0, acc[b][0]);
+    itk::ContinuousIndex<double, 3> c;
+    for (int d = 0; d < 3; ++d) c[d] = acc[b][2 + d] / std::max(1.0, acc[b][0]);
+    MaskImage::PointType pt;
+    seg->TransformContinuousIndexToPhysicalPoint(c, pt);
+    s.centroid_lps = {pt[0], pt[1], pt[2]};
+    out.push_back(s);
+  }
+  return out;
+}
+
+MaskImage::Pointer resample_mask_slices(const MaskImage* m, double slice_mm) {
+  if (!(slice_mm > 0)) throw UsageError("resample_mask_slices: the slice spacing must be > 0");
+  const auto in = m->GetLargestPossibleRegion().GetSize();
+  const double sz_in = m->GetSpacing()[2];
+  const auto nz = std::size_t(std::max(1.0, std::floor((double(in[2]) - 1) * sz_in / slice_mm) + 1));
+  MaskImage::SizeType sz = in;
+  sz[2] = nz;
+  MaskImage::SpacingType sp = m->GetSpacing();
+  sp[2] = slice_mm;
+  auto out = MaskImage::New();
+  out->SetRegions(sz);
+  out->SetSpacing(sp);
+  out->SetOrigin(m->GetOrigin());
+  out->SetDirection(m->GetDirection());
+  out->Allocate();
+  const std::size_t plane = in[0] * in[1];
+  for (std::size_t k = 0; k < nz; ++k) {
+    const auto src = std::min(in[2] - 1, std::size_t(std::lround(double(k) * slice_mm / sz_in)));
+    std::copy_n(m->GetBufferPointer() + src * plane, plane, out->GetBufferPointer() + k * plane);
+  }
+  return out;
 }
 
 MaskImage::Pointer downsample_mask(const MaskImage* m, const std::array<int, 3>& f) {

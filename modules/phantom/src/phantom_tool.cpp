@@ -17,8 +17,9 @@ namespace {
 // Options of `--from-mask` and the options that do not apply to it.
 struct MaskCli {
   std::string mask;
-  bool no_header = false, no_bladder = false;
+  bool no_header = false, no_bladder = false, deep_pools = false, pressed_bowel = false;
   int bowel_loops = 4;
+  double long_stretch_mm = 0, slice_mm = 0;
 };
 const char* const kSyntheticOnly[] = {"--size", "--format", "--collapsed", "--polyps", "--topological-noise",
                                       "--oral-contrast", "--excreted-contrast", "--enhanced-vessels", "--rectal-tube",
@@ -34,7 +35,17 @@ void add_mask_options(CLI::App& app, MaskCli& m) {
   app.add_option("--bowel-loops", m.bowel_loops, "with --from-mask: small-bowel loops with oral contrast (default 4; range [0, 8])")
       ->type_name("N");
   app.add_flag("--no-bladder", m.no_bladder, "with --from-mask: no bladder");
+  app.add_option("--long-stretch", m.long_stretch_mm,
+                 "with --from-mask: one stretch of this length (mm, 100-400) completely filled with tagged fluid where "
+                 "the colon lies beside other parts of itself")
+      ->type_name("MM");
+  app.add_flag("--deep-pools", m.deep_pools, "with --from-mask: pools at 30-50 % of their pocket, over the folds (one level along a segment)");
+  app.add_flag("--pressed-bowel", m.pressed_bowel, "with --from-mask: touching small-bowel loops pressed against the colon wall");
+  app.add_option("--slice-spacing", m.slice_mm, "with --from-mask: resample the mask to this slice spacing first (mm, 0.5-3)")
+      ->type_name("MM");
 }
+const char* const kMaskOnly[] = {"--no-position-header", "--bowel-loops", "--no-bladder", "--long-stretch",
+                                 "--deep-pools", "--pressed-bowel", "--slice-spacing"};
 
 // colonflat phantom --from-mask MASK -o DIR: checks, paints and writes (all files or none).
 int run_from_mask(CLI::App& app, const MaskCli& m, const PhantomOptions& o, const std::string& dir, bool quiet,
@@ -51,6 +62,11 @@ int run_from_mask(CLI::App& app, const MaskCli& m, const PhantomOptions& o, cons
   mo.bowel_loops = m.bowel_loops;
   mo.bladder = !m.no_bladder;
   mo.pools = o.tagged_fluid;
+  mo.long_stretch_mm = m.long_stretch_mm;
+  mo.deep_pools = m.deep_pools;
+  mo.pressed_bowel = m.pressed_bowel;
+  if (app.count("--slice-spacing") && !(m.slice_mm >= 0.5 && m.slice_mm <= 3))
+    throw UsageError("--slice-spacing must be in [0.5, 3] mm");
   gravity_of_position(mo.position);
   PathPlan plan;
   plan.input(m.mask);
@@ -60,6 +76,7 @@ int run_from_mask(CLI::App& app, const MaskCli& m, const PhantomOptions& o, cons
   Stopwatch t;
   ProgressScope phases(quiet ? nullptr : &err, "phantom");
   MaskImage::Pointer mask = read_binary_mask(m.mask);
+  if (m.slice_mm > 0) mask = resample_mask_slices(mask, m.slice_mm);
   MaskPhantom p = paint_phantom_from_mask(mask, mo);
   p.phantom.description["files"]["mask"] = m.mask;
   write_phantom(p.phantom, dir, "nrrd");
@@ -136,7 +153,7 @@ class PhantomTool : public Tool {
     add_mask_options(app, mask);
     return run_cli(app, name(), args, out, err, [&]() -> int {
       if (!mask.mask.empty()) return run_from_mask(app, mask, o, dir, quiet, err);
-      for (const char* opt : {"--no-position-header", "--bowel-loops", "--no-bladder"})
+      for (const char* opt : kMaskOnly)
         if (app.count(opt) > 0) throw UsageError(std::string(opt) + " needs --from-mask");
       if (format != "nrrd" && format != "dicom") throw UsageError("--format must be nrrd or dicom (got '" + format + "')");
       if (realistic) {

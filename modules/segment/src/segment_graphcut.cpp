@@ -1,6 +1,7 @@
 // The band graph cut (docs/segment.md step 8): partial-volume data terms, contrast-sensitive
 // smoothness, Boost.Graph's boykov_kolmogorov_max_flow on a compressed-sparse-row graph, in slabs of
-// 32 slices with 6 slices of overlap, two slabs at a time. Each of the two workers keeps one
+// 32 slices with 6 slices of overlap, one slab per worker at a time (cf::thread_count() workers,
+// slabs taken in order; each slab's result is the same whoever solves it). Each worker keeps one
 // SlabCut whose arrays (node map, edges, capacities, flow state) are reused from slab to slab, and
 // the energy terms are plain inline functions (no per-edge callbacks).
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
@@ -207,19 +208,15 @@ GraphCutOutput graph_cut_band(const GraphCutInput& in, Bytes& state) {
   std::mutex mu;
   Bytes result(d.total, 0);
   std::exception_ptr failure;
-  GraphCutOutput total;
-  parallel_for(2, [&](std::size_t, std::size_t) {
+  std::vector<GraphCutOutput> slab(nslabs);  // summed in slab order: the same totals for any thread count
+  const auto workers = std::size_t(std::max(1, std::min(cf::thread_count(), int(nslabs))));
+  cf::parallel_for(workers, [&](std::size_t, std::size_t) {
     try {
       SlabCut cut(d, state.data(), energy);
       for (std::size_t s; (s = next.fetch_add(1)) < nslabs;) {
         const std::size_t c0 = s * core, c1 = std::min(nz, c0 + core);
         const std::size_t k0 = c0 > margin ? c0 - margin : 0, k1 = std::min(nz, c1 + margin);
-        const GraphCutOutput so = cut.solve(k0, k1, c0, c1, result);
-        std::lock_guard<std::mutex> lock(mu);
-        total.flow += so.flow / kScale;
-        total.edges += so.edges;
-        total.build_cpu_s += so.build_cpu_s;
-        total.flow_cpu_s += so.flow_cpu_s;
+        slab[s] = cut.solve(k0, k1, c0, c1, result);
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(mu);
@@ -227,6 +224,13 @@ GraphCutOutput graph_cut_band(const GraphCutInput& in, Bytes& state) {
     }
   });
   if (failure) std::rethrow_exception(failure);
+  GraphCutOutput total;
+  for (const GraphCutOutput& so : slab) {
+    total.flow += so.flow / kScale;
+    total.edges += so.edges;
+    total.build_cpu_s += so.build_cpu_s;
+    total.flow_cpu_s += so.flow_cpu_s;
+  }
   for (std::size_t q = 0; q < d.total; ++q)
     if (state[q] == 2) state[q] = result[q];
   return total;

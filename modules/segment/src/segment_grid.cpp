@@ -53,8 +53,9 @@ Dims make_dims(const std::size_t n[3], const double sp[3]) {
 }
 
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body) {
-  // Two chunks at most: the voxel passes are memory-bound, a third thread gains nothing on them.
-  cf::parallel_for(n, body, 2);
+  // One chunk per thread of cf::thread_count() (--threads): every caller computes each line, row or
+  // slice the same way whichever chunk holds it, so results do not depend on the count.
+  cf::parallel_for(n, body);
 }
 
 RunLabels component_runs(const unsigned char* mask, const Dims& d) {

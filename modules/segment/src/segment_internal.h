@@ -62,7 +62,7 @@ struct Dims {
 
 Dims make_dims(const std::size_t n[3], const double sp[3]);
 using cf::process_cpu_seconds;  // core/threads.h
-// Splits [0, n) into at most 2 chunks on cf::thread_count() threads (core parallel_for).
+// Splits [0, n) into one chunk per cf::thread_count() thread (core parallel_for).
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
 // A run of voxels along axis 0: linear index of its first voxel and its length.
 struct Run {

@@ -181,6 +181,8 @@ std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std:
       grid_->absorb(l, id);
       ends_[c.segment].push_back(c.to);
       ends_[id].push_back(c.from);
+      for (const Contact& t : contacts)  // where it touches other colon bodies (gap 0) those ends continue each other
+        if (t.candidate == l && t.gap_mm <= 0 && t.segment != c.segment) ends_[t.segment].push_back(t.to), ends_[id].push_back(t.from);
       ++kept;
       continue;
     }
@@ -204,7 +206,9 @@ bool ColonSegmenter::end_is_free(std::uint32_t segment, const LocalShape& near) 
 // there (no front splits into two pieces, as it does on a tube's side, and the farthest front lies a
 // chord of at least 0.7 of its path length away: the body runs away from the contact), they point
 // the same way, their cross-sections (front sizes at the same path length) agree within a factor
-// of 1 / kMinCalibreRatio, and the candidate lies beyond the segment's end, not beside it.
+// of 1 / kMinCalibreRatio, and, across a gap, the candidate lies beyond the segment's end, not beside
+// it. Bodies touching in one cell (gap 0) are one lumen where gas gives way to fluid, and a colon
+// may turn at any angle there (the flexures and the sigmoid turn 90-180 degrees): no direction test.
 bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const LocalShape sg = grid_->segment_shape(c.segment, c.to, kShapeRadiusMm);
   const LocalShape sf = grid_->candidate_shape(c.candidate, c.from, kShapeRadiusMm);
@@ -223,6 +227,7 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const std::size_t common = std::min(sg.fronts.size(), sf.fronts.size()) - 1;  // the farthest front both reach
   const double cg = double(sg.fronts[common].cells), cf = double(sf.fronts[common].cells);
   if (std::min(cg, cf) < kMinCalibreRatio * std::max(cg, cf)) return why = "not at the colon's calibre there", false;
+  if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
   if (ug.dot(uf) < 0.3) return why = "does not continue the colon's direction", false;
   const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});

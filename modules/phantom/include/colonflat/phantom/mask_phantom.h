@@ -29,6 +29,12 @@ struct MaskPhantomOptions {
   int bowel_loops = 4;              // 0..8 small-bowel loops with oral contrast
   bool bladder = true;              // bladder with excreted contrast in its dependent part
   bool pools = true;                // dependent tagged-fluid pools in the gas-filled lumen
+  double long_stretch_mm = 0;       // 0, or 100..400 mm: one stretch completely filled with tagged fluid,
+                                    // where the colon lies beside other parts of itself (issue 25)
+  bool deep_pools = false;          // pools at 30-50 % of their pocket's height, over the folds into the
+                                    // neighbouring pockets: one level along tens of cm of a segment
+  bool pressed_bowel = false;       // the touching small-bowel loops pressed against the colon wall
+                                    // (no fat between the walls; the contrast 3 mm from the colon's lumen)
 };
 
 // One fluid body of the colon (a pool or a fully tagged stretch), in the result's `fluid_id` order.
@@ -65,6 +71,18 @@ struct MaskSegmentationScore {
   double small_bowel_ml = 0, bladder_ml = 0;  // segmented voxels labelled small bowel / bladder
 };
 MaskSegmentationScore score_segmentation(const MaskImage* segmentation, const Phantom& truth, double outside_mm = 2.0);
+
+// The mask resampled to `slice_mm` between slices (nearest slice centre; in-plane unchanged, the
+// same origin and direction): painted cases at 0.6-1.5 mm slice spacing.
+MaskImage::Pointer resample_mask_slices(const MaskImage* mask, double slice_mm);
+
+// Per colon fluid body (MaskPhantom::bodies order): its volume, the share segmented and its centroid.
+struct MaskBodyScore {
+  std::size_t body = 0;  // 1-based, as fluid_id
+  double ml = 0, kept = 0;
+  std::array<double, 3> centroid_lps{};
+};
+std::vector<MaskBodyScore> score_fluid_bodies(const MaskImage* segmentation, const MaskPhantom& truth);
 
 // Block-majority downsampling of a mask by integer factors (geometry: spacing x factor, origin at
 // the first block's centre, same direction); for fast tests on a real mask.
