@@ -138,8 +138,9 @@ TEST(RegisterPieces, DroppedStretchIsUnsupportedAndNeverPaired) {
   EXPECT_GT(inside, 0);
   const auto& un = reg.matching().supine_unaligned;  // only polyps of the dropped stretch are unaligned
   EXPECT_FALSE(un.empty());
-  for (const auto& q : pair.polyps)
+  for (const auto& q : pair.polyps) {
     if (q.in_prone) EXPECT_EQ(std::find(un.begin(), un.end(), q.id), un.end()) << "polyp " << q.id;
+  }
   const nlohmann::json j = reg.summary();
   EXPECT_FALSE(j["support"]["unsupported_supine_mm"].empty());
   EXPECT_EQ(j["pieces"]["prone"].size(), 2u);
@@ -187,6 +188,38 @@ TEST(RegisterPieces, TableShiftIsRecovered) {
   for (const auto& m : reg.matching().pairs) (m.supine_id == m.prone_id ? right : wrong) += 1;
   EXPECT_EQ(wrong, 0);
   EXPECT_GE(right, 6);
+}
+
+// Each supine vertex's partner is the exact nearest prone vertex in the cylinder embedding (checked
+// against all prone vertices), also where its image falls in the 200 mm the prone scan lacks,
+// far along from every prone vertex (the slab search of along_slabs.h, not the bucket locator).
+TEST(RegisterPieces, PartnerIsExactNearestAlsoAcrossAMissingStretch) {
+  SyntheticPairOptions o = long_pair(1);
+  o.prone_removed = {{300, 500}};
+  const SyntheticPair pair = make_synthetic_pair(o);
+  ColonRegistration reg(pair.supine, pair.prone);
+  reg.run();
+  const ScanCoordinates &sc = reg.supine_coordinates(), &pc = reg.prone_coordinates();
+  const double r = std::max(1.0, pc.mean_radius_mm);
+  auto embed = [r](double s, double t) { return Eigen::Vector3d(s, r * std::cos(t), r * std::sin(t)); };
+  int far = 0, checked = 0;
+  for (size_t v = 0; v < sc.s.size(); v += 7) {
+    if (std::isnan(sc.s[v])) continue;
+    double s2, t2;
+    reg.map_coordinates(Direction::kSupineToProne, sc.s[v], sc.theta[v], s2, t2);
+    const Eigen::Vector3d q = embed(s2, t2);
+    double best = INFINITY, along = INFINITY;
+    for (size_t w = 0; w < pc.s.size(); ++w) {
+      if (std::isnan(pc.s[w])) continue;
+      best = std::min(best, (embed(pc.s[w], pc.theta[w]) - q).norm());
+      along = std::min(along, std::abs(pc.s[w] - s2));
+    }
+    const int w = reg.supine_to_prone()[v];
+    ASSERT_GE(w, 0);
+    EXPECT_NEAR((embed(pc.s[size_t(w)], pc.theta[size_t(w)]) - q).norm(), best, 1e-9) << "vertex " << v;
+    far += along > 10, ++checked;
+  }
+  EXPECT_GT(far, checked / 20) << "too few images in the missing stretch to test the far path";
 }
 
 }  // namespace
