@@ -10,6 +10,10 @@
 //                               one phantom patient run from its true lumen masks, the prone mask
 //                               with stretches cut out (collapse, 25 % tagged dropped, split +3,
 //                               rectum cut short; issue 27), scored as --phantom.
+//   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG]
+//                               the real lumen mask with 10 synthetic polyps, both scans cut as
+//                               --cuts (by path distance through the lumen), the prone mask moved
+//                               on the table; scored by path distance (mask_pair.h).
 //   register_bench --write-synthetic DIR [--twist DEG]
 //                               writes a small synthetic pair as run folders DIR/supine, DIR/prone.
 //   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]
@@ -27,6 +31,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <Eigen/Geometry>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,6 +44,7 @@
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/register/register.h"
 #include "colonflat/testdata/lumen_cut.h"
+#include "colonflat/testdata/mask_pair.h"
 #include "colonflat/testdata/synthetic_pair.h"
 
 namespace {
@@ -226,7 +233,7 @@ std::vector<cf::ScanCandidate> as_candidates(const Truth& t, const Cuts& cuts = 
 }
 
 Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& pro_run, const fs::path& sup_truth,
-             const fs::path& pro_truth, const Cuts& prone_cuts = {}) {
+             const fs::path& pro_truth, const Cuts& prone_cuts = {}, const Cuts& supine_cuts = {}) {
   const cf::ColonScan sup = cf::read_run_dir(sup_run), pro = cf::read_run_dir(pro_run);
   Row r{name, sup.lps.size()};
   cf::Stopwatch clock;
@@ -239,7 +246,7 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
     return r;
   }
   const Truth ts = read_truth(sup_truth), tp = read_truth(pro_truth);
-  const auto cs = as_candidates(ts), cp = as_candidates(tp, prone_cuts);
+  const auto cs = as_candidates(ts, supine_cuts), cp = as_candidates(tp, prone_cuts);
   r.polyps = 0;
   for (const auto& q : cs)
     for (const auto& p : cp) r.polyps += p.id == q.id;
@@ -308,11 +315,48 @@ void phantom_table(int first, int last, const std::string& size, const fs::path&
   }
 }
 
-// One phantom patient, both positions run from their true lumen masks; the prone mask with
-// stretches cut out (lumen_cut.h) as real segmentations differ: a collapse, a fully tagged stretch
-// left out, the colon split into 3 more pieces, the rectum cut short by the catheter.
+// A scan's mask cut (and moved); the run folder from it (`colonflat run MASK --from reconstruct`).
+bool run_mask(const fs::path& mask, const fs::path& out) {
+  return fs::exists(out / "flat.vtp") ||
+         colonflat({"run", mask.string(), "--from", "reconstruct", "-o", out.string(), "-q"}) == 0;
+}
+
+// `colonflat register` on the two run folders (the command users run): its pairs of detected
+// candidates, wall and process CPU seconds, printed under the row.
+void register_cli(const fs::path& sup_run, const fs::path& pro_run, const fs::path& out, const Row& r) {
+  fs::remove_all(out);
+  cf::Stopwatch clock;
+  const std::clock_t cpu = std::clock();
+  if (colonflat({"register", sup_run.string(), pro_run.string(), "-o", out.string(), "--no-review", "-q"}) != 0) return;
+  const double cpu_s = double(std::clock() - cpu) / CLOCKS_PER_SEC, wall = clock.seconds();
+  std::ifstream in(out / "registration.json");
+  const auto j = nlohmann::json::parse(in);
+  std::printf("  colonflat register: %zu candidate pairs (bench: %d + %d + %d), %.1f s wall, %.1f s CPU\n",
+              j["candidates"]["pairs"].size(), r.det_pairs, r.det_false, r.det_nonpolyp, wall, cpu_s);
+}
+
+struct CutCase {
+  std::string name;
+  Cuts supine, prone;
+};
+
+// The kinds of difference of issue 27 on a colon of length L (mm along its course): a collapse,
+// fully tagged stretches left out (100 mm; 25 % of the colon), the colon split into 3 more pieces,
+// the rectum cut short by the catheter, both scans differing at once.
+std::vector<CutCase> cut_cases(double L) {
+  return {{"uncut", {}, {}},
+          {"collapse 20 mm at 45 %", {}, {{0.45 * L, 0.45 * L + 20}}},
+          {"tagged 25 % dropped", {}, {{0.40 * L, 0.65 * L}}},
+          {"split +3 (15 mm each)", {}, {{0.25 * L, 0.25 * L + 15}, {0.5 * L, 0.5 * L + 15}, {0.75 * L, 0.75 * L + 15}}},
+          {"rectum cut 60 mm", {}, {{0, 60}}},
+          {"tagged 100 mm at 70 %", {}, {{0.70 * L, 0.70 * L + 100}}},
+          {"both: sup 20+100, pro 25 %", {{0.2 * L, 0.2 * L + 20}, {0.8 * L, 0.8 * L + 100}}, {{0, 50}, {0.35 * L, 0.6 * L}}}};
+}
+
+// One phantom patient, both positions run from their true lumen masks, the masks cut along the
+// phantom's centre line (lumen_cut.h) as real segmentations differ.
 void cuts_table(int seed, const std::string& size, const fs::path& work) {
-  std::printf("Phantom seed %d (%s), both scans run from the lumen mask (--from reconstruct); prone mask cut\n", seed,
+  std::printf("Phantom seed %d (%s), both scans run from the lumen mask (--from reconstruct); masks cut\n", seed,
               size.c_str());
   const fs::path d = work / ("cuts_seed" + std::to_string(seed));
   for (const std::string position : {"supine", "prone"}) {
@@ -321,24 +365,85 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
     if (position == "prone") a.insert(a.end(), {"--position", "prone"});
     if (!fs::exists(ph / "polyps.json") && colonflat(a) != 0) return;
   }
-  auto run_mask = [&](const fs::path& mask, const fs::path& out) {
-    return fs::exists(out / "flat.vtp") || colonflat({"run", mask.string(), "--from", "reconstruct", "-o", out.string(), "-q"}) == 0;
-  };
   if (!run_mask(d / "supine_phantom" / "lumen_mask.nrrd", d / "supine_run")) return;
-  const cf::PhantomCentreline cl = cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json");
-  const double L = cl.arc_mm.back();
-  const std::vector<std::pair<std::string, Cuts>> cases = {
-      {"uncut", {}},
-      {"collapse 20 mm at 45 %", {{0.45 * L, 0.45 * L + 20}}},
-      {"tagged 25 % dropped", {{0.40 * L, 0.65 * L}}},
-      {"split +3 (15 mm each)", {{0.25 * L, 0.25 * L + 15}, {0.5 * L, 0.5 * L + 15}, {0.75 * L, 0.75 * L + 15}}},
-      {"rectum cut 60 mm", {{0, 60}}}};
+  const auto cases = cut_cases(cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back());
   print_header();
   for (size_t k = 0; k < cases.size(); ++k) {
-    const fs::path mask = d / ("prone_cut" + std::to_string(k) + ".nrrd"), run = d / ("prone_run" + std::to_string(k));
-    if (!fs::exists(mask)) cf::cut_lumen_mask(d / "prone_phantom" / "lumen_mask.nrrd", cl, cases[k].second, mask);
-    if (!run_mask(mask, run)) continue;
-    print_row(pair_row(cases[k].first, d / "supine_run", run, d / "supine_phantom", d / "prone_phantom", cases[k].second));
+    const std::string n = std::to_string(k);
+    fs::path sup_run = d / "supine_run";
+    for (const std::string pos : {"supine", "prone"}) {
+      const Cuts& cuts = pos == "supine" ? cases[k].supine : cases[k].prone;
+      if (pos == "supine" && cuts.empty()) continue;
+      const fs::path mask = d / (pos + "_cut" + n + ".nrrd"), ph = d / (pos + "_phantom");
+      if (!fs::exists(mask))
+        cf::cut_lumen_mask(ph / "lumen_mask.nrrd", cf::read_phantom_centreline(ph / "centerline.json"), cuts, mask);
+      if (pos == "supine") sup_run = d / ("supine_run" + n);
+      if (!run_mask(mask, d / (pos + "_run" + n))) return;
+    }
+    const Row r = pair_row(cases[k].name, sup_run, d / ("prone_run" + n), d / "supine_phantom", d / "prone_phantom",
+                           cases[k].prone, cases[k].supine);
+    print_row(r);
+    register_cli(sup_run, d / ("prone_run" + n), d / ("register" + n), r);
+  }
+}
+
+// Real anatomy (issue 27): the shared real lumen mask with 10 synthetic polyps on its wall
+// (mask_pair.h), both scans cut by path distance through the lumen, the prone mask moved on the
+// table (`shift` mm, `turn` degrees about the superior axis). along = |path distance of the mapped
+// supine polyp - that of the polyp| (mm along the lumen's course).
+void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn) {
+  cf::Stopwatch prep;
+  cf::MaskCourse course(cf::read_mask(mask_file));
+  const auto polyps = course.place_polyps(10, 1);
+  const double L = course.length_mm();
+  std::printf("Real mask %s: course %.0f mm, %zu polyps placed (%.1f s); prone moved (%.0f, %.0f, %.0f) mm, %.1f deg\n",
+              mask_file.filename().c_str(), L, polyps.size(), prep.seconds(), shift.x(), shift.y(), shift.z(), turn);
+  fs::create_directories(work);
+  auto seen = [&](const Cuts& cuts, bool prone) {
+    std::vector<cf::ScanCandidate> out;
+    for (const auto& q : polyps) {
+      bool cut = false;
+      for (const auto& [a, b] : cuts) cut |= q.path_mm >= a - q.diameter_mm && q.path_mm < b + q.diameter_mm;
+      if (!cut) out.push_back({q.id, prone ? cf::MaskCourse::moved(q.lps, course.centroid(), shift, turn) : q.lps, q.diameter_mm, 1});
+    }
+    return out;
+  };
+  const Eigen::Matrix3d back = Eigen::AngleAxisd(-turn * kPi / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  print_header();
+  const auto cases = cut_cases(L);
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const std::string n = std::to_string(k);
+    const CutCase& c = cases[k];
+    const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
+    if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
+    if (!fs::exists(pm)) cf::write_mask(course.cut_and_move(c.prone, shift, turn), pm);
+    const fs::path sr = work / ("supine_run" + (c.supine.empty() ? std::string() : n)), pr = work / ("prone_run" + n);
+    if (!run_mask(sm, sr) || !run_mask(pm, pr)) return;
+    const cf::ColonScan sup = cf::read_run_dir(sr), pro = cf::read_run_dir(pr);
+    Row r{c.name, sup.lps.size()};
+    cf::Stopwatch clock;
+    cf::ColonRegistration reg(sup, pro);
+    reg.run();
+    r.seconds = clock.seconds(), r.pieces = piece_counts(reg);
+    const auto cs = seen(c.supine, false), cp = seen(c.prone, true);
+    r.polyps = 0;
+    std::vector<double> along;
+    for (const auto& q : cs)
+      for (const auto& p : cp)
+        if (q.id == p.id) {
+          ++r.polyps;
+          const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
+          const Eigen::Vector3d unmoved = back * (m - course.centroid() - shift) + course.centroid();
+          const auto truth = std::find_if(polyps.begin(), polyps.end(), [&](const cf::MaskPolyp& t) { return t.id == q.id; });
+          if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(unmoved) - truth->path_mm));
+        }
+    count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
+    r.missed = r.polyps - r.matched, r.along = median(along);
+    std::sort(along.begin(), along.end());
+    count_id_pairs(reg.matching(), r.det_pairs, r.det_false);
+    print_row(r);
+    std::printf("  along max %.1f mm\n", along.empty() ? NAN : along.back());
+    register_cli(sr, pr, work / ("register" + n), r);
   }
 }
 
@@ -352,6 +457,12 @@ int main(int argc, char** argv) {
   CLI::App& app = cli.app();
   app.add_option("--phantom", phantoms, "phantom pairs of seeds N or N-M");
   int cuts_seed = 0;
+  std::string real_mask;
+  std::vector<double> table = {15, -30, 40};
+  double turn_deg = 0;
+  app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
+  app.add_option("--table", table, "with --real-mask: prone table shift in LPS mm")->expected(3);
+  app.add_option("--turn", turn_deg, "with --real-mask: prone turned about the superior axis (degrees)");
   app.add_option("--cuts", cuts_seed, "one phantom patient run from its masks, the prone mask cut (issue 27)");
   app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
   app.add_option("--work", work, "work folder of the phantom pairs");
@@ -360,7 +471,9 @@ int main(int argc, char** argv) {
   app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
-    if (cuts_seed > 0) {
+    if (!real_mask.empty()) {
+      real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg);
+    } else if (cuts_seed > 0) {
       cuts_table(cuts_seed, size, work);
     } else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
