@@ -59,26 +59,29 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+double largest(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }
+
 struct Row {
   std::string name;
   size_t vertices = 0;
   int polyps = 0, matched = 0, false_matches = 0, det_pairs = -1, det_false = -1, det_nonpolyp = 0;
   std::string pieces = "-";  // colon bands supine / prone (piecewise layout, pieces.h)
   int missed = 0;            // polyps seen in both scans and not paired
-  double along = NAN, around = NAN, seconds = 0;
+  double along = NAN, around = NAN, seconds = 0, along_max = NAN;  // along: median and largest error
   double lps_along = NAN, lps_around = NAN;  // baseline: the same LPS point taken in the other scan
 };
 
 void print_header() {
   std::printf("load average %.2f\n", load_average());
-  std::printf("%-28s %9s %7s %6s %7s %5s %6s %9s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "pieces", "polyps",
-              "matched", "false", "missed", "along_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s",
+  std::printf("%-28s %9s %7s %6s %7s %5s %6s %9s %7s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "pieces",
+              "polyps", "matched", "false", "missed", "along_mm", "max_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s",
               "lps_along", "lps_around");
 }
 
 void print_row(const Row& r) {
-  std::printf("%-28s %9zu %7s %6d %7d %5d %6d %9.1f %10.1f %9d %9d %6d %7.2f %11.1f %12.1f\n", r.name.c_str(),
-              r.vertices, r.pieces.c_str(), r.polyps, r.matched, r.false_matches, r.missed, r.along, r.around, r.det_pairs,
+  std::printf("%-28s %9zu %7s %6d %7d %5d %6d %9.1f %7.1f %10.1f %9d %9d %6d %7.2f %11.1f %12.1f\n", r.name.c_str(),
+              r.vertices, r.pieces.c_str(), r.polyps, r.matched, r.false_matches, r.missed, r.along, r.along_max, r.around,
+              r.det_pairs,
               r.det_false, r.det_nonpolyp, r.seconds, r.lps_along, r.lps_around);
   std::fflush(stdout);
 }
@@ -121,7 +124,7 @@ Row synthetic_row(const std::string& name, const cf::SyntheticPairOptions& o) {
     const double d = std::fmod(std::abs(pair.prone_phi[size_t(w)] - q.phi_rad), 2 * kPi);
     around.push_back((d > kPi ? 2 * kPi - d : d) * 180 / kPi);
   }
-  r.along = median(along), r.around = median(around);
+  r.along = median(along), r.around = median(around), r.along_max = largest(along);
   count_id_pairs(reg.matching(), r.det_pairs, r.det_false);
   return r;
 }
@@ -266,7 +269,7 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
         const auto [la, lb] = truth_error(tp, pro.lps[size_t(w)], p.lps);
         lps_along.push_back(la), lps_around.push_back(lb);
       }
-  r.along = median(along), r.around = median(around);
+  r.along = median(along), r.around = median(around), r.along_max = largest(along);
   r.lps_along = median(lps_along), r.lps_around = median(lps_around);
   r.det_pairs = r.det_false = 0;
   for (const auto& m : reg.matching().pairs) {
@@ -438,11 +441,9 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
           if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(unmoved) - truth->path_mm));
         }
     count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
-    r.missed = r.polyps - r.matched, r.along = median(along);
-    std::sort(along.begin(), along.end());
+    r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
     count_id_pairs(reg.matching(), r.det_pairs, r.det_false);
     print_row(r);
-    std::printf("  along max %.1f mm\n", along.empty() ? NAN : along.back());
     register_cli(sr, pr, work / ("register" + n), r);
   }
 }
