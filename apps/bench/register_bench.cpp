@@ -1,32 +1,21 @@
-// Supine-prone registration benchmark (Release):
-//   register_bench              synthetic full-length pairs (1.5 m, 0.7 mm vertices; known
-//                               correspondence): match rate, errors, false matches, time.
+// Supine-prone registration benchmark (Release; modes and columns: docs/register.md, "Benchmark"):
+//   register_bench              synthetic full-length pairs (1.5 m, known correspondence), also
+//                               with stretches left out of one scan (issue 27).
 //   register_bench --phantom 1-5 [--size full|small] --work DIR
-//                               phantom pairs: `colonflat phantom --seed N [--position prone]`,
-//                               `colonflat run` on both CTs, `colonflat register`-equivalent, scored
-//                               against the phantom truth (polyp ids, centre lines). Needs
-//                               `colonflat phantom --position prone` (reported when missing).
+//                               phantom pairs (`colonflat phantom [--position prone]`, `colonflat run`).
 //   register_bench --cuts SEED [--size full|small] --work DIR
-//                               one phantom patient run from its true lumen masks, the prone mask
-//                               with stretches cut out (collapse, 25 % tagged dropped, split +3,
-//                               rectum cut short; issue 27), scored as --phantom.
-//   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG]
-//                               the real lumen mask with 10 synthetic polyps, both scans cut as
-//                               --cuts (by path distance through the lumen), the prone mask moved
-//                               on the table; scored by path distance (mask_pair.h).
-//   register_bench --write-synthetic DIR [--twist DEG]
-//                               writes a small synthetic pair as run folders DIR/supine, DIR/prone.
-//   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]
-//                               one existing pair of run folders (scored when truth is given).
-// Columns: polyps >= 6 mm; matched = truth polyps paired with themselves when the two truth lists
-// are matched through the registration; false = pairs joining different polyps; along / around =
-// median error of the registered position of each polyp (mm along the true prone centre line,
-// degrees around it); det_pairs / det_false = the same for the runs' detected candidates
-// (a candidate is a polyp's when within diameter/2 + 5 mm; det_false = a pair of a polyp's
-// candidate with another polyp's or a non-polyp one; det_np = pairs of two non-polyp candidates,
-// e.g. the same fold tip or noise site seen in both scans); time = registration wall time;
-// lps_along / lps_around = baseline without registration: the prone wall point nearest to the
-// supine polyp's LPS position (small when the prone colon barely moves in patient coordinates).
+//                               one phantom patient run from its true lumen masks, the masks cut
+//                               (collapse, tagged stretches dropped, split +3, rectum cut; issue 27).
+//   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG] [--painted] [--cases K...]
+//                               the real lumen mask with 10 synthetic polyps, cut as --cuts (by path
+//                               distance through the lumen), the prone mask moved on the table.
+//   register_bench --write-synthetic DIR [--twist DEG]     a small synthetic pair as run folders.
+//   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]   one pair of run folders.
+// Columns: polyps >= 6 mm seen in both; matched = truth polyps paired with themselves when the two
+// truth lists are matched through the registration; false = pairs joining different polyps;
+// along (median, max) / around = error of each polyp's registered position; det_* = the same for
+// the runs' detected candidates (det_np: two non-polyp candidates); time = registration wall time;
+// lps_* = baseline without registration (the same LPS point taken in the other scan).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -50,7 +39,6 @@
 namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = 3.141592653589793;
-
 using cf::bench::load_average;
 
 double median(std::vector<double> v) {
@@ -394,7 +382,18 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
 // (mask_pair.h), both scans cut by path distance through the lumen, the prone mask moved on the
 // table (`shift` mm, `turn` degrees about the superior axis). along = |path distance of the mapped
 // supine polyp - that of the polyp| (mm along the lumen's course).
-void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn) {
+// With `painted`: each mask painted into a CT (`colonflat phantom --from-mask`, the position's
+// pools, a fully tagged stretch, small bowel) and run from the CT, segmentation included.
+bool run_scan(const fs::path& mask, const fs::path& out, bool painted, const std::string& position) {
+  if (!painted || fs::exists(out / "flat.vtp")) return run_mask(mask, out);
+  const fs::path ct = out.string() + "_ct";
+  return (fs::exists(ct / "ct.nrrd") || colonflat({"phantom", "--from-mask", mask.string(), "-o", ct.string(), "--position",
+                                                   position, "-q"}) == 0) &&
+         colonflat({"run", (ct / "ct.nrrd").string(), "-o", out.string(), "-q"}) == 0;
+}
+
+void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn,
+                bool painted, const std::vector<int>& only) {
   cf::Stopwatch prep;
   cf::MaskCourse course(cf::read_mask(mask_file));
   const auto polyps = course.place_polyps(10, 1);
@@ -415,13 +414,14 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
   print_header();
   const auto cases = cut_cases(L);
   for (size_t k = 0; k < cases.size(); ++k) {
+    if (!only.empty() && std::find(only.begin(), only.end(), int(k)) == only.end()) continue;
     const std::string n = std::to_string(k);
     const CutCase& c = cases[k];
     const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
     if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
     if (!fs::exists(pm)) cf::write_mask(course.cut_and_move(c.prone, shift, turn), pm);
     const fs::path sr = work / ("supine_run" + (c.supine.empty() ? std::string() : n)), pr = work / ("prone_run" + n);
-    if (!run_mask(sm, sr) || !run_mask(pm, pr)) return;
+    if (!run_scan(sm, sr, painted, "supine") || !run_scan(pm, pr, painted, "prone")) return;
     const cf::ColonScan sup = cf::read_run_dir(sr), pro = cf::read_run_dir(pr);
     Row r{c.name, sup.lps.size()};
     cf::Stopwatch clock;
@@ -461,6 +461,10 @@ int main(int argc, char** argv) {
   std::string real_mask;
   std::vector<double> table = {15, -30, 40};
   double turn_deg = 0;
+  bool painted = false;
+  std::vector<int> only;
+  app.add_flag("--painted", painted, "with --real-mask: paint each mask into a CT and run from the CT");
+  app.add_option("--cases", only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
   app.add_option("--table", table, "with --real-mask: prone table shift in LPS mm")->expected(3);
   app.add_option("--turn", turn_deg, "with --real-mask: prone turned about the superior axis (degrees)");
@@ -473,7 +477,7 @@ int main(int argc, char** argv) {
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
     if (!real_mask.empty()) {
-      real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg);
+      real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only);
     } else if (cuts_seed > 0) {
       cuts_table(cuts_seed, size, work);
     } else if (!phantoms.empty()) {
