@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include <Eigen/Geometry>
 
@@ -56,6 +57,13 @@ SyntheticPairOptions long_pair(std::uint64_t seed) {
   o.spacing_mm = 2.0;
   o.seed = seed;
   return o;
+}
+
+// The registration of a pair, run (the pair must outlive it).
+std::unique_ptr<ColonRegistration> registered(const SyntheticPair& pair) {
+  auto reg = std::make_unique<ColonRegistration>(pair.supine, pair.prone);
+  reg->run();
+  return reg;
 }
 
 // Runs the registration and checks the targets on the polyps seen in both scans.
@@ -199,8 +207,8 @@ TEST(RegisterPieces, PartnerIsExactNearestAlsoAcrossAMissingStretch) {
   SyntheticPairOptions o = long_pair(1);
   o.prone_removed = {{300, 500}};
   const SyntheticPair pair = make_synthetic_pair(o);
-  ColonRegistration reg(pair.supine, pair.prone);
-  reg.run();
+  const auto run = registered(pair);
+  const ColonRegistration& reg = *run;
   const ScanCoordinates &sc = reg.supine_coordinates(), &pc = reg.prone_coordinates();
   const double r = std::max(1.0, pc.mean_radius_mm);
   auto embed = [r](double s, double t) { return Eigen::Vector3d(s, r * std::cos(t), r * std::sin(t)); };
@@ -241,8 +249,8 @@ TEST(RegisterPieces, SmallTableRotationKeepsPairsRight) {
     for (auto& p : pair.prone.lps) move(p);
     for (auto& q : pair.prone.candidates) move(q.lps);
     for (auto& q : pair.polyps) move(q.prone_lps);
-    ColonRegistration reg(pair.supine, pair.prone);
-    reg.run();
+    const auto run = registered(pair);
+    const ColonRegistration& reg = *run;
     const PairScore p = score(pair, reg);
     EXPECT_EQ(p.wrong, 0) << deg << " deg";
     EXPECT_EQ(p.right, p.seen_in_both) << deg << " deg";
