@@ -179,6 +179,27 @@ TEST(RegisterPieces, PiecesArePlacedInOrderAndDirection) {
   }
 }
 
+// A supine piece spanning a 200 mm stretch the prone scan lacks (prone the reference: 2 pieces
+// against 3) lies on both sides of the prone gap at its own length: the gap is measured from it
+// and the pieces of both scans placed within 5 mm of their material position (no slide, no shift:
+// material mm = common s), although the supine centre points inside the gap project onto the
+// prone pieces' ends.
+TEST(RegisterPieces, PieceSpanningAGapIsPlacedAtItsLength) {
+  SyntheticPairOptions o = long_pair(1);
+  o.slide_mm = 0, o.shift_mm = 0;
+  o.supine_removed = {{100, 115}, {650, 665}};
+  o.prone_removed = {{300, 500}};
+  const SyntheticPair pair = make_synthetic_pair(o);
+  const PieceLayout L = layout_pieces(pair.supine, pair.prone, PieceOptions{});
+  ASSERT_FALSE(L.supine_is_reference);
+  ASSERT_EQ(L.prone.size(), 2u);
+  ASSERT_EQ(L.supine.size(), 3u);
+  const double p0 = L.prone[0].start_mm;  // material 0
+  EXPECT_NEAR(L.prone[1].start_mm - p0, 500.0, 5.0);
+  EXPECT_NEAR(L.supine[1].start_mm - p0, 115.0, 5.0);
+  EXPECT_NEAR(L.supine[2].start_mm - p0, 665.0, 5.0);
+}
+
 // Moving the prone scan on the table (a rigid shift of 59 mm) moves the fitted shift by the same
 // amount up to a slide along the colon's long axis (within 20 mm: a tube fits itself shifted
 // along its length almost as well), also with a quarter of one colon missing, and the pairs stay right.
