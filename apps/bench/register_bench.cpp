@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <Eigen/Geometry>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -39,14 +38,12 @@
 namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = 3.141592653589793;
-using cf::bench::load_average;
 
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
-
 double largest(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }
 
 struct Row {
@@ -60,7 +57,7 @@ struct Row {
 };
 
 void print_header() {
-  std::printf("load average %.2f\n", load_average());
+  std::printf("load average %.2f\n", cf::bench::load_average());
   std::printf("%-28s %9s %7s %6s %7s %5s %6s %9s %7s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "pieces",
               "polyps", "matched", "false", "missed", "along_mm", "max_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s",
               "lps_along", "lps_around");
@@ -204,10 +201,23 @@ std::pair<double, double> truth_error(const Truth& t, const Eigen::Vector3d& map
 }
 
 // The truth polyp a detected candidate stands for (-1 = none).
-int hit(const Truth& t, const cf::ScanCandidate& c) {
-  for (const auto& q : t.polyps)
-    if ((q.lps - c.lps).norm() <= q.diameter / 2 + 5) return q.id;
+int hit(const std::vector<cf::ScanCandidate>& truth, const cf::ScanCandidate& c) {
+  for (const auto& q : truth)
+    if ((q.lps - c.lps).norm() <= q.size_mm / 2 + 5) return q.id;
   return -1;
+}
+
+// det_pairs / det_false / det_np of the registration's pairs of detected candidates.
+void count_detected(const cf::ColonRegistration& reg, const std::vector<cf::ScanCandidate>& ts,
+                    const std::vector<cf::ScanCandidate>& tp, Row& r) {
+  r.det_pairs = r.det_false = r.det_nonpolyp = 0;
+  for (const auto& m : reg.matching().pairs) {
+    int hs = -2, hp = -3;
+    for (const auto& c : reg.supine().candidates) if (c.id == m.supine_id) hs = hit(ts, c);
+    for (const auto& c : reg.prone().candidates) if (c.id == m.prone_id) hp = hit(tp, c);
+    if (hs == hp) (hs >= 0 ? r.det_pairs : r.det_nonpolyp) += 1;
+    else r.det_false += 1;
+  }
 }
 
 using Cuts = std::vector<std::pair<double, double>>;
@@ -259,14 +269,12 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
       }
   r.along = median(along), r.around = median(around), r.along_max = largest(along);
   r.lps_along = median(lps_along), r.lps_around = median(lps_around);
-  r.det_pairs = r.det_false = 0;
-  for (const auto& m : reg.matching().pairs) {
-    int hs = -2, hp = -3;
-    for (const auto& c : sup.candidates) if (c.id == m.supine_id) hs = hit(ts, c);
-    for (const auto& c : pro.candidates) if (c.id == m.prone_id) hp = hit(tp, c);
-    if (hs == hp) (hs >= 0 ? r.det_pairs : r.det_nonpolyp) += 1;
-    else r.det_false += 1;
-  }
+  auto all = [](const Truth& t) {
+    std::vector<cf::ScanCandidate> out;
+    for (const auto& q : t.polyps) out.push_back({q.id, q.lps, q.diameter, 1});
+    return out;
+  };
+  count_detected(reg, all(ts), all(tp), r);
   return r;
 }
 
@@ -403,14 +411,10 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
   fs::create_directories(work);
   auto seen = [&](const Cuts& cuts, bool prone) {
     std::vector<cf::ScanCandidate> out;
-    for (const auto& q : polyps) {
-      bool cut = false;
-      for (const auto& [a, b] : cuts) cut |= q.path_mm >= a - q.diameter_mm && q.path_mm < b + q.diameter_mm;
-      if (!cut) out.push_back({q.id, prone ? cf::MaskCourse::moved(q.lps, course.centroid(), shift, turn) : q.lps, q.diameter_mm, 1});
-    }
+    for (const auto& q : cf::polyps_seen(polyps, cuts))
+      out.push_back({q.id, prone ? cf::MaskCourse::moved(q.lps, course.centroid(), shift, turn) : q.lps, q.diameter_mm, 1});
     return out;
   };
-  const Eigen::Matrix3d back = Eigen::AngleAxisd(-turn * kPi / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   print_header();
   const auto cases = cut_cases(L);
   for (size_t k = 0; k < cases.size(); ++k) {
@@ -436,13 +440,12 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
         if (q.id == p.id) {
           ++r.polyps;
           const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
-          const Eigen::Vector3d unmoved = back * (m - course.centroid() - shift) + course.centroid();
-          const auto truth = std::find_if(polyps.begin(), polyps.end(), [&](const cf::MaskPolyp& t) { return t.id == q.id; });
-          if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(unmoved) - truth->path_mm));
+          const Eigen::Vector3d at = cf::MaskCourse::unmoved(m, course.centroid(), shift, turn);
+          if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(at) - polyps[size_t(q.id - 1)].path_mm));
         }
     count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
     r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
-    count_id_pairs(reg.matching(), r.det_pairs, r.det_false);
+    count_detected(reg, cs, cp, r);  // the polyps cut out of a scan are not there to hit
     print_row(r);
     register_cli(sr, pr, work / ("register" + n), r);
   }
@@ -476,19 +479,16 @@ int main(int argc, char** argv) {
   app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
-    if (!real_mask.empty()) {
-      real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only);
-    } else if (cuts_seed > 0) {
-      cuts_table(cuts_seed, size, work);
-    } else if (!phantoms.empty()) {
+    if (!real_mask.empty()) real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only);
+    else if (cuts_seed > 0) cuts_table(cuts_seed, size, work);
+    else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
       phantom_table(first, last, size, work);
     } else if (!synthetic_dir.empty()) {
       cf::SyntheticPairOptions o;
       o.twist_deg = twist_deg;
-      const cf::SyntheticPair pair_data = cf::make_synthetic_pair(o);
-      cf::write_run_dir(pair_data.supine, fs::path(synthetic_dir) / "supine");
-      cf::write_run_dir(pair_data.prone, fs::path(synthetic_dir) / "prone");
+      const cf::SyntheticPair p = cf::make_synthetic_pair(o);
+      cf::write_run_dir(p.supine, fs::path(synthetic_dir) / "supine"), cf::write_run_dir(p.prone, fs::path(synthetic_dir) / "prone");
     } else if (!pair.empty()) {
       print_header();
       print_row(pair_row("pair", pair[0], pair[1], truth.empty() ? "" : truth[0], truth.empty() ? "" : truth[1]));

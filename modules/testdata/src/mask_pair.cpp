@@ -121,7 +121,7 @@ std::vector<MaskPolyp> MaskCourse::place_polyps(int count, std::uint64_t seed) {
     if (near.empty()) continue;
     const MaskImage::IndexType c = near[std::uniform_int_distribution<size_t>(0, near.size() - 1)(rng)];
     const double diameter = 6 + n % 5, r = diameter / 2;
-    out.push_back({n + 1, physical(mask_, c), diameter, path_[box_index(c)]});
+    out.push_back({int(out.size()) + 1, physical(mask_, c), diameter, path_[box_index(c)]});
     const int rx = int(r / sp[0]) + 1, ry = int(r / sp[1]) + 1, rz = int(r / sp[2]) + 1;
     for (long z = c[2] - rz; z <= c[2] + rz; ++z)
       for (long y = c[1] - ry; y <= c[1] + ry; ++y)
@@ -140,6 +140,22 @@ Eigen::Vector3d MaskCourse::moved(const Eigen::Vector3d& p, const Eigen::Vector3
                                   double rotate_deg) {
   const Eigen::Matrix3d R = Eigen::AngleAxisd(rotate_deg * kPi / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return R * (p - centre) + centre + shift;
+}
+
+Eigen::Vector3d MaskCourse::unmoved(const Eigen::Vector3d& p, const Eigen::Vector3d& centre, const Eigen::Vector3d& shift,
+                                    double rotate_deg) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(rotate_deg * kPi / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return R.transpose() * (p - centre - shift) + centre;
+}
+
+std::vector<MaskPolyp> polyps_seen(const std::vector<MaskPolyp>& polyps, const std::vector<std::pair<double, double>>& cuts) {
+  std::vector<MaskPolyp> out;
+  for (const auto& q : polyps) {
+    bool cut = false;
+    for (const auto& [a, b] : cuts) cut |= q.path_mm >= a - q.diameter_mm && q.path_mm < b + q.diameter_mm;
+    if (!cut) out.push_back(q);
+  }
+  return out;
 }
 
 MaskImage::Pointer MaskCourse::cut_and_move(const std::vector<std::pair<double, double>>& cuts,

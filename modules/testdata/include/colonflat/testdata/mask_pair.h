@@ -34,7 +34,7 @@ class MaskCourse {
   // Path distance of the lumen voxel nearest to an LPS point (searched within 15 mm; NaN if none).
   double path_at(const Eigen::Vector3d& lps) const;
   // Removes `count` polyps (balls of 6-10 mm diameter centred on wall voxels, i.e. soft tissue
-  // bulging into the lumen) spread evenly along 8-92 % of the course; returns them.
+  // bulging into the lumen) spread evenly along 8-92 % of the course; returns them (ids 1, 2, ...).
   std::vector<MaskPolyp> place_polyps(int count, std::uint64_t seed);
   // A copy with every lumen voxel whose path distance lies in one of the ranges removed, then moved
   // by `shift_mm` (LPS) and turned by `rotate_deg` about the superior axis through the lumen's
@@ -44,6 +44,8 @@ class MaskCourse {
   // The same rigid move applied to a point of the unmoved mask.
   static Eigen::Vector3d moved(const Eigen::Vector3d& p, const Eigen::Vector3d& centre, const Eigen::Vector3d& shift_mm,
                                double rotate_deg);
+  static Eigen::Vector3d unmoved(const Eigen::Vector3d& p, const Eigen::Vector3d& centre, const Eigen::Vector3d& shift_mm,
+                                 double rotate_deg);
   Eigen::Vector3d centroid() const { return centroid_; }
 
  private:
@@ -55,5 +57,8 @@ class MaskCourse {
   double length_ = 0;
   Eigen::Vector3d centroid_{0, 0, 0};
 };
+
+// The polyps a scan cut by `cuts_mm` still shows: none within a diameter of a cut.
+std::vector<MaskPolyp> polyps_seen(const std::vector<MaskPolyp>& polyps, const std::vector<std::pair<double, double>>& cuts_mm);
 
 }  // namespace cf
