@@ -401,7 +401,7 @@ bool run_scan(const fs::path& mask, const fs::path& out, bool painted, const std
 }
 
 void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn,
-                bool painted, const std::vector<int>& only) {
+                bool painted, const std::vector<int>& only, bool cli) {
   cf::Stopwatch prep;
   cf::MaskCourse course(cf::read_mask(mask_file));
   const auto polyps = course.place_polyps(10, 1);
@@ -447,7 +447,7 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
     r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
     count_detected(reg, cs, cp, r);  // the polyps cut out of a scan are not there to hit
     print_row(r);
-    register_cli(sr, pr, work / ("register" + n), r);
+    if (cli) register_cli(sr, pr, work / ("register" + n), r);
   }
 }
 
@@ -457,16 +457,16 @@ int main(int argc, char** argv) {
   cf::bench::BenchCli cli("register_bench", "Supine-prone registration benchmark (see the file's header)");
   std::string phantoms, size = "full", work = "register_bench_work", synthetic_dir;
   std::vector<std::string> pair, truth;
-  double twist_deg = 0;
+  double twist_deg = 0, turn_deg = 0;
   CLI::App& app = cli.app();
   app.add_option("--phantom", phantoms, "phantom pairs of seeds N or N-M");
   int cuts_seed = 0;
-  std::string real_mask;
+  std::string real_mask;  // the options of --real-mask
   std::vector<double> table = {15, -30, 40};
-  double turn_deg = 0;
-  bool painted = false;
+  bool painted = false, no_cli = false;
   std::vector<int> only;
   app.add_flag("--painted", painted, "with --real-mask: paint each mask into a CT and run from the CT");
+  app.add_flag("--no-cli", no_cli, "with --real-mask: no `colonflat register` run per pair");
   app.add_option("--cases", only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
   app.add_option("--table", table, "with --real-mask: prone table shift in LPS mm")->expected(3);
@@ -479,7 +479,7 @@ int main(int argc, char** argv) {
   app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
-    if (!real_mask.empty()) real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only);
+    if (!real_mask.empty()) real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only, !no_cli);
     else if (cuts_seed > 0) cuts_table(cuts_seed, size, work);
     else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
