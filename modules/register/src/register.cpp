@@ -39,7 +39,7 @@ vtkSmartPointer<vtkStaticPointLocator> make_locator(const std::vector<Eigen::Vec
 // within kFarAlongMm along s (the image of a stretch the other scan lacks) goes to the slabs
 // (along_slabs.h): the bucket locator's shell search costs the cube of the distance there.
 struct ColonRegistration::Index {
-  static constexpr double kFarAlongMm = 10;  // a few locator buckets (about 2 mm each at 0.7 mm vertices)
+  static constexpr double kFarAlongMm = 10;  // a few locator buckets (about 4 vertices each)
   static constexpr double kSlabMm = 1;       // slab thickness along s
   vtkSmartPointer<vtkStaticPointLocator> lps, cylinder;
   std::vector<Eigen::Vector3d> embedded;
