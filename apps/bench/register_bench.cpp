@@ -1,32 +1,26 @@
-// Supine-prone registration benchmark (Release):
-//   register_bench              synthetic full-length pairs (1.5 m, 0.7 mm vertices; known
-//                               correspondence): match rate, errors, false matches, time.
+// Supine-prone registration benchmark (Release; modes and columns: docs/register.md, "Benchmark"):
+//   register_bench              synthetic full-length pairs (1.5 m, known correspondence), also
+//                               with stretches left out of one scan (issue 27).
 //   register_bench --phantom 1-5 [--size full|small] --work DIR
-//                               phantom pairs: `colonflat phantom --seed N [--position prone]`,
-//                               `colonflat run` on both CTs, `colonflat register`-equivalent, scored
-//                               against the phantom truth (polyp ids, centre lines). Needs
-//                               `colonflat phantom --position prone` (reported when missing).
+//                               phantom pairs (`colonflat phantom [--position prone]`, `colonflat run`).
 //   register_bench --cuts SEED [--size full|small] --work DIR
-//                               one phantom patient run from its true lumen masks, the prone mask
-//                               with stretches cut out (collapse, 25 % tagged dropped, split +3,
-//                               rectum cut short; issue 27), scored as --phantom.
-//   register_bench --write-synthetic DIR [--twist DEG]
-//                               writes a small synthetic pair as run folders DIR/supine, DIR/prone.
-//   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]
-//                               one existing pair of run folders (scored when truth is given).
-// Columns: polyps >= 6 mm; matched = truth polyps paired with themselves when the two truth lists
-// are matched through the registration; false = pairs joining different polyps; along / around =
-// median error of the registered position of each polyp (mm along the true prone centre line,
-// degrees around it); det_pairs / det_false = the same for the runs' detected candidates
-// (a candidate is a polyp's when within diameter/2 + 5 mm; det_false = a pair of a polyp's
-// candidate with another polyp's or a non-polyp one; det_np = pairs of two non-polyp candidates,
-// e.g. the same fold tip or noise site seen in both scans); time = registration wall time;
-// lps_along / lps_around = baseline without registration: the prone wall point nearest to the
-// supine polyp's LPS position (small when the prone colon barely moves in patient coordinates).
+//                               one phantom patient run from its true lumen masks, the masks cut
+//                               (collapse, tagged stretches dropped, split +3, rectum cut; issue 27).
+//   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG] [--painted] [--cases K...]
+//                               the real lumen mask with 10 synthetic polyps, cut as --cuts (by path
+//                               distance through the lumen), the prone mask moved on the table.
+//   register_bench --write-synthetic DIR [--twist DEG]     a small synthetic pair as run folders.
+//   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]   one pair of run folders.
+// Columns: polyps >= 6 mm seen in both; matched = truth polyps paired with themselves when the two
+// truth lists are matched through the registration; false = pairs joining different polyps;
+// along (median, max) / around = error of each polyp's registered position; det_* = the same for
+// the runs' detected candidates (det_np: two non-polyp candidates); time = registration wall time;
+// lps_* = baseline without registration (the same LPS point taken in the other scan).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,19 +32,19 @@
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/register/register.h"
 #include "colonflat/testdata/lumen_cut.h"
+#include "colonflat/testdata/mask_pair.h"
 #include "colonflat/testdata/synthetic_pair.h"
 
 namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = 3.141592653589793;
 
-using cf::bench::load_average;
-
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
+double largest(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }
 
 struct Row {
   std::string name;
@@ -58,20 +52,21 @@ struct Row {
   int polyps = 0, matched = 0, false_matches = 0, det_pairs = -1, det_false = -1, det_nonpolyp = 0;
   std::string pieces = "-";  // colon bands supine / prone (piecewise layout, pieces.h)
   int missed = 0;            // polyps seen in both scans and not paired
-  double along = NAN, around = NAN, seconds = 0;
+  double along = NAN, around = NAN, seconds = 0, along_max = NAN;  // along: median and largest error
   double lps_along = NAN, lps_around = NAN;  // baseline: the same LPS point taken in the other scan
 };
 
 void print_header() {
-  std::printf("load average %.2f\n", load_average());
-  std::printf("%-28s %9s %7s %6s %7s %5s %6s %9s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "pieces", "polyps",
-              "matched", "false", "missed", "along_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s",
+  std::printf("load average %.2f\n", cf::bench::load_average());
+  std::printf("%-28s %9s %7s %6s %7s %5s %6s %9s %7s %10s %9s %9s %6s %7s %11s %12s\n", "pair", "vertices", "pieces",
+              "polyps", "matched", "false", "missed", "along_mm", "max_mm", "around_deg", "det_pairs", "det_false", "det_np", "time_s",
               "lps_along", "lps_around");
 }
 
 void print_row(const Row& r) {
-  std::printf("%-28s %9zu %7s %6d %7d %5d %6d %9.1f %10.1f %9d %9d %6d %7.2f %11.1f %12.1f\n", r.name.c_str(),
-              r.vertices, r.pieces.c_str(), r.polyps, r.matched, r.false_matches, r.missed, r.along, r.around, r.det_pairs,
+  std::printf("%-28s %9zu %7s %6d %7d %5d %6d %9.1f %7.1f %10.1f %9d %9d %6d %7.2f %11.1f %12.1f\n", r.name.c_str(),
+              r.vertices, r.pieces.c_str(), r.polyps, r.matched, r.false_matches, r.missed, r.along, r.along_max, r.around,
+              r.det_pairs,
               r.det_false, r.det_nonpolyp, r.seconds, r.lps_along, r.lps_around);
   std::fflush(stdout);
 }
@@ -114,7 +109,7 @@ Row synthetic_row(const std::string& name, const cf::SyntheticPairOptions& o) {
     const double d = std::fmod(std::abs(pair.prone_phi[size_t(w)] - q.phi_rad), 2 * kPi);
     around.push_back((d > kPi ? 2 * kPi - d : d) * 180 / kPi);
   }
-  r.along = median(along), r.around = median(around);
+  r.along = median(along), r.around = median(around), r.along_max = largest(along);
   count_id_pairs(reg.matching(), r.det_pairs, r.det_false);
   return r;
 }
@@ -206,10 +201,23 @@ std::pair<double, double> truth_error(const Truth& t, const Eigen::Vector3d& map
 }
 
 // The truth polyp a detected candidate stands for (-1 = none).
-int hit(const Truth& t, const cf::ScanCandidate& c) {
-  for (const auto& q : t.polyps)
-    if ((q.lps - c.lps).norm() <= q.diameter / 2 + 5) return q.id;
+int hit(const std::vector<cf::ScanCandidate>& truth, const cf::ScanCandidate& c) {
+  for (const auto& q : truth)
+    if ((q.lps - c.lps).norm() <= q.size_mm / 2 + 5) return q.id;
   return -1;
+}
+
+// det_pairs / det_false / det_np of the registration's pairs of detected candidates.
+void count_detected(const cf::ColonRegistration& reg, const std::vector<cf::ScanCandidate>& ts,
+                    const std::vector<cf::ScanCandidate>& tp, Row& r) {
+  r.det_pairs = r.det_false = r.det_nonpolyp = 0;
+  for (const auto& m : reg.matching().pairs) {
+    int hs = -2, hp = -3;
+    for (const auto& c : reg.supine().candidates) if (c.id == m.supine_id) hs = hit(ts, c);
+    for (const auto& c : reg.prone().candidates) if (c.id == m.prone_id) hp = hit(tp, c);
+    if (hs == hp) (hs >= 0 ? r.det_pairs : r.det_nonpolyp) += 1;
+    else r.det_false += 1;
+  }
 }
 
 using Cuts = std::vector<std::pair<double, double>>;
@@ -226,7 +234,7 @@ std::vector<cf::ScanCandidate> as_candidates(const Truth& t, const Cuts& cuts = 
 }
 
 Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& pro_run, const fs::path& sup_truth,
-             const fs::path& pro_truth, const Cuts& prone_cuts = {}) {
+             const fs::path& pro_truth, const Cuts& prone_cuts = {}, const Cuts& supine_cuts = {}) {
   const cf::ColonScan sup = cf::read_run_dir(sup_run), pro = cf::read_run_dir(pro_run);
   Row r{name, sup.lps.size()};
   cf::Stopwatch clock;
@@ -239,7 +247,7 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
     return r;
   }
   const Truth ts = read_truth(sup_truth), tp = read_truth(pro_truth);
-  const auto cs = as_candidates(ts), cp = as_candidates(tp, prone_cuts);
+  const auto cs = as_candidates(ts, supine_cuts), cp = as_candidates(tp, prone_cuts);
   r.polyps = 0;
   for (const auto& q : cs)
     for (const auto& p : cp) r.polyps += p.id == q.id;
@@ -259,16 +267,14 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
         const auto [la, lb] = truth_error(tp, pro.lps[size_t(w)], p.lps);
         lps_along.push_back(la), lps_around.push_back(lb);
       }
-  r.along = median(along), r.around = median(around);
+  r.along = median(along), r.around = median(around), r.along_max = largest(along);
   r.lps_along = median(lps_along), r.lps_around = median(lps_around);
-  r.det_pairs = r.det_false = 0;
-  for (const auto& m : reg.matching().pairs) {
-    int hs = -2, hp = -3;
-    for (const auto& c : sup.candidates) if (c.id == m.supine_id) hs = hit(ts, c);
-    for (const auto& c : pro.candidates) if (c.id == m.prone_id) hp = hit(tp, c);
-    if (hs == hp) (hs >= 0 ? r.det_pairs : r.det_nonpolyp) += 1;
-    else r.det_false += 1;
-  }
+  auto all = [](const Truth& t) {
+    std::vector<cf::ScanCandidate> out;
+    for (const auto& q : t.polyps) out.push_back({q.id, q.lps, q.diameter, 1});
+    return out;
+  };
+  count_detected(reg, all(ts), all(tp), r);
   return r;
 }
 
@@ -308,11 +314,48 @@ void phantom_table(int first, int last, const std::string& size, const fs::path&
   }
 }
 
-// One phantom patient, both positions run from their true lumen masks; the prone mask with
-// stretches cut out (lumen_cut.h) as real segmentations differ: a collapse, a fully tagged stretch
-// left out, the colon split into 3 more pieces, the rectum cut short by the catheter.
+// A scan's mask cut (and moved); the run folder from it (`colonflat run MASK --from reconstruct`).
+bool run_mask(const fs::path& mask, const fs::path& out) {
+  return fs::exists(out / "flat.vtp") ||
+         colonflat({"run", mask.string(), "--from", "reconstruct", "-o", out.string(), "-q"}) == 0;
+}
+
+// `colonflat register` on the two run folders (the command users run): its pairs of detected
+// candidates, wall and process CPU seconds, printed under the row.
+void register_cli(const fs::path& sup_run, const fs::path& pro_run, const fs::path& out, const Row& r) {
+  fs::remove_all(out);
+  cf::Stopwatch clock;
+  const std::clock_t cpu = std::clock();
+  if (colonflat({"register", sup_run.string(), pro_run.string(), "-o", out.string(), "--no-review", "-q"}) != 0) return;
+  const double cpu_s = double(std::clock() - cpu) / CLOCKS_PER_SEC, wall = clock.seconds();
+  std::ifstream in(out / "registration.json");
+  const auto j = nlohmann::json::parse(in);
+  std::printf("  colonflat register: %zu candidate pairs (bench: %d + %d + %d), %.1f s wall, %.1f s CPU\n",
+              j["candidates"]["pairs"].size(), r.det_pairs, r.det_false, r.det_nonpolyp, wall, cpu_s);
+}
+
+struct CutCase {
+  std::string name;
+  Cuts supine, prone;
+};
+
+// The kinds of difference of issue 27 on a colon of length L (mm along its course): a collapse,
+// fully tagged stretches left out (100 mm; 25 % of the colon), the colon split into 3 more pieces,
+// the rectum cut short by the catheter, both scans differing at once.
+std::vector<CutCase> cut_cases(double L) {
+  return {{"uncut", {}, {}},
+          {"collapse 20 mm at 45 %", {}, {{0.45 * L, 0.45 * L + 20}}},
+          {"tagged 25 % dropped", {}, {{0.40 * L, 0.65 * L}}},
+          {"split +3 (15 mm each)", {}, {{0.25 * L, 0.25 * L + 15}, {0.5 * L, 0.5 * L + 15}, {0.75 * L, 0.75 * L + 15}}},
+          {"rectum cut 60 mm", {}, {{0, 60}}},
+          {"tagged 100 mm at 70 %", {}, {{0.70 * L, 0.70 * L + 100}}},
+          {"both: sup 20+100, pro 25 %", {{0.2 * L, 0.2 * L + 20}, {0.8 * L, 0.8 * L + 100}}, {{0, 50}, {0.35 * L, 0.6 * L}}}};
+}
+
+// One phantom patient, both positions run from their true lumen masks, the masks cut along the
+// phantom's centre line (lumen_cut.h) as real segmentations differ.
 void cuts_table(int seed, const std::string& size, const fs::path& work) {
-  std::printf("Phantom seed %d (%s), both scans run from the lumen mask (--from reconstruct); prone mask cut\n", seed,
+  std::printf("Phantom seed %d (%s), both scans run from the lumen mask (--from reconstruct); masks cut\n", seed,
               size.c_str());
   const fs::path d = work / ("cuts_seed" + std::to_string(seed));
   for (const std::string position : {"supine", "prone"}) {
@@ -321,24 +364,90 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
     if (position == "prone") a.insert(a.end(), {"--position", "prone"});
     if (!fs::exists(ph / "polyps.json") && colonflat(a) != 0) return;
   }
-  auto run_mask = [&](const fs::path& mask, const fs::path& out) {
-    return fs::exists(out / "flat.vtp") || colonflat({"run", mask.string(), "--from", "reconstruct", "-o", out.string(), "-q"}) == 0;
-  };
   if (!run_mask(d / "supine_phantom" / "lumen_mask.nrrd", d / "supine_run")) return;
-  const cf::PhantomCentreline cl = cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json");
-  const double L = cl.arc_mm.back();
-  const std::vector<std::pair<std::string, Cuts>> cases = {
-      {"uncut", {}},
-      {"collapse 20 mm at 45 %", {{0.45 * L, 0.45 * L + 20}}},
-      {"tagged 25 % dropped", {{0.40 * L, 0.65 * L}}},
-      {"split +3 (15 mm each)", {{0.25 * L, 0.25 * L + 15}, {0.5 * L, 0.5 * L + 15}, {0.75 * L, 0.75 * L + 15}}},
-      {"rectum cut 60 mm", {{0, 60}}}};
+  const auto cases = cut_cases(cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back());
   print_header();
   for (size_t k = 0; k < cases.size(); ++k) {
-    const fs::path mask = d / ("prone_cut" + std::to_string(k) + ".nrrd"), run = d / ("prone_run" + std::to_string(k));
-    if (!fs::exists(mask)) cf::cut_lumen_mask(d / "prone_phantom" / "lumen_mask.nrrd", cl, cases[k].second, mask);
-    if (!run_mask(mask, run)) continue;
-    print_row(pair_row(cases[k].first, d / "supine_run", run, d / "supine_phantom", d / "prone_phantom", cases[k].second));
+    const std::string n = std::to_string(k);
+    fs::path sup_run = d / "supine_run";
+    for (const std::string pos : {"supine", "prone"}) {
+      const Cuts& cuts = pos == "supine" ? cases[k].supine : cases[k].prone;
+      if (pos == "supine" && cuts.empty()) continue;
+      const fs::path mask = d / (pos + "_cut" + n + ".nrrd"), ph = d / (pos + "_phantom");
+      if (!fs::exists(mask))
+        cf::cut_lumen_mask(ph / "lumen_mask.nrrd", cf::read_phantom_centreline(ph / "centerline.json"), cuts, mask);
+      if (pos == "supine") sup_run = d / ("supine_run" + n);
+      if (!run_mask(mask, d / (pos + "_run" + n))) return;
+    }
+    const Row r = pair_row(cases[k].name, sup_run, d / ("prone_run" + n), d / "supine_phantom", d / "prone_phantom",
+                           cases[k].prone, cases[k].supine);
+    print_row(r);
+    register_cli(sup_run, d / ("prone_run" + n), d / ("register" + n), r);
+  }
+}
+
+// Real anatomy (issue 27): the shared real lumen mask with 10 synthetic polyps on its wall
+// (mask_pair.h), both scans cut by path distance through the lumen, the prone mask moved on the
+// table (`shift` mm, `turn` degrees about the superior axis). along = |path distance of the mapped
+// supine polyp - that of the polyp| (mm along the lumen's course).
+// With `painted`: each mask painted into a CT (`colonflat phantom --from-mask`, the position's
+// pools, a fully tagged stretch, small bowel) and run from the CT, segmentation included.
+bool run_scan(const fs::path& mask, const fs::path& out, bool painted, const std::string& position) {
+  if (!painted || fs::exists(out / "flat.vtp")) return run_mask(mask, out);
+  const fs::path ct = out.string() + "_ct";
+  return (fs::exists(ct / "ct.nrrd") || colonflat({"phantom", "--from-mask", mask.string(), "-o", ct.string(), "--position",
+                                                   position, "-q"}) == 0) &&
+         colonflat({"run", (ct / "ct.nrrd").string(), "-o", out.string(), "-q"}) == 0;
+}
+
+void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn,
+                bool painted, const std::vector<int>& only, bool cli) {
+  cf::Stopwatch prep;
+  cf::MaskCourse course(cf::read_mask(mask_file));
+  const auto polyps = course.place_polyps(10, 1);
+  const double L = course.length_mm();
+  std::printf("Real mask %s: course %.0f mm, %zu polyps placed (%.1f s); prone moved (%.0f, %.0f, %.0f) mm, %.1f deg\n",
+              mask_file.filename().c_str(), L, polyps.size(), prep.seconds(), shift.x(), shift.y(), shift.z(), turn);
+  fs::create_directories(work);
+  auto seen = [&](const Cuts& cuts, bool prone) {
+    std::vector<cf::ScanCandidate> out;
+    for (const auto& q : cf::polyps_seen(polyps, cuts))
+      out.push_back({q.id, prone ? cf::MaskCourse::moved(q.lps, course.centroid(), shift, turn) : q.lps, q.diameter_mm, 1});
+    return out;
+  };
+  print_header();
+  const auto cases = cut_cases(L);
+  for (size_t k = 0; k < cases.size(); ++k) {
+    if (!only.empty() && std::find(only.begin(), only.end(), int(k)) == only.end()) continue;
+    const std::string n = std::to_string(k);
+    const CutCase& c = cases[k];
+    const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
+    if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
+    if (!fs::exists(pm)) cf::write_mask(course.cut_and_move(c.prone, shift, turn), pm);
+    const fs::path sr = work / ("supine_run" + (c.supine.empty() ? std::string() : n)), pr = work / ("prone_run" + n);
+    if (!run_scan(sm, sr, painted, "supine") || !run_scan(pm, pr, painted, "prone")) return;
+    const cf::ColonScan sup = cf::read_run_dir(sr), pro = cf::read_run_dir(pr);
+    Row r{c.name, sup.lps.size()};
+    cf::Stopwatch clock;
+    cf::ColonRegistration reg(sup, pro);
+    reg.run();
+    r.seconds = clock.seconds(), r.pieces = piece_counts(reg);
+    const auto cs = seen(c.supine, false), cp = seen(c.prone, true);
+    r.polyps = 0;
+    std::vector<double> along;
+    for (const auto& q : cs)
+      for (const auto& p : cp)
+        if (q.id == p.id) {
+          ++r.polyps;
+          const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
+          const Eigen::Vector3d at = cf::MaskCourse::unmoved(m, course.centroid(), shift, turn);
+          if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(at) - polyps[size_t(q.id - 1)].path_mm));
+        }
+    count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
+    r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
+    count_detected(reg, cs, cp, r);  // the polyps cut out of a scan are not there to hit
+    print_row(r);
+    if (cli) register_cli(sr, pr, work / ("register" + n), r);
   }
 }
 
@@ -348,10 +457,20 @@ int main(int argc, char** argv) {
   cf::bench::BenchCli cli("register_bench", "Supine-prone registration benchmark (see the file's header)");
   std::string phantoms, size = "full", work = "register_bench_work", synthetic_dir;
   std::vector<std::string> pair, truth;
-  double twist_deg = 0;
+  double twist_deg = 0, turn_deg = 0;
   CLI::App& app = cli.app();
   app.add_option("--phantom", phantoms, "phantom pairs of seeds N or N-M");
   int cuts_seed = 0;
+  std::string real_mask;  // the options of --real-mask
+  std::vector<double> table = {15, -30, 40};
+  bool painted = false, no_cli = false;
+  std::vector<int> only;
+  app.add_flag("--painted", painted, "with --real-mask: paint each mask into a CT and run from the CT");
+  app.add_flag("--no-cli", no_cli, "with --real-mask: no `colonflat register` run per pair");
+  app.add_option("--cases", only, "with --real-mask: only these cases (0-6)");
+  app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
+  app.add_option("--table", table, "with --real-mask: prone table shift in LPS mm")->expected(3);
+  app.add_option("--turn", turn_deg, "with --real-mask: prone turned about the superior axis (degrees)");
   app.add_option("--cuts", cuts_seed, "one phantom patient run from its masks, the prone mask cut (issue 27)");
   app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
   app.add_option("--work", work, "work folder of the phantom pairs");
@@ -360,17 +479,16 @@ int main(int argc, char** argv) {
   app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
-    if (cuts_seed > 0) {
-      cuts_table(cuts_seed, size, work);
-    } else if (!phantoms.empty()) {
+    if (!real_mask.empty()) real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only, !no_cli);
+    else if (cuts_seed > 0) cuts_table(cuts_seed, size, work);
+    else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
       phantom_table(first, last, size, work);
     } else if (!synthetic_dir.empty()) {
       cf::SyntheticPairOptions o;
       o.twist_deg = twist_deg;
-      const cf::SyntheticPair pair_data = cf::make_synthetic_pair(o);
-      cf::write_run_dir(pair_data.supine, fs::path(synthetic_dir) / "supine");
-      cf::write_run_dir(pair_data.prone, fs::path(synthetic_dir) / "prone");
+      const cf::SyntheticPair p = cf::make_synthetic_pair(o);
+      cf::write_run_dir(p.supine, fs::path(synthetic_dir) / "supine"), cf::write_run_dir(p.prone, fs::path(synthetic_dir) / "prone");
     } else if (!pair.empty()) {
       print_header();
       print_row(pair_row("pair", pair[0], pair[1], truth.empty() ? "" : truth[0], truth.empty() ? "" : truth[1]));

@@ -12,6 +12,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
+#include "along_slabs.h"
 
 namespace cf {
 namespace {
@@ -34,27 +35,33 @@ vtkSmartPointer<vtkStaticPointLocator> make_locator(const std::vector<Eigen::Vec
 }  // namespace
 
 // Point locators of one scan: its wall in LPS, and its registered vertices in the cylinder
-// embedding (s, R cos theta, R sin theta), R = the scan's mean radius.
+// embedding (s, R cos theta, R sin theta), R = the scan's mean radius. A query with no vertex
+// within kFarAlongMm along s (the image of a stretch the other scan lacks) goes to the slabs
+// (along_slabs.h): the bucket locator's shell search costs the cube of the distance there.
 struct ColonRegistration::Index {
+  static constexpr double kFarAlongMm = 10;  // a few locator buckets (about 4 vertices each)
+  static constexpr double kSlabMm = 1;       // slab thickness along s
   vtkSmartPointer<vtkStaticPointLocator> lps, cylinder;
+  std::vector<Eigen::Vector3d> embedded;
   std::vector<int> cylinder_vertex;  // locator point -> scan vertex
   double radius = 1;
+  std::unique_ptr<AlongSlabs> slabs;
   Index(const ColonScan& scan, const ScanCoordinates& c) : radius(std::max(1.0, c.mean_radius_mm)) {
     lps = make_locator(scan.lps);
-    std::vector<Eigen::Vector3d> emb;
     for (size_t v = 0; v < c.s.size(); ++v) {
       if (std::isnan(c.s[v])) continue;
-      emb.push_back(embed(c.s[v], c.theta[v]));
+      embedded.push_back(embed(c.s[v], c.theta[v]));
       cylinder_vertex.push_back(int(v));
     }
-    cylinder = make_locator(emb);
+    cylinder = make_locator(embedded);
+    slabs = std::make_unique<AlongSlabs>(embedded, kSlabMm);
   }
   Eigen::Vector3d embed(double s, double theta) const {
     return {s, radius * std::cos(theta), radius * std::sin(theta)};
   }
   int nearest(double s, double theta) const {
     const Eigen::Vector3d q = embed(s, theta);
-    const vtkIdType id = cylinder->FindClosestPoint(q.data());
+    const vtkIdType id = slabs->gap_mm(s) > kFarAlongMm ? slabs->nearest(q) : cylinder->FindClosestPoint(q.data());
     return id < 0 ? -1 : cylinder_vertex[size_t(id)];
   }
 };
