@@ -246,6 +246,7 @@ struct AreaCorrection {
   int iterations = 0;
   std::size_t faces = 0;  // faces the correction worked on
   double energy_before = 0, energy_after = 0;
+  const char* stop = "";  // why the (last) descent stopped (proxy_descent.h)
 };
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
