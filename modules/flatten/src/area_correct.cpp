@@ -11,7 +11,9 @@
 // branches are fixed, so the map stays bijective.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
+#include "colonflat/core/threads.h"
 #include "colonflat/core/union_find.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
@@ -240,8 +242,18 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
     minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res);
     return res;
   }
-  for (std::vector<int>& piece : connected_pieces(s, faces))
-    minimise(s, emb, std::move(piece), free_vertex, area3, scale, o, true, res);
+  // The pieces side by side: each reads and moves only its own vertices (pieces share none), and
+  // their results are combined in piece order, so the map is the same for any thread count.
+  std::vector<std::vector<int>> pieces = connected_pieces(s, faces);
+  std::vector<AreaCorrection> part(pieces.size());
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t i = 0; i < pieces.size(); ++i)
+    tasks.push_back([&, i] { minimise(s, emb, std::move(pieces[i]), free_vertex, area3, scale, o, true, part[i]); });
+  parallel_tasks(tasks);
+  for (const AreaCorrection& p : part) {
+    res.energy_before += p.energy_before, res.energy_after += p.energy_after;
+    if (p.iterations >= res.iterations) res.iterations = p.iterations, res.stop = p.stop;
+  }
   return res;
 }
 

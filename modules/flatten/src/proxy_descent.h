@@ -53,7 +53,13 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   const std::vector<int>& unknowns = sys.unknowns();
   const CornerGather gather(s, energy.faces(), sys);
   std::vector<std::array<V2, 3>> face_gradients(energy.faces().size());
-  std::vector<V2> trial = emb.pos;  // emb.pos with the unknowns moved (nothing else ever differs)
+  // emb.pos with the unknowns moved, filled only where the region reads it (its faces' corners):
+  // regions far apart may run side by side on one embedding, each reading and writing its own.
+  std::vector<V2> trial(emb.pos.size());
+  for (const std::vector<int>* list : {&energy.faces(), &judged})
+    for (int f : *list)
+      for (int v : s.t[f]) trial[v] = emb.pos[v];
+  for (int v : unknowns) trial[v] = emb.pos[v];
   auto move_to = [&](const Eigen::MatrixXd& d, double t) {
     for_each_block(unknowns.size(), [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) trial[unknowns[i]] = emb.pos[unknowns[i]] + t * V2(d(i, 0), d(i, 1));
