@@ -115,11 +115,13 @@ void hold_crushed(const Surface& s, const Embedding& emb, const std::vector<doub
 // The local region: the pockets not shown (area ratio at `scale` below coverage_min_ratio) grown
 // by kLocalRings vertex rings; a piece of it whose 2D area is still below kLocalRoom x its 3D area
 // (a pouch left in the band, a wide stretch the conformal map shrank: the rings around it cannot
-// give it room) grows by kLocalRings more, up to kLocalGrowths times (the balancing's region rule).
+// give it room) grows by kLocalRings more, up to `growths` times (the balancing's region rule;
+// kLocalGrowths in the second local pass, 0 in the first: grown regions merge pockets, and a merged
+// piece gets fewer steps and shares its line search with the stumps in it).
 constexpr int kLocalRings = 12, kLocalGrowths = 3;
 constexpr double kLocalRoom = 0.6;
 std::vector<char> local_region(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
-                               const std::vector<double>& area3, double scale, double min_ratio) {
+                               const std::vector<double>& area3, double scale, double min_ratio, int growths) {
   std::vector<char> in(s.t.size(), 0);
   std::vector<int> ring;
   for (std::size_t f = 0; f < s.t.size(); ++f)
@@ -133,7 +135,7 @@ std::vector<char> local_region(const Surface& s, const std::vector<std::vector<i
             if (!in[g]) in[g] = 1, next.push_back(g);
       ring.swap(next);
     }
-    if (growth == kLocalGrowths || ring.empty()) return in;
+    if (growth == growths || ring.empty()) return in;
     UnionFind sets(s.p.size());  // pieces of the region and their 2D / 3D areas
     for (std::size_t f = 0; f < s.t.size(); ++f)
       if (in[f]) sets.unite(std::uint32_t(s.t[f][0]), std::uint32_t(s.t[f][1])), sets.unite(std::uint32_t(s.t[f][0]), std::uint32_t(s.t[f][2]));
@@ -159,8 +161,8 @@ std::vector<char> local_region(const Surface& s, const std::vector<std::vector<i
 std::vector<int> correction_faces(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
                                   const std::vector<double>& area3, const std::vector<char>& fixed,
                                   const std::vector<char>& degenerate, double scale, const FlattenOptions& o,
-                                  bool local, std::vector<char>& free_vertex) {
-  const std::vector<char> in = local ? local_region(s, vf, emb, area3, scale, o.coverage_min_ratio)
+                                  bool local, bool grow, std::vector<char>& free_vertex) {
+  const std::vector<char> in = local ? local_region(s, vf, emb, area3, scale, o.coverage_min_ratio, grow ? kLocalGrowths : 0)
                                      : std::vector<char>(s.t.size(), 1);
   std::vector<int> faces;
   free_vertex.assign(s.p.size(), 0);
@@ -225,7 +227,7 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
 
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o) {
+                            const FlattenOptions& o, bool grow) {
   AreaCorrection res;
   if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
   std::vector<double> area3(s.t.size());
@@ -236,7 +238,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   }
   const double scale = a2 > 0 ? a3 / a2 : 1.0;
   std::vector<char> free_vertex;
-  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, scale, o, local, free_vertex);
+  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
   res.faces = faces.size();
   if (!local) {
     minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res);

@@ -165,9 +165,9 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
 
 // Runs one area correction pass (COLONFLAT_FLATTEN_DEBUG: what it did).
 static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
-                        const std::vector<char>& degenerate, const FlattenOptions& o, bool local) {
+                        const std::vector<char>& degenerate, const FlattenOptions& o, bool local, bool grow = false) {
   const Stopwatch sw;
-  const AreaCorrection corr = correct_area(w.ann, vf, w.emb, fixed, degenerate, local, o);
+  const AreaCorrection corr = correct_area(w.ann, vf, w.emb, fixed, degenerate, local, o, grow);
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
     std::fprintf(stderr, "flatten debug area correction (%s): %zu faces, %d iterations, energy %.6g -> %.6g (%s), %.2f s\n",
                  local ? "local" : "whole band", corr.faces, corr.iterations, corr.energy_before, corr.energy_after,
@@ -217,8 +217,11 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
     w.seg.corrected_iterations = correct_pass(w, vf, fixed, degenerate, o, false);
     need.local = needs_correction(w, degenerate, o).local;
   }
-  if (need.local)
-    w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, fixed, degenerate, o, true));
+  for (bool grow : {false, true}) {  // pockets; then, grown until they have room, those left
+    if (!need.local) break;
+    w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, fixed, degenerate, o, true, grow));
+    need.local = !grow && needs_correction(w, degenerate, o).local;
+  }
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o);
   w.seg.balanced_vertices = bal.vertices;

@@ -252,9 +252,11 @@ struct AreaCorrection {
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
 // 10 x area_correction_iterations steps there while faces x steps <= 1e7, each vertex-connected
 // piece on its own (`iterations`: the most steps any piece took).
+// `grow` (local): a piece whose region has no room (2D area < 0.6 x 3D) grows by 12 rings more, up
+// to 3 times (the second local pass, for pockets the first one could not open).
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o);
+                            const FlattenOptions& o, bool grow = false);
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
