@@ -4,6 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <unordered_map>
+
+#include "colonflat/core/run_stats.h"
+#include "colonflat/core/union_find.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -28,6 +32,50 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
   for (const FaceDistortion& d : fd) crowded += !d.degenerate && too_small_in_map(d.area2, d.area3);
   std::fprintf(stderr, "flatten debug %s: crowded %zu, flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
                step, crowded, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
+}
+
+// COLONFLAT_FLATTEN_DEBUG=1: the faces shown below 0.1 (at the band's area scale) by decade of
+// their area ratio, and their largest vertex-connected pockets (faces, mm2, smallest ratio, LPS).
+void debug_pockets(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
+  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  const Surface& s = w.ann;
+  double a2 = 0, a3 = 0;
+  std::vector<double> ratio(s.t.size(), 1.0);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (!degenerate[f]) a2 += std::max(w.emb.area2(s, int(f)), 0.0), a3 += face_area_3d(s, int(f));
+  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  UnionFind sets(s.p.size());
+  std::array<double, 9> decade_area{};
+  std::array<std::size_t, 9> decade_faces{};
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (degenerate[f]) continue;
+    ratio[f] = scale * w.emb.area2(s, int(f)) / std::max(face_area_3d(s, int(f)), 1e-300);
+    if (!(ratio[f] < 0.1)) continue;
+    const int d = ratio[f] <= 0 ? 8 : std::clamp(int(-std::log10(ratio[f])), 1, 8);
+    decade_area[d] += face_area_3d(s, int(f)), ++decade_faces[d];
+    for (int k = 1; k < 3; ++k) sets.unite(std::uint32_t(s.t[f][0]), std::uint32_t(s.t[f][k]));
+  }
+  for (int d = 1; d <= 8; ++d)
+    std::fprintf(stderr, "flatten debug pockets %s: ratio in [1e-%d, 1e-%d): %zu faces, %.0f mm2\n", step, d + 1, d,
+                 decade_faces[d], decade_area[d]);
+  struct Pocket { std::size_t faces = 0, below3 = 0; double area = 0, min_ratio = 1; V3 c = V3::Zero(); };
+  std::unordered_map<std::uint32_t, Pocket> pockets;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (degenerate[f] || !(ratio[f] < 0.1)) continue;
+    Pocket& p = pockets[sets.find(std::uint32_t(s.t[f][0]))];
+    const double a = face_area_3d(s, int(f));
+    ++p.faces, p.area += a, p.min_ratio = std::min(p.min_ratio, ratio[f]), p.below3 += ratio[f] < 1e-3;
+    p.c += a * (s.p[s.t[f][0]] + s.p[s.t[f][1]] + s.p[s.t[f][2]]) / 3;
+  }
+  std::vector<Pocket> list;
+  for (auto& [root, p] : pockets) list.push_back(p);
+  std::sort(list.begin(), list.end(), [](const Pocket& a, const Pocket& b) { return a.area > b.area; });
+  for (std::size_t i = 0; i < std::min<std::size_t>(list.size(), 25); ++i) {
+    const Pocket& p = list[i];
+    const V3 c = p.c / std::max(p.area, 1e-300);
+    std::fprintf(stderr, "flatten debug pocket %s: %zu faces (%zu below 1e-3), %.1f mm2, min ratio %.2g, LPS %.1f %.1f %.1f\n",
+                 step, p.faces, p.below3, p.area, p.min_ratio, c.x(), c.y(), c.z());
+  }
 }
 
 
@@ -89,13 +137,16 @@ std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double ban
 
 }  // namespace
 
-// Whether a band needs the area correction: on the whole band when its area ratio 5th percentile
-// is below 0.25, its 95th above 4 or its quasi-conformal mean above 1.45; on pockets only (local)
-// when just more than 0.25 % of its wall is shown below coverage_min_ratio (margins under the
-// targets 0.2, 5, 1.5 and 99.5 %). A band within all of them is left as it is: on a large colon
-// a global correction costs several times the conformal solve.
-enum class Correction { none, local, global };
-static Correction needs_correction(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o) {
+// Which area corrections a band needs: on the whole band when its area ratio 5th percentile is
+// below 0.25, its 95th above 4 or its quasi-conformal mean above 1.45; on pockets (local) when
+// more than 0.25 % of its wall is shown below coverage_min_ratio (margins under the targets 0.2,
+// 5, 1.5 and 99.5 %). A band within all of them is left as it is: on a large colon a whole-band
+// correction costs several times the conformal solve. The whole-band pass holds crushed pockets
+// (area_correct.cpp), so pockets left after it are opened by a local pass.
+struct CorrectionNeed {
+  bool global = false, local = false;
+};
+static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o) {
   const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
   double a2 = 0, a3 = 0;
   for (const FaceDistortion& d : fd)
@@ -109,8 +160,22 @@ static Correction needs_correction(const SegmentWork& w, const std::vector<char>
     if (!too_small_in_map(d.area2, d.area3)) in_map.push_back(d);
   }
   const DistortionStats st = stats_of(in_map);
-  if (st.area_p05 < 0.25 || st.area_p95 > 4 || st.qc_mean > 1.45) return Correction::global;
-  return hidden > 0.0025 * a3 ? Correction::local : Correction::none;
+  return {st.area_p05 < 0.25 || st.area_p95 > 4 || st.qc_mean > 1.45, hidden > 0.0025 * a3};
+}
+
+// Runs one area correction pass (COLONFLAT_FLATTEN_DEBUG: what it did).
+static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
+                        const std::vector<char>& degenerate, const FlattenOptions& o, bool local, bool grow = false) {
+  const Stopwatch sw;
+  const AreaCorrection corr = correct_area(w.ann, vf, w.emb, fixed, degenerate, local, o, grow);
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
+    std::fprintf(stderr, "flatten debug area correction (%s): %zu faces, %d iterations, energy %.6g -> %.6g (%s), %.2f s\n",
+                 local ? "local" : "whole band", corr.faces, corr.iterations, corr.energy_before, corr.energy_after,
+                 corr.stop, sw.seconds());
+    debug_stats(local ? "local area correction" : "area correction", w, degenerate);
+    debug_pockets(local ? "local area correction" : "area correction", w, degenerate);
+  }
+  return corr.iterations;
 }
 
 // Band length: the centreline length L, moved towards the conformal length by at most 8 % (the
@@ -146,15 +211,23 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   w.seg.period = period;
   w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
   debug_stats("reparametrised", w, degenerate);
-  if (const Correction mode = needs_correction(w, degenerate, o); mode != Correction::none) {
-    const AreaCorrection corr = correct_area(w.ann, vf, emb, fixed, degenerate, mode == Correction::local, o);
-    w.seg.corrected_iterations = corr.iterations;
-    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-      std::fprintf(stderr, "flatten debug area correction: %zu faces, %d iterations, energy %.6g -> %.6g\n", corr.faces,
-                   corr.iterations, corr.energy_before, corr.energy_after);
-    debug_stats("area correction", w, degenerate);
+  debug_pockets("reparametrised", w, degenerate);
+  CorrectionNeed need = needs_correction(w, degenerate, o);
+  if (need.global) {
+    w.seg.corrected_iterations = correct_pass(w, vf, fixed, degenerate, o, false);
+    need.local = needs_correction(w, degenerate, o).local;
   }
-  w.seg.balanced_vertices = balance_area(w.ann, vf, emb, fixed, degenerate, o).vertices;
+  for (bool grow : {false, true}) {  // pockets; then, grown until they have room, those left
+    if (!need.local) break;
+    w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, fixed, degenerate, o, true, grow));
+    need.local = !grow && needs_correction(w, degenerate, o).local;
+  }
+  const Stopwatch sw;
+  const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o);
+  w.seg.balanced_vertices = bal.vertices;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug balance: %zu faces, %zu iterations, %.2f s\n", bal.faces, bal.iterations,
+                 sw.seconds());
 }
 
 }  // namespace cf::flat_detail

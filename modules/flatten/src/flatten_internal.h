@@ -246,14 +246,17 @@ struct AreaCorrection {
   int iterations = 0;
   std::size_t faces = 0;  // faces the correction worked on
   double energy_before = 0, energy_after = 0;
+  const char* stop = "";  // why the (last) descent stopped (proxy_descent.h)
 };
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
 // 10 x area_correction_iterations steps there while faces x steps <= 1e7, each vertex-connected
 // piece on its own (`iterations`: the most steps any piece took).
+// `grow` (local): a piece whose region has no room (2D area < 0.6 x 3D) grows by 12 rings more, up
+// to 3 times (the second local pass, for pockets the first one could not open).
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o);
+                            const FlattenOptions& o, bool grow = false);
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with

@@ -21,6 +21,9 @@ namespace cf::flat_detail {
 struct DescentResult {
   int steps = 0;                                // steps taken (the last one, below min_gain, not counted)
   double energy_before = 0, energy_after = 0;
+  // Why it stopped: "steps" (max_steps taken), "converged" (gain below min_gain), "no descent"
+  // (no step lowers E, or the direction does not descend), "not injective" (E infinite at the start).
+  const char* stop = "steps";
 };
 
 // The gradient over the unknowns of a region system from per-face corner gradients: each unknown
@@ -43,11 +46,20 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
                             double min_gain) {
   DescentResult res;
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
-  if (e0 >= Energy::kHuge) return res;  // the region is not injective: leave it
+  if (e0 >= Energy::kHuge) {  // the region is not injective: leave it
+    res.stop = "not injective";
+    return res;
+  }
   const std::vector<int>& unknowns = sys.unknowns();
   const CornerGather gather(s, energy.faces(), sys);
   std::vector<std::array<V2, 3>> face_gradients(energy.faces().size());
-  std::vector<V2> trial = emb.pos;  // emb.pos with the unknowns moved (nothing else ever differs)
+  // emb.pos with the unknowns moved, filled only where the region reads it (its faces' corners):
+  // regions far apart may run side by side on one embedding, each reading and writing its own.
+  std::vector<V2> trial(emb.pos.size());
+  for (const std::vector<int>* list : {&energy.faces(), &judged})
+    for (int f : *list)
+      for (int v : s.t[f]) trial[v] = emb.pos[v];
+  for (int v : unknowns) trial[v] = emb.pos[v];
   auto move_to = [&](const Eigen::MatrixXd& d, double t) {
     for_each_block(unknowns.size(), [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) trial[unknowns[i]] = emb.pos[unknowns[i]] + t * V2(d(i, 0), d(i, 1));
@@ -58,7 +70,10 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     const Eigen::MatrixXd g = gather.sum(face_gradients);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
     const double slope = (g.array() * d.array()).sum();
-    if (!(slope < 0)) break;
+    if (!(slope < 0)) {
+      res.stop = "no descent";
+      break;
+    }
     move_to(d, 1.0);
     double t = std::min(1.0, 0.9 * max_area_step(s, emb, trial, judged, area3, 0.0));
     double e1 = Energy::kHuge;
@@ -67,11 +82,17 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       e1 = energy.energy(trial);
       if (e1 <= e0 + 1e-4 * t * slope) break;
     }
-    if (!(e1 < e0)) break;
+    if (!(e1 < e0)) {
+      res.stop = "no descent";
+      break;
+    }
     for (int v : unknowns) emb.pos[v] = trial[v];
     const double gain = (e0 - e1) / e0;
     e0 = res.energy_after = e1;
-    if (!(gain > min_gain)) break;
+    if (!(gain > min_gain)) {
+      res.stop = "converged";
+      break;
+    }
   }
   return res;
 }

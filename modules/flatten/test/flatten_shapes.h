@@ -99,4 +99,18 @@ inline TriangleList stalked_polyp() {
       {-18, -18, -18}, {218, 18, 18}, 0.8);
 }
 
+// Closed tube along x (radius 12 mm, 0..200 mm) with a wide pouch (sphere radius 28 mm at x = 70)
+// and a strand stump: a finger of tissue of radius 1 mm rising 9 mm from the wall at x = 150 into
+// the lumen (what denoise leaves where it cut a strand), at 0.8 mm. The pouch needs the whole-band
+// area correction; the conformal map crushes the stump's tip to ~1e-7 of its area.
+inline TriangleList pouch_and_stump() {
+  return surface_of(
+      [](const Eigen::Vector3d& p) {
+        const double tube = std::min(capsule(p, {0, 0, 0}, {200, 0, 0}, 12), (p - Eigen::Vector3d(70, 8, 0)).norm() - 28);
+        const double stump = capsule(p, {150, 0, -14}, {150, 0, -3}, 1.0);
+        return std::max(tube, -stump);  // lumen = tube and pouch minus the stump's tissue
+      },
+      {-15, -22, -31}, {215, 38, 31}, 0.8);
+}
+
 }  // namespace cf::test_shapes
