@@ -30,7 +30,7 @@ int row_of(const std::vector<int>& ends, int* out, char& boundary) {
     std::size_t e = k;
     while (e < ends.size() && ends[e] == ends[k]) ++e;
     if (e - k == 1) boundary = 1;
-    if (out) out[n] = ends[k];
+    out[n] = ends[k];
     ++n;
     k = e;
   }
@@ -45,23 +45,21 @@ VertexGraph vertex_graph(const TriangleList& surface) {
   VertexGraph g;
   g.on_boundary.assign(n, 0);
   g.start.assign(n + 1, 0);
-  // Two passes over fixed chunks of vertices: row lengths, then rows (identical for any thread count).
+  // One pass over fixed chunks of vertices (identical for any thread count): each row written at
+  // its room in `rows` (2 per corner, an upper bound of its length), then the rows packed.
+  std::vector<int> rows(2 * vc.corner.size());
   parallel_for(n, [&](std::size_t b, std::size_t e) {
     std::vector<int> ends;
     for (std::size_t v = b; v < e; ++v) {
       gather_ends(surface, vc, v, ends);
-      g.start[v + 1] = row_of(ends, nullptr, g.on_boundary[v]);
+      g.start[v + 1] = row_of(ends, rows.data() + 2 * std::size_t(vc.start[v]), g.on_boundary[v]);
     }
   });
   for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
   g.neighbours.resize(std::size_t(g.start[n]));
   parallel_for(n, [&](std::size_t b, std::size_t e) {
-    std::vector<int> ends;
-    char unused = 0;
-    for (std::size_t v = b; v < e; ++v) {
-      gather_ends(surface, vc, v, ends);
-      row_of(ends, g.neighbours.data() + g.start[v], unused);
-    }
+    for (std::size_t v = b; v < e; ++v)
+      std::copy_n(rows.data() + 2 * std::size_t(vc.start[v]), g.start[v + 1] - g.start[v], g.neighbours.data() + g.start[v]);
   });
   return g;
 }
