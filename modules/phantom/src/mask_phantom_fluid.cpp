@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <queue>
 
+#include "colonflat/core/voxel_path.h"
 #include "mask_phantom_model.h"
 
 namespace cf::phantom_detail {
@@ -29,37 +29,13 @@ constexpr int kDeepPools = 2;
 constexpr double kStretchMinMm = 60, kStretchMaxMm = 120, kStretchGapMm = 40;
 }  // namespace
 
-// Path distance (mm, 26-neighbour Dijkstra through the lumen) from `start` over the lumen box;
-// infinity where the lumen does not connect. Indexed like the box (i - lo, j - lo, k - lo).
+// Path distance (mm, 26-neighbour Dijkstra through the lumen; core voxel_path_distance) from `start`
+// over the lumen box; infinity where the lumen does not connect. Indexed like the box (i - lo, j - lo, k - lo).
 std::vector<float> MaskPainter::path_distance(std::size_t start) const {
-  const int bn[3] = {hi_[0] - lo_[0], hi_[1] - lo_[1], hi_[2] - lo_[2]};
-  auto box = [&](int i, int j, int k) { return (std::size_t(k - lo_[2]) * bn[1] + (j - lo_[1])) * bn[0] + (i - lo_[0]); };
-  std::vector<float> dist(std::size_t(bn[0]) * bn[1] * bn[2], std::numeric_limits<float>::infinity());
-  using Item = std::pair<float, std::size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+  const VoxelBox box{mask_buf_, g_.n, g_.sp, {lo_[0], lo_[1], lo_[2]}, {hi_[0], hi_[1], hi_[2]}};
   int si, sj, sk;
   ijk(start, si, sj, sk);
-  dist[box(si, sj, sk)] = 0;
-  heap.push({0.f, start});
-  while (!heap.empty()) {
-    const auto [d, q] = heap.top();
-    heap.pop();
-    int i, j, k;
-    ijk(q, i, j, k);
-    if (d > dist[box(i, j, k)]) continue;
-    for (int dk = -1; dk <= 1; ++dk)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) {
-          const int a = i + di, b = j + dj, c = k + dk;
-          if (a < lo_[0] || b < lo_[1] || c < lo_[2] || a >= hi_[0] || b >= hi_[1] || c >= hi_[2]) continue;
-          const std::size_t t = g_.index(a, b, c);
-          if (!lumen(t)) continue;
-          const float nd = d + float(V3(di * g_.sp[0], dj * g_.sp[1], dk * g_.sp[2]).norm());
-          float& cur = dist[box(a, b, c)];
-          if (nd < cur) cur = nd, heap.push({nd, t});
-        }
-  }
-  return dist;
+  return voxel_path_distance(box, {si, sj, sk});
 }
 
 // K stretches of 60-120 mm of path, 15-85 % of the way from the rectal end, 40 mm apart (and first,

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <queue>
 #include <random>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/voxel_path.h"
 
 namespace cf {
 namespace {
@@ -42,30 +42,17 @@ MaskCourse::MaskCourse(MaskImage::Pointer mask) : mask_(std::move(mask)) {
   centroid_ /= double(n);
   lo_ = lo;
   for (int d = 0; d < 3; ++d) size_[d] = size_t(hi[d] - lo[d] + 1);
-  path_.assign(size_[0] * size_[1] * size_[2], kUnreached);
   const auto sp = mask_->GetSpacing();
-  using Item = std::pair<float, size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-  path_[box_index(start)] = 0;
-  queue.push({0.f, box_index(start)});
-  while (!queue.empty()) {
-    const auto [d, k] = queue.top();
-    queue.pop();
-    if (d > path_[k]) continue;
-    length_ = std::max(length_, double(d));
-    const long x = long(k % size_[0]), y = long(k / size_[0] % size_[1]), z = long(k / (size_[0] * size_[1]));
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const long a = x + dx, b = y + dy, c = z + dz;
-          if (a < 0 || b < 0 || c < 0 || a >= long(size_[0]) || b >= long(size_[1]) || c >= long(size_[2])) continue;
-          const MaskImage::IndexType j = {{lo_[0] + a, lo_[1] + b, lo_[2] + c}};
-          if (!mask_->GetPixel(j)) continue;
-          const float step = float(std::sqrt(dx * dx * sp[0] * sp[0] + dy * dy * sp[1] * sp[1] + dz * dz * sp[2] * sp[2]));
-          const size_t kj = box_index(j);
-          if (d + step < path_[kj]) path_[kj] = d + step, queue.push({d + step, kj});
-        }
-  }
+  const auto full = mask_->GetBufferedRegion();
+  const VoxelBox box{mask_->GetBufferPointer(),
+                     {int(full.GetSize(0)), int(full.GetSize(1)), int(full.GetSize(2))},
+                     {sp[0], sp[1], sp[2]},
+                     {int(lo[0] - full.GetIndex(0)), int(lo[1] - full.GetIndex(1)), int(lo[2] - full.GetIndex(2))},
+                     {int(hi[0] - full.GetIndex(0)) + 1, int(hi[1] - full.GetIndex(1)) + 1, int(hi[2] - full.GetIndex(2)) + 1}};
+  path_ = voxel_path_distance(box, {int(start[0] - full.GetIndex(0)), int(start[1] - full.GetIndex(1)),
+                                    int(start[2] - full.GetIndex(2))});
+  for (float d : path_)
+    if (d != kUnreached) length_ = std::max(length_, double(d));
 }
 
 size_t MaskCourse::box_index(const MaskImage::IndexType& i) const {
