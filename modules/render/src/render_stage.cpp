@@ -1,5 +1,7 @@
 #include "colonflat/render/render_stage.h"
 
+#include <future>
+
 #include <vtkImageData.h>
 #include <vtkPolyData.h>
 
@@ -40,8 +42,66 @@ const ParamTable<RenderOptions>& render_param_table() {
   return table;
 }
 
+namespace {
+
+// The snapshot of the surface before denoising, its caption giving the genus and the loop count.
+ImagePtr snapshot_before(const Mesh& m, vtkPolyData* loops, SnapshotOptions so) {
+  const auto topo = analyze_topology(m);
+  so.caption = "before denoising: genus " + (topo.genus ? std::to_string(*topo.genus) : std::string("?")) +
+               (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
+  return render_snapshot(to_triangle_list(m), loops, so);
+}
+
+}  // namespace
+
+// Snapshots on: orients the snapshot inputs, builds the loops' polylines and starts the snapshot
+// before denoising on a second thread. It needs only the surface and the loops, the colon image
+// drawn meanwhile on this thread needs no OpenGL, and the display is set up here first (Xvfb is
+// forked before any second thread runs). Where no display can be had, `error` says why.
+RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, RunContext& ctx) const {
+  Snapshots s;
+  for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
+    if (bag.has(port)) ctx.report["orientation"][port] = orient_mesh_input(bag, port, ctx, "render");
+  if (bag.has("loops")) s.loops = loops_to_polydata(bag.get<LoopSet>("loops"));
+  s.options.width = s.options.height = opts_.snapshot_size;
+  try {
+    s.display = ensure_display();
+  } catch (const Error& e) {
+    s.error = e.what();
+    return s;
+  }
+  if (bag.has("surface"))
+    s.before = std::async(std::launch::async, snapshot_before, std::cref(bag.get<Mesh>("surface")), s.loops.Get(), s.options);
+  return s;
+}
+
+// Waits for the snapshot before denoising, renders the one after (its caption counts the
+// candidates) and puts both into the bag; a snapshot error is reported, never fatal.
+void RenderStage::finish_snapshots(Snapshots& s, const FlatMap& flat, std::size_t candidates, ArtifactBag& bag,
+                                   RunContext& ctx) const {
+  try {
+    if (!s.error.empty()) throw Error(s.error);
+    if (s.before.valid()) {
+      bag.put("snapshot_before", s.before.get());
+      phase_done("3D snapshot before denoising (beside the colon image)");
+    }
+    TriangleList after = bag.has("denoised") ? to_triangle_list(bag.get<Mesh>("denoised")) : flat_to_surface(flat);
+    s.options.caption = std::string(bag.has("denoised") ? "after denoising" : "flattened surface") + ", " +
+                        std::to_string(candidates) + " polyp candidates" +
+                        (s.loops ? ", cut loops highlighted" : std::string());
+    bag.put("snapshot_after", render_snapshot(after, s.loops, s.options));
+    phase_done("3D snapshot after denoising");
+    ctx.report["display"] = s.display;
+  } catch (const Error& e) {
+    ctx.report["snapshot_error"] = e.what();
+    ctx.progress(std::string("render: no 3D snapshots: ") + e.what());
+  }
+}
+
 void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   const FlatMap& flat = bag.get<FlatMap>("flat");
+  Snapshots snapshots;
+  if (opts_.snapshots) snapshots = start_snapshots(bag, ctx);
   Stopwatch sw;
   RenderResult r = render_flat(flat, opts_);
   phase_done("colon image and candidates");
@@ -53,34 +113,7 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
                " px, " + std::to_string(r.candidates.size()) + " polyp candidates");
   bag.put("colon_image", r.colon.image);
   bag.put("candidates", r.candidates_json);
-  if (!opts_.snapshots) return;
-  for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
-    if (bag.has(port)) ctx.report["orientation"][port] = orient_mesh_input(bag, port, ctx, "render");
-  try {
-    // denoise's loops, in memory in `colonflat run` or read from --loops: drawn as polylines
-    vtkSmartPointer<vtkPolyData> loops;
-    if (bag.has("loops")) loops = loops_to_polydata(bag.get<LoopSet>("loops"));
-    SnapshotOptions so;
-    so.width = so.height = opts_.snapshot_size;
-    if (bag.has("surface")) {
-      const Mesh& m = bag.get<Mesh>("surface");
-      const auto topo = analyze_topology(m);
-      so.caption = "before denoising: genus " + (topo.genus ? std::to_string(*topo.genus) : std::string("?")) +
-                   (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
-      bag.put("snapshot_before", render_snapshot(to_triangle_list(m), loops, so));
-      phase_done("3D snapshot before denoising");
-    }
-    TriangleList after = bag.has("denoised") ? to_triangle_list(bag.get<Mesh>("denoised")) : flat_to_surface(flat);
-    so.caption = std::string(bag.has("denoised") ? "after denoising" : "flattened surface") + ", " +
-                 std::to_string(r.candidates.size()) + " polyp candidates" +
-                 (loops ? ", cut loops highlighted" : std::string());
-    bag.put("snapshot_after", render_snapshot(after, loops, so));
-    phase_done("3D snapshot after denoising");
-    ctx.report["display"] = ensure_display();
-  } catch (const Error& e) {
-    ctx.report["snapshot_error"] = e.what();
-    ctx.progress(std::string("render: no 3D snapshots: ") + e.what());
-  }
+  if (opts_.snapshots) finish_snapshots(snapshots, flat, r.candidates.size(), bag, ctx);
 }
 
 std::unique_ptr<Stage> make_render_stage() { return std::make_unique<RenderStage>(); }

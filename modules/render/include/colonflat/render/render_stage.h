@@ -3,13 +3,18 @@
 //  [--denoised D.vtp] [--snapshot-before B.png] [--snapshot-after A.png] [parameters:
 // render_params.def]`: polyp candidates on the 3D wall, the 2D colon image with overlays, their
 // JSON, and 3D snapshots.
+#include <future>
 #include <memory>
 #include <string>
+
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
 
 #include "colonflat/core/stage.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/render/colon_image.h"
 #include "colonflat/render/polyps.h"
+#include "colonflat/render/snapshot.h"
 
 #include "colonflat/core/params.h"
 namespace cf {
@@ -41,6 +46,19 @@ class RenderStage : public StageWithOptions<RenderOptions> {
 
  protected:
   const ParamTable<RenderOptions>& table() const override { return render_param_table(); }
+
+ private:
+  // The 3D snapshots of one run: the one before denoising renders on a second thread while the
+  // colon image is drawn.
+  struct Snapshots {
+    vtkSmartPointer<vtkPolyData> loops;
+    SnapshotOptions options;
+    std::string display, error;
+    std::future<ImagePtr> before;
+  };
+  Snapshots start_snapshots(ArtifactBag& bag, RunContext& ctx) const;
+  void finish_snapshots(Snapshots& s, const FlatMap& flat, std::size_t candidates, ArtifactBag& bag,
+                        RunContext& ctx) const;
 };
 
 std::unique_ptr<Stage> make_render_stage();
