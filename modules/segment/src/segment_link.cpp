@@ -26,11 +26,9 @@ constexpr double kMinChord = 0.7;       // last front's distance from the contac
 constexpr double kSameEndMm = 30;       // a used end within this path length of a new contact: the same end
 constexpr double kMinCalibreRatio = 0.3; // cross-sections (front sizes) of the two bodies within this ratio
 constexpr std::size_t kContactsPerPair = 3;
-// Fat (adipose tissue, -190..-30 HU) along a gap: a collapsed neck of colon is its own wall pressed
-// together (soft tissue, 20-60 HU, perhaps a thread of gas or fluid), never fat; a layer of at least
-// kFatRunMm (and at least one voxel's diagonal, beyond the partial volume of a gas/tissue edge) means
-// the two bodies are separate bowels with pericolic or mesenteric fat between them.
-constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
+// Fat (adipose tissue) on a gap, printed with COLONFLAT_SEGMENT_DEBUG: a collapsed neck of colon is
+// its own wall (soft tissue), never fat (docs/segment.md, session 11: not yet a rule).
+constexpr double kFatLowHu = -190, kFatHighHu = -30;
 constexpr double kContactSeparationMm = 20;
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
@@ -233,8 +231,6 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const double cg = double(sg.fronts[common].cells), cf = double(sf.fronts[common].cells);
   if (std::min(cg, cf) < kMinCalibreRatio * std::max(cg, cf)) return why = "not at the colon's calibre there", false;
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
-  const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
-  if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
   if (ug.dot(uf) < 0.3) return why = "does not continue the colon's direction", false;
   const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});
