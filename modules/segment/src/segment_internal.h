@@ -183,6 +183,7 @@ class ColonSegmenter {
   std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
   bool continues_colon(const Contact& c, std::string& why) const;
   bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
+  double gap_fat_mm(const Contact& c) const;
   void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
   void report_candidate(const BodyStats& b, double kept_gap, const std::string& why);
   // Helpers.

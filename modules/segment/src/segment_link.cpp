@@ -26,6 +26,9 @@ constexpr double kMinChord = 0.7;       // last front's distance from the contac
 constexpr double kSameEndMm = 30;       // a used end within this path length of a new contact: the same end
 constexpr double kMinCalibreRatio = 0.3; // cross-sections (front sizes) of the two bodies within this ratio
 constexpr std::size_t kContactsPerPair = 3;
+// Fat (adipose tissue) on a gap, printed with COLONFLAT_SEGMENT_DEBUG: a collapsed neck of colon is
+// its own wall (soft tissue), never fat (docs/segment.md, session 11: not yet a rule).
+constexpr double kFatLowHu = -190, kFatHighHu = -30;
 constexpr double kContactSeparationMm = 20;
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
@@ -235,9 +238,36 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   return true;
 }
 
+// Longest run (mm) of fat on the straight line between the contact's two cells (cell centres),
+// each sample the mean of its voxel and 6 face neighbours (a single noisy voxel is not fat).
+double ColonSegmenter::gap_fat_mm(const Contact& c) const {
+  const Eigen::Vector3d a = grid_->fine_centre(c.to), b = grid_->fine_centre(c.from);
+  const Eigen::Vector3d sp(d_.sp[0], d_.sp[1], d_.sp[2]);
+  const double len = (b - a).cwiseProduct(sp).norm();
+  const int n = int(std::ceil(len / (0.25 * sp.minCoeff())));
+  double run = 0, best = 0;
+  for (int t = 0; t <= n && n > 0; ++t) {
+    const Eigen::Vector3d p = a + (b - a) * (double(t) / n);
+    long x[3];
+    for (int k = 0; k < 3; ++k) x[k] = std::clamp(std::lround(p[k]), 0L, long(d_.n[k]) - 1);
+    static constexpr int kSeven[7][3] = {{0, 0, 0}, {-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+    double sum = 0;
+    int cnt = 0;
+    for (const auto& o : kSeven) {
+      const long y[3] = {x[0] + o[0], x[1] + o[1], x[2] + o[2]};
+      if (y[0] < 0 || y[1] < 0 || y[2] < 0 || y[0] >= long(d_.n[0]) || y[1] >= long(d_.n[1]) || y[2] >= long(d_.n[2])) continue;
+      sum += hu_[d_.idx(std::size_t(y[0]), std::size_t(y[1]), std::size_t(y[2]))], ++cnt;
+    }
+    const double v = sum / cnt;
+    run = v >= kFatLowHu && v <= kFatHighHu ? run + len / n : 0;
+    best = std::max(best, run);
+  }
+  return best;
+}
+
 void ColonSegmenter::debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const {
   const Eigen::Vector3d a = grid_->mm(c.to);
-  std::fprintf(stderr, "link cand %u seg %x at (%.0f %.0f %.0f) gap %.1f |", c.candidate, c.segment, a[0], a[1], a[2], c.gap_mm);
+  std::fprintf(stderr, "link cand %u seg %x at (%.0f %.0f %.0f) gap %.1f fat %.1f |", c.candidate, c.segment, a[0], a[1], a[2], c.gap_mm, gap_fat_mm(c));
   for (const LocalShape* s : {&sg, &sf}) {
     std::fprintf(stderr, " reach %.0f:", s->reach_mm);
     for (const Front& f : s->fronts)

@@ -69,6 +69,12 @@ class LinkGrid {
   // A kept candidate becomes part of colon segment `segment` (colon for later contacts).
   void absorb(std::uint32_t candidate, std::uint32_t segment);
   Eigen::Vector3d mm(std::size_t cell) const;
+  // The centre of `cell` in fine voxel coordinates (continuous).
+  Eigen::Vector3d fine_centre(std::size_t cell) const {
+    std::size_t c[3];
+    d_.coords(cell, c[0], c[1], c[2]);
+    return {double(c[0]) * f_[0] + 0.5 * (f_[0] - 1), double(c[1]) * f_[1] + 0.5 * (f_[1] - 1), double(c[2]) * f_[2] + 0.5 * (f_[2] - 1)};
+  }
 
  private:
   LocalShape shape(const std::vector<std::uint32_t>& labels, std::uint32_t id, std::size_t start, double radius_mm) const;

@@ -24,12 +24,14 @@ const MaskImage* real_mask() {
 
 // Paints a case on the downsampled real mask, segments it and scores it; with a long stretch, also
 // checks that the long stretch (beside other parts of the colon) is >= 95 % kept.
-MaskSegmentationScore segment_painted(const std::string& position, bool header, double long_stretch_mm = 0) {
+// `hard`: pools over the folds, small-bowel loops pressed against the colon, slices resampled to 1 mm.
+MaskSegmentationScore segment_painted(const std::string& position, bool header, double long_stretch_mm = 0, bool hard = false) {
   MaskPhantomOptions o;
   o.position = position;
   o.position_header = header;
   o.long_stretch_mm = long_stretch_mm;
-  const MaskPhantom p = paint_phantom_from_mask(real_mask(), o);
+  o.deep_pools = o.pressed_bowel = hard;
+  const MaskPhantom p = paint_phantom_from_mask(hard ? resample_mask_slices(real_mask(), 1.0).GetPointer() : real_mask(), o);
   const MaskImage::Pointer seg = segment_colon(p.phantom.ct, {}, nullptr);
   const MaskSegmentationScore s = score_segmentation(seg, p.phantom);
   std::printf("painted real mask%s, %s%s: dice %.4f, colon fluid kept %.1f %% of %.1f mL, %.1f mL outside the colon "
@@ -70,6 +72,19 @@ TEST(SegmentPainted, RealMaskFilledStretchBesideSegmentsMeetsIssue25Targets) {
   EXPECT_GE(s.dice, 0.97);
   EXPECT_GE(s.fluid_kept, 0.95);
   EXPECT_LE(s.outside_ml, 10.0);
+}
+
+// The hard left-down case of segment_bench --painted (no header, 1 mm slices, 200 mm long stretch, deep
+// pools, small-bowel loops pressed against the colon): no small-bowel loop is linked to the colon.
+// Now a 66 mL loop is linked across a 19 mm gap (49.7 mL outside the colon, Dice 0.950); with the
+// fat rule of session 11 it passes (0.3 mL, Dice 0.957). DISABLED until that rule can be enabled
+// (docs/segment.md, session 11). Not asserted even then: >= 95 % of the colon fluid (84 % kept).
+TEST(SegmentPainted, DISABLED_RealMaskHardLeftDownKeepsNoSmallBowel) {
+  if (!real_mask()) GTEST_SKIP() << "no ../shared/real/ctc_lumen_mask_a.nii.gz";
+  const MaskSegmentationScore s = segment_painted("left-down", false, 200, true);
+  EXPECT_LE(s.outside_ml, 10.0);
+  EXPECT_LE(s.small_bowel_ml, 1.0);
+  EXPECT_GE(s.dice, 0.955);
 }
 
 }  // namespace

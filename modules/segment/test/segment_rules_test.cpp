@@ -154,6 +154,28 @@ TEST(SegmentRules, ThinTubeAtColonEndRejectedByCalibre) {
   }
 }
 
+// A contrast tube continuing a gas tube's end in line across a 6 mm gap is kept when the gap is soft
+// tissue (a collapsed neck of colon) and rejected when the gap is fat (-100 HU: a separate bowel loop
+// with mesenteric fat between; issue 25's pressed small-bowel loop linked across 12 mm). DISABLED:
+// the fat rule is not in the linking yet (docs/segment.md, session 11: with it the easy painted
+// supine case loses a 412 mL stretch piece whose only passing link crossed fat).
+TEST(SegmentRules, DISABLED_TubeAcrossFatFromColonEndRejected) {
+  for (bool fat : {false, true}) {
+    SCOPED_TRACE(fat);
+    auto ct = make_volume(100, [&](double x, double y, double z) {
+      const double d = tube_dist(y, z, 50, 50);
+      if (x >= 8 && x <= 40 && d < 9) return -1000.0;
+      if (x >= 47 && x <= 80 && d < 8) return 500.0;
+      if (fat && x > 40 && x < 47 && d < 14) return -100.0;
+      return kKeep;
+    }, 0.6, 10);
+    auto [m, st] = segment_small(ct, tagged_options(1));
+    EXPECT_EQ(st.tagged_stretches, fat ? 0 : 1) << st.to_json()["decisions"].dump(1);
+    EXPECT_EQ(at(m, 70, 50, 50), !fat);
+    if (fat) EXPECT_TRUE(has_decision(st, "rejected", "separated from the colon by fat")) << st.to_json()["decisions"].dump(1);
+  }
+}
+
 // A catheter (air channel 2 mm, plastic wall to 3.5 mm at 150 HU) enters from the inferior face
 // and runs 20 mm up inside the rectal gas with an open tip: neither its channel nor its wall is
 // lumen, the rectal gas beside it is.
