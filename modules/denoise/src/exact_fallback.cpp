@@ -1,5 +1,6 @@
 // The exact method's fallback for loops that cannot be capped cleanly (exact_greedy.h): the
-// surgery is undone and another loop of the same class, away from the first, is cut instead.
+// surgery is undone and another loop that removes the same handle is cut instead (one of the
+// same class away from the first, or one crossing it).
 #include <algorithm>
 
 #include "colonflat/core/error.h"
@@ -93,18 +94,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::crossing_loop(const std::vector<Mes
   Stopwatch sw;
   const std::vector<std::uint8_t> cochain = crossing_cochain(st_.mesh, loop);
   search_->set_cochain(&cochain);
-  double best = limit;
-  std::vector<Mesh::VertexHandle> found;
-  const std::size_t stride = std::max<std::size_t>(1, loop.size() / kFallbackSources);
-  for (std::size_t i = 0; i < loop.size(); i += stride) {
-    const CycleCandidate c = search_->run(loop[i], best);
-    ++searches_;
-    settled_ += static_cast<long long>(search_->last_settled());
-    if (c.found && c.value < best) {
-      best = c.value;
-      found = search_->extract(c);
-    }
-  }
+  const std::vector<Mesh::VertexHandle> found = shortest_from_spread(loop, limit, nullptr);
   search_->set_cochain(nullptr);
   st_.t.search += sw.seconds();
   fallback_s_ += sw.seconds();
@@ -130,11 +120,26 @@ std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<M
   };
   search_->set_cochain(nullptr);
   search_->set_avoid(&avoid);
-  double best = 3.0 * loop_length(st_.mesh, loop) + 4.0 * tube;
+  std::vector<Mesh::VertexHandle> sources;
+  for (int v : rim) sources.push_back(Mesh::VertexHandle(v));
+  const std::vector<Mesh::VertexHandle> found =
+      shortest_from_spread(sources, 3.0 * loop_length(st_.mesh, loop) + 4.0 * tube, &same_class);
+  search_->set_avoid(nullptr);
+  st_.t.search += sw.seconds();
+  fallback_s_ += sw.seconds();
+  return found;
+}
+
+// The shortest fundamental cycle of value below `limit` (in the search's current mode, approved
+// by `accept` when given) from up to kFallbackSources of `sources`, spread evenly; empty if none.
+std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources,
+                                                                  double limit,
+                                                                  const FundamentalCycleSearch::Accept* accept) {
+  double best = limit;
   std::vector<Mesh::VertexHandle> found;
-  const std::size_t stride = std::max<std::size_t>(1, rim.size() / kFallbackSources);
-  for (std::size_t i = 0; i < rim.size(); i += stride) {
-    const CycleCandidate c = search_->run(Mesh::VertexHandle(rim[i]), best, &same_class);
+  const std::size_t stride = std::max<std::size_t>(1, sources.size() / kFallbackSources);
+  for (std::size_t i = 0; i < sources.size(); i += stride) {
+    const CycleCandidate c = search_->run(sources[i], best, accept);
     ++searches_;
     settled_ += static_cast<long long>(search_->last_settled());
     if (c.found && c.value < best) {
@@ -142,9 +147,6 @@ std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<M
       found = search_->extract(c);
     }
   }
-  search_->set_avoid(nullptr);
-  st_.t.search += sw.seconds();
-  fallback_s_ += sw.seconds();
   return found;
 }
 

@@ -124,6 +124,8 @@ class ExactGreedy {
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
                             int iteration, std::vector<std::uint64_t>* cut_class);
   std::vector<Mesh::VertexHandle> crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit);
+  std::vector<Mesh::VertexHandle> shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources, double limit,
+                                                       const FundamentalCycleSearch::Accept* accept);
   SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration,
                              CapAttempt attempt = CapAttempt::kFull);
   void revert_cut(const SurgeryResult& sr);

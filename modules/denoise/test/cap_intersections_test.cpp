@@ -112,6 +112,16 @@ TEST(DenoiseCapIntersections, MarchingCubesJunctionsCutCleanly) {
   }
 }
 
+// Both components (torus and blocker) have genus 0; closed, manifold, oriented, and CGAL finds
+// no intersecting pair.
+void expect_two_clean_spheres(const Mesh& mesh) {
+  const TopologyReport t = analyze_topology(mesh);
+  ASSERT_EQ(t.components.size(), 2u);
+  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
+  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
+  EXPECT_EQ(testing::count_self_intersections(mesh), 0u);
+}
+
 // When every placement of the shortest loop's caps crosses the surface (a rod inside the tube
 // pierces every cap of the thinnest meridian), the surgery is undone and another loop of the
 // same class away from the rod is cut instead: 0 intersecting pairs (CGAL), genus 0 per
@@ -130,11 +140,7 @@ TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
   EXPECT_LT(loop.length, 2 * kPi * 1.15);  // still a meridian (same class), not the longitude
   EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 1);
   EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
-  const TopologyReport t = analyze_topology(r.mesh);
-  ASSERT_EQ(t.components.size(), 2u);
-  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
-  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
-  EXPECT_EQ(testing::count_self_intersections(r.mesh), 0u);
+  expect_two_clean_spheres(r.mesh);
 }
 
 // With a ring along the whole tube core no meridian can be capped cleanly (the ring links every
@@ -154,11 +160,7 @@ TEST(DenoiseCapIntersections, UncappableLoopIsReplacedByTheHandlesOtherLoop) {
   EXPECT_LT(loop.length, 2 * kPi * 3.2);
   EXPECT_EQ(r.report["search"]["loops_replaced_by_crossing_loop"], 1);
   EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
-  const TopologyReport t = analyze_topology(r.mesh);
-  ASSERT_EQ(t.components.size(), 2u);
-  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
-  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
-  EXPECT_EQ(testing::count_self_intersections(r.mesh), 0u);
+  expect_two_clean_spheres(r.mesh);
 }
 
 // With a second ring through the hole as well, every loop that removes the torus' handle is
