@@ -19,8 +19,8 @@ namespace cf::detail {
 //  2. the shortest loop crossing `loop` an odd number of times: the handle's other loop, whose
 //     disk is the handle's other disk (where no disk of `loop`'s class avoids the surface, e.g.
 //     something runs through the tube, the other may: it spans the hole). Plain triangulations
-//     only: the restricted ones cost 5-15 s on such loops of the real CT surface (200-250
-//     vertices) and never found clean caps there.
+//     only: on the real CT surface the restricted ones took 7-14 s (wall, loaded machine) on
+//     such loops (235-242 vertices) and never found clean caps.
 // If none is, `loop` is cut again and its intersections are reported as before. Precondition:
 // `reduced` = loop's class reduced modulo the span (nonzero). *cut_class receives the class of
 // the loop actually cut. Throws when a cut separates.
