@@ -224,15 +224,20 @@ TriangleList varying_torus(double R, double r0, double amp, double thin_at, int 
 
 }  // namespace
 
-Mesh blocked_torus(bool ring) {
+Mesh blocked_torus(Blocker kind) {
   constexpr double kPi = 3.14159265358979323846;
   const TriangleList outer = varying_torus(4, 1, 0.15, 0, 64, 16);
   TriangleList blocker;
-  if (ring) {
-    blocker = varying_torus(4, 0.15, 0.15, kPi, 64, 8);
-  } else {
+  if (kind == Blocker::kRod) {
     blocker = synthetic::sphere(1, 16, 8);
     for (auto& p : blocker.points) p = {4 + 0.15 * p[0], 1.4 * p[1], 0.15 * p[2]};
+  } else {
+    blocker = varying_torus(4, 0.15, 0.15, kPi, 64, 8);
+  }
+  if (kind == Blocker::kCoreAndLinkRings) {
+    TriangleList link = varying_torus(2.5, 0.15, 0, 0, 48, 8);  // axis z, in the xy plane
+    for (auto& p : link.points) p = {4 + p[0], -p[2], p[1]};  // a rotation: axis y, around the tube at u = 0
+    blocker = synthetic::disjoint_union(blocker, link);
   }
   return synthetic::to_mesh(synthetic::disjoint_union(outer, blocker));
 }

@@ -38,10 +38,15 @@ Mesh colon_like_surface(const ColonLikeOptions& options);
 
 // A torus (axis z, major radius 4 mm, tube radius 1 mm - 15 % at angle u = 0, so its shortest
 // loop is the meridian there; 64 x 16 quads) with a blocker inside its tube that every cap of
-// that meridian must cross: a thin ellipsoid along the tube core (0.15 mm thick, +-1.4 mm along
-// the tube), or, with `ring`, a thin torus along the whole core (tube 0.15 mm - 15 % at u = pi,
-// so it is cut there) that blocks the caps of every meridian. Genus 1 (2 with `ring`), closed,
-// embedded.
-Mesh blocked_torus(bool ring);
+// that meridian must cross:
+//  - kRod: a thin ellipsoid along the tube core (0.15 mm thick, +-1.4 mm along the tube);
+//  - kCoreRing: a thin torus along the whole core (tube 0.15 mm - 15 % at u = pi, so it is cut
+//    there): it links every meridian, so no meridian has a clean cap; the longitude's has;
+//  - kCoreAndLinkRings: that ring and a second thin ring (radius 2.5 mm, tube 0.15 mm) around the
+//    tube at u = 0, through the hole: it links every loop crossing a meridian, so no loop that
+//    removes the torus' handle has a clean cap.
+// Closed and embedded; genus 1 + one per ring.
+enum class Blocker { kRod, kCoreRing, kCoreAndLinkRings };
+Mesh blocked_torus(Blocker blocker);
 
 }  // namespace cf::bench

@@ -60,9 +60,14 @@ struct DenoiseState {
 void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
                    double* t_analysis);
 
+// How hard a surgery looks for clean caps (with --check-caps): kFull, every step; kTrial, an
+// attempt undone unless its caps are clean (concentric caps in one placement: their pairs are
+// only counted); kPlainTrial, a trial without the restricted triangulations.
+enum class CapAttempt { kFull, kTrial, kPlainTrial };
+
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
-              HomologyBasis* hb, SurgeryResult* out);
+              HomologyBasis* hb, SurgeryResult* out, CapAttempt attempt = CapAttempt::kFull);
 
 // Both return the reason the method stopped; `stats` receives method-specific counters.
 std::string run_exact(DenoiseState& st, const DenoiseOptions& o, int needed, const DenoiseProgress& progress,

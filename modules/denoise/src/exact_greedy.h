@@ -122,8 +122,12 @@ class ExactGreedy {
   static constexpr std::size_t kBatchLanes = 2;
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
-                            int iteration);
-  SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration);
+                            int iteration, std::vector<std::uint64_t>* cut_class);
+  std::vector<Mesh::VertexHandle> crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit);
+  std::vector<Mesh::VertexHandle> shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources, double limit,
+                                                       const FundamentalCycleSearch::Accept* accept);
+  SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration,
+                             CapAttempt attempt = CapAttempt::kFull);
   void revert_cut(const SurgeryResult& sr);
   std::vector<Mesh::VertexHandle> same_class_loop(const std::vector<Mesh::VertexHandle>& loop,
                                                   const std::vector<std::uint64_t>& reduced, double tube);
@@ -175,7 +179,8 @@ class ExactGreedy {
   long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
   std::uint32_t group_stamp_ = 0;
-  int alternatives_ = 0;  // loops replaced by another of the same class (caps)
+  int alternatives_ = 0;           // loops replaced by another of the same class (caps)
+  int crossing_alternatives_ = 0;  // loops replaced by a loop crossing them (the handle's other loop)
   long long settled_at_build_ = 0;
   // A rebuild once the searches since the last build settled this many times the vertex count
   // (about two builds' worth of CPU: a build costs about as much as settling 1.3 n vertices;

@@ -41,12 +41,14 @@ LoopRecord& DenoiseState::record(const std::vector<Mesh::VertexHandle>& loop, in
 }
 
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,
-              HomologyBasis* hb, SurgeryResult* out) {
+              HomologyBasis* hb, SurgeryResult* out, CapAttempt attempt) {
   const int comp = st.component[loop.front().idx()];
   Stopwatch sw;
   SurgeryOptions so;
   so.ring_pull = o.ring_pull;
   so.cap_rings = o.method == "paper" && o.ring_pull == 0 ? 1 : so.cap_rings;
+  so.trial = attempt != CapAttempt::kFull;
+  so.restricted = attempt != CapAttempt::kPlainTrial;
   if (o.check_caps) {
     if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * st.mean_edge);
     so.guard = st.guard.get();
@@ -172,14 +174,14 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
 void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   set_bound(slot, SourceBound{0, false, -1, 0});  // searched again after the surgery
   const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
-  const std::vector<std::uint64_t> cls = search_->cycle_class(loop);
+  std::vector<std::uint64_t> cls = search_->cycle_class(loop);
   std::vector<std::uint64_t> reduced = cls;
   if (span_.reduce(reduced.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
   const int comp = st_.component[loop.front().idx()];
   const double surgery0 = st_.t.surgery;
-  const SurgeryResult sr = cut_cleanly(loop, reduced, iteration);
+  const SurgeryResult sr = cut_cleanly(loop, reduced, iteration, &cls);
   if (std::getenv("COLONFLAT_DENOISE_DEBUG")) debug_cut(iteration, st_.t.surgery - surgery0);
-  span_.insert(cls.data());  // the same span whichever loop of the class was cut
+  span_.insert(cls.data());  // the class of the loop cut (a same-class replacement: the same span)
   --st_.genus_left[comp];
   if (crossing_) return;  // back to the span family on the new mesh
   Stopwatch sw;
@@ -216,7 +218,8 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["crossing_family_switches"] = crossing_modes_;
-  stats["loops_replaced_for_clean_caps"] = alternatives_;
+  stats["loops_replaced_for_clean_caps"] = alternatives_ + crossing_alternatives_;
+  stats["loops_replaced_by_crossing_loop"] = crossing_alternatives_;
   stats["first_search_radius_mm"] = first_radius_;
   stats["largest_search_limit_mm"] = largest_limit_;
   stats["sources_last"] = active_.size();

@@ -180,8 +180,8 @@ bool Surgery::mirror_cap(const std::vector<std::array<int, 3>>& right, std::vect
 //     curved band they join opposite sides and follow the band) in every placement; then, in
 //     every placement, minimum-area triangulations restricted to triangles that intersect
 //     nothing (a grid query per candidate triangle: the expensive step, so it comes last, within
-//     kMaxGridQueries, and stops once the right ring has none). Kept when neither the caps nor
-//     the faces around the pulled rings intersect anything.
+//     kMaxGridQueries, and stops once the right ring has none; not with opts_.restricted off).
+//     Kept when neither the caps nor the faces around the pulled rings intersect anything.
 bool Surgery::try_triangulated_caps() {
   if (!opts_.guard || k_ > kMaxTriangulatedLoop) return false;
   edge_left_ = edge_targets(result_.left_ring);
@@ -189,13 +189,15 @@ bool Surgery::try_triangulated_caps() {
   ring_faces_ = faces_around_rings();
   query_budget_ = kMaxGridQueries;
   std::vector<std::array<int, 3>> tri_right, tri_left;
-  for (bool avoid : {false, true})
+  for (bool avoid : {false, true}) {
+    if (avoid && !opts_.restricted) break;
     for (const Placement& tr : placements())
       if (!gave_up_ && place_checked(tr) && triangulate_both(avoid, &tri_right, &tri_left)) {
         add_triangulated_caps(tri_right, tri_left);
         cap_kind_ = avoid ? "restricted" : "plain";
         return true;
       }
+  }
   return false;
 }
 
@@ -381,7 +383,7 @@ void Surgery::search_concentric_placement() {
   refresh();
   std::size_t best = opts_.guard->count_intersections(mesh_, moving);
   double best_pull = opts_.ring_pull, best_dome = 0;
-  if (best > 0 && k_ <= kMaxTriangulatedLoop) {
+  if (best > 0 && k_ <= kMaxTriangulatedLoop && !opts_.trial) {
     for (double pull : {opts_.ring_pull, 0.4, 0.15})
       for (double dome : {0.25, 0.5, 1.0, 0.0, -0.25}) {
         if (pull <= 0 && dome == 0) continue;

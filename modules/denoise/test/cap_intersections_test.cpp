@@ -112,12 +112,22 @@ TEST(DenoiseCapIntersections, MarchingCubesJunctionsCutCleanly) {
   }
 }
 
+// Both components (torus and blocker) have genus 0; closed, manifold, oriented, and CGAL finds
+// no intersecting pair.
+void expect_two_clean_spheres(const Mesh& mesh) {
+  const TopologyReport t = analyze_topology(mesh);
+  ASSERT_EQ(t.components.size(), 2u);
+  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
+  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
+  EXPECT_EQ(testing::count_self_intersections(mesh), 0u);
+}
+
 // When every placement of the shortest loop's caps crosses the surface (a rod inside the tube
 // pierces every cap of the thinnest meridian), the surgery is undone and another loop of the
 // same class away from the rod is cut instead: 0 intersecting pairs (CGAL), genus 0 per
 // component, and the report names the loop it replaced.
 TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
-  const Mesh m = bench::blocked_torus(false);
+  const Mesh m = bench::blocked_torus(bench::Blocker::kRod);
   ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
   const DenoiseResult r = denoise(m, DenoiseOptions{});
   ASSERT_EQ(r.loops.size(), 1u);
@@ -130,17 +140,34 @@ TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
   EXPECT_LT(loop.length, 2 * kPi * 1.15);  // still a meridian (same class), not the longitude
   EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 1);
   EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
-  const TopologyReport t = analyze_topology(r.mesh);
-  ASSERT_EQ(t.components.size(), 2u);
-  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
-  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
-  EXPECT_EQ(testing::count_self_intersections(r.mesh), 0u);
+  expect_two_clean_spheres(r.mesh);
 }
 
-// With a ring along the whole tube core no meridian can be capped cleanly: the intersecting
-// pairs are reported (never hidden) and --strict turns them into an error.
+// With a ring along the whole tube core no meridian can be capped cleanly (the ring links every
+// one): the handle is removed through its other loop, one crossing the meridian (the longitude,
+// whose disk spans the torus' hole), with 0 intersecting pairs (CGAL), genus 0 per component,
+// and the report names the meridian it replaced. Before, the meridian was cut across the ring.
+TEST(DenoiseCapIntersections, UncappableLoopIsReplacedByTheHandlesOtherLoop) {
+  const Mesh m = bench::blocked_torus(bench::Blocker::kCoreRing);
+  ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 2u);  // the core ring's own meridian, then the torus' handle
+  const LoopRecord& loop = r.loops[1];
+  EXPECT_EQ(loop.cap_intersections, 0u);
+  EXPECT_GT(loop.replaced_intersections, 0u) << "the meridian's caps must have been blocked";
+  EXPECT_NEAR(loop.replaced_length, 2 * kPi * 0.85, 0.05 * 2 * kPi * 0.85);  // the thinnest meridian
+  EXPECT_GT(loop.length, 2 * kPi * 2.8);  // around the hole: a longitude (inner radius 2.85-3.15)
+  EXPECT_LT(loop.length, 2 * kPi * 3.2);
+  EXPECT_EQ(r.report["search"]["loops_replaced_by_crossing_loop"], 1);
+  EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
+  expect_two_clean_spheres(r.mesh);
+}
+
+// With a second ring through the hole as well, every loop that removes the torus' handle is
+// linked with a ring, so no clean cap exists: the intersecting pairs are reported (never hidden)
+// and --strict turns them into an error.
 TEST(DenoiseCapIntersections, UncappableLoopIsReportedAndStrictFails) {
-  const Mesh m = bench::blocked_torus(true);
+  const Mesh m = bench::blocked_torus(bench::Blocker::kCoreAndLinkRings);
   ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
   const DenoiseResult r = denoise(m, DenoiseOptions{});
   EXPECT_GT(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);

@@ -126,11 +126,11 @@ TEST(DenoiseCli, PaperMarksSeparatingLoops) {
   EXPECT_TRUE(loops[0].separating);
 }
 
-// --strict on an input whose loop cannot be capped cleanly (a ring inside the torus tube crosses
-// every cap of its meridians): exit 1, one error line naming the input, no output written.
+// --strict on an input whose handle cannot be capped cleanly (a ring inside the torus tube links
+// every meridian, a ring through its hole every loop crossing them): exit 1, one error line naming the input, no output written.
 TEST(DenoiseCli, StrictFailsWhenNoCleanCapExists) {
   testing::TempDir dir;
-  write_mesh(bench::blocked_torus(true), dir / "in.off");
+  write_mesh(bench::blocked_torus(bench::Blocker::kCoreAndLinkRings), dir / "in.off");
   auto r = call({"denoise", dir.str("in.off"), "-o", dir.str("out.vtp"), "--report", dir.str("report.json"), "--strict",
                  "-q"});
   EXPECT_EQ(r.code, 1);

@@ -143,6 +143,16 @@ TEST(DenoiseThreads, ColonLikeSurfaceIsTheSameForAnyThreadCount) {
   }
 }
 
+// A handle removed through the crossing-loop fallback (no meridian of the blocked torus can be
+// capped cleanly, the longitude is cut): identical loops and mesh with 1 and 2 threads.
+TEST(DenoiseThreads, CrossingLoopFallbackIsTheSameForAnyThreadCount) {
+  const Mesh m = bench::blocked_torus(bench::Blocker::kCoreRing);
+  const DenoiseResult a = denoise_with_threads(m, 1);
+  EXPECT_EQ(a.report["search"]["loops_replaced_by_crossing_loop"], 1);
+  EXPECT_EQ(a.report["genus_after"], 0);
+  expect_same_result(a, denoise_with_threads(m, 2));
+}
+
 // The real GCA large-intestine surfaces (genus 1): one loop, clean caps (whole-mesh CGAL).
 TEST(DenoiseReal, GcaLargeIntestine) {
   for (const char* f : {"gca_large_intestine_20k.vtk", "gca_large_intestine_100k.vtk"}) {

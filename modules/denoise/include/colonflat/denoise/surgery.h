@@ -28,6 +28,10 @@ struct SurgeryOptions {
   int cap_rings = 4;        // concentric rings of a cap (1 = the paper's fan to the centroid)
   FaceGrid* guard = nullptr;  // when set: try placements until the new geometry intersects
                               // nothing (see SurgeryResult::intersections), and update the grid
+  bool restricted = true;  // with a guard: also the triangulations restricted to clean triangles
+  bool trial = false;      // with a guard: the caller keeps the result only when it intersects
+                           // nothing, so concentric caps stay in their first placement (their
+                           // pairs counted, not minimised over the placements)
 };
 
 // What undo_surgery() needs to put the mesh back as it was before cut_and_cap(): the element
