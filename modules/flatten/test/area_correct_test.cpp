@@ -13,6 +13,7 @@
 #include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "flatten_shapes.h"
+#include "../src/flatten_internal.h"
 
 namespace cf {
 namespace {
@@ -90,6 +91,54 @@ TEST(AreaCorrection, InvalidParametersAreRefused) {
     EXPECT_NE(r.err.find(option.substr(2)), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
   }
+}
+
+// A flat 24 x 12 grid whose map squeezes the middle columns to a fifth of their width (area ratio
+// 0.2, below area_ratio_low), its ends and rims fixed: a band the whole-band pass must correct.
+struct SqueezedGrid {
+  static constexpr int kNx = 24, kNy = 12;
+  flat_detail::Surface s;
+  flat_detail::Embedding emb;
+  std::vector<char> fixed, degenerate;
+  std::vector<std::vector<int>> vf;
+  SqueezedGrid() {
+    for (int j = 0; j < kNy; ++j)
+      for (int i = 0; i < kNx; ++i) {
+        s.p.push_back(flat_detail::V3(i, j, 0));
+        const double x = i < 8 ? i : i < 16 ? 8 + 0.2 * (i - 8) : 9.6 + (i - 16);
+        emb.pos.push_back(flat_detail::V2(x, j));
+        fixed.push_back(i == 0 || j == 0 || i == kNx - 1 || j == kNy - 1);
+      }
+    for (int j = 0; j + 1 < kNy; ++j)
+      for (int i = 0; i + 1 < kNx; ++i) {
+        const int a = j * kNx + i;
+        s.t.push_back({a, a + 1, a + kNx + 1});
+        s.t.push_back({a, a + kNx + 1, a + kNx});
+      }
+    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
+    emb.period = 1000;
+    degenerate.assign(s.t.size(), 0);
+    vf = flat_detail::vertex_faces(s);
+  }
+};
+
+// The whole-band pass asks its caller after each step whether its goal is met and ends there
+// ("bounds met"): asked to stop after the first step it takes exactly one; left to run, the same
+// band takes more (so the stop is what ended it), and neither folds a face.
+TEST(AreaCorrection, WholeBandPassEndsWhenItsCallerSaysTheBoundsAreMet) {
+  FlattenOptions o;
+  SqueezedGrid free_run, stopped;
+  const flat_detail::AreaCorrection all = flat_detail::correct_area(free_run.s, free_run.vf, free_run.emb, free_run.fixed,
+                                                                    free_run.degenerate, false, o);
+  int asked = 0;
+  const flat_detail::AreaCorrection one = flat_detail::correct_area(
+      stopped.s, stopped.vf, stopped.emb, stopped.fixed, stopped.degenerate, false, o, false, [&] { return ++asked >= 1; });
+  EXPECT_GT(all.iterations, 1);
+  EXPECT_EQ(one.iterations, 1);
+  EXPECT_EQ(asked, 1);
+  EXPECT_STREQ(one.stop, "bounds met");
+  for (const SqueezedGrid* g : {&free_run, &stopped})
+    for (std::size_t f = 0; f < g->s.t.size(); ++f) EXPECT_GT(g->emb.area2(g->s, int(f)), 0.0) << f;
 }
 
 }  // namespace
