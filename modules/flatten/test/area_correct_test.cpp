@@ -13,6 +13,7 @@
 #include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "flatten_shapes.h"
+#include "squeezed_grid.h"
 #include "../src/flatten_internal.h"
 
 namespace cf {
@@ -93,34 +94,7 @@ TEST(AreaCorrection, InvalidParametersAreRefused) {
   }
 }
 
-// A flat 24 x 12 grid whose map squeezes the middle columns to a fifth of their width (area ratio
-// 0.2, below area_ratio_low), its ends and rims fixed: a band the whole-band pass must correct.
-struct SqueezedGrid {
-  static constexpr int kNx = 24, kNy = 12;
-  flat_detail::Surface s;
-  flat_detail::Embedding emb;
-  std::vector<char> fixed, degenerate;
-  std::vector<std::vector<int>> vf;
-  SqueezedGrid() {
-    for (int j = 0; j < kNy; ++j)
-      for (int i = 0; i < kNx; ++i) {
-        s.p.push_back(flat_detail::V3(i, j, 0));
-        const double x = i < 8 ? i : i < 16 ? 8 + 0.2 * (i - 8) : 9.6 + (i - 16);
-        emb.pos.push_back(flat_detail::V2(x, j));
-        fixed.push_back(i == 0 || j == 0 || i == kNx - 1 || j == kNy - 1);
-      }
-    for (int j = 0; j + 1 < kNy; ++j)
-      for (int i = 0; i + 1 < kNx; ++i) {
-        const int a = j * kNx + i;
-        s.t.push_back({a, a + 1, a + kNx + 1});
-        s.t.push_back({a, a + kNx + 1, a + kNx});
-      }
-    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
-    emb.period = 1000;
-    degenerate.assign(s.t.size(), 0);
-    vf = flat_detail::vertex_faces(s);
-  }
-};
+using test_shapes::SqueezedGrid;  // squeezed to 0.2 (below area_ratio_low): the whole-band pass must correct it
 
 // The whole-band pass asks its caller after each step whether its goal is met and ends there
 // ("bounds met"): asked to stop after the first step it takes exactly one; left to run, the same
