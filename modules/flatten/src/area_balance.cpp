@@ -153,16 +153,63 @@ SymmetricDirichlet make_energy(const Surface& s, const Embedding& emb, const std
   return sd;
 }
 
+// What the balancing exists to lower, measured on the region's faces (3D-area weighted sums):
+// `out_of_bounds`, per face (log of how far its area ratio lies outside [lo, hi] + log of how far
+// its quasi-conformal ratio lies above kMaxAnisotropy)^2, zero exactly for a face that would not
+// seed a region; `angle`, per face its quasi-conformal ratio - 1 (the angle distortion the
+// symmetric Dirichlet energy also lowers, reported as the qc mean).
+struct BalanceMeasure {
+  double out_of_bounds = 0, angle = 0;
+};
+BalanceMeasure measure_region(const Surface& s, const Embedding& emb, const std::vector<int>& faces,
+                              const std::vector<double>& area3, double lo, double hi) {
+  const std::size_t nb = face_blocks(faces.size());
+  std::vector<BalanceMeasure> part(nb);
+  for_each_block(faces.size(), [&](std::size_t begin, std::size_t end) {
+    BalanceMeasure& m = part[begin / kFaceBlock];
+    for (std::size_t i = begin; i < end; ++i) {
+      const int f = faces[i];
+      const double q = std::max(ratio_of(s, emb, area3, f), 1e-300), qc = anisotropy(s, emb, f);
+      const double e = std::max({0.0, std::log(lo / q), std::log(q / hi)}) + std::max(0.0, std::log(qc / kMaxAnisotropy));
+      m.out_of_bounds += area3[f] * e * e;
+      m.angle += area3[f] * (qc - 1);
+    }
+  });
+  BalanceMeasure sum;  // block order: the same for any thread count
+  for (const BalanceMeasure& m : part) sum.out_of_bounds += m.out_of_bounds, sum.angle += m.angle;
+  return sum;
+}
+
+// A step that lowers the region's out-of-bounds measure by less than kMinOutOfBoundsGain and its
+// angle measure by less than kMinAngleGain (relative) ends the descent. The out-of-bounds measure
+// is a sum of squared log distances to the bounds, so 1 % of it is ~0.5 % of the out-of-bounds
+// faces' (rms) log distance: a face at area ratio 0.2 moves by less than 0.001 towards 0.4. At
+// 0.1 % per step of the angle measure the whole step budget (30) lowers the region's mean qc - 1 by
+// less than 3 %, where the early steps lower it by several percent each. The symmetric Dirichlet
+// energy keeps falling (by more than its 1e-4 convergence gain) long after both: on the real CT
+// colon band 54 steps on 695 k faces changed no reported statistic (qc mean 1.739, area p05 0.2713
+// before and after).
+constexpr double kMinOutOfBoundsGain = 0.01, kMinAngleGain = 0.001;
+
 // Minimises the symmetric Dirichlet energy on one region (proxy_descent.h: the cotangent
-// Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps).
-int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3) {
+// Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps), until
+// the energy converges or a step no longer lowers measure_region() (kMinOutOfBoundsGain, kMinAngleGain).
+int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3,
+                    double lo, double hi) {
   RegionSystem sys;
   if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces))) return 0;
   std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
   for (int f : r.faces)
     if (emb.area2(s, f) > 0) unfolded.push_back(f);
   const SymmetricDirichlet sd = make_energy(s, emb, unfolded);
-  return proxy_descent(s, emb, sd, sys, unfolded, area3, iterations, 1e-4).steps;
+  auto settled = [&, last = measure_region(s, emb, unfolded, area3, lo, hi)]() mutable {
+    const BalanceMeasure now = measure_region(s, emb, unfolded, area3, lo, hi);
+    const bool done = !(now.out_of_bounds < (1 - kMinOutOfBoundsGain) * last.out_of_bounds) &&
+                      !(now.angle < (1 - kMinAngleGain) * last.angle);
+    last = now;
+    return done;
+  };
+  return proxy_descent(s, emb, sd, sys, unfolded, area3, iterations, 1e-4, settled).steps;
 }
 
 }  // namespace
@@ -232,7 +279,7 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
   for (int pass = 0; pass < 2; ++pass) {
     const Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
     if (r.faces.empty()) break;
-    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3));
+    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high));
     res.faces = std::max(res.faces, r.faces.size());
     for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || r.free_vertex[v];
   }

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -254,9 +255,10 @@ struct AreaCorrection {
 // piece on its own (`iterations`: the most steps any piece took).
 // `grow` (local): a piece whose region has no room (2D area < 0.6 x 3D) grows by 12 rings more, up
 // to 3 times (the second local pass, for pockets the first one could not open).
+// `enough` (whole band only, optional): asked after each step; true ends the pass (its goal met).
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o, bool grow = false);
+                            const FlattenOptions& o, bool grow = false, const std::function<bool()>& enough = {});
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with

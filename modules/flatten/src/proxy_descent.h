@@ -12,6 +12,7 @@
 // Every per-face loop runs on all worker threads in fixed blocks (face_blocks.h): the steps are
 // the same for any thread count.
 #include <algorithm>
+#include <functional>
 
 #include "face_blocks.h"
 #include "flatten_internal.h"
@@ -22,7 +23,8 @@ struct DescentResult {
   int steps = 0;                                // steps taken (the last one, below min_gain, not counted)
   double energy_before = 0, energy_after = 0;
   // Why it stopped: "steps" (max_steps taken), "converged" (gain below min_gain), "no descent"
-  // (no step lowers E, or the direction does not descend), "not injective" (E infinite at the start).
+  // (no step lowers E, or the direction does not descend), "not injective" (E infinite at the start),
+  // "bounds met" (the caller's `enough` said so after a step).
   const char* stop = "steps";
 };
 
@@ -40,10 +42,11 @@ class CornerGather {
 
 // At most `max_steps` steps moving the unknowns of `sys` in emb.pos; stops when E gains less than
 // `min_gain` (relative) or no step lowers it. `judged`: the faces kept positive (the energy's).
+// `enough` (optional): asked after each step taken; true stops the descent there (its goal is met).
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
                             const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
-                            double min_gain) {
+                            double min_gain, const std::function<bool()>& enough = {}) {
   DescentResult res;
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
   if (e0 >= Energy::kHuge) {  // the region is not injective: leave it
@@ -91,6 +94,11 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     e0 = res.energy_after = e1;
     if (!(gain > min_gain)) {
       res.stop = "converged";
+      break;
+    }
+    if (enough && enough()) {
+      ++res.steps;
+      res.stop = "bounds met";
       break;
     }
   }

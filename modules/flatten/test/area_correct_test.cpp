@@ -13,6 +13,8 @@
 #include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "flatten_shapes.h"
+#include "squeezed_grid.h"
+#include "../src/flatten_internal.h"
 
 namespace cf {
 namespace {
@@ -90,6 +92,27 @@ TEST(AreaCorrection, InvalidParametersAreRefused) {
     EXPECT_NE(r.err.find(option.substr(2)), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
   }
+}
+
+using test_shapes::SqueezedGrid;  // squeezed to 0.2 (below area_ratio_low): the whole-band pass must correct it
+
+// The whole-band pass asks its caller after each step whether its goal is met and ends there
+// ("bounds met"): asked to stop after the first step it takes exactly one; left to run, the same
+// band takes more (so the stop is what ended it), and neither folds a face.
+TEST(AreaCorrection, WholeBandPassEndsWhenItsCallerSaysTheBoundsAreMet) {
+  FlattenOptions o;
+  SqueezedGrid free_run, stopped;
+  const flat_detail::AreaCorrection all = flat_detail::correct_area(free_run.s, free_run.vf, free_run.emb, free_run.fixed,
+                                                                    free_run.degenerate, false, o);
+  int asked = 0;
+  const flat_detail::AreaCorrection one = flat_detail::correct_area(
+      stopped.s, stopped.vf, stopped.emb, stopped.fixed, stopped.degenerate, false, o, false, [&] { return ++asked >= 1; });
+  EXPECT_GT(all.iterations, 1);
+  EXPECT_EQ(one.iterations, 1);
+  EXPECT_EQ(asked, 1);
+  EXPECT_STREQ(one.stop, "bounds met");
+  for (const SqueezedGrid* g : {&free_run, &stopped})
+    for (std::size_t f = 0; f < g->s.t.size(); ++f) EXPECT_GT(g->emb.area2(g->s, int(f)), 0.0) << f;
 }
 
 }  // namespace
