@@ -12,7 +12,13 @@
 //      (the nearest reference point within `place_radius_mm` gives its common s): its start and
 //      direction come from these projections, so a missing, split or merged piece needs no rule
 //      of its own; a piece with no counterpart (small bowel, a stretch present in one scan only)
-//      is left unregistered.
+//      is left unregistered. The reference's side-branch bands are projection targets too, at their
+//      neck's s: a stretch one scan's flatten cut off as a side branch and the other's kept in a
+//      colon band (another cut end changes what is a pouch) is then placed at that neck, not
+//      counted as colon length. Each placed piece maps its own mm to the common s through its
+//      projections (running median, monotone), so its own centreline's length errors do not push
+//      the pieces after it.
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -26,6 +32,8 @@ struct PieceOptions {
   double bin_mm = 2.0;            // mm; sampling of each piece's centre line
   double place_radius_mm = 50;    // mm; a centre point with a reference point this close projects onto it
   double min_placed_fraction = 0.3;  // a piece with fewer projecting centre points has no counterpart
+  double follow_mm = 10;          // mm; half window of the running median of a placed piece's projections
+                                  // (a projection can jump to a touching loop for a few mm; ~ a fold's spacing)
 };
 
 struct ColonPiece {
@@ -37,8 +45,16 @@ struct ColonPiece {
   double placed_fraction = 1;     // share of its centre points that projected onto the reference
   std::string x0_end, x1_end;     // FlatSegments labels ("" when absent)
   std::vector<Eigen::Vector3d> centre;  // LPS mm, centroid per bin of its own centreline_mm
-  double s_of(double local_mm) const { return flipped ? start_mm + length_mm - local_mm : start_mm + local_mm; }
-  double end_mm() const { return start_mm + length_mm; }
+  // Common s per centre bin where the piece was placed by its projections (empty: the reference,
+  // s = start_mm + own mm). A stretch of it that the reference holds as a side branch sits at the
+  // branch's neck, as the reference's own branch vertices do (its own mm then over-measures the
+  // colon: see layout_pieces).
+  std::vector<double> s_bin;
+  double bin_mm = 2;
+  double s_of(double local_mm) const;
+  double first_mm() const { return std::min(s_of(0), s_of(length_mm)); }  // common s range it covers
+  double end_mm() const { return std::max(s_of(0), s_of(length_mm)); }
+  void move_by(double mm);  // moves the piece along the common s
 };
 
 struct PieceLayout {
