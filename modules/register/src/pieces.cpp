@@ -363,4 +363,19 @@ std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece
   return s;
 }
 
+std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
+  std::map<int, const ColonPiece*> by_segment;
+  for (const auto& p : pieces)
+    if (p.registered && !p.s_bin.empty()) by_segment[p.segment] = &p;
+  std::vector<char> held(scan.lps.size(), 0);
+  for (size_t v = 0; v < held.size(); ++v) {
+    const auto p = by_segment.find(scan.segment[v]);
+    const double c = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
+    if (p == by_segment.end() || !std::isfinite(c)) continue;
+    const double h = p->second->bin_mm;  // a colon stretch does not halve its length between the positions
+    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h;
+  }
+  return held;
+}
+
 }  // namespace cf

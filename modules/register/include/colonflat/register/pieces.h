@@ -78,6 +78,11 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
 // side-branch vertices sit at their neck on the parent band (FlatSegments attach_mm).
 std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces);
 
+// Per vertex: 1 when it lies on a stretch of a placed piece that the layout holds at one common s
+// (local slope of s over own mm below 1/2: the other scan keeps that stretch as a side branch, so
+// along the colon nothing is aligned there), else 0.
+std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPiece>& pieces);
+
 // Rigid shift t with b + t ~ a by trimmed nearest-point iterations (the better of starting at 0 and
 // at the centroid difference). `residual` receives the trimmed mean distance.
 Eigen::Vector3d fit_shift(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
