@@ -83,7 +83,8 @@ void chain(std::vector<ColonPiece>& ref) {
 struct RefPoint {
   Eigen::Vector3d p;
   double s;
-  int piece;  // index of the reference piece
+  int piece;            // index of the reference piece
+  bool branch = false;  // a centre point of one of its side branches (s = the neck's)
 };
 
 // Centre points of a piece that project onto the reference: own mm, reference s, reference piece.
@@ -139,7 +140,7 @@ std::vector<RefPoint> ref_points(const std::vector<ColonPiece>& ref, const std::
     for (size_t i = 0; i < ref.size(); ++i) {
       if (ref[i].segment != b.parent) continue;
       const double s = ref[i].s_of(std::min(b.attach_mm, ref[i].length_mm));
-      for (const auto& c : b.centre) pts.push_back({c, s, int(i)});
+      for (const auto& c : b.centre) pts.push_back({c, s, int(i), true});
     }
   return pts;
 }
@@ -181,14 +182,17 @@ Projection place(ColonPiece& piece, const std::vector<RefPoint>& ref, const Eige
                  const PieceOptions& o) {
   Projection pr;
   piece.s_bin.clear();
+  piece.on_branch.assign(piece.centre.size(), 0);
   std::vector<double>& local = pr.local;
   std::vector<double>& sref = pr.sref;
   for (size_t k = 0; k < piece.centre.size(); ++k) {
     const Eigen::Vector3d q = piece.centre[k] + shift;
     double best = o.place_radius_mm * o.place_radius_mm, s = kNaN;
     int from = -1;
+    bool branch = false;
     for (const auto& r : ref)
-      if (const double d = (r.p - q).squaredNorm(); d <= best) best = d, s = r.s, from = r.piece;
+      if (const double d = (r.p - q).squaredNorm(); d <= best) best = d, s = r.s, from = r.piece, branch = r.branch;
+    piece.on_branch[k] = branch;
     if (!std::isnan(s)) local.push_back((double(k) + 0.5) * bin), sref.push_back(s), pr.ref_piece.push_back(from);
   }
   piece.placed_fraction = piece.centre.empty() ? 0.0 : double(local.size()) / double(piece.centre.size());
@@ -373,7 +377,9 @@ std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPie
     const double c = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
     if (p == by_segment.end() || !std::isfinite(c)) continue;
     const double h = p->second->bin_mm;  // a colon stretch does not halve its length between the positions
-    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h;
+    const size_t k = std::min(p->second->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
+    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h ||
+              (!p->second->on_branch.empty() && p->second->on_branch[k]);
   }
   return held;
 }

@@ -144,8 +144,8 @@ void make_side_branch(SyntheticPair& pair, double from, double to) {
 }
 
 // Polyps within `margin` mm of [from, to) left out of the count "seen in both": next to a stretch held
-// at a neck the prone piece's map follows its projections' running median (PieceOptions::follow_mm,
-// 10 mm) and is held there too, so a polyp there is listed unaligned (docs/register.md, Limits).
+// at a neck the prone piece's map follows its projections' running median (PieceOptions::follow_mm)
+// and is held there too, so a polyp there is listed unaligned (docs/register.md, Limits).
 void exclude_near(SyntheticPair& pair, double from, double to, double margin) {
   for (auto& q : pair.polyps) q.in_supine = q.in_supine && (q.sigma_mm < from - margin || q.sigma_mm >= to + margin);
 }
