@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "bench_cli.h"
+#include "register_bench_real.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/pipeline/dispatch.h"
 #include "colonflat/register/register.h"
@@ -400,39 +401,36 @@ bool run_scan(const fs::path& mask, const fs::path& out, bool painted, const std
          colonflat({"run", (ct / "ct.nrrd").string(), "-o", out.string(), "-q"}) == 0;
 }
 
-void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Vector3d& shift, double turn,
-                bool painted, const std::vector<int>& only, bool cli) {
+void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskOptions& o) {
+  const Eigen::Vector3d shift(o.table[0], o.table[1], o.table[2]);
+  const double turn = o.turn_deg;
   cf::Stopwatch prep;
-  cf::MaskCourse course(cf::read_mask(mask_file));
+  cf::MaskImage::Pointer mask = cf::read_mask(mask_file);
+  if (o.downsample > 1) mask = cf::downsample_mask(mask, o.downsample);
+  cf::MaskCourse course(mask);
   const auto polyps = course.place_polyps(10, 1);
   const double L = course.length_mm();
   std::printf("Real mask %s: course %.0f mm, %zu polyps placed (%.1f s); prone moved (%.0f, %.0f, %.0f) mm, %.1f deg\n",
               mask_file.filename().c_str(), L, polyps.size(), prep.seconds(), shift.x(), shift.y(), shift.z(), turn);
   fs::create_directories(work);
-  auto seen = [&](const Cuts& cuts, bool prone) {
-    std::vector<cf::ScanCandidate> out;
-    for (const auto& q : cf::polyps_seen(polyps, cuts))
-      out.push_back({q.id, prone ? cf::MaskCourse::moved(q.lps, course.centroid(), shift, turn) : q.lps, q.diameter_mm, 1});
-    return out;
-  };
   print_header();
   const auto cases = cut_cases(L);
   for (size_t k = 0; k < cases.size(); ++k) {
-    if (!only.empty() && std::find(only.begin(), only.end(), int(k)) == only.end()) continue;
+    if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), int(k)) == o.only.end()) continue;
     const std::string n = std::to_string(k);
     const CutCase& c = cases[k];
     const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
     if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
     if (!fs::exists(pm)) cf::write_mask(course.cut_and_move(c.prone, shift, turn), pm);
     const fs::path sr = work / ("supine_run" + (c.supine.empty() ? std::string() : n)), pr = work / ("prone_run" + n);
-    if (!run_scan(sm, sr, painted, "supine") || !run_scan(pm, pr, painted, "prone")) return;
+    if (!run_scan(sm, sr, o.painted, "supine") || !run_scan(pm, pr, o.painted, "prone")) return;
     const cf::ColonScan sup = cf::read_run_dir(sr), pro = cf::read_run_dir(pr);
     Row r{c.name, sup.lps.size()};
     cf::Stopwatch clock;
     cf::ColonRegistration reg(sup, pro);
     reg.run();
     r.seconds = clock.seconds(), r.pieces = piece_counts(reg);
-    const auto cs = seen(c.supine, false), cp = seen(c.prone, true);
+    const auto cs = seen_polyps(polyps, c.supine, course, {0, 0, 0}, 0), cp = seen_polyps(polyps, c.prone, course, shift, turn);
     r.polyps = 0;
     std::vector<double> along;
     for (const auto& q : cs)
@@ -442,12 +440,14 @@ void real_table(const fs::path& mask_file, const fs::path& work, const Eigen::Ve
           const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
           const Eigen::Vector3d at = cf::MaskCourse::unmoved(m, course.centroid(), shift, turn);
           if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(at) - polyps[size_t(q.id - 1)].path_mm));
+          if (o.show) show_polyp(reg, q, p, polyps[size_t(q.id - 1)].path_mm, along.empty() ? NAN : along.back());
         }
     count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
     r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
     count_detected(reg, cs, cp, r);  // the polyps cut out of a scan are not there to hit
     print_row(r);
-    if (cli) register_cli(sr, pr, work / ("register" + n), r);
+    if (o.show) show_pieces(reg, course, shift, turn);
+    if (!o.no_cli) register_cli(sr, pr, work / ("register" + n), r);
   }
 }
 
@@ -457,20 +457,20 @@ int main(int argc, char** argv) {
   cf::bench::BenchCli cli("register_bench", "Supine-prone registration benchmark (see the file's header)");
   std::string phantoms, size = "full", work = "register_bench_work", synthetic_dir;
   std::vector<std::string> pair, truth;
-  double twist_deg = 0, turn_deg = 0;
+  double twist_deg = 0;
   CLI::App& app = cli.app();
   app.add_option("--phantom", phantoms, "phantom pairs of seeds N or N-M");
   int cuts_seed = 0;
   std::string real_mask;  // the options of --real-mask
-  std::vector<double> table = {15, -30, 40};
-  bool painted = false, no_cli = false;
-  std::vector<int> only;
-  app.add_flag("--painted", painted, "with --real-mask: paint each mask into a CT and run from the CT");
-  app.add_flag("--no-cli", no_cli, "with --real-mask: no `colonflat register` run per pair");
-  app.add_option("--cases", only, "with --real-mask: only these cases (0-6)");
+  RealMaskOptions real;
+  app.add_flag("--painted", real.painted, "with --real-mask: paint each mask into a CT and run from the CT");
+  app.add_flag("--no-cli", real.no_cli, "with --real-mask: no `colonflat register` run per pair");
+  app.add_flag("--show-pieces", real.show, "with --real-mask: each piece's own mm -> true path mm -> common s; each polyp");
+  app.add_option("--downsample", real.downsample, "with --real-mask: the mask at this many times its voxel size");
+  app.add_option("--cases", real.only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
-  app.add_option("--table", table, "with --real-mask: prone table shift in LPS mm")->expected(3);
-  app.add_option("--turn", turn_deg, "with --real-mask: prone turned about the superior axis (degrees)");
+  app.add_option("--table", real.table, "with --real-mask: prone table shift in LPS mm")->expected(3);
+  app.add_option("--turn", real.turn_deg, "with --real-mask: prone turned about the superior axis (degrees)");
   app.add_option("--cuts", cuts_seed, "one phantom patient run from its masks, the prone mask cut (issue 27)");
   app.add_option("--size", size, "phantom size")->check(CLI::IsMember({"full", "small"}));
   app.add_option("--work", work, "work folder of the phantom pairs");
@@ -479,7 +479,7 @@ int main(int argc, char** argv) {
   app.add_option("--pair", pair, "one existing pair of run folders: SUP_RUN PRO_RUN")->expected(2);
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
-    if (!real_mask.empty()) real_table(real_mask, work, {table[0], table[1], table[2]}, turn_deg, painted, only, !no_cli);
+    if (!real_mask.empty()) real_table(real_mask, work, real);
     else if (cuts_seed > 0) cuts_table(cuts_seed, size, work);
     else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);

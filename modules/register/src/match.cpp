@@ -1,6 +1,7 @@
 // Candidate matching and the registration summary of cf::ColonRegistration.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "colonflat/register/register.h"
@@ -34,12 +35,14 @@ CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
     where_p.push_back({s, t});
   }
   std::vector<double> gap_s(cs.size()), gap_p(cp.size());
-  for (size_t j = 0; j < cp.size(); ++j) gap_p[j] = support_gap_mm(false, where_p[j].s);
+  constexpr double kHeld = std::numeric_limits<double>::infinity();  // held at a neck: no support along
+  for (size_t j = 0; j < cp.size(); ++j)
+    gap_p[j] = held_at_neck(cp[j].lps, Direction::kProneToSupine) ? kHeld : support_gap_mm(false, where_p[j].s);
   struct Option { double cost; size_t i, j; CandidateMatch m; };
   std::vector<Option> options;
   for (size_t i = 0; i < cs.size(); ++i) {
     const auto [s, t] = locate(cs[i].lps, Direction::kSupineToProne);
-    gap_s[i] = support_gap_mm(true, s);
+    gap_s[i] = held_at_neck(cs[i].lps, Direction::kSupineToProne) ? kHeld : support_gap_mm(true, s);
     if (std::isnan(s) || gap_s[i] > opts_.max_unsupported_mm) continue;  // no support: never paired
     double s2, t2;
     map_coordinates(Direction::kSupineToProne, s, t, s2, t2);

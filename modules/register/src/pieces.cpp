@@ -7,6 +7,24 @@
 #include <numeric>
 
 namespace cf {
+
+double ColonPiece::s_of(double local_mm) const {
+  const double linear = flipped ? start_mm + length_mm - local_mm : start_mm + local_mm;
+  if (s_bin.empty()) return linear;
+  const double x = local_mm / bin_mm - 0.5;  // bin k's centre is at (k + 0.5) bins
+  const int n = int(s_bin.size());
+  const double dir = flipped ? -1.0 : 1.0;
+  if (x <= 0) return s_bin.front() + dir * x * bin_mm;  // beyond the last bin: the piece's own mm
+  if (x >= n - 1) return s_bin.back() + dir * (x - (n - 1)) * bin_mm;
+  const int k = int(x);
+  return s_bin[size_t(k)] + (s_bin[size_t(k) + 1] - s_bin[size_t(k)]) * (x - k);
+}
+
+void ColonPiece::move_by(double mm) {
+  start_mm += mm;
+  for (double& s : s_bin) s += mm;
+}
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -65,7 +83,8 @@ void chain(std::vector<ColonPiece>& ref) {
 struct RefPoint {
   Eigen::Vector3d p;
   double s;
-  int piece;  // index of the reference piece
+  int piece;            // index of the reference piece
+  bool branch = false;  // a centre point of one of its side branches (s = the neck's)
 };
 
 // Centre points of a piece that project onto the reference: own mm, reference s, reference piece.
@@ -74,26 +93,106 @@ struct Projection {
   std::vector<int> ref_piece;
 };
 
-std::vector<RefPoint> ref_points(const std::vector<ColonPiece>& ref, double bin) {
+// Side-branch band -> (colon band, mm on it where the branch's neck is); a branch of a branch
+// resolves to its ancestor's neck.
+std::map<int, std::pair<int, double>> branch_necks(const ColonScan& scan) {
+  std::map<int, std::pair<int, double>> neck;
+  for (const auto& seg : scan.segments) {
+    if (seg.value("kind", std::string("colon")) != "branch") continue;
+    int parent = seg.value("parent", -1);
+    double attach = seg.value("attach_mm", 0.0);
+    for (int guard = 0; guard < 16 && is_branch(scan, parent); ++guard) {
+      const auto* e = segment_entry(scan, parent);
+      attach = e->value("attach_mm", 0.0), parent = e->value("parent", -1);
+    }
+    neck[seg.value("id", -1)] = {parent, attach};
+  }
+  return neck;
+}
+
+// A side-branch band's centre line and where it hangs on the colon.
+struct BranchLine {
+  int parent = -1;
+  double attach_mm = 0;
+  std::vector<Eigen::Vector3d> centre;
+};
+
+std::vector<BranchLine> branch_lines(const ColonScan& scan, double bin) {
+  std::map<int, double> length;
+  for (size_t v = 0; v < scan.lps.size(); ++v)
+    if (const double c = scan.centreline_mm[v]; std::isfinite(c) && c >= 0 && is_branch(scan, scan.segment[v]))
+      length[scan.segment[v]] = std::max(length[scan.segment[v]], c);
+  std::vector<BranchLine> out;
+  for (const auto& [seg, neck] : branch_necks(scan))
+    if (const auto it = length.find(seg); it != length.end())
+      out.push_back({neck.first, neck.second, piece_centre(scan, seg, std::max(it->second, bin), bin)});
+  return out;
+}
+
+// The reference's centre points with their common s: its colon pieces', and its side branches' at
+// their neck (where the registration puts the branch's vertices, common_s).
+std::vector<RefPoint> ref_points(const std::vector<ColonPiece>& ref, const std::vector<BranchLine>& branches, double bin) {
   std::vector<RefPoint> pts;
   for (size_t i = 0; i < ref.size(); ++i)
     for (size_t k = 0; k < ref[i].centre.size(); ++k)
       pts.push_back({ref[i].centre[k], ref[i].s_of((double(k) + 0.5) * bin), int(i)});
+  for (const auto& b : branches)
+    for (size_t i = 0; i < ref.size(); ++i) {
+      if (ref[i].segment != b.parent) continue;
+      const double s = ref[i].s_of(std::min(b.attach_mm, ref[i].length_mm));
+      for (const auto& c : b.centre) pts.push_back({c, s, int(i), true});
+    }
   return pts;
+}
+
+// Common s per centre bin of a placed piece: the running median (half window `follow_mm`) of its
+// projections' offsets from its own mm (sref - own mm; flipped: sref + own mm), linear between bins
+// that project, the piece's own mm beyond them; then made monotone along its direction.
+std::vector<double> follow_projections(const ColonPiece& piece, const std::vector<double>& local,
+                                       const std::vector<double>& sref, const PieceOptions& o) {
+  const int n = int(piece.centre.size());
+  const double dir = piece.flipped ? -1.0 : 1.0;
+  std::vector<double> offset(size_t(n), kNaN);
+  std::vector<int> bin(local.size());
+  for (size_t i = 0; i < local.size(); ++i) bin[i] = std::clamp(int(local[i] / o.bin_mm), 0, n - 1);
+  const int half = std::max(0, int(std::lround(o.follow_mm / o.bin_mm)));
+  for (size_t i = 0; i < local.size(); ++i) {
+    std::vector<double> near;
+    for (size_t j = 0; j < local.size(); ++j)
+      if (std::abs(bin[j] - bin[i]) <= half) near.push_back(sref[j] - dir * local[j]);
+    offset[size_t(bin[i])] = median(near);
+  }
+  std::vector<double> s(static_cast<size_t>(n));
+  int last = -1;
+  for (int k = 0; k < n; ++k) {
+    if (std::isnan(offset[size_t(k)])) continue;
+    for (int j = last + 1; j < k; ++j)  // before the first projecting bin: its offset; between: linear
+      offset[size_t(j)] = last < 0 ? offset[size_t(k)] : offset[size_t(last)] + (offset[size_t(k)] - offset[size_t(last)]) * double(j - last) / double(k - last);
+    last = k;
+  }
+  for (int j = last + 1; j < n; ++j) offset[size_t(j)] = offset[size_t(last)];
+  for (int k = 0; k < n; ++k) s[size_t(k)] = offset[size_t(k)] + dir * (double(k) + 0.5) * o.bin_mm;
+  for (int k = 1; k < n; ++k)  // a colon does not run back along itself
+    s[size_t(k)] = piece.flipped ? std::min(s[size_t(k)], s[size_t(k) - 1]) : std::max(s[size_t(k)], s[size_t(k) - 1]);
+  return s;
 }
 
 // Places `piece` on the reference axis from the projections of its (shifted) centre points.
 Projection place(ColonPiece& piece, const std::vector<RefPoint>& ref, const Eigen::Vector3d& shift, double bin,
                  const PieceOptions& o) {
   Projection pr;
+  piece.s_bin.clear();
+  piece.on_branch.assign(piece.centre.size(), 0);
   std::vector<double>& local = pr.local;
   std::vector<double>& sref = pr.sref;
   for (size_t k = 0; k < piece.centre.size(); ++k) {
     const Eigen::Vector3d q = piece.centre[k] + shift;
     double best = o.place_radius_mm * o.place_radius_mm, s = kNaN;
     int from = -1;
+    bool branch = false;
     for (const auto& r : ref)
-      if (const double d = (r.p - q).squaredNorm(); d <= best) best = d, s = r.s, from = r.piece;
+      if (const double d = (r.p - q).squaredNorm(); d <= best) best = d, s = r.s, from = r.piece, branch = r.branch;
+    piece.on_branch[k] = branch;
     if (!std::isnan(s)) local.push_back((double(k) + 0.5) * bin), sref.push_back(s), pr.ref_piece.push_back(from);
   }
   piece.placed_fraction = piece.centre.empty() ? 0.0 : double(local.size()) / double(piece.centre.size());
@@ -108,6 +207,8 @@ Projection place(ColonPiece& piece, const std::vector<RefPoint>& ref, const Eige
   for (size_t i = 0; i < local.size(); ++i)
     start[i] = piece.flipped ? sref[i] + local[i] - piece.length_mm : sref[i] - local[i];
   piece.start_mm = median(start);
+  piece.bin_mm = bin;
+  piece.s_bin = follow_projections(piece, local, sref, o);
   return pr;
 }
 
@@ -228,8 +329,9 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
   auto& other = L.supine_is_reference ? L.prone : L.supine;
   const Eigen::Vector3d shift = L.supine_is_reference ? L.prone_to_supine : Eigen::Vector3d(-L.prone_to_supine);
   chain(ref);
+  const std::vector<BranchLine> branches = branch_lines(L.supine_is_reference ? supine : prone, o.bin_mm);
   for (int pass = 0;; ++pass) {  // place, lengthen the reference gaps the other scan spans, again
-    const std::vector<RefPoint> pts = ref_points(ref, o.bin_mm);
+    const std::vector<RefPoint> pts = ref_points(ref, branches, o.bin_mm);
     std::vector<Projection> proj;
     for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
     if (pass == 3) break;
@@ -239,40 +341,20 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
     if (largest < 2 * o.bin_mm) break;
   }
   std::stable_sort(other.begin(), other.end(), [](const ColonPiece& x, const ColonPiece& y) {
-    return x.registered != y.registered ? x.registered : x.start_mm < y.start_mm;
+    return x.registered != y.registered ? x.registered : x.first_mm() < y.first_mm();
   });
-  const ColonPiece* prev = nullptr;  // pieces of one colon do not overlap: at least the straight gap apart
-  for (auto& p : other) {
-    if (!p.registered) continue;
-    if (prev) {
-      const Eigen::Vector3d& end = prev->flipped ? prev->centre.front() : prev->centre.back();
-      const Eigen::Vector3d& begin = p.flipped ? p.centre.back() : p.centre.front();
-      p.start_mm = std::max(p.start_mm, prev->end_mm() + (begin - end).norm());
-    }
-    prev = &p;
-  }
   double lo = 0;  // the other scan may reach beyond the reference's first end (rectum cut short)
   for (const auto& p : other)
-    if (p.registered) lo = std::min(lo, p.start_mm);
+    if (p.registered) lo = std::min(lo, p.first_mm());
   for (auto* side : {&ref, &other})
-    for (auto& p : *side) p.start_mm -= lo;
+    for (auto& p : *side) p.move_by(-lo);
   return L;
 }
 
 std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
   std::map<int, const ColonPiece*> by_segment;
   for (const auto& p : pieces) by_segment[p.segment] = &p;
-  std::map<int, std::pair<int, double>> neck;  // branch band -> (colon band, attach mm on it)
-  for (const auto& seg : scan.segments) {
-    if (seg.value("kind", std::string("colon")) != "branch") continue;
-    int parent = seg.value("parent", -1);
-    double attach = seg.value("attach_mm", 0.0);
-    for (int guard = 0; guard < 16 && is_branch(scan, parent); ++guard) {  // branch of a branch
-      const auto* e = segment_entry(scan, parent);
-      attach = e->value("attach_mm", 0.0), parent = e->value("parent", -1);
-    }
-    neck[seg.value("id", -1)] = {parent, attach};
-  }
+  const std::map<int, std::pair<int, double>> neck = branch_necks(scan);  // branch band -> (colon band, attach mm)
   std::vector<double> s(scan.lps.size(), kNaN);
   for (size_t v = 0; v < s.size(); ++v) {
     int seg = scan.segment[v];
@@ -283,6 +365,23 @@ std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece
     s[v] = p->second->s_of(std::min(local, p->second->length_mm));
   }
   return s;
+}
+
+std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
+  std::map<int, const ColonPiece*> by_segment;
+  for (const auto& p : pieces)
+    if (p.registered && !p.s_bin.empty()) by_segment[p.segment] = &p;
+  std::vector<char> held(scan.lps.size(), 0);
+  for (size_t v = 0; v < held.size(); ++v) {
+    const auto p = by_segment.find(scan.segment[v]);
+    const double c = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
+    if (p == by_segment.end() || !std::isfinite(c)) continue;
+    const double h = p->second->bin_mm;  // a colon stretch does not halve its length between the positions
+    const size_t k = std::min(p->second->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
+    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h ||
+              (!p->second->on_branch.empty() && p->second->on_branch[k]);
+  }
+  return held;
 }
 
 }  // namespace cf

@@ -133,6 +133,7 @@ void ColonRegistration::compute_coordinates() {
     sup_ = colon_coordinates_from_s(supine_, std::move(s_sup), opts_.profile, extent, "pieces (centreline_mm)", rectum);
     pro_ = colon_coordinates_from_s(prone_, std::move(s_pro), opts_.profile, extent, "pieces (centreline_mm)", rectum);
     b_to_a_ = layout_.prone_to_supine;
+    sup_held_ = cf::held_at_neck(supine_, layout_.supine), pro_held_ = cf::held_at_neck(prone_, layout_.prone);
   } else {
     sup_ = colon_coordinates(supine_, opts_.profile);
     pro_ = colon_coordinates(prone_, opts_.profile, opts_.orientation == "reverse");
@@ -242,6 +243,18 @@ Eigen::Vector3d ColonRegistration::map_lps(const Eigen::Vector3d& p, Direction d
   const int v = map_vertex(d, s, theta);
   if (v < 0) return Eigen::Vector3d::Constant(kNaN);
   return (d == Direction::kSupineToProne ? prone_ : supine_).lps[size_t(v)];
+}
+
+bool ColonRegistration::held_at_neck(const Eigen::Vector3d& p, Direction from) const {
+  const bool sup = from == Direction::kSupineToProne;
+  const std::vector<char>& own = sup ? sup_held_ : pro_held_;
+  const std::vector<char>& other = sup ? pro_held_ : sup_held_;
+  if (own.empty() || other.empty()) return false;
+  const vtkIdType v = (sup ? *sup_index_ : *pro_index_).lps->FindClosestPoint(p.data());
+  if (v >= 0 && own[size_t(v)]) return true;
+  const auto [s, theta] = locate(p, from);
+  const int w = map_vertex(from, s, theta);
+  return w >= 0 && other[size_t(w)];
 }
 
 }  // namespace cf

@@ -1,6 +1,7 @@
 #include "colonflat/testdata/mask_pair.h"
 
 #include <itkImageRegionConstIteratorWithIndex.h>
+#include <itkImageRegionIteratorWithIndex.h>
 #include <itkImageDuplicator.h>
 
 #include <Eigen/Geometry>
@@ -174,6 +175,38 @@ MaskImage::Pointer MaskCourse::cut_and_move(const std::vector<std::pair<double, 
   const Eigen::Vector3d origin = moved({o[0], o[1], o[2]}, centroid_, shift, rotate_deg);
   out->SetDirection(dir);
   out->SetOrigin(origin.data());
+  return out;
+}
+
+MaskImage::Pointer downsample_mask(const MaskImage* mask, int factor) {
+  const auto region = mask->GetLargestPossibleRegion();
+  MaskImage::SizeType size;
+  for (int d = 0; d < 3; ++d) size[d] = std::max<size_t>(1, region.GetSize()[d] / size_t(factor));
+  auto out = MaskImage::New();
+  out->SetRegions(MaskImage::RegionType(region.GetIndex(), size));
+  MaskImage::SpacingType spacing = mask->GetSpacing();
+  for (int d = 0; d < 3; ++d) spacing[d] *= factor;
+  out->SetSpacing(spacing);
+  out->SetDirection(mask->GetDirection());
+  MaskImage::PointType origin;  // the coarse voxel's centre is the centre of the fine voxels it covers
+  MaskImage::IndexType first = region.GetIndex();
+  itk::ContinuousIndex<double, 3> centre;
+  for (int d = 0; d < 3; ++d) centre[d] = double(first[d]) + 0.5 * (factor - 1);
+  mask->TransformContinuousIndexToPhysicalPoint(centre, origin);
+  out->SetOrigin(origin);
+  out->Allocate(true);
+  const int half = (factor * factor * factor + 1) / 2;
+  itk::ImageRegionIteratorWithIndex<MaskImage> it(out, out->GetLargestPossibleRegion());
+  for (; !it.IsAtEnd(); ++it) {
+    const auto c = it.GetIndex();
+    int n = 0;
+    for (int z = 0; z < factor; ++z)
+      for (int y = 0; y < factor; ++y)
+        for (int x = 0; x < factor; ++x)
+          n += mask->GetPixel({{first[0] + (c[0] - first[0]) * factor + x, first[1] + (c[1] - first[1]) * factor + y,
+                                first[2] + (c[2] - first[2]) * factor + z}}) != 0;
+    it.Set(n >= half ? 1 : 0);
+  }
   return out;
 }
 

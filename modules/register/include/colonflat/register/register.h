@@ -92,6 +92,9 @@ class ColonRegistration {
   // An LPS point of one scan to the other: nearest wall vertex, its (s, theta), mapped, the
   // target's wall vertex there; returns its LPS position (NaN when the point is not registered).
   Eigen::Vector3d map_lps(const Eigen::Vector3d& p, Direction d) const;
+  // True when a candidate at this LPS point of one scan, or its image in the other, lies on a stretch
+  // held at a neck (pieces.h): never paired there.
+  bool held_at_neck(const Eigen::Vector3d& p, Direction from) const;
   // (s, theta) of the wall vertex nearest to an LPS point of a scan (NaN when not registered).
   std::pair<double, double> locate(const Eigen::Vector3d& p, Direction from) const;
 
@@ -133,6 +136,7 @@ class ColonRegistration {
   std::vector<double> twist_;
   int twist_windows_ = 0;
   std::vector<int> sup_to_pro_, pro_to_sup_;
+  std::vector<char> sup_held_, pro_held_;  // per vertex: held at a neck (pieces.h held_at_neck)
   CandidateMatching matching_;
   std::unique_ptr<Index> sup_index_, pro_index_;
   nlohmann::json timing_ = nlohmann::json::object();

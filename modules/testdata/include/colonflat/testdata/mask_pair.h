@@ -58,6 +58,11 @@ class MaskCourse {
   Eigen::Vector3d centroid_{0, 0, 0};
 };
 
+// The mask at `factor` times the voxel size (same origin, direction and extent): a voxel is lumen
+// when at least half of the fine voxels it covers are (keeps the lumen's volume and shape, not its
+// finest contacts). For tests that must run a real mask through the pipeline quickly.
+MaskImage::Pointer downsample_mask(const MaskImage* mask, int factor);
+
 // The polyps a scan cut by `cuts_mm` still shows: none within a diameter of a cut.
 std::vector<MaskPolyp> polyps_seen(const std::vector<MaskPolyp>& polyps, const std::vector<std::pair<double, double>>& cuts_mm);
 
