@@ -22,6 +22,7 @@ BUILD_PKGS=(
   dicom3tools            # tests only: dciodvfy checks the DICOM objects we write against their IOD
   orthanc                # tests only: a real PACS (started by the tests on loopback ports they choose)
   python3-pydicom        # tests only: an independent reader of the SEG we write
+  python3-numpy          # tests only: pydicom decodes pixel data with NumPy (a Recommends, not installed by --no-install-recommends)
   xvfb xauth             # off-screen rendering where there is no display
   python3                # small test helpers
   snakemake              # cohort processing (workflow/Snakefile) and its ctest test
