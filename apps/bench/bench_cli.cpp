@@ -7,6 +7,8 @@
 #include <regex>
 #include <stdexcept>
 
+#include "colonflat/core/malloc_tunables.h"
+
 namespace cf::bench {
 
 BenchCli::BenchCli(std::string name, std::string description) : name_(std::move(name)), app_(description, name_) {
@@ -15,6 +17,7 @@ BenchCli::BenchCli(std::string name, std::string description) : name_(std::move(
 }
 
 int BenchCli::run(int argc, char** argv, const std::function<int()>& body) {
+  rerun_with_huge_page_malloc(argv);  // measure with the allocator settings colonflat runs with
   try {
     app_.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -3,9 +3,11 @@
 #include <string>
 #include <vector>
 
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/pipeline/dispatch.h"
 
 int main(int argc, char** argv) {
+  cf::rerun_with_huge_page_malloc(argv);  // large blocks on huge pages (core/malloc_tunables.h)
   std::vector<std::string> args(argv + 1, argv + argc);
   return cf::colonflat_main(args, std::cout, std::cerr);
 }

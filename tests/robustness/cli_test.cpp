@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include "colonflat/core/run_stats.h"
+#include "colonflat/testdata/synthetic.h"
+#include "colonflat/testing/shell.h"
 #include "support.h"
 
 namespace cf::robust {
@@ -155,6 +157,25 @@ TEST_F(RobustCli, InfoOnLoopsAndFlatMap) {
   EXPECT_NE(r.out.find("segment 0 (colon)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("wall shown: "), std::string::npos) << r.out;
 }
+
+#ifdef COLONFLAT_BINARY
+// The colonflat executable itself runs with glibc.malloc.hugetlb=1 (its stage report records the
+// tunables), and a user's own setting of that tunable is kept as given.
+TEST(RobustBinary, RunsWithHugePageMallocUnlessTheUserSetsIt) {
+  testing::TempDir dir;
+  write_mesh(synthetic::to_mesh(synthetic::sphere(10, 24, 12)), dir.path() / "sphere.off");
+  const std::pair<std::string, std::string> cases[] = {{"env -u GLIBC_TUNABLES", "glibc.malloc.hugetlb=1"},
+                                                       {"env GLIBC_TUNABLES=glibc.malloc.hugetlb=0", "glibc.malloc.hugetlb=0"}};
+  for (const auto& [env, expected] : cases) {
+    const fs::path report = dir.path() / "report.json";
+    fs::remove(report);
+    const auto [code, out] = testing::shell(env + " " + COLONFLAT_BINARY + " denoise -q " + (dir.path() / "sphere.off").string() +
+                                            " -o " + (dir.path() / "out.off").string() + " --report " + report.string());
+    ASSERT_EQ(code, 0) << out;
+    EXPECT_EQ(nlohmann::json::parse(slurp(report)).value("malloc_tunables", std::string("missing")), expected) << env;
+  }
+}
+#endif
 
 }  // namespace
 }  // namespace cf::robust

@@ -9,6 +9,7 @@
 
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/core/threads.h"
 
 namespace fs = std::filesystem;
@@ -67,6 +68,7 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
           {"time_s", clock.seconds()},
           {"cpu_time_s", process_cpu_seconds() - cpu0},
           {"threads", thread_count()},
+          {"malloc_tunables", malloc_tunables()},
           {"phases", phases.phases()},
           {"peak_memory_mib", peak_memory_mib()},
           {"outputs", nlohmann::json::object()}};
