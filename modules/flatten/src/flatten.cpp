@@ -451,6 +451,7 @@ FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
 TriangleList flat_to_surface(const FlatMap& flat, std::vector<int>* flat_to_3d) {
   TriangleList t;
   std::unordered_map<int, int> map;
+  map.reserve(flat.uv.size());
   std::vector<int> f2d(flat.uv.size());
   for (std::size_t i = 0; i < flat.uv.size(); ++i) {
     auto it = map.find(flat.source_vertex[i]);

@@ -14,9 +14,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <array>
+#include <vector>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 #include "colon_image_steps.h"
 
 namespace cf::detail {
@@ -62,7 +64,9 @@ void colour_of_shape_index(double si, double rgb[3]) {
   rgb[0] = stops[5].r, rgb[1] = stops[5].g, rgb[2] = stops[5].b;
 }
 
-// One band: rasterise, smooth the view normals, then shade (or hatch) each pixel into the image.
+// One band: rasterise, smooth the view normals, then shade (or hatch) each pixel into the image,
+// rows split over the threads (each pixel depends only on the probed band, so any count gives the
+// same image).
 void ColonImagePainter::paint_band(const Band& b) {
   const FlatSegment& s = flat_.segments[b.seg];
   out_.roll[b.seg] = b.c0;
@@ -72,7 +76,20 @@ void ColonImagePainter::paint_band(const Band& b) {
   ImagePtr mean = smoothed_normals(view);
   const auto* vnp = static_cast<const double*>(view->GetScalarPointer());
   const auto* mp = static_cast<const double*>(mean->GetScalarPointer());
-  for (int j = 0; j < b.h; ++j)
+  const int chunks = std::max(1, std::min(thread_count(), b.h));
+  std::vector<std::array<std::size_t, 2>> counts(chunks, {0, 0});
+  parallel_for(std::size_t(chunks), [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      paint_rows(b, probed, vnp, mp, int(b.h * c / chunks), int(b.h * (c + 1) / chunks), counts[c].data());
+  });
+  for (const auto& c : counts) out_.compressed_pixels += c[0], out_.missing_pixels += c[1];
+}
+
+// Rows [j0, j1) of a band; counts[0] += compressed pixels, counts[1] += missing pixels.
+void ColonImagePainter::paint_rows(const Band& b, const ProbedBand& probed, const double* view, const double* mean,
+                                   int j0, int j1, std::size_t counts[2]) const {
+  const FlatSegment& s = flat_.segments[b.seg];
+  for (int j = j0; j < j1; ++j)
     for (int i = 0; i < b.w; ++i) {
       const vtkIdType id = vtkIdType(j) * b.w + i;
       unsigned char* d = pixels_ + (std::size_t(b.row0 + j) * width_ + b.col0 + i) * 3;
@@ -81,10 +98,12 @@ void ColonImagePainter::paint_band(const Band& b) {
       if (!probed.valid->GetValue(id) && past_edge) continue;
       if (!probed.valid->GetValue(id)) {
         hatch_missing(stripe, d);
+        ++counts[1];
         continue;
       }
-      const PixelGeometry g = pixel_geometry(b, probed, vnp, mp, i, j);
-      shade_pixel(g, probed.shape_index->GetTuple1(id), probed.ratio->GetTuple1(id), stripe, d);
+      const PixelGeometry g = pixel_geometry(b, probed, view, mean, i, j);
+      // GetComponent, not GetTuple1: the latter shares one buffer per array (not thread-safe).
+      counts[0] += shade_pixel(g, probed.shape_index->GetComponent(id, 0), probed.ratio->GetComponent(id, 0), stripe, d);
     }
 }
 
@@ -92,7 +111,35 @@ void ColonImagePainter::paint_band(const Band& b) {
 vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_segment(const FlatSegment& s, double c0) const {
   const FlatMap& f = flat_;
   const double P = s.period;
-  std::map<std::pair<int, int>, vtkIdType> ids;
+  std::vector<RolledTriangle> rolled;
+  std::vector<int> local(f.uv.size(), -1);  // flat vertex -> its index among the segment's vertices
+  int vertices = 0, kmin = 0, kmax = 0;
+  for (std::size_t ti = 0; ti < f.triangles.size(); ++ti) {
+    const auto& t = f.triangles[ti];
+    if (f.segment[t[0]] != s.id) continue;
+    for (int v : t)
+      if (local[v] < 0) local[v] = vertices++;
+    const double cy = (f.uv[t[0]][1] + f.uv[t[1]][1] + f.uv[t[2]][1]) / 3;
+    const int k = int(std::floor((cy - c0) / P));
+    const double ymin = std::min({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
+    const double ymax = std::max({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
+    for (int extra : {0, -1, 1}) {
+      if (extra == -1 && ymax < c0 + P) continue;  // crosses the top: copy one period down
+      if (extra == 1 && ymin > c0) continue;       // crosses the bottom: copy one period up
+      rolled.push_back({int(ti), extra - k});
+      kmin = std::min(kmin, extra - k), kmax = std::max(kmax, extra - k);
+    }
+  }
+  return rolled_polydata(rolled, local, vertices, kmin, kmax, P);
+}
+
+// The rolled copies as polydata: one point per (vertex, period) used, with the arrays the
+// shading reads (n, p, si, ratio).
+vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_polydata(const std::vector<RolledTriangle>& rolled,
+                                                               const std::vector<int>& local, int vertices,
+                                                               int kmin, int kmax, double P) const {
+  const FlatMap& f = flat_;
+  std::vector<vtkIdType> ids(std::size_t(vertices) * (kmax - kmin + 1), -1);  // (local vertex, period) -> point
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
   vtkNew<vtkDoubleArray> nrm, pos, shp, rat;
@@ -103,30 +150,20 @@ vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_segment(const FlatSegment
   shp->SetName("si");
   rat->SetName("ratio");
   vtkNew<vtkCellArray> polys;
-  auto vid = [&](int v, int copy) {
-    auto it = ids.find({v, copy});
-    if (it != ids.end()) return it->second;
-    const vtkIdType id = pts->InsertNextPoint(f.uv[v][0], f.uv[v][1] + copy * P, 0.0);
+  auto vid = [&](int v, int periods) {
+    vtkIdType& id = ids[std::size_t(local[v]) * (kmax - kmin + 1) + (periods - kmin)];
+    if (id >= 0) return id;
+    id = pts->InsertNextPoint(f.uv[v][0], f.uv[v][1] + periods * P, 0.0);
     nrm->InsertNextTuple(f.normal[v].data());
     pos->InsertNextTuple(f.position[v].data());
     shp->InsertNextValue(shape_index_.empty() ? 0.0 : shape_index_[v]);
     rat->InsertNextValue(vertex_ratio_[v]);
-    ids.emplace(std::make_pair(v, copy), id);
     return id;
   };
-  for (const auto& t : f.triangles) {
-    if (f.segment[t[0]] != s.id) continue;
-    const double cy = (f.uv[t[0]][1] + f.uv[t[1]][1] + f.uv[t[2]][1]) / 3;
-    const int k = int(std::floor((cy - c0) / P));
-    const double ymin = std::min({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
-    const double ymax = std::max({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
-    for (int extra : {0, -1, 1}) {
-      if (extra == -1 && ymax < c0 + P) continue;  // crosses the top: copy one period down
-      if (extra == 1 && ymin > c0) continue;       // crosses the bottom: copy one period up
-      const int kk = -k + (extra == -1 ? -1 : extra == 1 ? 1 : 0);
-      vtkIdType c[3] = {vid(t[0], kk), vid(t[1], kk), vid(t[2], kk)};
-      polys->InsertNextCell(3, c);
-    }
+  for (const RolledTriangle& r : rolled) {
+    const auto& t = f.triangles[r.t];
+    vtkIdType c[3] = {vid(t[0], r.periods), vid(t[1], r.periods), vid(t[2], r.periods)};
+    polys->InsertNextCell(3, c);
   }
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
@@ -209,8 +246,8 @@ PixelGeometry ColonImagePainter::pixel_geometry(const Band& b, const ProbedBand&
 
 // Diffuse + specular shading against a light tilted from the large-scale normal towards the colon
 // axis; curvature colouring and blue hatching (compressed wall) on top.
-void ColonImagePainter::shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe,
-                                    unsigned char* d) {
+bool ColonImagePainter::shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe,
+                                    unsigned char* d) const {
   const double* v = g.view;
   const double* m = g.mean;
   const double* t = g.tangent;
@@ -229,18 +266,17 @@ void ColonImagePainter::shade_pixel(const PixelGeometry& g, double shape_index, 
     for (int k = 0; k < 3; ++k) base[k] = 0.35 * base[k] + 0.65 * c[k];
   }
   const bool compressed = ratio < opts_.compressed_ratio;
-  if (compressed) ++out_.compressed_pixels;
   for (int k = 0; k < 3; ++k) {
     double val = 255.0 * (base[k] * shade + spec);
     if (compressed && stripe) val = 0.45 * val + 0.55 * 255.0 * (k == 2 ? 1.0 : k == 1 ? 0.9 : 0.2);
     d[k] = static_cast<unsigned char>(std::clamp(val, 0.0, 255.0));
   }
+  return compressed;
 }
 
 // Wall not in the map: hatched dark red.
 void ColonImagePainter::hatch_missing(bool stripe, unsigned char* d) {
   d[0] = stripe ? 120 : 40, d[1] = d[2] = stripe ? 20 : 10;
-  ++out_.missing_pixels;
 }
 
 }  // namespace cf::detail

@@ -59,6 +59,12 @@ struct ProbedBand {
 };
 
 // The wall seen at one pixel: unit view normal, large-scale normal, tangent along the colon.
+// A copy of a segment's triangle t that rolled_segment() keeps, moved by `periods` periods.
+struct RolledTriangle {
+  int t;
+  int periods;
+};
+
 struct PixelGeometry {
   const double* view;  // unit normal into the lumen
   double mean[3];      // smoothed view normal (not unit)
@@ -89,13 +95,19 @@ class ColonImagePainter {
   // Rasterising and shading (colon_image_raster.cpp).
   void paint_band(const Band& band);
   vtkSmartPointer<vtkPolyData> rolled_segment(const FlatSegment& segment, double c0) const;
+  vtkSmartPointer<vtkPolyData> rolled_polydata(const std::vector<RolledTriangle>& rolled,
+                                               const std::vector<int>& local, int vertices, int kmin, int kmax,
+                                               double P) const;
   ProbedBand probe_band(const Band& band, vtkPolyData* rolled) const;
   ImagePtr view_normals(const Band& band, const ProbedBand& probed) const;
   ImagePtr smoothed_normals(vtkImageData* view) const;
   PixelGeometry pixel_geometry(const Band& band, const ProbedBand& probed, const double* view, const double* mean,
                                int column, int row) const;
-  void shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe, unsigned char* rgb);
-  void hatch_missing(bool stripe, unsigned char* rgb);
+  // Both return whether the pixel counts as compressed / missing (paint_band sums them).
+  bool shade_pixel(const PixelGeometry& g, double shape_index, double ratio, bool stripe, unsigned char* rgb) const;
+  static void hatch_missing(bool stripe, unsigned char* rgb);
+  void paint_rows(const Band& b, const ProbedBand& probed, const double* view, const double* mean, int j0, int j1,
+                  std::size_t counts[2]) const;
   // Overlays (colon_image_overlay.cpp).
   void draw_markers(vtkImageCanvasSource2D* canvas);
   void draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& marker, const Band& band);

@@ -42,7 +42,6 @@ class FlatRenderer {
   std::vector<int> flat_to_surface_;                // flat vertex -> surface vertex
   std::vector<int> surface_to_flat_;                // surface vertex -> its first flat vertex
   std::vector<std::array<double, 3>> normals_;      // per surface vertex, outward
-  std::vector<std::vector<int>> vertex_triangles_;  // flat vertex -> its flat triangles
   std::vector<double> shape_index_flat_;            // per flat vertex (empty without curvature)
   std::vector<KnownPolyp> known_;
   std::vector<double> known_distance_;              // known polyp centre -> nearest wall vertex (mm)
@@ -67,9 +66,6 @@ void FlatRenderer::map_surface() {
     normals_[flat_to_surface_[i]] = flat_.normal[i];
     if (surface_to_flat_[flat_to_surface_[i]] < 0) surface_to_flat_[flat_to_surface_[i]] = int(i);
   }
-  vertex_triangles_.assign(flat_.uv.size(), {});
-  for (std::size_t t = 0; t < flat_.triangles.size(); ++t)
-    for (int v : flat_.triangles[t]) vertex_triangles_[v].push_back(int(t));
 }
 
 // Candidates (when detect is on) and the shape index per flat vertex (for curvature colouring).
@@ -131,12 +127,13 @@ int FlatRenderer::nearest_flat_vertex(const std::array<double, 3>& c, double* bd
   return best;
 }
 
-// Local length scale 2D/3D around a flat vertex (sqrt of the area ratio of its triangles).
+// Local length scale 2D/3D around a flat vertex (sqrt of the area ratio of its triangles). Called
+// once per marker, so its triangles are found by a scan rather than an index kept for every vertex.
 double FlatRenderer::local_scale(int v) const {
   const FlatMap& f = flat_;
   double a2 = 0, a3 = 0;
-  for (int t : vertex_triangles_[v]) {
-    const auto& T = f.triangles[t];
+  for (const auto& T : f.triangles) {
+    if (T[0] != v && T[1] != v && T[2] != v) continue;
     auto p = [&](int i, int k) { return f.position[T[i]][k]; };
     double e1[3], e2[3];
     for (int k = 0; k < 3; ++k) e1[k] = p(1, k) - p(0, k), e2[k] = p(2, k) - p(0, k);
