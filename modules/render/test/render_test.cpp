@@ -11,11 +11,13 @@
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/flatten/flatten.h"
@@ -107,6 +109,35 @@ TEST(RenderImage, MissingWallIsHatched) {
   const ColonImage holed = render_colon_image(f, {}, none, o);
   const double px_area = holed.pixel_size * holed.pixel_size;
   EXPECT_NEAR(double(holed.missing_pixels) * px_area, removed, 0.15 * removed);
+}
+
+// The colon image is the same, pixel for pixel and in its counts, for 1 and 2 threads (a hole
+// in the map makes hatched pixels count too).
+TEST(RenderImage, SameImageForAnyThreadCount) {
+  auto c = test_colon();
+  FlatMap f = flatten_colon(c.mesh);
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& t : f.triangles)
+    if (f.uv[t[0]][0] < 100 || f.uv[t[0]][0] > 110) kept.push_back(t);
+  f.triangles = kept;
+  std::vector<ImageMarker> none;
+  ColonImageOptions o;
+  o.color = "curvature";
+  std::vector<double> si(f.uv.size());
+  for (std::size_t v = 0; v < si.size(); ++v) si[v] = std::sin(0.1 * f.uv[v][0]);
+  set_thread_count(1);
+  const ColonImage one = render_colon_image(f, si, none, o);
+  set_thread_count(2);
+  const ColonImage two = render_colon_image(f, si, none, o);
+  set_thread_count(0);
+  ASSERT_GT(one.missing_pixels, 0u);
+  EXPECT_EQ(one.missing_pixels, two.missing_pixels);
+  EXPECT_EQ(one.compressed_pixels, two.compressed_pixels);
+  ASSERT_EQ(one.width, two.width);
+  ASSERT_EQ(one.height, two.height);
+  const auto* a = static_cast<const unsigned char*>(one.image->GetScalarPointer());
+  const auto* b = static_cast<const unsigned char*>(two.image->GetScalarPointer());
+  EXPECT_TRUE(std::equal(a, a + std::size_t(one.width) * one.height * 3, b));
 }
 
 // Wall the image cannot show (a coverage cluster of flatten) is ringed in red at the mapped point
