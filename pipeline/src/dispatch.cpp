@@ -6,6 +6,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/pipeline/registry.h"
+#include "colonflat/volume/volume_io.h"
 
 namespace cf {
 namespace {
@@ -100,6 +101,7 @@ int help_on(const std::vector<std::string>& args, std::vector<std::unique_ptr<To
 }  // namespace
 
 int colonflat_main(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  itk_follows_thread_count();  // --threads bounds ITK's pool too
   auto tools = all_tools();
   if (args.size() > 1 && args[0] == "help") return help_on(args, tools, out, err);
   if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {

@@ -7,7 +7,11 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <mutex>
 #include <thread>
+
+#include <vtkMultiThreader.h>
+#include <vtkSMPTools.h>
 
 namespace cf {
 
@@ -53,7 +57,40 @@ int thread_count() {
   return n > 0 ? n : default_thread_count();
 }
 
-void set_thread_count(int n) { g_threads.store(n > 0 ? n : 0); }
+namespace {
+
+std::mutex g_listeners_mutex;
+std::vector<ThreadCountListener>& listeners() {
+  static std::vector<ThreadCountListener> all;
+  return all;
+}
+
+// VTK's pools: vtkSMPTools (TBB here; fairing, flying edges) and vtkMultiThreader (threaded image
+// filters such as the Gaussian smoothing of render).
+void vtk_follows(int n) {
+  vtkSMPTools::Initialize(n);
+  vtkMultiThreader::SetGlobalMaximumNumberOfThreads(n);
+}
+
+}  // namespace
+
+void set_thread_count(int n) {
+  g_threads.store(n > 0 ? n : 0);
+  const int now = thread_count();
+  vtk_follows(now);
+  std::lock_guard<std::mutex> lock(g_listeners_mutex);
+  for (ThreadCountListener l : listeners()) l(now);
+}
+
+void add_thread_count_listener(ThreadCountListener listener) {
+  {
+    std::lock_guard<std::mutex> lock(g_listeners_mutex);
+    for (ThreadCountListener l : listeners())
+      if (l == listener) return;
+    listeners().push_back(listener);
+  }
+  listener(thread_count());
+}
 
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body, int max_threads) {
   if (n == 0) return;

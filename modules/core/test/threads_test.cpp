@@ -1,6 +1,7 @@
 #include "colonflat/core/threads.h"
 
 #include <gtest/gtest.h>
+#include <vtkSMPTools.h>
 
 #include <atomic>
 #include <cstdlib>
@@ -101,6 +102,28 @@ TEST_F(CoreThreads, DefaultFollowsTheEnvironment) {
   EXPECT_EQ(cf::thread_count(), 5);
   cf::set_thread_count(0);
   EXPECT_EQ(cf::thread_count(), cf::default_thread_count());
+}
+
+}  // namespace
+
+namespace {
+
+int g_heard = -1;
+void hear(int n) { g_heard = n; }
+
+// The count reaches VTK's SMP pool and every registered listener (ITK's in colonflat_main), at
+// registration and on every change, so --threads N bounds the libraries' pools as well.
+TEST_F(CoreThreads, LibraryPoolsAndListenersFollowTheCount) {
+  cf::set_thread_count(1);
+  EXPECT_EQ(vtkSMPTools::GetEstimatedNumberOfThreads(), 1);
+  cf::add_thread_count_listener(hear);
+  EXPECT_EQ(g_heard, 1);
+  cf::set_thread_count(2);
+  EXPECT_EQ(vtkSMPTools::GetEstimatedNumberOfThreads(), 2);
+  EXPECT_EQ(g_heard, 2);
+  cf::add_thread_count_listener(hear);  // registered once: no second call per change
+  cf::set_thread_count(0);
+  EXPECT_EQ(g_heard, cf::default_thread_count());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <itkImageSeriesWriter.h>
 #include <itkMetaDataObject.h>
 #include <itkMetaImageIO.h>
+#include <itkMultiThreaderBase.h>
 #include <itkNiftiImageIO.h>
 #include <itkNrrdImageIO.h>
 
@@ -27,6 +28,7 @@
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 
 #include "volume_internal.h"
 
@@ -138,6 +140,10 @@ void set_patient_position(itk::ImageBase<3>* image, const std::string& position)
     return;
   }
   itk::EncapsulateMetaData<std::string>(d, "0018|5100", position);
+}
+
+void itk_follows_thread_count() {
+  add_thread_count_listener([](int n) { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(itk::ThreadIdType(n)); });
 }
 
 }  // namespace cf

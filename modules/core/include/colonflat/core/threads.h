@@ -15,8 +15,15 @@ namespace cf {
 
 // Worker threads to use, >= 1.
 int thread_count();
-// Sets the count; n <= 0 restores the default (all cores / COLONFLAT_THREADS).
+// Sets the count; n <= 0 restores the default (all cores / COLONFLAT_THREADS). The libraries'
+// own thread pools follow it too (VTK's SMP tools and threaded image filters here; ITK's once
+// its module registered a listener), so that --threads N bounds every pool of the process, not
+// only ColonFlat's own (a cohort scheduler's `threads:` is then obeyed).
 void set_thread_count(int n);
+// Called with the new thread_count() by every set_thread_count(), and once at registration.
+// For libraries core does not link (ITK: volume_io.h's itk_follows_thread_count()).
+using ThreadCountListener = void (*)(int threads);
+void add_thread_count_listener(ThreadCountListener listener);
 // The default the machine gives (>= 1): COLONFLAT_THREADS if set and positive, else all cores.
 int default_thread_count();
 

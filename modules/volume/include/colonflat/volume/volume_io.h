@@ -39,6 +39,10 @@ struct DicomSeriesInfo {
   std::string description;  // SeriesDescription
 };
 
+// ITK's filters use cf::thread_count() threads from now on (core threads.h listener; called by
+// colonflat_main, idempotent).
+void itk_follows_thread_count();
+
 // The series in a folder (empty if it holds no readable DICOM file).
 std::vector<DicomSeriesInfo> list_dicom_series(const std::filesystem::path& dir);
 
