@@ -109,6 +109,37 @@ bool FaceGrid::triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const
   return false;
 }
 
+// Calls visit(cell) for the cells segment pq passes through, in order (a 3D DDA walk), until
+// visit returns true; returns whether it did. A face the segment meets lies in the cell of the
+// meeting point (faces are hashed by bounding box), so these cells hold every face it can hit.
+template <class Visit>
+bool FaceGrid::segment_cells(const Vec3& p, const Vec3& q, Visit&& visit) const {
+  const Key a = key(p), b = key(q);
+  long long k[3] = {a.x, a.y, a.z};
+  const long long last[3] = {b.x, b.y, b.z};
+  const Vec3 d = q - p;
+  long long step[3];
+  double next[3], delta[3];
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    step[i] = d[i] > 0 ? 1 : (d[i] < 0 ? -1 : 0);
+    const double boundary = (k[i] + (step[i] > 0 ? 1 : 0)) * cell_;
+    next[i] = step[i] != 0 ? (boundary - p[i]) / d[i] : kInf;
+    delta[i] = step[i] != 0 ? cell_ / std::fabs(d[i]) : kInf;
+  }
+  const long long cells = std::llabs(b.x - a.x) + std::llabs(b.y - a.y) + std::llabs(b.z - a.z) + 1;
+  for (long long n = 0; n < cells; ++n) {
+    if (visit(Key{k[0], k[1], k[2]})) return true;
+    if (k[0] == last[0] && k[1] == last[1] && k[2] == last[2]) break;
+    int i = 0;
+    if (next[1] < next[i]) i = 1;
+    if (next[2] < next[i]) i = 2;
+    k[i] += step[i];
+    next[i] += delta[i];
+  }
+  return false;
+}
+
 // Calls visit(face id) for the grid faces of cell k (a face may come again from another cell)
 // until visit returns true; returns whether it did.
 template <class Visit>
@@ -271,21 +302,25 @@ void FaceGrid::erase(const Mesh& mesh, Mesh::FaceHandle f) {
 }
 
 namespace {
-// Segment [p, q] against triangle (a, b, c), excluding the segment's first 1e-9 (Moller-Trumbore).
-bool segment_hits_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 d = q - p, e1 = b - a, e2 = c - a;
-  const Vec3 h = OpenMesh::cross(d, e2);
+// Parameter t > 1e-9 at which the ray p + t d meets triangle (a, b, c), or infinity (Moller-Trumbore).
+double ray_triangle(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  const Vec3 e1 = b - a, e2 = c - a, h = OpenMesh::cross(d, e2);
   const double det = OpenMesh::dot(e1, h);
-  const double scale = e1.norm() * e2.norm() * d.norm();
-  if (std::fabs(det) <= 1e-12 * scale) return false;
+  if (std::fabs(det) <= 1e-12 * e1.norm() * e2.norm() * d.norm()) return kNever;
   const Vec3 s = p - a;
   const double u = OpenMesh::dot(s, h) / det;
-  if (u < 0 || u > 1) return false;
+  if (u < 0 || u > 1) return kNever;
   const Vec3 qv = OpenMesh::cross(s, e1);
   const double v = OpenMesh::dot(d, qv) / det;
-  if (v < 0 || u + v > 1) return false;
+  if (v < 0 || u + v > 1) return kNever;
   const double t = OpenMesh::dot(e2, qv) / det;
-  return t > 1e-9 && t <= 1.0;
+  return t > 1e-9 ? t : kNever;
+}
+
+// Segment [p, q] against triangle (a, b, c), excluding the segment's first 1e-9.
+bool segment_hits_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return ray_triangle(p, q - p, a, b, c) <= 1.0;
 }
 
 // Improper intersection of two triangles (ids = mesh vertex ids): disjoint ones by VTK's
@@ -317,6 +352,45 @@ bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3,
   return OpenMesh::dot(na, nb) / (na.norm() * nb.norm()) < -0.9999999;
 }
 }  // namespace
+
+bool FaceGrid::segment_hits(const Mesh& mesh, int a, int b) const {
+  const Vec3 p = mesh.point(Mesh::VertexHandle(a)), q = mesh.point(Mesh::VertexHandle(b));
+  auto pierces = [&](int gi) {
+    Vec3 lo, hi;
+    std::array<int, 3> ids;
+    std::array<Vec3, 3> t;
+    face_box(mesh, Mesh::FaceHandle(gi), lo, hi, ids, t);
+    const bool at_a = ids[0] == a || ids[1] == a || ids[2] == a, at_b = ids[0] == b || ids[1] == b || ids[2] == b;
+    if (at_a && at_b) return false;  // pq is that face's edge
+    // from the shared end (the exclusion of a triangle's first 1e-9 is the one hits() applies)
+    return at_b ? segment_hits_triangle(q, p, t[0], t[1], t[2]) : segment_hits_triangle(p, q, t[0], t[1], t[2]);
+  };
+  if (std::any_of(big_.begin(), big_.end(), pierces)) return true;
+  return segment_cells(p, q, [&](const Key& k) { return cell_faces(k, pierces); });
+}
+
+double FaceGrid::free_distance(const Mesh& mesh, const Vec3& origin, const Vec3& dir, double max_dist,
+                               int skip_vertex) const {
+  double best = max_dist;
+  auto meet = [&](int gi) {
+    Vec3 lo, hi;
+    std::array<int, 3> ids;
+    std::array<Vec3, 3> q;
+    face_box(mesh, Mesh::FaceHandle(gi), lo, hi, ids, q);
+    if (ids[0] != skip_vertex && ids[1] != skip_vertex && ids[2] != skip_vertex)
+      best = std::min(best, ray_triangle(origin, dir, q[0], q[1], q[2]));
+    return false;
+  };
+  std::for_each(big_.begin(), big_.end(), meet);
+  Vec3 lo = origin, hi = origin;
+  lo.minimize(origin + max_dist * dir);
+  hi.maximize(origin + max_dist * dir);
+  const Key a = key(lo), b = key(hi);
+  for (long long x = a.x; x <= b.x; ++x)
+    for (long long y = a.y; y <= b.y; ++y)
+      for (long long z = a.z; z <= b.z; ++z) cell_faces(Key{x, y, z}, meet);
+  return best;
+}
 
 std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const {
   return intersecting_pairs(mesh, faces).size();

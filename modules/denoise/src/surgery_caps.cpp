@@ -31,6 +31,12 @@ Vec3 area_normal(const Mesh& mesh, Mesh::FaceHandle f) {
 }
 }  // namespace
 
+Vec3 vertex_area_normal(const Mesh& mesh, Mesh::VertexHandle v) {
+  Vec3 nrm(0, 0, 0);
+  for (auto f : mesh.vf_range(v)) nrm += area_normal(mesh, f);
+  return nrm;
+}
+
 // 6. Side targets: after the split, a ring vertex's non-ring neighbours are exactly its own
 //    side's; a ring is pulled towards the centroid of those (face barycentres as a fallback),
 //    projected on the tangent plane.
@@ -55,8 +61,7 @@ std::vector<Vec3> Surgery::side_targets(const std::vector<Mesh::VertexHandle>& r
       }
     }
     target[i] = n ? c / double(n) : mesh_.point(ring[i]);
-    Vec3 nrm(0, 0, 0);
-    for (auto f : mesh_.vf_range(ring[i])) nrm += area_normal(mesh_, f);
+    Vec3 nrm = vertex_area_normal(mesh_, ring[i]);
     if (nrm.norm() > 0) {
       nrm /= nrm.norm();
       const Vec3 move = target[i] - mesh_.point(ring[i]);
@@ -115,8 +120,7 @@ std::vector<Mesh::FaceHandle> Surgery::faces_around_rings() const {
 // Minimum-area triangulations of both rings (with `avoid`: only triangles that intersect nothing);
 // true when both exist and together intersect nothing.
 bool Surgery::triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left) {
-  std::vector<Mesh::VertexHandle> order_left{result_.left_ring[0]};
-  for (std::size_t i = k_ - 1; i >= 1; --i) order_left.push_back(result_.left_ring[i]);  // x_(k-1) -> ... -> x_0
+  const std::vector<Mesh::VertexHandle> order_left = left_cap_order();
   // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
   auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
   const FaceGrid* grid = avoid ? opts_.guard : nullptr;
@@ -177,7 +181,9 @@ bool Surgery::mirror_cap(const std::vector<std::array<int, 3>>& right, std::vect
 
 // 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area
 //     triangulations of the pulled rings (no interior vertex: on an elongated loop around a thin
-//     curved band they join opposite sides and follow the band) in every placement; then, in
+//     curved band they join opposite sides and follow the band) in every placement; then collar
+//     caps (surgery_collar.cpp: the rings lifted off the wall first) in the first clean
+//     placement; then, in
 //     every placement, minimum-area triangulations restricted to triangles that intersect
 //     nothing (a grid query per candidate triangle: the expensive step, so it comes last, within
 //     kMaxGridQueries, and stops once the right ring has none; not with opts_.restricted off).
@@ -189,14 +195,18 @@ bool Surgery::try_triangulated_caps() {
   ring_faces_ = faces_around_rings();
   query_budget_ = kMaxGridQueries;
   std::vector<std::array<int, 3>> tri_right, tri_left;
-  for (bool avoid : {false, true}) {
+  for (const char* kind : {"plain", "collar", "restricted"}) {
+    const bool avoid = kind[0] == 'r', collar = kind[0] == 'c';
     if (avoid && !opts_.restricted) break;
-    for (const Placement& tr : placements())
-      if (!gave_up_ && place_checked(tr) && triangulate_both(avoid, &tri_right, &tri_left)) {
-        add_triangulated_caps(tri_right, tri_left);
-        cap_kind_ = avoid ? "restricted" : "plain";
-        return true;
-      }
+    for (const Placement& tr : placements()) {
+      if (gave_up_ || !place_checked(tr)) continue;
+      const bool done = collar ? try_collar_caps() : triangulate_both(avoid, &tri_right, &tri_left);
+      if (collar && !done) break;  // the first clean placement only: a lift moves the rings far more than a placement
+      if (!done) continue;
+      if (!collar) add_triangulated_caps(tri_right, tri_left);
+      cap_kind_ = kind;
+      return true;
+    }
   }
   return false;
 }
@@ -205,10 +215,8 @@ void Surgery::add_triangulated_caps(const std::vector<std::array<int, 3>>& right
                                     const std::vector<std::array<int, 3>>& left) {
   add_cap(mesh_, right, opts_.guard, "surgery");  // ear order: each face joins the hole's boundary
   add_cap(mesh_, left, opts_.guard, "surgery");
-  std::vector<Mesh::VertexHandle> order_left{result_.left_ring[0]};
-  for (std::size_t i = k_ - 1; i >= 1; --i) order_left.push_back(result_.left_ring[i]);
   set_chord_classes(result_.right_ring);
-  set_chord_classes(order_left);
+  set_chord_classes(left_cap_order());
   result_.right_cap = result_.right_ring[0];
   result_.left_cap = result_.left_ring[0];
   result_.intersections = 0;
@@ -216,15 +224,28 @@ void Surgery::add_triangulated_caps(const std::vector<std::array<int, 3>>& right
 
 // Classes of a triangulated cap's chords: ring vertex i gets the potential P_i (prefix XOR of
 // the ring's edge classes) and chord (i, j) the class P_i ^ P_j, so every cap triangle sums to zero.
-void Surgery::set_chord_classes(const std::vector<Mesh::VertexHandle>& ring) {
-  if (!homology_) return;
+std::unordered_map<int, std::vector<std::uint64_t>> Surgery::ring_potentials(
+    const std::vector<Mesh::VertexHandle>& ring) const {
   std::unordered_map<int, std::vector<std::uint64_t>> potential;
-  std::vector<std::uint64_t> acc(words_, 0), cls(words_);
-  for (std::size_t i = 0; i < k_; ++i) {
+  std::vector<std::uint64_t> acc(words_, 0);
+  for (std::size_t i = 0; i < ring.size(); ++i) {
     potential[ring[i].idx()] = acc;
-    const auto he = mesh_.find_halfedge(ring[i], ring[(i + 1) % k_]);
+    const auto he = mesh_.find_halfedge(ring[i], ring[(i + 1) % ring.size()]);
     xor_into(acc.data(), homology_->edge_class(mesh_.edge_handle(he)), words_);
   }
+  return potential;
+}
+
+std::vector<Mesh::VertexHandle> Surgery::left_cap_order() const {
+  std::vector<Mesh::VertexHandle> order{result_.left_ring[0]};
+  for (std::size_t i = k_ - 1; i >= 1; --i) order.push_back(result_.left_ring[i]);
+  return order;
+}
+
+void Surgery::set_chord_classes(const std::vector<Mesh::VertexHandle>& ring) {
+  if (!homology_) return;
+  auto potential = ring_potentials(ring);
+  std::vector<std::uint64_t> cls(words_);
   for (std::size_t i = 0; i < k_; ++i)
     for (auto he : mesh_.voh_range(ring[i])) {
       const auto w = mesh_.to_vertex_handle(he);

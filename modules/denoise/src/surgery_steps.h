@@ -18,6 +18,9 @@ struct ConcentricCap {
   std::vector<Mesh::FaceHandle> faces;
 };
 
+// Sum of the cross products of v's faces (twice their vector area): v's normal, not normalised.
+Vec3 vertex_area_normal(const Mesh& mesh, Mesh::VertexHandle v);
+
 class Surgery {
  public:
   Surgery(Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop, const SurgeryOptions& opts, HomologyBasis* homology)
@@ -53,6 +56,21 @@ class Surgery {
                        const std::vector<Mesh::VertexHandle>& inner);
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
+  std::unordered_map<int, std::vector<std::uint64_t>> ring_potentials(const std::vector<Mesh::VertexHandle>& ring) const;
+  std::vector<Mesh::VertexHandle> left_cap_order() const;  // left ring as its hole runs: x_(k-1) -> ... -> x_0
+  // Collar caps (surgery_collar.cpp).
+  struct CollarShape {
+    double sign;                   // -1: against the normals (into the enclosed solid), +1: along them
+    double right_frac, left_frac;  // fraction of each ring's collar height used
+  };
+  bool try_collar_caps();
+  std::vector<Vec3> unit_normals(const std::vector<Mesh::VertexHandle>& ring) const;
+  std::vector<double> collar_heights(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Vec3>& normals,
+                                     double sign) const;
+  bool collar_caps(const CollarShape& shape, const std::vector<double>& h_right, const std::vector<double>& h_left);
+  std::vector<std::array<int, 3>> collar_right_triangles(const std::vector<Mesh::VertexHandle>& collar);
+  bool clean(const std::vector<std::array<int, 3>>& tris) const;
+  void set_collar_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::VertexHandle>& collar);
   ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void shape_concentric_cap(ConcentricCap& cap, double dome);
@@ -75,6 +93,7 @@ class Surgery {
   std::vector<Vec3> original_;                               // loop positions before any move
   std::vector<Vec3> target_left_, target_right_, edge_left_, edge_right_;
   std::vector<Mesh::FaceHandle> ring_faces_;                 // faces around the two rings
+  std::vector<Vec3> normal_left_, normal_right_;             // unit normals of the placed rings' own sides
   ConcentricCap cap_left_, cap_right_;
   SurgeryResult result_;
   bool gave_up_ = false;                // no more restricted triangulations (budget spent, or the right ring has none)

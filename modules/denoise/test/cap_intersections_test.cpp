@@ -11,6 +11,7 @@
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/surgery.h"
 #include "self_intersections.h"
+#include "swept_profile.h"
 
 namespace cf {
 namespace {
@@ -32,28 +33,7 @@ Mesh chevron_band(double thickness, int side, int nu, int twist, double R = 4) {
     const double x = -1 + 2.0 * s / (side - 1);
     profile.push_back({x * 0.7, std::fabs(x) * 0.7 + h * std::sqrt(2.0)});
   }
-  const int n = static_cast<int>(profile.size());
-  TriangleList t;
-  for (int i = 0; i < nu; ++i) {
-    const double u = 2 * kPi * i / nu, a = twist * kPi * i / nu;
-    for (const auto& p : profile) {
-      const double r = p[0] * std::cos(a) - p[1] * std::sin(a), z = p[0] * std::sin(a) + p[1] * std::cos(a);
-      t.points.push_back({(R + r) * std::cos(u), (R + r) * std::sin(u), z});
-    }
-  }
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int a = i * n + j, b = ((i + 1) % nu) * n + j, c = ((i + 1) % nu) * n + (j + 1) % n, d = i * n + (j + 1) % n;
-      t.triangles.push_back({a, b, c});
-      t.triangles.push_back({a, c, d});
-    }
-  return synthetic::to_mesh(t);
-}
-
-double mean_edge(const Mesh& m) {
-  double s = 0;
-  for (auto e : m.edges()) s += m.calc_edge_length(e);
-  return s / m.n_edges();
+  return synthetic::to_mesh(testing::swept_profile(profile, nu, twist, R));
 }
 
 struct Band {
@@ -77,7 +57,7 @@ TEST_P(DenoiseCapIntersections, ChevronBandCutCleanly) {
   const int n = 2 * b.side;
   std::vector<Mesh::VertexHandle> loop;
   for (int j = 0; j < n; ++j) loop.push_back(Mesh::VertexHandle(7 * n + j));
-  FaceGrid grid(m, 2 * mean_edge(m));
+  FaceGrid grid(m, 2 * testing::mean_edge(m));
   SurgeryOptions o;
   o.guard = &grid;
   const SurgeryResult r = cut_and_cap(m, loop, o);

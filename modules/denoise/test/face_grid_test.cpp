@@ -45,5 +45,36 @@ TEST(DenoiseFaceGrid, ErasedFacesAreMissedUntilInsertedAgain) {
   EXPECT_TRUE(grid.hits(m, wide));
 }
 
+// FaceGrid::segment_hits: a chord through the unit sphere's wall (from inside to outside, in
+// any direction, across many cells) pierces it; one inside it, and a chord between two surface
+// vertices that runs inside, do not; whenever a chord pierces, a triangle on it hits.
+TEST(DenoiseFaceGrid, SegmentHitsPiercingChords) {
+  Mesh m = to_mesh(sphere(1, 24, 12));
+  const FaceGrid grid(m, 0.1);
+  const auto in = m.add_vertex(Vec3(0.1, -0.2, 0.3)), in2 = m.add_vertex(Vec3(-0.3, 0.2, -0.1));
+  const auto out = m.add_vertex(Vec3(1.7, 1.1, -0.9)), out2 = m.add_vertex(Vec3(-1.2, -1.5, 1.3));
+  EXPECT_TRUE(grid.segment_hits(m, in.idx(), out.idx()));
+  EXPECT_TRUE(grid.segment_hits(m, out2.idx(), in.idx()));
+  EXPECT_TRUE(grid.segment_hits(m, out.idx(), out2.idx()));  // through the sphere: two walls
+  EXPECT_TRUE(grid.hits(m, {in.idx(), out.idx(), in2.idx()}));
+  EXPECT_FALSE(grid.segment_hits(m, in.idx(), in2.idx()));
+  const auto north = Mesh::VertexHandle(0), far = Mesh::VertexHandle(static_cast<int>(m.n_vertices()) / 2 - 7);
+  ASSERT_GT((m.point(north) - m.point(far)).norm(), 0.5);
+  EXPECT_FALSE(grid.segment_hits(m, north.idx(), far.idx()));  // a chord of the sphere, inside it
+}
+
+// FaceGrid::free_distance: from the centre of the unit sphere the ray meets the wall at about 1
+// in any direction; the limit holds when nothing is nearer; faces at the start vertex are skipped.
+TEST(DenoiseFaceGrid, FreeDistanceIsTheDistanceToTheWall) {
+  Mesh m = to_mesh(sphere(1, 48, 24));
+  const FaceGrid grid(m, 0.2);
+  for (const Vec3 d : {Vec3(1, 0, 0), Vec3(0, 0, -1), Vec3(0.6, -0.48, 0.64)})
+    EXPECT_NEAR(grid.free_distance(m, Vec3(0, 0, 0), d, 5.0, -1), 1.0, 0.01);
+  EXPECT_DOUBLE_EQ(grid.free_distance(m, Vec3(0, 0, 0), Vec3(1, 0, 0), 0.5, -1), 0.5);
+  const auto v = Mesh::VertexHandle(5);
+  const Vec3 inward = -m.point(v) / m.point(v).norm();
+  EXPECT_NEAR(grid.free_distance(m, m.point(v), inward, 5.0, v.idx()), 2.0, 0.02);
+}
+
 }  // namespace
 }  // namespace cf

@@ -45,6 +45,14 @@ class FaceGrid {
   // True when triangle `tri` (mesh vertex ids, not in the mesh) intersects a grid face or one of
   // `others` (stops at the first hit).
   bool hits(const Mesh& mesh, const std::array<int, 3>& tri, const std::vector<std::array<int, 3>>& others = {}) const;
+  // Distance from `origin` along the unit direction `dir` to the first grid face the ray meets,
+  // faces with corner `skip_vertex` (the vertex the ray leaves from) ignored; `max_dist` when
+  // none is nearer.
+  double free_distance(const Mesh& mesh, const Vec3& origin, const Vec3& dir, double max_dist, int skip_vertex) const;
+  // True when the segment between mesh vertices a and b (not an edge of the mesh) pierces a grid
+  // face other than at a or b. Then every triangle with that side intersects that face improperly
+  // (hits() would say so), which makes this a cheap first test for cap triangles.
+  bool segment_hits(const Mesh& mesh, int a, int b) const;
   // The intersecting pairs themselves (same rules as count_intersections).
   std::vector<std::pair<int, int>> intersecting_pairs(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const;
 
@@ -68,6 +76,8 @@ class FaceGrid {
   std::vector<int> candidates(const Vec3& lo, const Vec3& hi) const;  // faces in the box's cells, sorted, unique
   template <class Visit>
   bool triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const;  // the cells triangle p's plane crosses
+  template <class Visit>
+  bool segment_cells(const Vec3& p, const Vec3& q, Visit&& visit) const;  // the cells segment pq passes through
   template <class Visit>
   bool cell_faces(const Key& k, Visit&& visit) const;  // the faces of cell k
   void insert_dynamic(const Mesh& mesh, Mesh::FaceHandle f);

@@ -49,6 +49,7 @@ struct SurgeryResult {
   std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
   Mesh::VertexHandle left_cap, right_cap;                 // cap centres
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
+  const char* caps = "concentric";  // which step made the caps: plain, collar, restricted or concentric
   SurgeryUndo undo;
 };
 
