@@ -382,7 +382,8 @@ int main(int argc, char** argv) {
   RealMaskOptions real;
   app.add_flag("--painted", real.painted, "with --real-mask: paint each mask into a CT and run from the CT");
   app.add_flag("--no-cli", real.no_cli, "with --real-mask: no `colonflat register` run per pair");
-  app.add_flag("--show-pieces", real.show, "with --real-mask: each piece's own mm -> true path mm -> common s; each polyp");
+  app.add_flag("--show-pieces", real.show,
+               "with --real-mask: each piece's own mm -> true path mm -> common s; with --real-mask or --pair: each polyp");
   app.add_option("--downsample", real.downsample, "with --real-mask: the mask at this many times its voxel size");
   app.add_option("--cases", real.only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
