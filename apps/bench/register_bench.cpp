@@ -34,17 +34,14 @@
 #include "colonflat/register/register.h"
 #include "colonflat/testdata/lumen_cut.h"
 #include "colonflat/testdata/mask_pair.h"
+#include "colonflat/testdata/phantom_pair.h"
 #include "colonflat/testdata/synthetic_pair.h"
 
 namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = 3.141592653589793;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+double median(std::vector<double> v) { return cf::upper_median(std::move(v)); }
 double largest(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }
 
 struct Row {
@@ -156,51 +153,6 @@ void synthetic_table() {
 
 // ---- phantom pairs -------------------------------------------------------------------------
 
-struct TruthPolyp {
-  int id = 0;
-  Eigen::Vector3d lps{0, 0, 0};
-  double diameter = 0;
-  double arc = 0;  // mm along the phantom centre line from the rectum
-};
-
-struct Truth {
-  std::vector<TruthPolyp> polyps;
-  std::vector<Eigen::Vector3d> centreline;
-  std::vector<double> arc;
-};
-
-Eigen::Vector3d vec3(const nlohmann::json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
-
-Truth read_truth(const fs::path& dir) {
-  Truth t;
-  std::ifstream pin(dir / "polyps.json"), cin(dir / "centerline.json");
-  const auto pj = nlohmann::json::parse(pin), cj = nlohmann::json::parse(cin);
-  for (const auto& e : pj)
-    t.polyps.push_back({e.value("id", 0), vec3(e.contains("position_lps_mm") ? e["position_lps_mm"] : e["center_lps_mm"]),
-                        e.value("diameter_mm", 0.0), e.value("centreline_mm", e.value("arclength_mm", 0.0))});
-  for (const auto& p : cj["points"]) t.centreline.push_back(vec3(p["p_lps_mm"])), t.arc.push_back(p["arclength_mm"].get<double>());
-  return t;
-}
-
-// Nearest centre-line sample of a point.
-size_t nearest_sample(const Truth& t, const Eigen::Vector3d& p) {
-  size_t best = 0;
-  for (size_t i = 1; i < t.centreline.size(); ++i)
-    if ((t.centreline[i] - p).squaredNorm() < (t.centreline[best] - p).squaredNorm()) best = i;
-  return best;
-}
-
-// Along (mm) and around (deg) distance of `mapped` from `truth` measured on the true centre line.
-std::pair<double, double> truth_error(const Truth& t, const Eigen::Vector3d& mapped, const Eigen::Vector3d& truth) {
-  const size_t a = nearest_sample(t, mapped), b = nearest_sample(t, truth);
-  const size_t n = t.centreline.size();
-  const Eigen::Vector3d tangent = (t.centreline[std::min(n - 1, b + 1)] - t.centreline[b > 0 ? b - 1 : 0]).normalized();
-  Eigen::Vector3d ra = mapped - t.centreline[b], rb = truth - t.centreline[b];
-  ra -= ra.dot(tangent) * tangent, rb -= rb.dot(tangent) * tangent;
-  const double angle = std::acos(std::clamp(ra.normalized().dot(rb.normalized()), -1.0, 1.0)) * 180 / kPi;
-  return {std::abs(t.arc[a] - t.arc[b]), angle};
-}
-
 // The truth polyp a detected candidate stands for (-1 = none).
 int hit(const std::vector<cf::ScanCandidate>& truth, const cf::ScanCandidate& c) {
   for (const auto& q : truth)
@@ -221,21 +173,10 @@ void count_detected(const cf::ColonRegistration& reg, const std::vector<cf::Scan
   }
 }
 
-using Cuts = std::vector<std::pair<double, double>>;
-
-// Truth polyps >= 6 mm, those inside a stretch cut out of the scan's mask left out (not seen).
-std::vector<cf::ScanCandidate> as_candidates(const Truth& t, const Cuts& cuts = {}) {
-  std::vector<cf::ScanCandidate> out;
-  for (const auto& q : t.polyps) {
-    bool cut = false;
-    for (const auto& [a, b] : cuts) cut |= q.arc >= a - q.diameter && q.arc < b + q.diameter;
-    if (q.diameter >= 6 && !cut) out.push_back({q.id, q.lps, q.diameter, 1});
-  }
-  return out;
-}
+using Cuts = cf::CutList;
 
 Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& pro_run, const fs::path& sup_truth,
-             const fs::path& pro_truth, const Cuts& prone_cuts = {}, const Cuts& supine_cuts = {}) {
+             const fs::path& pro_truth, const Cuts& prone_cuts = {}, const Cuts& supine_cuts = {}, bool show = false) {
   const cf::ColonScan sup = cf::read_run_dir(sup_run), pro = cf::read_run_dir(pro_run);
   Row r{name, sup.lps.size()};
   cf::Stopwatch clock;
@@ -247,35 +188,27 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
     r.det_pairs = int(reg.matching().pairs.size());
     return r;
   }
-  const Truth ts = read_truth(sup_truth), tp = read_truth(pro_truth);
-  const auto cs = as_candidates(ts, supine_cuts), cp = as_candidates(tp, prone_cuts);
-  r.polyps = 0;
-  for (const auto& q : cs)
-    for (const auto& p : cp) r.polyps += p.id == q.id;
-  count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
-  r.missed = r.polyps - r.matched;
-  std::vector<double> along, around, lps_along, lps_around;
+  const cf::PhantomTruth ts = cf::read_phantom_truth(sup_truth), tp = cf::read_phantom_truth(pro_truth);
+  const auto cs = cf::truth_candidates(ts, supine_cuts), cp = cf::truth_candidates(tp, prone_cuts);
+  const cf::PairFigures f = cf::score_truth_pair(reg, cs, cp, tp);
+  r.polyps = f.seen_in_both, r.matched = f.right, r.false_matches = f.wrong, r.missed = r.polyps - r.matched;
+  r.along = f.along_median_mm(), r.around = median(f.around_deg), r.along_max = f.along_max_mm();
+  std::vector<double> lps_along, lps_around;  // baseline: the nearest prone wall vertex of the supine polyp
   for (const auto& q : cs)
     for (const auto& p : cp)
       if (p.id == q.id) {
-        const Eigen::Vector3d mapped = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
-        if (!std::isfinite(mapped.sum())) continue;
-        const auto [a, b] = truth_error(tp, mapped, p.lps);
-        along.push_back(a), around.push_back(b);
-        const auto [s, t] = reg.locate(q.lps, cf::Direction::kProneToSupine);  // nearest prone wall vertex
+        const auto [s, t] = reg.locate(q.lps, cf::Direction::kProneToSupine);
         const int w = reg.vertex_at(false, s, t);
         if (w < 0) continue;
-        const auto [la, lb] = truth_error(tp, pro.lps[size_t(w)], p.lps);
+        const auto [la, lb] = cf::truth_error(tp, pro.lps[size_t(w)], p.lps);
         lps_along.push_back(la), lps_around.push_back(lb);
       }
-  r.along = median(along), r.around = median(around), r.along_max = largest(along);
   r.lps_along = median(lps_along), r.lps_around = median(lps_around);
-  auto all = [](const Truth& t) {
-    std::vector<cf::ScanCandidate> out;
-    for (const auto& q : t.polyps) out.push_back({q.id, q.lps, q.diameter, 1});
-    return out;
-  };
-  count_detected(reg, all(ts), all(tp), r);
+  if (show)
+    for (const auto& q : cs)
+      for (const auto& p : cp)
+        if (p.id == q.id) show_polyp(reg, q, p, NAN, NAN, (reg.map_lps(q.lps, cf::Direction::kSupineToProne) - p.lps).norm());
+  count_detected(reg, cf::all_truth_candidates(ts), cf::all_truth_candidates(tp), r);
   return r;
 }
 
@@ -335,24 +268,6 @@ void register_cli(const fs::path& sup_run, const fs::path& pro_run, const fs::pa
               j["candidates"]["pairs"].size(), r.det_pairs, r.det_false, r.det_nonpolyp, wall, cpu_s);
 }
 
-struct CutCase {
-  std::string name;
-  Cuts supine, prone;
-};
-
-// The kinds of difference of issue 27 on a colon of length L (mm along its course): a collapse,
-// fully tagged stretches left out (100 mm; 25 % of the colon), the colon split into 3 more pieces,
-// the rectum cut short by the catheter, both scans differing at once.
-std::vector<CutCase> cut_cases(double L) {
-  return {{"uncut", {}, {}},
-          {"collapse 20 mm at 45 %", {}, {{0.45 * L, 0.45 * L + 20}}},
-          {"tagged 25 % dropped", {}, {{0.40 * L, 0.65 * L}}},
-          {"split +3 (15 mm each)", {}, {{0.25 * L, 0.25 * L + 15}, {0.5 * L, 0.5 * L + 15}, {0.75 * L, 0.75 * L + 15}}},
-          {"rectum cut 60 mm", {}, {{0, 60}}},
-          {"tagged 100 mm at 70 %", {}, {{0.70 * L, 0.70 * L + 100}}},
-          {"both: sup 20+100, pro 25 %", {{0.2 * L, 0.2 * L + 20}, {0.8 * L, 0.8 * L + 100}}, {{0, 50}, {0.35 * L, 0.6 * L}}}};
-}
-
 // One phantom patient, both positions run from their true lumen masks, the masks cut along the
 // phantom's centre line (lumen_cut.h) as real segmentations differ.
 void cuts_table(int seed, const std::string& size, const fs::path& work) {
@@ -366,7 +281,7 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
     if (!fs::exists(ph / "polyps.json") && colonflat(a) != 0) return;
   }
   if (!run_mask(d / "supine_phantom" / "lumen_mask.nrrd", d / "supine_run")) return;
-  const auto cases = cut_cases(cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back());
+  const auto cases = cf::segmentation_cut_cases(cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back());
   print_header();
   for (size_t k = 0; k < cases.size(); ++k) {
     const std::string n = std::to_string(k);
@@ -414,11 +329,11 @@ void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskO
               mask_file.filename().c_str(), L, polyps.size(), prep.seconds(), shift.x(), shift.y(), shift.z(), turn);
   fs::create_directories(work);
   print_header();
-  const auto cases = cut_cases(L);
+  const auto cases = cf::segmentation_cut_cases(L);
   for (size_t k = 0; k < cases.size(); ++k) {
     if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), int(k)) == o.only.end()) continue;
     const std::string n = std::to_string(k);
-    const CutCase& c = cases[k];
+    const cf::CutCase& c = cases[k];
     const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
     if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
     if (!fs::exists(pm)) cf::write_mask(course.cut_and_move(c.prone, shift, turn), pm);
@@ -440,7 +355,9 @@ void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskO
           const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
           const Eigen::Vector3d at = cf::MaskCourse::unmoved(m, course.centroid(), shift, turn);
           if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(at) - polyps[size_t(q.id - 1)].path_mm));
-          if (o.show) show_polyp(reg, q, p, polyps[size_t(q.id - 1)].path_mm, along.empty() ? NAN : along.back());
+          if (o.show)
+            show_polyp(reg, q, p, polyps[size_t(q.id - 1)].path_mm, along.empty() ? NAN : along.back(),
+                       (at - polyps[size_t(q.id - 1)].lps).norm());
         }
     count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
     r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
@@ -465,7 +382,8 @@ int main(int argc, char** argv) {
   RealMaskOptions real;
   app.add_flag("--painted", real.painted, "with --real-mask: paint each mask into a CT and run from the CT");
   app.add_flag("--no-cli", real.no_cli, "with --real-mask: no `colonflat register` run per pair");
-  app.add_flag("--show-pieces", real.show, "with --real-mask: each piece's own mm -> true path mm -> common s; each polyp");
+  app.add_flag("--show-pieces", real.show,
+               "with --real-mask: each piece's own mm -> true path mm -> common s; with --real-mask or --pair: each polyp");
   app.add_option("--downsample", real.downsample, "with --real-mask: the mask at this many times its voxel size");
   app.add_option("--cases", real.only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
@@ -491,7 +409,7 @@ int main(int argc, char** argv) {
       cf::write_run_dir(p.supine, fs::path(synthetic_dir) / "supine"), cf::write_run_dir(p.prone, fs::path(synthetic_dir) / "prone");
     } else if (!pair.empty()) {
       print_header();
-      print_row(pair_row("pair", pair[0], pair[1], truth.empty() ? "" : truth[0], truth.empty() ? "" : truth[1]));
+      print_row(pair_row("pair", pair[0], pair[1], truth.empty() ? "" : truth[0], truth.empty() ? "" : truth[1], {}, {}, real.show));
     } else {
       synthetic_table();
     }

@@ -54,13 +54,15 @@ inline std::vector<cf::ScanCandidate> seen_polyps(const std::vector<cf::MaskPoly
 
 // One polyp seen in both scans: its common s in each, the supine s mapped, support gaps, error.
 inline void show_polyp(const cf::ColonRegistration& reg, const cf::ScanCandidate& q, const cf::ScanCandidate& p, double path_mm,
-                       double along_mm) {
+                       double along_mm, double distance_mm) {
   const auto [ss, st] = reg.locate(q.lps, cf::Direction::kSupineToProne);
   const auto [ps, pt] = reg.locate(p.lps, cf::Direction::kProneToSupine);
   double ms, mt;
   reg.map_coordinates(cf::Direction::kSupineToProne, ss, st, ms, mt);
-  std::printf("  polyp %d path %.0f: supine s %.0f -> %.0f, prone s %.0f (gap %.0f / %.0f), along %.1f\n", q.id, path_mm, ss,
-              ms, ps, reg.support_gap_mm(true, ss), reg.support_gap_mm(false, ps), along_mm);
+  const double deg = 180 / 3.141592653589793;
+  std::printf("  polyp %d path %.0f: supine s %.0f (%.0f deg) -> %.0f (%.0f deg), prone s %.0f (%.0f deg) (gap %.0f / %.0f), "
+              "along %.1f, 3-D %.1f mm\n", q.id, path_mm, ss, st * deg, ms, mt * deg, ps, pt * deg, reg.support_gap_mm(true, ss),
+              reg.support_gap_mm(false, ps), along_mm, distance_mm);
 }
 
 }  // namespace

@@ -235,6 +235,17 @@ ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<doub
   return c;
 }
 
+double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3d& x, double* radial) {
+  const int k = p.bin_of(s);
+  const Eigen::Vector3d& t = p.tangent[size_t(k)];
+  const Eigen::Vector3d& e1 = p.reference[size_t(k)];
+  Eigen::Vector3d d = x - p.centre[size_t(k)];
+  d -= d.dot(t) * t;
+  if (radial) *radial = d.norm();
+  const double a = std::atan2(d.dot(t.cross(e1)), d.dot(e1));
+  return a < 0 ? a + kTwoPi : a;
+}
+
 void fill_profile(const ColonScan& scan, const ProfileOptions& o, int bins, ScanCoordinates& c) {
   LengthProfile& p = c.profile;
   p.bin_mm = o.bin_mm;
@@ -246,13 +257,7 @@ void fill_profile(const ColonScan& scan, const ProfileOptions& o, int bins, Scan
   for (size_t v = 0; v < c.s.size(); ++v) {
     if (std::isnan(c.s[v])) continue;
     const int k = p.bin_of(c.s[v]);
-    const Eigen::Vector3d& t = p.tangent[size_t(k)];
-    const Eigen::Vector3d& e1 = p.reference[size_t(k)];
-    Eigen::Vector3d d = scan.lps[v] - p.centre[size_t(k)];
-    d -= d.dot(t) * t;
-    double a = std::atan2(d.dot(t.cross(e1)), d.dot(e1));
-    c.theta[v] = a < 0 ? a + kTwoPi : a;
-    c.radial[v] = d.norm();
+    c.theta[v] = angle_about_centre(p, c.s[v], scan.lps[v], &c.radial[v]);
     rsum[size_t(k)] += c.radial[v];
   }
   p.radius.assign(size_t(bins), 0.0);

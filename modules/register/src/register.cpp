@@ -234,8 +234,13 @@ std::pair<double, double> ColonRegistration::locate(const Eigen::Vector3d& p, Di
   const Index& idx = sup ? *sup_index_ : *pro_index_;
   const ScanCoordinates& c = sup ? sup_ : pro_;
   const vtkIdType v = idx.lps->FindClosestPoint(p.data());
-  if (v < 0) return {kNaN, kNaN};
-  return {c.s[size_t(v)], c.theta[size_t(v)]};
+  if (v < 0 || std::isnan(c.s[size_t(v)])) return {kNaN, kNaN};
+  // The angle of the point itself, not of its nearest vertex: a point off the wall (the head of a
+  // pedunculated polyp, up to 15 mm across and reaching the colon's axis) is surrounded by its own
+  // surface at about the same distance, so the nearest vertex may lie on any side of it.
+  double radial = 0;
+  const double theta = angle_about_centre(c.profile, c.s[size_t(v)], p, &radial);
+  return {c.s[size_t(v)], radial > 0 ? theta : c.theta[size_t(v)]};
 }
 
 Eigen::Vector3d ColonRegistration::map_lps(const Eigen::Vector3d& p, Direction d) const {

@@ -62,6 +62,10 @@ ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<doub
 // The profile, theta and radial of `c` from its s (`bins` bins of opts.bin_mm).
 void fill_profile(const ColonScan& scan, const ProfileOptions& opts, int bins, ScanCoordinates& c);
 
+// Angle (rad in [0, 2 pi)) of the LPS point `x` about the centre line at s (0 = the bin's reference
+// direction, the patient's anterior); its distance from the centre line in `radial` when given.
+double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3d& x, double* radial = nullptr);
+
 // Gaussian smoothing of a sampled signal (sigma in samples), edges by renormalisation.
 std::vector<double> gaussian_smooth(const std::vector<double>& v, double sigma_samples);
 

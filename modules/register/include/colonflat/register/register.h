@@ -95,7 +95,8 @@ class ColonRegistration {
   // True when a candidate at this LPS point of one scan, or its image in the other, lies on a stretch
   // held at a neck (pieces.h): never paired there.
   bool held_at_neck(const Eigen::Vector3d& p, Direction from) const;
-  // (s, theta) of the wall vertex nearest to an LPS point of a scan (NaN when not registered).
+  // (s, theta) of an LPS point of a scan: s of its nearest wall vertex, theta of the point about
+  // the centre line there (NaN when that vertex is not registered).
   std::pair<double, double> locate(const Eigen::Vector3d& p, Direction from) const;
 
   const ScanCoordinates& supine_coordinates() const { return sup_; }
