@@ -209,14 +209,14 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`.
 void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
               const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
-              AreaCorrection& res, const std::function<bool()>& enough = {}) {
+              AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr) {
   const std::size_t nfaces = faces.size();
   const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
                                    scale);
   RegionSystem sys;
   if (!sys.build(s, free_vertex, energy.faces(), energy.weights())) return;
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
-  const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough);
+  const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch);
   res.energy_before += d.energy_before;
   res.energy_after += d.energy_after;
   res.iterations = std::max(res.iterations, d.steps);
@@ -248,9 +248,12 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   // their results are combined in piece order, so the map is the same for any thread count.
   std::vector<std::vector<int>> pieces = connected_pieces(s, faces);
   std::vector<AreaCorrection> part(pieces.size());
+  std::vector<V2> trial(emb.pos.size());  // one trial buffer for all pieces: each writes only its own vertices
   std::vector<std::function<void()>> tasks;
   for (std::size_t i = 0; i < pieces.size(); ++i)
-    tasks.push_back([&, i] { minimise(s, emb, std::move(pieces[i]), free_vertex, area3, scale, o, true, part[i]); });
+    tasks.push_back([&, i] {
+      minimise(s, emb, std::move(pieces[i]), free_vertex, area3, scale, o, true, part[i], {}, &trial);
+    });
   parallel_tasks(tasks);
   for (const AreaCorrection& p : part) {
     res.energy_before += p.energy_before, res.energy_after += p.energy_after;

@@ -159,16 +159,13 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
   for (const FaceDistortion& d : fd)
     if (!d.degenerate) a2 += std::max(d.area2, 0.0), a3 += d.area3;
   double hidden = 0;
-  std::vector<FaceDistortion> in_map;  // the statistics leave the faces out of the map out, as measure() does
-  in_map.reserve(fd.size());
-  for (const FaceDistortion& d : fd) {
-    if (d.degenerate) continue;
-    if (d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
-    if (!too_small_in_map(d.area2, d.area3)) in_map.push_back(d);
-  }
-  const DistortionStats st = stats_of(in_map);
-  const bool area = st.area_p05 < kWholeBandAreaLow || st.area_p95 > kWholeBandAreaHigh;
-  return {area || st.qc_mean > kWholeBandQcMean, hidden > 0.0025 * a3, area, st.qc_mean};
+  for (const FaceDistortion& d : fd)
+    if (!d.degenerate && d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
+  // the faces out of the map are left out, as measure() does
+  const BoundStats st = bound_stats_in_map(fd);
+  const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
+  const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
+  return {area || qc_mean > kWholeBandQcMean, hidden > 0.0025 * a3, area, qc_mean};
 }
 
 // When the whole-band pass has done its job, asked after each of its steps (the trigger's own

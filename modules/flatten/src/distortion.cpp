@@ -43,6 +43,33 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
+BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd) {
+  auto in_map = [](const FaceDistortion& d) { return !d.degenerate && !too_small_in_map(d.area2, d.area3); };
+  double a3 = 0, a2 = 0, qsum = 0;  // sums in face order, as stats_of adds them
+  std::size_t n = 0;
+  for (const FaceDistortion& d : fd)
+    if (in_map(d)) a3 += d.area3, a2 += std::abs(d.area2);
+  const double scale = a2 > 0 ? a3 / a2 : 1;
+  std::vector<double> ratio;
+  ratio.reserve(fd.size());
+  for (const FaceDistortion& d : fd) {
+    if (!in_map(d)) continue;
+    ++n, qsum += std::isfinite(d.qc) ? d.qc : 1e9;
+    if (d.area3 > 0) ratio.push_back(std::abs(d.area2) * scale / d.area3);
+  }
+  BoundStats b;
+  b.qc_mean = n ? qsum / double(n) : 0;
+  if (ratio.empty()) return b;
+  // percentile()'s order statistics; the 95th selected among the values above the 5th
+  const std::size_t k05 = std::min(ratio.size() - 1, std::size_t(0.05 * double(ratio.size() - 1) + 0.5));
+  const std::size_t k95 = std::min(ratio.size() - 1, std::size_t(0.95 * double(ratio.size() - 1) + 0.5));
+  std::nth_element(ratio.begin(), ratio.begin() + long(k05), ratio.end());
+  b.area_p05 = ratio[k05];
+  std::nth_element(ratio.begin() + long(k05), ratio.begin() + long(k95), ratio.end());
+  b.area_p95 = ratio[k95];
+  return b;
+}
+
 DistortionStats stats_of(const std::vector<FaceDistortion>& fd) {
   DistortionStats s;
   s.faces = fd.size();

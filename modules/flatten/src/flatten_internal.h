@@ -278,6 +278,13 @@ struct FaceDistortion {
 };
 FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0, const V2& q1, const V2& q2);
 DistortionStats stats_of(const std::vector<FaceDistortion>& fd);
+// The area ratio 5th / 95th percentiles and the quasi-conformal mean of stats_of(the faces of fd in
+// the map: not degenerate, not too_small_in_map), the same numbers, without copying the faces or
+// computing the other statistics (the area correction's trigger, asked after every whole-band step).
+struct BoundStats {
+  double area_p05 = 0, area_p95 = 0, qc_mean = 0;
+};
+BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd);
 double percentile(std::vector<double> v, double p);
 
 // Coverage of the 3D wall by the map (faces shown: in the map, area ratio >= min_ratio).

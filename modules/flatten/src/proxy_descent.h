@@ -43,10 +43,14 @@ class CornerGather {
 // At most `max_steps` steps moving the unknowns of `sys` in emb.pos; stops when E gains less than
 // `min_gain` (relative) or no step lowers it. `judged`: the faces kept positive (the energy's).
 // `enough` (optional): asked after each step taken; true stops the descent there (its goal is met).
+// `scratch` (optional): a vector of emb.pos's size for the trial positions, shared by regions that run
+// side by side (each writes only its own vertices; one allocation of the mesh's size per region
+// instead: 59 local pieces of the real CT colon band zeroed 1 GB).
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
                             const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
-                            double min_gain, const std::function<bool()>& enough = {}) {
+                            double min_gain, const std::function<bool()>& enough = {},
+                            std::vector<V2>* scratch = nullptr) {
   DescentResult res;
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
   if (e0 >= Energy::kHuge) {  // the region is not injective: leave it
@@ -58,7 +62,9 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   std::vector<std::array<V2, 3>> face_gradients(energy.faces().size());
   // emb.pos with the unknowns moved, filled only where the region reads it (its faces' corners):
   // regions far apart may run side by side on one embedding, each reading and writing its own.
-  std::vector<V2> trial(emb.pos.size());
+  std::vector<V2> own;
+  if (!scratch) own.resize(emb.pos.size());
+  std::vector<V2>& trial = scratch ? *scratch : own;
   for (const std::vector<int>* list : {&energy.faces(), &judged})
     for (int f : *list)
       for (int v : s.t[f]) trial[v] = emb.pos[v];

@@ -25,20 +25,26 @@ bool RegionSystem::build(const Surface& s, const std::vector<char>& free_vertex,
     for (int v : s.t[f])
       if (free_vertex[v] && index_[v] < 0) index_[v] = int(vars_.size()), vars_.push_back(v);
   const int n = int(vars_.size());
+  // Only the lower triangle is assembled (every solver here reads only it), the diagonal summed per
+  // unknown in face order (the order setFromTriplets added its duplicates): the same matrix entries
+  // from a quarter of the triplets (21.8 M on the real CT colon band's 1.8 M faces otherwise).
+  std::vector<double> diagonal(std::size_t(n), 0.0);
   std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(12 * faces_.size());
+  trip.reserve(3 * faces_.size() + std::size_t(n));
   for (std::size_t i = 0; i < faces_.size(); ++i) {
     const Tri& t = s.t[faces_[i]];
     for (int k = 0; k < 3; ++k) {
       const int a = index_[t[(k + 1) % 3]], b = index_[t[(k + 2) % 3]];
       const double wk = w_[i][k];
-      if (a >= 0) trip.emplace_back(a, a, wk);
-      if (b >= 0) trip.emplace_back(b, b, wk);
-      if (a >= 0 && b >= 0) trip.emplace_back(a, b, -wk), trip.emplace_back(b, a, -wk);
+      if (a >= 0) diagonal[std::size_t(a)] += wk;
+      if (b >= 0) diagonal[std::size_t(b)] += wk;
+      if (a >= 0 && b >= 0) trip.emplace_back(std::max(a, b), std::min(a, b), -wk);
     }
   }
+  for (int u = 0; u < n; ++u) trip.emplace_back(u, u, diagonal[std::size_t(u)]);
   Eigen::SparseMatrix<double> A(n, n);
   A.setFromTriplets(trip.begin(), trip.end());
+  trip = {};
   impl_ = std::make_shared<Impl>();
   if (n == 0) return true;
   return impl_->solver.compute(A);

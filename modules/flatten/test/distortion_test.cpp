@@ -1,0 +1,50 @@
+// Distortion statistics of the flat map (src/distortion.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "../src/flatten_internal.h"
+
+namespace {
+
+using cf::flat_detail::FaceDistortion;
+
+// Faces of every kind the statistics meet: ordinary, degenerate, crushed below what the map holds
+// (too_small_in_map), folded, with an infinite quasi-conformal ratio.
+std::vector<FaceDistortion> mixed_faces(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<FaceDistortion> fd(n);
+  for (FaceDistortion& d : fd) {
+    d.area3 = 0.1 + u(rng);
+    d.area2 = d.area3 * std::exp(4 * (u(rng) - 0.5));
+    d.qc = 1 + 3 * u(rng);
+    const double kind = u(rng);
+    if (kind < 0.02) d.degenerate = true;
+    else if (kind < 0.04) d.area2 = 1e-12 * d.area3;  // crushed: out of the map
+    else if (kind < 0.05) d.area2 = -0.3 * d.area3;   // folded: out of the map too
+    else if (kind < 0.06) d.qc = std::numeric_limits<double>::infinity();
+  }
+  return fd;
+}
+
+}  // namespace
+
+// bound_stats_in_map (the area correction's trigger, after every whole-band step) gives exactly the
+// numbers stats_of gives on the faces in the map, for sizes below, at and above a percentile step.
+TEST(FlattenDistortion, BoundStatsEqualStatsOfTheFacesInTheMap) {
+  for (std::size_t n : {1u, 2u, 21u, 1000u, 40001u}) {
+    const std::vector<FaceDistortion> fd = mixed_faces(n, unsigned(n));
+    std::vector<FaceDistortion> in_map;
+    for (const FaceDistortion& d : fd)
+      if (!d.degenerate && !cf::flat_detail::too_small_in_map(d.area2, d.area3)) in_map.push_back(d);
+    const cf::DistortionStats want = cf::flat_detail::stats_of(in_map);
+    const cf::flat_detail::BoundStats got = cf::flat_detail::bound_stats_in_map(fd);
+    EXPECT_EQ(got.area_p05, want.area_p05) << n;
+    EXPECT_EQ(got.area_p95, want.area_p95) << n;
+    EXPECT_EQ(got.qc_mean, want.qc_mean) << n;
+    if (n >= 1000) EXPECT_LT(got.area_p05, 0.5 * got.area_p95) << n;  // the two are not one value
+  }
+}
