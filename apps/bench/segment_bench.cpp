@@ -12,7 +12,7 @@
 //                                     of the inferior slice (pelvic floor, thighs' soft tissue, the rectal
 //                                     tube's channel) below the volume so the scan has N slices (the 512 x 512
 //                                     x 450 case of issue 13: --pad-to 450); Dice on the original slices.
-//   segment_bench --painted [--mask FILE] [--downsample N] [--cases easy,stretch,pools,bowel,hard]
+//   segment_bench --painted [--mask FILE] [--downsample N] [--cases easy,stretch,pools,bowel,hard] [--seeds 1,2]
 //                                     issue 25: CTs painted around a real lumen mask (colonflat phantom
 //                                     --from-mask; default ../shared/real/ctc_lumen_mask_a.nii.gz, full resolution
 //                                     unless --downsample N (N x N in-plane)): easy and hard cases (a 200-250 mm
@@ -366,45 +366,48 @@ void print_lost_bodies(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
                   b.body, b.ml, 100 * b.kept, b.centroid_lps[0], b.centroid_lps[1], b.centroid_lps[2]);
 }
 
-void painted_table(const std::string& mask_file, int downsample, const std::string& only) {
+void painted_table(const std::string& mask_file, int downsample, const std::string& only, const std::vector<int>& seeds) {
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_p" + std::to_string(::getpid()));
   cf::MaskImage::Pointer mask = cf::read_binary_mask(mask_file);
   if (downsample > 1) mask = cf::downsample_mask(mask, {downsample, downsample, 1});
   const auto sz = mask->GetLargestPossibleRegion().GetSize();
   std::printf("segment_bench --painted: %s, %zu x %zu x %zu at %.2f x %.2f x %.2f mm; pools, 4 small-bowel loops, bladder\n",
               mask_file.c_str(), sz[0], sz[1], sz[2], mask->GetSpacing()[0], mask->GetSpacing()[1], mask->GetSpacing()[2]);
-  std::printf("%-8s %-10s %4s %5s %7s %7s %7s %5s %7s %7s %8s %7s %7s %7s %6s %s\n", "case", "position", "hdr", "dz", "paint_s",
+  std::printf("%4s %-8s %-10s %4s %5s %7s %7s %7s %5s %7s %7s %8s %7s %7s %7s %6s %s\n", "seed", "case", "position", "hdr", "dz", "paint_s",
               "seg_s", "seg_cpu", "load", "seg_MiB", "dice", "fluid_mL", "kept_%", "long_%", "out_mL", "sb_mL", "gravity");
-  for (const PaintedCase& c : kPaintedCases) {
-    if (!only.empty() && only.find(c.name) == std::string::npos) continue;
-    fs::remove_all(tmp);
-    cf::Stopwatch t;
-    cf::MaskPhantomOptions o;
-    o.position = c.position;
-    o.position_header = c.header;
-    o.long_stretch_mm = c.long_mm;
-    o.deep_pools = c.deep;
-    o.pressed_bowel = c.pressed;
-    cf::MaskImage::Pointer m = c.slice_mm > 0 ? cf::resample_mask_slices(mask, c.slice_mm) : mask;
-    cf::MaskPhantom p = cf::paint_phantom_from_mask(m, o);
-    const double paint_s = t.seconds();
-    cf::write_phantom(p.phantom, tmp, "nrrd");
-    p.phantom.ct = nullptr;
-    reset_peak_memory();
-    cf::CtImage::Pointer ct = cf::read_ct_volume(tmp / "ct.nrrd");
-    cf::SegmentStats st;
-    const double load = load_average();
-    t.restart();
-    cf::MaskImage::Pointer seg = cf::segment_colon(ct, {}, &st);
-    const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
-    ct = nullptr;
-    const cf::MaskSegmentationScore s = cf::score_segmentation(seg, p.phantom);
-    std::printf("%-8s %-10s %4s %5.2f %7.2f %7.2f %7.2f %5.1f %7.0f %7.4f %8.1f %7.1f %7.1f %7.1f %6.1f %s (%s)\n", c.name, c.position,
-                c.header ? "yes" : "no", m->GetSpacing()[2], paint_s, seg_s, st.cpu_time_s, load, seg_mib, s.dice, s.fluid_ml,
-                100 * s.fluid_kept, long_stretch_kept(p, seg), s.outside_ml, s.small_bowel_ml, st.gravity.c_str(),
-                st.gravity_source.c_str());
-    print_lost_bodies(p, seg);
-    std::fflush(stdout);
+  for (int seed : seeds) {
+    for (const PaintedCase& c : kPaintedCases) {
+      if (!only.empty() && only.find(c.name) == std::string::npos) continue;
+      fs::remove_all(tmp);
+      cf::Stopwatch t;
+      cf::MaskPhantomOptions o;
+      o.seed = std::uint64_t(seed);
+      o.position = c.position;
+      o.position_header = c.header;
+      o.long_stretch_mm = c.long_mm;
+      o.deep_pools = c.deep;
+      o.pressed_bowel = c.pressed;
+      cf::MaskImage::Pointer m = c.slice_mm > 0 ? cf::resample_mask_slices(mask, c.slice_mm) : mask;
+      cf::MaskPhantom p = cf::paint_phantom_from_mask(m, o);
+      const double paint_s = t.seconds();
+      cf::write_phantom(p.phantom, tmp, "nrrd");
+      p.phantom.ct = nullptr;
+      reset_peak_memory();
+      cf::CtImage::Pointer ct = cf::read_ct_volume(tmp / "ct.nrrd");
+      cf::SegmentStats st;
+      const double load = load_average();
+      t.restart();
+      cf::MaskImage::Pointer seg = cf::segment_colon(ct, {}, &st);
+      const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
+      ct = nullptr;
+      const cf::MaskSegmentationScore s = cf::score_segmentation(seg, p.phantom);
+      std::printf("%4d %-8s %-10s %4s %5.2f %7.2f %7.2f %7.2f %5.1f %7.0f %7.4f %8.1f %7.1f %7.1f %7.1f %6.1f %s (%s)\n", seed, c.name, c.position,
+                  c.header ? "yes" : "no", m->GetSpacing()[2], paint_s, seg_s, st.cpu_time_s, load, seg_mib, s.dice, s.fluid_ml,
+                  100 * s.fluid_kept, long_stretch_kept(p, seg), s.outside_ml, s.small_bowel_ml, st.gravity.c_str(),
+                  st.gravity_source.c_str());
+      print_lost_bodies(p, seg);
+      std::fflush(stdout);
+    }
   }
   fs::remove_all(tmp);
   std::printf("columns: dz = slice spacing (mm); fluid_mL = the painted colon fluid; kept_%% = its share segmented; long_%% = share "
@@ -460,6 +463,7 @@ BENCHMARK(BM_GenerateSmallPhantom)->Unit(benchmark::kMillisecond);
 int main(int argc, char** argv) {
   bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false;
   int pad_to = 0, downsample = 1;
+  bool seeds_given = false;
   std::string mask_file = std::string(COLONFLAT_SHARED_DIR) + "/real/ctc_lumen_mask_a.nii.gz";
   std::string size = "full", real, cases;
   std::vector<int> seeds = {1, 2, 3, 4, 5};
@@ -479,11 +483,12 @@ int main(int argc, char** argv) {
     else if (a == "--size" && i + 1 < argc) size = argv[++i];
     else if (a == "--seeds" && i + 1 < argc) {
       seeds.clear();
+      seeds_given = true;
       std::stringstream s(argv[++i]);
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  if (painted) painted_table(mask_file, downsample, cases);
+  if (painted) painted_table(mask_file, downsample, cases, seeds_given ? seeds : std::vector<int>{1});
   else if (!real.empty()) real_table(real, pad_to);
   else if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);

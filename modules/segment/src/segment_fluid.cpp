@@ -31,23 +31,10 @@ void ColonSegmenter::find_fluid_bodies() {
   Bytes gas(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) gas[q] = lab_[q] == kGas;
   const RunLabels gl = component_runs(gas.data(), d_);
-  gas_runs_.clear();
-  gas_run_len_.clear();
   gas_voxels_.assign(gl.count() + 1, 0);
   for (std::uint32_t l = 1; l <= gl.count(); ++l)
     for (const Run* r = gl.begin(l); r != gl.end(l); ++r) gas_voxels_[l] += r->length;
-  for (const auto& [run, label] : gl.raster(std::vector<unsigned char>(gl.count() + 1, 1))) {
-    gas_runs_.emplace_back(run.start, label);
-    gas_run_len_.push_back(run.length);
-  }
-}
-
-// The gas component holding crop voxel q (0: not gas).
-std::uint32_t ColonSegmenter::gas_label_at(std::size_t q) const {
-  auto it = std::upper_bound(gas_runs_.begin(), gas_runs_.end(), std::make_pair(q, UINT32_MAX));
-  if (it == gas_runs_.begin()) return 0;
-  --it;
-  return q < it->first + gas_run_len_[std::size_t(it - gas_runs_.begin())] ? it->second : 0;
+  gas_lookup_ = RunLookup(gl);
 }
 
 // Scans every line along `axis` for gas and fluid at most interface-width apart. contact: 1 where
@@ -102,7 +89,7 @@ std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis,
       const long p = side == 0 ? long(c[axis]) - t : long(c[axis]) + t;
       if (p < 0 || p >= long(d_.n[axis])) break;
       const std::size_t r = side == 0 ? q - std::size_t(t) * d_.stride[axis] : q + std::size_t(t) * d_.stride[axis];
-      if (lab_[r] == kGas) g = gas_label_at(r);
+      if (lab_[r] == kGas) g = gas_lookup_.at(r);
     }
     heights[side][{fluid_label_[q], g}].push_back(float(double(c[axis]) * d_.sp[axis]));
   }

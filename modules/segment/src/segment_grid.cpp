@@ -209,6 +209,21 @@ void box_mean3_slices(const float* in, const Dims& d, const std::function<void(s
   });
 }
 
+RunLookup::RunLookup(const RunLabels& labels) {
+  for (const auto& [run, label] : labels.raster(std::vector<unsigned char>(labels.count() + 1, 1))) {
+    start_.push_back(run.start);
+    length_.push_back(run.length);
+    label_.push_back(label);
+  }
+}
+
+std::uint32_t RunLookup::at(std::size_t q) const {
+  const auto it = std::upper_bound(start_.begin(), start_.end(), q);
+  if (it == start_.begin()) return 0;
+  const std::size_t r = std::size_t(it - start_.begin()) - 1;
+  return q < start_[r] + length_[r] ? label_[r] : 0;
+}
+
 std::size_t line_base(const Dims& d, int ax, std::size_t l) {
   if (ax == 0) return l * d.n[0];
   if (ax == 1) return (l % d.n[0]) + (l / d.n[0]) * d.n[0] * d.n[1];

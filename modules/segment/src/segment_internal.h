@@ -83,6 +83,17 @@ struct RunLabels {
   std::vector<std::pair<Run, std::uint32_t>> raster(const std::vector<unsigned char>& keep) const;
 };
 RunLabels component_runs(const unsigned char* mask, const Dims& d);
+// Voxel -> label of a RunLabels (0: in no run), by binary search over its runs in raster order.
+class RunLookup {
+ public:
+  RunLookup() = default;
+  explicit RunLookup(const RunLabels& labels);
+  std::uint32_t at(std::size_t q) const;
+
+ private:
+  std::vector<std::size_t> start_, length_;
+  std::vector<std::uint32_t> label_;
+};
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
@@ -137,6 +148,17 @@ struct BodyStats {
   bool touches_face = false;
 };
 
+// Gas/fluid columns between one candidate and one gas owner (segment_open.cpp), per image axis:
+// all columns and those without a tissue layer between gas and fluid.
+struct InterfaceTally {
+  std::size_t columns[3] = {0, 0, 0}, open[3] = {0, 0, 0};
+  std::size_t bins[6] = {0, 0, 0, 0, 0, 0};  // tissue run lengths in 0.5 mm bins (debug output)
+  void add(const InterfaceTally& t) {
+    for (int a = 0; a < 3; ++a) columns[a] += t.columns[a], open[a] += t.open[a];
+    for (int b = 0; b < 6; ++b) bins[b] += t.bins[b];
+  }
+};
+
 class ColonSegmenter {
  public:
   ColonSegmenter(const CtImage* ct, const SegmentOptions& opts);
@@ -167,7 +189,6 @@ class ColonSegmenter {
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
   void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
-  std::uint32_t gas_label_at(std::size_t q) const;
   void scan_contacts(int axis, Bytes* contact, bool layer);
   std::vector<std::array<std::size_t, 2>> level_contacts(int axis, std::size_t min_gas_voxels);
   void gravity_from_levels();
@@ -185,6 +206,11 @@ class ColonSegmenter {
   bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
   double gap_fat_mm(const Contact& c) const;
   void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
+  double tissue_run_mm(std::size_t base, std::size_t stride, int a, int b, double h) const;
+  // Open interfaces (segment_open.cpp).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> gas_fluid_interfaces(const RunLookup& cand) const;
+  std::uint32_t meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const;
+  void debug_interfaces(const std::vector<BodyStats>& bodies) const;
   void report_candidate(const BodyStats& b, double kept_gap, const std::string& why);
   // Helpers.
   std::array<double, 3> lps_of(const double crop_voxel[3]) const;
@@ -213,10 +239,10 @@ class ColonSegmenter {
   Buffer<std::uint32_t> fluid_label_;  // fluid components in the crop
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
-  std::vector<std::pair<std::size_t, std::uint32_t>> gas_runs_;  // crop gas components: (run start, label) in raster order
-  std::vector<std::size_t> gas_run_len_;
+  RunLookup gas_lookup_;                 // crop gas components
   std::vector<std::size_t> gas_voxels_;  // per crop gas component: its voxels
   std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
+  std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> interfaces_;  // (candidate, gas body) -> columns (linking)
   std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   Bytes state_;                        // crop: final 0/1 (after the graph cut)
   Bytes lumen0_;                       // crop: initial lumen

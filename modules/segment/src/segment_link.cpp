@@ -26,10 +26,13 @@ constexpr double kMinChord = 0.7;       // last front's distance from the contac
 constexpr double kSameEndMm = 30;       // a used end within this path length of a new contact: the same end
 constexpr double kMinCalibreRatio = 0.3; // cross-sections (front sizes) of the two bodies within this ratio
 constexpr std::size_t kContactsPerPair = 3;
-// Fat (adipose tissue) on a gap, printed with COLONFLAT_SEGMENT_DEBUG: a collapsed neck of colon is
-// its own wall (soft tissue), never fat (docs/segment.md, session 11: not yet a rule).
-constexpr double kFatLowHu = -190, kFatHighHu = -30;
+// Fat (adipose tissue, -190..-30 HU) along a gap: a collapsed neck of colon is its own wall pressed
+// together (soft tissue, 20-60 HU, perhaps a thread of gas or fluid), never fat; a layer of at least
+// kFatRunMm (and at least one voxel's diagonal, beyond the partial volume of a gas/tissue edge) means
+// the two bodies are separate bowels with pericolic or mesenteric fat between them.
+constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
 constexpr double kContactSeparationMm = 20;
+const char* const kOpenReason = "colon fluid: meets a colon segment's gas with no wall between (one lumen)";
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
   std::ostringstream s;
@@ -145,6 +148,8 @@ void ColonSegmenter::link_tagged_stretches() {
     else if (bodies[l].touches_face) why[l] = "reaches beyond the colon's region (bone, vessel, bladder)";
     else eligible[l] = 1, why[l] = "no colon segment end within --link-gap";
   }
+  interfaces_ = gas_fluid_interfaces(RunLookup(cl));
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_interfaces(bodies);
   std::vector<double> kept_gap(n + 1, -1);
   ends_.clear();
   for (int pass = 0; pass < 7; ++pass)
@@ -159,6 +164,7 @@ void ColonSegmenter::link_tagged_stretches() {
     }
     report_candidate(bodies[l], kept_gap[l], why[l]);
   }
+  interfaces_.clear();
   for (std::uint32_t l = 1; l <= n; ++l)
     for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
       for (std::size_t q = r->start; q < r->start + r->length; ++q) lab_[q] = keep[l] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
@@ -191,6 +197,15 @@ std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std:
     }
     if (!tried[l]) why[l] = reason, tried[l] = 1;  // the nearest contact's reason is reported
   }
+  for (std::uint32_t l = 1; l < eligible.size(); ++l) {  // fluid in the colon's lumen, wherever it meets the gas
+    const std::uint32_t owner = eligible[l] ? meets_colon_gas(l, kept_gap) : 0;
+    if (!owner) continue;
+    kept_gap[l] = 0;
+    eligible[l] = 0;
+    why[l] = kOpenReason;
+    grid_->absorb(l, owner);  // part of that body's lumen: its ends are the body's, it has none of its own
+    ++kept;
+  }
   return kept;
 }
 
@@ -218,7 +233,6 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const Eigen::Vector3d link = grid_->mm(c.from) - grid_->mm(c.to);
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_link(c, sg, sf);
   if (sg.fronts.empty() || sf.fronts.empty()) return why = "too small near the link", false;
-  if (!end_is_free(c.segment, sg)) return why = "the colon end it meets already continues into another body", false;
   for (const Front& f : sg.fronts)
     if (f.pieces >= 2) return why = "lies beside a colon segment, not at its end", false;
   for (const Front& f : sf.fronts)
@@ -230,7 +244,10 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const std::size_t common = std::min(sg.fronts.size(), sf.fronts.size()) - 1;  // the farthest front both reach
   const double cg = double(sg.fronts[common].cells), cf = double(sf.fronts[common].cells);
   if (std::min(cg, cf) < kMinCalibreRatio * std::max(cg, cf)) return why = "not at the colon's calibre there", false;
+  if (!end_is_free(c.segment, sg)) return why = "the colon end it meets already continues into another body", false;
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
+  const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
+  if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
   if (ug.dot(uf) < 0.3) return why = "does not continue the colon's direction", false;
   const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});
@@ -288,6 +305,7 @@ void ColonSegmenter::report_candidate(const BodyStats& b, double kept_gap, const
     return decide(what, ml, c, false, why);
   }
   if (what != "gas body") ++st_.tagged_stretches, st_.tagged_stretch_volume_ml += ml;
+  if (why == kOpenReason) return decide(what, ml, c, true, why);
   decide(what, ml, c, true,
          (what == "gas body" ? "colon segment continuing a segment's end (gap " : "fully tagged colon stretch continuing a segment's end (gap ") +
              fixed1(kept_gap) + " mm)");

@@ -59,6 +59,12 @@ class LinkGrid {
     if (segment) seg_[c] = segment;
     if (candidate) cand_[c] = candidate;
   }
+  // The segment id of the cell holding fine voxel q (0: none).
+  std::uint32_t segment_at(std::size_t q, const Dims& fine) const {
+    std::size_t i, j, k;
+    fine.coords(q, i, j, k);
+    return seg_[d_.idx(i / f_[0], j / f_[1], k / f_[2])];
+  }
   // Contacts of the eligible candidates with the segments within gap_mm: per (candidate, segment)
   // up to max_per_pair contacts, nearest first, at least separation_mm apart on the candidate.
   std::vector<Contact> contacts(const std::vector<unsigned char>& eligible, double gap_mm, std::size_t max_per_pair,

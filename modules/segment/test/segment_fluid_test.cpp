@@ -31,12 +31,6 @@ std::pair<std::size_t, std::size_t> kept_in(const MaskImage* m, int x0, int x1, 
   return {n, kept};
 }
 
-bool has_reason(const SegmentStats& st, const std::string& decision, const std::string& part) {
-  for (const auto& d : st.decisions)
-    if (d["decision"] == decision && d["reason"].get<std::string>().find(part) != std::string::npos) return true;
-  return false;
-}
-
 // A colon tube with dependent fluid along its whole side (level at its axis) and a thinner loop of
 // oral contrast (300 HU, radius 5 mm) pressed against the pool's bottom across a 1.5 mm wall (one
 // bright body in the 3 x 3 x 3 mean): the pool is kept along the whole side, the loop is not.

@@ -107,11 +107,14 @@ TEST(SegmentRules, ProneFluidLevelsRecognised) {
     for (int z = 12; z <= 52; z += 4)
       for (int y = int(level_y) - 3; y <= int(level_y) + 3; ++y) EXPECT_TRUE(at(m, 32, y, z)) << y << " " << z;
   }
-  // The same volume declared supine: the fluid lies above the gas, which no pool does.
+  // The same volume declared supine: the fluid lies above the gas, which no pool does, so it is no
+  // pool; it meets the gas with no wall between, so it is kept as the same lumen (session 12: a
+  // wrong header does not drop colon fluid), with that reason.
   set_patient_position(ct.GetPointer(), "HFS");
   auto [m, st] = segment_small(ct);
   EXPECT_EQ(st.gravity, "+y (posterior)");
-  EXPECT_FALSE(at(m, 32, 22, 32));
+  EXPECT_TRUE(at(m, 32, 22, 32));
+  EXPECT_TRUE(has_decision(st, "kept", "no wall between")) << st.to_json()["decisions"].dump(1);
 }
 
 // A rectal tube's air lumen (2 mm radius) enters the rectum from the inferior face: the channel is
@@ -156,10 +159,9 @@ TEST(SegmentRules, ThinTubeAtColonEndRejectedByCalibre) {
 
 // A contrast tube continuing a gas tube's end in line across a 6 mm gap is kept when the gap is soft
 // tissue (a collapsed neck of colon) and rejected when the gap is fat (-100 HU: a separate bowel loop
-// with mesenteric fat between; issue 25's pressed small-bowel loop linked across 12 mm). DISABLED:
-// the fat rule is not in the linking yet (docs/segment.md, session 11: with it the easy painted
-// supine case loses a 412 mL stretch piece whose only passing link crossed fat).
-TEST(SegmentRules, DISABLED_TubeAcrossFatFromColonEndRejected) {
+// with mesenteric fat between; issue 25's pressed small-bowel loop linked across 12 mm). Without the
+// fat rule the fat case is kept.
+TEST(SegmentRules, TubeAcrossFatFromColonEndRejected) {
   for (bool fat : {false, true}) {
     SCOPED_TRACE(fat);
     auto ct = make_volume(100, [&](double x, double y, double z) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <string>
 
 #include "colonflat/segment/segment.h"
 
@@ -77,6 +78,13 @@ inline std::size_t components(const MaskImage* m) {
   cc->SetInput(m);
   cc->Update();
   return cc->GetObjectCount();
+}
+
+// Whether the report holds a decision (`kept` / `rejected`) whose reason contains `part`.
+inline bool has_reason(const SegmentStats& st, const std::string& decision, const std::string& part) {
+  for (const auto& d : st.decisions)
+    if (d["decision"] == decision && d["reason"].get<std::string>().find(part) != std::string::npos) return true;
+  return false;
 }
 
 inline SegmentOptions small_volume_options() {

@@ -1,0 +1,124 @@
+// Open interfaces (docs/segment.md step 6, issue 25 session 12): where gas and tagged fluid meet
+// along an image axis, is there tissue between them? Fluid and gas in one lumen meet directly (the
+// profile crosses the soft-tissue range only within the partial-volume blur); two lumens pressed
+// together keep their walls between them (at least two bowel walls, >= 2 mm of tissue), and bowels
+// lying apart have fat between them.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+
+#include "segment_internal.h"
+#include "segment_linkgrid.h"
+
+namespace cf::segment_detail {
+namespace {
+constexpr unsigned char kGas = 1, kCandidate = 4;
+// Tissue between gas and fluid: fat (-190 HU) up to enhanced bowel wall (150 HU). A direct gas/fluid
+// interface crosses this range in about 0.6 blur sigma (the blurred step from -1000 to 500-900 HU).
+constexpr double kTissueLowHu = -190, kTissueHighHu = 150;
+constexpr int kSubSamples = 8;  // samples per voxel of the linear profile between voxel centres
+// A column is walled when the profile stays in the tissue range for >= kWallMm: two lumens pressed
+// together are separated by two bowel walls (each 1-3 mm), >= 2 mm; a direct gas/fluid interface
+// stays in the range for 0.6 blur sigma, plus up to about one voxel where a partial-volume voxel
+// lies near 0 HU (measured on the painted cases at 1.64 mm pixels: 0.5-1.5 mm).
+constexpr double kWallMm = 1.5;
+// Columns whose gas and fluid lie within kWindowMm are looked at: wide enough that a wall of two
+// bowel walls (2-6 mm) between them is seen (interface-width, 3 mm, is the layer taken as lumen).
+constexpr double kWindowMm = 6;
+// One lumen: the open columns cover >= 1 cm^2 (as a level, docs/segment.md step 4: a colon's
+// cross-section is 7-50 cm^2) and are most of the pair's columns (a wall seen open where it is
+// thinner than a voxel stays a minority).
+constexpr double kMinOpenAreaMm2 = 100, kMinOpenShare = 0.5;
+}  // namespace
+
+// Longest run (mm) of the profile along a line (linear between voxel centres) inside the tissue
+// range, from position a to position b (voxel indices along the line).
+double ColonSegmenter::tissue_run_mm(std::size_t base, std::size_t stride, int a, int b, double h) const {
+  double run = 0, best = 0;
+  for (int p = a; p < b; ++p) {
+    const double v0 = hu_[base + std::size_t(p) * stride], v1 = hu_[base + std::size_t(p + 1) * stride];
+    for (int s = 0; s < kSubSamples; ++s) {
+      const double v = v0 + (v1 - v0) * (s + 0.5) / kSubSamples;
+      run = v >= kTissueLowHu && v <= kTissueHighHu ? run + h / kSubSamples : 0;
+      best = std::max(best, run);
+    }
+  }
+  return best;
+}
+
+// Every column along each image axis where the gas of a colon segment or of a candidate meets the
+// fluid (>= fluid-threshold) of another candidate within kWindowMm: per (candidate, gas owner) the
+// columns and the open ones (no tissue between). Owner: the segment's link-grid id, or 0x80000000 + candidate.
+std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter::gas_fluid_interfaces(const RunLookup& cand) const {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> out;
+  std::mutex lock;
+  for (int axis = 0; axis < 3; ++axis) {
+    const int wvox = int(std::ceil(kWindowMm / d_.sp[axis]));
+    const std::size_t stride = d_.stride[axis], len = d_.n[axis];
+    parallel_for(d_.total / len, [&](std::size_t l0, std::size_t l1) {
+      std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> local;
+      for (std::size_t l = l0; l < l1; ++l) {
+        const std::size_t base = line_base(d_, axis, l);
+        int last_kind = 0, last_pos = -1000000;
+        for (int p = 0; p < int(len); ++p) {
+          const std::size_t q = base + std::size_t(p) * stride;
+          const bool gas = hu_[q] < opts_.air_threshold && (lab_[q] == kGas || lab_[q] == kCandidate);
+          const int k = gas ? 1 : (lab_[q] == kCandidate && hu_[q] >= opts_.fluid_threshold ? 2 : 0);
+          if (!k) continue;
+          if (last_kind && last_kind != k && p - last_pos - 1 <= wvox) {
+            const std::size_t g = k == 1 ? q : base + std::size_t(last_pos) * stride, f = k == 1 ? base + std::size_t(last_pos) * stride : q;
+            const std::uint32_t fl = cand.at(f);
+            const std::uint32_t owner = lab_[g] == kGas ? grid_->segment_at(g, d_) : 0x80000000u + cand.at(g);
+            if (owner && owner != 0x80000000u + fl && owner != 0x80000000u) {
+              const double run = tissue_run_mm(base, stride, last_pos, p, d_.sp[axis]);
+              InterfaceTally& t = local[{fl, owner}];
+              ++t.bins[std::min(5, int(run / 0.5))];
+              t.columns[axis] += 1;
+              t.open[axis] += run < kWallMm;
+            }
+          }
+          last_kind = k;
+          last_pos = p;
+        }
+      }
+      std::lock_guard<std::mutex> g(lock);
+      for (const auto& [key, t] : local) out[key].add(t);
+    });
+  }
+  return out;
+}
+
+// Candidate l's fluid meets the gas of a colon body (a segment, or a candidate kept already) with no
+// wall between: over >= kMinOpenAreaMm2 and over most of their columns (per gas body). Returns that
+// body's link-grid id (the first such body), 0 if none.
+std::uint32_t ColonSegmenter::meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const {
+  for (auto it = interfaces_.lower_bound({l, 0}); it != interfaces_.end() && it->first.first == l; ++it) {
+    const std::uint32_t owner = it->first.second;
+    if (owner >= 0x80000000u && kept_gap[owner - 0x80000000u] < 0) continue;  // gas of a candidate not kept
+    const InterfaceTally& t = it->second;
+    double open_mm2 = 0;
+    std::size_t columns = 0, open = 0;
+    for (int a = 0; a < 3; ++a) {
+      open_mm2 += double(t.open[a]) * d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[a];
+      columns += t.columns[a], open += t.open[a];
+    }
+    if (open_mm2 >= kMinOpenAreaMm2 && double(open) >= kMinOpenShare * double(columns)) return owner;
+  }
+  return 0;
+}
+
+// Every (candidate, gas body) interface of >= 8 columns: columns, open ones, tissue runs (0.5 mm bins).
+void ColonSegmenter::debug_interfaces(const std::vector<BodyStats>& bodies) const {
+  for (const auto& [key, t] : interfaces_) {
+    const std::size_t cols = t.columns[0] + t.columns[1] + t.columns[2], open = t.open[0] + t.open[1] + t.open[2];
+    if (cols < 8) continue;
+    std::fprintf(stderr, "iface cand %u (%.1f mL) gas of %x: columns %zu open %zu runs", key.first, double(bodies[key.first].voxels) * voxel_ml_,
+                 key.second, cols, open);
+    for (std::size_t b : t.bins) std::fprintf(stderr, " %zu", b);
+    std::fprintf(stderr, "\n");
+  }
+}
+
+}  // namespace cf::segment_detail
