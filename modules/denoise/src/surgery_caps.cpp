@@ -120,7 +120,7 @@ std::vector<Mesh::FaceHandle> Surgery::faces_around_rings() const {
 // Minimum-area triangulations of both rings (with `avoid`: only triangles that intersect nothing);
 // true when both exist and together intersect nothing.
 bool Surgery::triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left) {
-  const std::vector<Mesh::VertexHandle> order_left = left_cap_order();
+  const std::vector<Mesh::VertexHandle> order_left = left_cap_order(result_.left_ring);
   // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
   auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
   const FaceGrid* grid = avoid ? opts_.guard : nullptr;
@@ -216,7 +216,7 @@ void Surgery::add_triangulated_caps(const std::vector<std::array<int, 3>>& right
   add_cap(mesh_, right, opts_.guard, "surgery");  // ear order: each face joins the hole's boundary
   add_cap(mesh_, left, opts_.guard, "surgery");
   set_chord_classes(result_.right_ring);
-  set_chord_classes(left_cap_order());
+  set_chord_classes(left_cap_order(result_.left_ring));
   result_.right_cap = result_.right_ring[0];
   result_.left_cap = result_.left_ring[0];
   result_.intersections = 0;
@@ -236,9 +236,9 @@ std::unordered_map<int, std::vector<std::uint64_t>> Surgery::ring_potentials(
   return potential;
 }
 
-std::vector<Mesh::VertexHandle> Surgery::left_cap_order() const {
-  std::vector<Mesh::VertexHandle> order{result_.left_ring[0]};
-  for (std::size_t i = k_ - 1; i >= 1; --i) order.push_back(result_.left_ring[i]);
+std::vector<Mesh::VertexHandle> Surgery::left_cap_order(const std::vector<Mesh::VertexHandle>& ring) {
+  std::vector<Mesh::VertexHandle> order{ring[0]};
+  for (std::size_t i = ring.size() - 1; i >= 1; --i) order.push_back(ring[i]);
   return order;
 }
 

@@ -121,9 +121,7 @@ bool Surgery::collar_caps(const CollarShape& shape, const std::vector<double>& h
   add_cap(mesh_, right, opts_.guard, "surgery (collar)");
   add_cap(mesh_, left, opts_.guard, "surgery (collar)");
   set_collar_classes(result_.right_ring, collar_right);
-  std::vector<Mesh::VertexHandle> order_left = left_cap_order(), collar_order{collar_left[0]};
-  for (std::size_t i = k_ - 1; i >= 1; --i) collar_order.push_back(collar_left[i]);
-  set_collar_classes(order_left, collar_order);
+  set_collar_classes(left_cap_order(result_.left_ring), left_cap_order(collar_left));
   result_.right_cap = result_.right_ring[0];
   result_.left_cap = result_.left_ring[0];
   result_.intersections = 0;

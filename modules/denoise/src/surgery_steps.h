@@ -57,7 +57,8 @@ class Surgery {
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
   std::unordered_map<int, std::vector<std::uint64_t>> ring_potentials(const std::vector<Mesh::VertexHandle>& ring) const;
-  std::vector<Mesh::VertexHandle> left_cap_order() const;  // left ring as its hole runs: x_(k-1) -> ... -> x_0
+  // A left-side ring as its hole runs: x_0, x_(k-1), ..., x_1 (the left ring itself, or its collar).
+  static std::vector<Mesh::VertexHandle> left_cap_order(const std::vector<Mesh::VertexHandle>& ring);
   // Collar caps (surgery_collar.cpp).
   struct CollarShape {
     double sign;                   // -1: against the normals (into the enclosed solid), +1: along them
