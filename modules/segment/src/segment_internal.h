@@ -206,8 +206,8 @@ class ColonSegmenter {
   bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
   double gap_fat_mm(const Contact& c) const;
   void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
-  double tissue_run_mm(std::size_t base, std::size_t stride, int a, int b, double h) const;
   // Open interfaces (segment_open.cpp).
+  double tissue_run_mm(std::size_t base, std::size_t stride, int a, int b, double h) const;
   std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> gas_fluid_interfaces(const RunLookup& cand) const;
   std::uint32_t meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const;
   void debug_interfaces(const std::vector<BodyStats>& bodies) const;

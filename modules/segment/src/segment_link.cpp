@@ -186,7 +186,7 @@ std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std:
     if (continues_colon(c, reason)) {
       kept_gap[l] = c.gap_mm;
       eligible[l] = 0;
-      const std::uint32_t id = 0x80000000u + l;
+      const std::uint32_t id = kKeptCandidateId + l;
       grid_->absorb(l, id);
       ends_[c.segment].push_back(c.to);
       ends_[id].push_back(c.from);

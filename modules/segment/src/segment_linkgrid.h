@@ -18,6 +18,10 @@
 
 namespace cf::segment_detail {
 
+// The link-grid segment id a kept candidate l takes (absorb(l, kKeptCandidateId + l)): above every
+// gas segment's id, so that the segment and candidate id spaces never meet.
+constexpr std::uint32_t kKeptCandidateId = 0x80000000u;
+
 // A contact between a candidate body and a colon segment across the gap (coarse cells).
 struct Contact {
   std::uint32_t candidate = 0, segment = 0;

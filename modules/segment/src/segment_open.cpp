@@ -50,7 +50,7 @@ double ColonSegmenter::tissue_run_mm(std::size_t base, std::size_t stride, int a
 
 // Every column along each image axis where the gas of a colon segment or of a candidate meets the
 // fluid (>= fluid-threshold) of another candidate within kWindowMm: per (candidate, gas owner) the
-// columns and the open ones (no tissue between). Owner: the segment's link-grid id, or 0x80000000 + candidate.
+// columns and the open ones (no tissue between). Owner: the segment's link-grid id, or kKeptCandidateId + candidate.
 std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter::gas_fluid_interfaces(const RunLookup& cand) const {
   std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> out;
   std::mutex lock;
@@ -70,8 +70,8 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter
           if (last_kind && last_kind != k && p - last_pos - 1 <= wvox) {
             const std::size_t g = k == 1 ? q : base + std::size_t(last_pos) * stride, f = k == 1 ? base + std::size_t(last_pos) * stride : q;
             const std::uint32_t fl = cand.at(f);
-            const std::uint32_t owner = lab_[g] == kGas ? grid_->segment_at(g, d_) : 0x80000000u + cand.at(g);
-            if (owner && owner != 0x80000000u + fl && owner != 0x80000000u) {
+            const std::uint32_t owner = lab_[g] == kGas ? grid_->segment_at(g, d_) : kKeptCandidateId + cand.at(g);
+            if (owner && owner != kKeptCandidateId + fl && owner != kKeptCandidateId) {
               const double run = tissue_run_mm(base, stride, last_pos, p, d_.sp[axis]);
               InterfaceTally& t = local[{fl, owner}];
               ++t.bins[std::min(5, int(run / 0.5))];
@@ -96,7 +96,7 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter
 std::uint32_t ColonSegmenter::meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const {
   for (auto it = interfaces_.lower_bound({l, 0}); it != interfaces_.end() && it->first.first == l; ++it) {
     const std::uint32_t owner = it->first.second;
-    if (owner >= 0x80000000u && kept_gap[owner - 0x80000000u] < 0) continue;  // gas of a candidate not kept
+    if (owner >= kKeptCandidateId && kept_gap[owner - kKeptCandidateId] < 0) continue;  // gas of a candidate not kept
     const InterfaceTally& t = it->second;
     double open_mm2 = 0;
     std::size_t columns = 0, open = 0;
