@@ -148,6 +148,11 @@ struct BodyStats {
   bool touches_face = false;
 };
 
+// Reasons of candidates kept by an open interface (segment_open.cpp): its fluid meets a colon body's
+// gas, or its gas meets a colon body's fluid, with no wall between.
+inline constexpr const char* kOpenFluidReason = "colon fluid: meets a colon segment's gas with no wall between (one lumen)";
+inline constexpr const char* kOpenGasReason = "colon gas: meets a colon body's fluid with no wall between (one lumen)";
+
 // Gas/fluid columns between one candidate and one gas owner (segment_open.cpp), per image axis:
 // all columns and those without a tissue layer between gas and fluid.
 struct InterfaceTally {
@@ -209,7 +214,11 @@ class ColonSegmenter {
   // Open interfaces (segment_open.cpp).
   double tissue_run_mm(std::size_t base, std::size_t stride, int a, int b, double h) const;
   std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> gas_fluid_interfaces(const RunLookup& cand) const;
-  std::uint32_t meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const;
+  bool one_lumen(const InterfaceTally& t) const;
+  std::uint32_t colon_body_of(std::uint32_t owner) const;
+  std::uint32_t meets_colon_gas(std::uint32_t l) const;
+  std::uint32_t gas_meets_colon_fluid(std::uint32_t l) const;
+  std::size_t join_open_bodies(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
   void debug_interfaces(const std::vector<BodyStats>& bodies) const;
   void report_candidate(const BodyStats& b, double kept_gap, const std::string& why);
   // Helpers.
@@ -243,6 +252,7 @@ class ColonSegmenter {
   std::vector<std::size_t> gas_voxels_;  // per crop gas component: its voxels
   std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
   std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> interfaces_;  // (candidate, gas body) -> columns (linking)
+  std::vector<std::uint32_t> kept_id_;     // per candidate: link-grid id of the colon body it belongs to (0: not kept)
   std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   Bytes state_;                        // crop: final 0/1 (after the graph cut)
   Bytes lumen0_;                       // crop: initial lumen

@@ -32,7 +32,6 @@ constexpr std::size_t kContactsPerPair = 3;
 // the two bodies are separate bowels with pericolic or mesenteric fat between them.
 constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
 constexpr double kContactSeparationMm = 20;
-const char* const kOpenReason = "colon fluid: meets a colon segment's gas with no wall between (one lumen)";
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
   std::ostringstream s;
@@ -151,6 +150,7 @@ void ColonSegmenter::link_tagged_stretches() {
   interfaces_ = gas_fluid_interfaces(RunLookup(cl));
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_interfaces(bodies);
   std::vector<double> kept_gap(n + 1, -1);
+  kept_id_.assign(n + 1, 0);
   ends_.clear();
   for (int pass = 0; pass < 7; ++pass)
     if (link_pass(eligible, why, kept_gap) == 0) break;
@@ -175,10 +175,10 @@ void ColonSegmenter::link_tagged_stretches() {
 // free end of the segment is kept and becomes colon. Returns the number kept.
 std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why,
                                       std::vector<double>& kept_gap) {
+  std::size_t kept = join_open_bodies(eligible, why, kept_gap);  // one lumen with a colon body: joins it, uses no end
   std::vector<Contact> contacts = grid_->contacts(eligible, opts_.link_gap, kContactsPerPair, kContactSeparationMm);
   std::stable_sort(contacts.begin(), contacts.end(), [](const Contact& a, const Contact& b) { return a.gap_mm < b.gap_mm; });
   std::vector<unsigned char> tried(eligible.size(), 0);
-  std::size_t kept = 0;
   for (const Contact& c : contacts) {
     const std::uint32_t l = c.candidate;
     if (!eligible[l]) continue;  // kept earlier in this pass
@@ -187,6 +187,7 @@ std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std:
       kept_gap[l] = c.gap_mm;
       eligible[l] = 0;
       const std::uint32_t id = kKeptCandidateId + l;
+      kept_id_[l] = id;
       grid_->absorb(l, id);
       ends_[c.segment].push_back(c.to);
       ends_[id].push_back(c.from);
@@ -197,16 +198,7 @@ std::size_t ColonSegmenter::link_pass(std::vector<unsigned char>& eligible, std:
     }
     if (!tried[l]) why[l] = reason, tried[l] = 1;  // the nearest contact's reason is reported
   }
-  for (std::uint32_t l = 1; l < eligible.size(); ++l) {  // fluid in the colon's lumen, wherever it meets the gas
-    const std::uint32_t owner = eligible[l] ? meets_colon_gas(l, kept_gap) : 0;
-    if (!owner) continue;
-    kept_gap[l] = 0;
-    eligible[l] = 0;
-    why[l] = kOpenReason;
-    grid_->absorb(l, owner);  // part of that body's lumen: its ends are the body's, it has none of its own
-    ++kept;
-  }
-  return kept;
+  return kept + join_open_bodies(eligible, why, kept_gap);
 }
 
 // A body continues at most two others (a tube has two ends), and not twice at the same end: no
@@ -305,7 +297,7 @@ void ColonSegmenter::report_candidate(const BodyStats& b, double kept_gap, const
     return decide(what, ml, c, false, why);
   }
   if (what != "gas body") ++st_.tagged_stretches, st_.tagged_stretch_volume_ml += ml;
-  if (why == kOpenReason) return decide(what, ml, c, true, why);
+  if (why == kOpenFluidReason || why == kOpenGasReason) return decide(what, ml, c, true, why);
   decide(what, ml, c, true,
          (what == "gas body" ? "colon segment continuing a segment's end (gap " : "fully tagged colon stretch continuing a segment's end (gap ") +
              fixed1(kept_gap) + " mm)");

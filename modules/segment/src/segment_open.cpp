@@ -90,23 +90,65 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter
   return out;
 }
 
-// Candidate l's fluid meets the gas of a colon body (a segment, or a candidate kept already) with no
-// wall between: over >= kMinOpenAreaMm2 and over most of their columns (per gas body). Returns that
-// body's link-grid id (the first such body), 0 if none.
-std::uint32_t ColonSegmenter::meets_colon_gas(std::uint32_t l, const std::vector<double>& kept_gap) const {
+// One lumen: the pair's open columns cover >= kMinOpenAreaMm2 (summed over the three axes) and are
+// >= kMinOpenShare of its columns.
+bool ColonSegmenter::one_lumen(const InterfaceTally& t) const {
+  double open_mm2 = 0;
+  std::size_t columns = 0, open = 0;
+  for (int a = 0; a < 3; ++a) {
+    open_mm2 += double(t.open[a]) * d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[a];
+    columns += t.columns[a], open += t.open[a];
+  }
+  return open_mm2 >= kMinOpenAreaMm2 && double(open) >= kMinOpenShare * double(columns);
+}
+
+// The link-grid id of the colon body that gas owner `owner` (a segment id, or kKeptCandidateId +
+// candidate) belongs to now; 0 when it is the gas of a candidate not kept.
+std::uint32_t ColonSegmenter::colon_body_of(std::uint32_t owner) const {
+  return owner >= kKeptCandidateId ? kept_id_[owner - kKeptCandidateId] : owner;
+}
+
+// Candidate l's fluid meets the gas of a colon body (a segment, or a candidate kept already) in one
+// lumen (one_lumen). Returns that body's link-grid id (the first such body), 0 if none.
+std::uint32_t ColonSegmenter::meets_colon_gas(std::uint32_t l) const {
   for (auto it = interfaces_.lower_bound({l, 0}); it != interfaces_.end() && it->first.first == l; ++it) {
-    const std::uint32_t owner = it->first.second;
-    if (owner >= kKeptCandidateId && kept_gap[owner - kKeptCandidateId] < 0) continue;  // gas of a candidate not kept
-    const InterfaceTally& t = it->second;
-    double open_mm2 = 0;
-    std::size_t columns = 0, open = 0;
-    for (int a = 0; a < 3; ++a) {
-      open_mm2 += double(t.open[a]) * d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[a];
-      columns += t.columns[a], open += t.open[a];
-    }
-    if (open_mm2 >= kMinOpenAreaMm2 && double(open) >= kMinOpenShare * double(columns)) return owner;
+    const std::uint32_t body = colon_body_of(it->first.second);
+    if (body && one_lumen(it->second)) return body;
   }
   return 0;
+}
+
+// The other way round (an open interface is one lumen whichever side is colon already): candidate
+// l's gas meets the fluid of a kept candidate in one lumen. Returns that body's id, 0 if none.
+std::uint32_t ColonSegmenter::gas_meets_colon_fluid(std::uint32_t l) const {
+  for (const auto& [key, t] : interfaces_) {
+    const std::uint32_t body = key.second == kKeptCandidateId + l ? kept_id_[key.first] : 0;
+    if (body && one_lumen(t)) return body;
+  }
+  return 0;
+}
+
+// Eligible candidates in one lumen with a colon body (their fluid meets its gas, or their gas meets
+// its fluid, with no wall between) join that body: its ends are theirs, they use none of their own
+// (a piece of the lumen's fluid or gas has no end of its own). Repeated until nothing joins (a body
+// joined may be the gas or fluid another one meets). Returns the number kept.
+std::size_t ColonSegmenter::join_open_bodies(std::vector<unsigned char>& eligible, std::vector<std::string>& why,
+                                             std::vector<double>& kept_gap) {
+  std::size_t kept = 0;
+  for (bool again = true; again;) {
+    again = false;
+    for (std::uint32_t l = 1; l < eligible.size(); ++l) {
+      if (!eligible[l]) continue;
+      std::uint32_t body = meets_colon_gas(l);
+      why[l] = body ? kOpenFluidReason : why[l];
+      if (!body && (body = gas_meets_colon_fluid(l))) why[l] = kOpenGasReason;
+      if (!body) continue;
+      kept_gap[l] = 0, eligible[l] = 0, kept_id_[l] = body;
+      grid_->absorb(l, body);
+      ++kept, again = true;
+    }
+  }
+  return kept;
 }
 
 // Every (candidate, gas body) interface of >= 8 columns: columns, open ones, tissue runs (0.5 mm bins).
