@@ -1,5 +1,7 @@
 #include "colonflat/register/pieces.h"
 
+#include "piece_split.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -360,6 +362,20 @@ ColonPiece branch_piece(const ColonScan& scan, int seg, double length, const std
   return p;
 }
 
+// Cuts every placed piece whose projections turn back along the reference into its two runs
+// (piece_split.h; each run at least a side branch of colon length). True when one was cut.
+bool split_where_turning(std::vector<ColonPiece>& other, const std::vector<Projection>& proj, const PieceOptions& o) {
+  std::vector<ColonPiece> out;
+  for (size_t p = 0; p < other.size(); ++p) {
+    const double cut = other[p].registered ? reversal_cut_mm(proj[p].local, proj[p].sref, o.min_branch_piece_mm) : kNaN;
+    if (std::isnan(cut)) out.push_back(other[p]);
+    else for (auto& piece : split_piece(other[p], cut)) out.push_back(std::move(piece));
+  }
+  const bool cut = out.size() > other.size();
+  other = std::move(out);
+  return cut;
+}
+
 }  // namespace
 
 bool has_pieces(const ColonScan& scan) {
@@ -419,6 +435,10 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
     const std::vector<RefPoint> pts = ref_points(ref, branches, o.bin_mm);
     std::vector<Projection> proj;
     for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
+    if (pass == 0 && split_where_turning(other, proj, o)) {
+      proj.clear();
+      for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
+    }
     if (pass == 3) break;
     const std::vector<double> ext = gap_extensions(other, proj, ref);
     double added = 0, largest = 0;
@@ -440,35 +460,34 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
 }
 
 std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
-  std::map<int, const ColonPiece*> by_segment;
+  std::multimap<int, const ColonPiece*> by_segment;
   std::set<int> ids;
-  for (const auto& p : pieces) by_segment[p.segment] = &p, ids.insert(p.segment);
+  for (const auto& p : pieces) by_segment.insert({p.segment, &p}), ids.insert(p.segment);
   const std::map<int, std::pair<int, double>> neck = branch_necks(scan, ids);  // short branch -> (piece, attach mm)
   std::vector<double> s(scan.lps.size(), kNaN);
   for (size_t v = 0; v < s.size(); ++v) {
     int seg = scan.segment[v];
     double local = scan.centreline_mm[v];
     if (auto it = neck.find(seg); it != neck.end() && !ids.count(seg)) seg = it->second.first, local = it->second.second;
-    const auto p = by_segment.find(seg);
-    if (p == by_segment.end() || !p->second->registered || !std::isfinite(local) || local < 0) continue;
-    s[v] = p->second->s_of(std::min(local, p->second->length_mm));
+    const ColonPiece* p = piece_at(by_segment, seg, local);
+    if (!p || !p->registered || !std::isfinite(local) || local < 0) continue;
+    s[v] = p->s_of(std::clamp(local - p->from_mm, 0.0, p->length_mm));
   }
   return s;
 }
 
 std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
-  std::map<int, const ColonPiece*> by_segment;
+  std::multimap<int, const ColonPiece*> by_segment;
   for (const auto& p : pieces)
-    if (p.registered && !p.s_bin.empty()) by_segment[p.segment] = &p;
+    if (p.registered && !p.s_bin.empty()) by_segment.insert({p.segment, &p});
   std::vector<char> held(scan.lps.size(), 0);
   for (size_t v = 0; v < held.size(); ++v) {
-    const auto p = by_segment.find(scan.segment[v]);
-    const double c = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
-    if (p == by_segment.end() || !std::isfinite(c)) continue;
-    const double h = p->second->bin_mm;  // a colon stretch does not halve its length between the positions
-    const size_t k = std::min(p->second->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
-    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h ||
-              (!p->second->on_branch.empty() && p->second->on_branch[k]);
+    const double own = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
+    const ColonPiece* p = std::isfinite(own) ? piece_at(by_segment, scan.segment[v], own) : nullptr;
+    if (!p) continue;
+    const double c = own - p->from_mm, h = p->bin_mm;  // a colon stretch does not halve its length between the positions
+    const size_t k = std::min(p->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
+    held[v] = std::abs(p->s_of(c + h) - p->s_of(c - h)) < 0.5 * 2 * h || (!p->on_branch.empty() && p->on_branch[k]);
   }
   return held;
 }

@@ -224,6 +224,32 @@ TEST(RegisterPieces, SideBranchInBothScansIsMappedBranchToBranch) {
   EXPECT_LT(supine_s_error(pair, reg, 230, 360), 10.0);
 }
 
+// The prone colon band runs from the rectum to material 400 mm, then on from the cecal end (800 mm)
+// back to 400 mm (flatten's band passing from one stretch into another where their walls touch, as
+// the painted supine's band does): one direction per piece held the whole second half at the turn
+// (no polyp there paired). Cut where its projections turn, both halves are placed: every polyp seen
+// in both paired right, median error <= 10 mm, the band laid out as two pieces.
+TEST(RegisterPieces, BandTurningBackAlongTheColonIsCutInTwo) {
+  SyntheticPairOptions o = long_pair(2);
+  SyntheticPair pair = make_synthetic_pair(o);
+  ColonScan& p = pair.prone;
+  double turn = 1e18, end = 0;  // centreline mm at material 400 and at the band's end
+  for (size_t v = 0; v < p.lps.size(); ++v) {
+    if (pair.prone_sigma[v] >= 400) turn = std::min(turn, p.centreline_mm[v]);
+    end = std::max(end, p.centreline_mm[v]);
+  }
+  for (size_t v = 0; v < p.lps.size(); ++v)
+    if (pair.prone_sigma[v] >= 400) p.centreline_mm[v] = turn + (end - p.centreline_mm[v]);
+  p.segments.at(0)["x1_end"] = "end B";  // the band's far end is no longer the cecum
+  ColonRegistration reg(pair.supine, pair.prone);
+  reg.run();
+  EXPECT_EQ(reg.pieces().prone.size(), 2u);
+  const PairScore s = score(pair, reg);
+  EXPECT_EQ(s.wrong, 0);
+  EXPECT_EQ(s.right, s.seen_in_both);
+  EXPECT_LE(s.along_median_mm, 10.0);
+}
+
 // Where the prone scan has no wall (a dropped stretch) the alignment is marked unsupported (80 %
 // of the stretch), the supine polyps there are never paired, and only polyps of that stretch are
 // listed as unaligned; elsewhere it is supported.

@@ -63,6 +63,7 @@ struct ColonPiece {
   bool branch = false;            // a side-branch band of colon length (PieceOptions::min_branch_piece_mm)
   int parent = -1;                // branch: the colon band it hangs on (a branch of a branch: its ancestor's)
   double attach_mm = 0;           // branch: the neck's centreline mm on `parent`
+  double from_mm = 0;             // own mm of its band where it starts (a band cut where it turns back, piece_split.h)
   // Reference band: its long branches inserted at their necks (own mm of the neck, branch length);
   // the band's s after a neck moves on by the branch's length.
   std::vector<std::pair<double, double>> inserts;
