@@ -97,7 +97,7 @@ nlohmann::json ColonRegistration::pieces_json() const {
     for (const auto& p : pieces)
       a.push_back({{"segment", p.segment}, {"start_mm", p.start_mm}, {"length_mm", p.length_mm},
                    {"flipped", p.flipped}, {"registered", p.registered}, {"placed_fraction", p.placed_fraction},
-                   {"x0_end", p.x0_end}, {"x1_end", p.x1_end}});
+                   {"x0_end", p.x0_end}, {"x1_end", p.x1_end}, {"branch", p.branch}});
     return a;
   };
   return {{"piecewise", piecewise_},

@@ -1,15 +1,21 @@
 #include "colonflat/register/pieces.h"
 
+#include "piece_split.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <set>
 
 namespace cf {
 
 double ColonPiece::s_of(double local_mm) const {
-  const double linear = flipped ? start_mm + length_mm - local_mm : start_mm + local_mm;
+  double inserted = 0;  // branches inserted at necks before this point (reference bands)
+  for (const auto& [neck, len] : inserts)
+    if (neck < local_mm) inserted += len;
+  const double linear = flipped ? start_mm + length_mm - local_mm : start_mm + local_mm + inserted;
   if (s_bin.empty()) return linear;
   const double x = local_mm / bin_mm - 0.5;  // bin k's centre is at (k + 0.5) bins
   const int n = int(s_bin.size());
@@ -18,6 +24,12 @@ double ColonPiece::s_of(double local_mm) const {
   if (x >= n - 1) return s_bin.back() + dir * (x - (n - 1)) * bin_mm;
   const int k = int(x);
   return s_bin[size_t(k)] + (s_bin[size_t(k) + 1] - s_bin[size_t(k)]) * (x - k);
+}
+
+double ColonPiece::span_mm() const {
+  double span = length_mm;
+  for (const auto& ins : inserts) span += ins.second;
+  return span;
 }
 
 void ColonPiece::move_by(double mm) {
@@ -70,14 +82,45 @@ std::vector<Eigen::Vector3d> piece_centre(const ColonScan& scan, int seg, double
   return sum;
 }
 
-// Reference pieces: in their order, each gap the straight line between the ends it joins.
-void chain(std::vector<ColonPiece>& ref) {
-  double at = 0;
-  for (size_t k = 0; k < ref.size(); ++k) {
-    if (k > 0) at += (ref[k].centre.front() - ref[k - 1].centre.back()).norm();
-    ref[k].start_mm = at, ref[k].flipped = false;
-    at += ref[k].length_mm;
+// A reference branch piece starts at its neck's s on its band, after the branches inserted at the
+// band's earlier necks (at one neck: the lower segment id first); without its band it is unregistered.
+void seat_branches(std::vector<ColonPiece>& ref) {
+  for (auto& b : ref) {
+    if (!b.branch) continue;
+    b.registered = false;
+    for (const auto& band : ref) {
+      if (band.branch || band.segment != b.parent) continue;
+      const double neck = std::min(b.attach_mm, band.length_mm);
+      double before = 0;
+      for (const auto& o : ref)
+        if (o.branch && o.parent == b.parent && o.segment != b.segment &&
+            std::make_pair(std::min(o.attach_mm, band.length_mm), o.segment) < std::make_pair(neck, b.segment))
+          before += o.length_mm;
+      b.start_mm = band.start_mm + neck + before, b.registered = true;
+    }
   }
+}
+
+// Reference pieces: the bands in their order, each with its long branches inserted at their necks,
+// each gap the straight line between the ends it joins; then the branches seated at their necks.
+void chain(std::vector<ColonPiece>& ref) {
+  for (auto& band : ref) {
+    band.inserts.clear();
+    if (band.branch) continue;
+    for (const auto& b : ref)
+      if (b.branch && b.parent == band.segment) band.inserts.push_back({std::min(b.attach_mm, band.length_mm), b.length_mm});
+    std::sort(band.inserts.begin(), band.inserts.end());
+  }
+  double at = 0;
+  const ColonPiece* prev = nullptr;
+  for (auto& p : ref) {
+    if (p.branch) continue;
+    if (prev) at += (p.centre.front() - prev->centre.back()).norm();
+    p.start_mm = at, p.flipped = false;
+    at += p.span_mm();
+    prev = &p;
+  }
+  seat_branches(ref);
 }
 
 struct RefPoint {
@@ -94,14 +137,14 @@ struct Projection {
 };
 
 // Side-branch band -> (colon band, mm on it where the branch's neck is); a branch of a branch
-// resolves to its ancestor's neck.
-std::map<int, std::pair<int, double>> branch_necks(const ColonScan& scan) {
+// resolves to its ancestor's neck, or to its parent's when that is one of `pieces`.
+std::map<int, std::pair<int, double>> branch_necks(const ColonScan& scan, const std::set<int>& pieces = {}) {
   std::map<int, std::pair<int, double>> neck;
   for (const auto& seg : scan.segments) {
     if (seg.value("kind", std::string("colon")) != "branch") continue;
     int parent = seg.value("parent", -1);
     double attach = seg.value("attach_mm", 0.0);
-    for (int guard = 0; guard < 16 && is_branch(scan, parent); ++guard) {
+    for (int guard = 0; guard < 16 && is_branch(scan, parent) && !pieces.count(parent); ++guard) {
       const auto* e = segment_entry(scan, parent);
       attach = e->value("attach_mm", 0.0), parent = e->value("parent", -1);
     }
@@ -117,14 +160,17 @@ struct BranchLine {
   std::vector<Eigen::Vector3d> centre;
 };
 
-std::vector<BranchLine> branch_lines(const ColonScan& scan, double bin) {
+// The short side branches (not pieces) of a scan whose pieces are `pieces`.
+std::vector<BranchLine> branch_lines(const ColonScan& scan, const std::vector<ColonPiece>& pieces, double bin) {
+  std::set<int> ids;
+  for (const auto& p : pieces) ids.insert(p.segment);
   std::map<int, double> length;
   for (size_t v = 0; v < scan.lps.size(); ++v)
     if (const double c = scan.centreline_mm[v]; std::isfinite(c) && c >= 0 && is_branch(scan, scan.segment[v]))
       length[scan.segment[v]] = std::max(length[scan.segment[v]], c);
   std::vector<BranchLine> out;
-  for (const auto& [seg, neck] : branch_necks(scan))
-    if (const auto it = length.find(seg); it != length.end())
+  for (const auto& [seg, neck] : branch_necks(scan, ids))
+    if (const auto it = length.find(seg); it != length.end() && !ids.count(seg))
       out.push_back({neck.first, neck.second, piece_centre(scan, seg, std::max(it->second, bin), bin)});
   return out;
 }
@@ -157,10 +203,20 @@ std::vector<double> follow_projections(const ColonPiece& piece, const std::vecto
   for (size_t i = 0; i < local.size(); ++i) bin[i] = std::clamp(int(local[i] / o.bin_mm), 0, n - 1);
   const int half = std::max(0, int(std::lround(o.follow_mm / o.bin_mm)));
   for (size_t i = 0; i < local.size(); ++i) {
-    std::vector<double> near;
-    for (size_t j = 0; j < local.size(); ++j)
-      if (std::abs(bin[j] - bin[i]) <= half) near.push_back(sref[j] - dir * local[j]);
-    offset[size_t(bin[i])] = median(near);
+    std::vector<double> near, before, after;
+    for (size_t j = 0; j < local.size(); ++j) {
+      if (std::abs(bin[j] - bin[i]) > half) continue;
+      const double v = sref[j] - dir * local[j];
+      near.push_back(v);
+      if (bin[j] <= bin[i]) before.push_back(v);
+      if (bin[j] >= bin[i]) after.push_back(v);
+    }
+    // A jump (a stretch inserted in one scan's course, skipped in the other's): keep the side of it
+    // this bin's own projection lies on instead of ramping across it (each side a median of at least
+    // half a half window: near a piece's end the short side is a few noisy projections).
+    const double b = median(before), a = median(after), own = sref[i] - dir * local[i];
+    const bool sides = 2 * std::min(before.size(), after.size()) >= size_t(half);
+    offset[size_t(bin[i])] = sides && std::abs(b - a) > o.jump_mm ? (std::abs(b - own) <= std::abs(a - own) ? b : a) : median(near);
   }
   std::vector<double> s(static_cast<size_t>(n));
   int last = -1;
@@ -216,12 +272,14 @@ Projection place(ColonPiece& piece, const std::vector<RefPoint>& ref, const Eige
 // there. A piece of the other scan that projects onto both sides of the gap measures it: the extra
 // length (its own mm between the two sides minus the reference's) per gap k (before reference piece k).
 std::vector<double> gap_extensions(const std::vector<ColonPiece>& other, const std::vector<Projection>& proj,
-                                   size_t ref_pieces) {
+                                   const std::vector<ColonPiece>& ref) {
+  const size_t ref_pieces = ref.size();
   std::vector<double> ext(ref_pieces, 0.0);
   for (size_t p = 0; p < other.size(); ++p) {
     if (!other[p].registered) continue;
     const Projection& pr = proj[p];
     for (size_t k = 1; k < ref_pieces; ++k) {
+      if (ref[k].branch || ref[k - 1].branch) continue;  // the bands come first, in their order
       std::vector<double> before, after;  // own mm - reference s (flipped: own mm + reference s)
       for (size_t i = 0; i < pr.local.size(); ++i) {
         const double v = other[p].flipped ? pr.local[i] + pr.sref[i] : pr.local[i] - pr.sref[i];
@@ -270,6 +328,54 @@ double refine_shift(const std::vector<Eigen::Vector3d>& a, const std::vector<Eig
   return residual;
 }
 
+// A band of the scan as a piece: its length, end labels and centre line.
+ColonPiece band_piece(const ColonScan& scan, int seg, double length, double bin) {
+  ColonPiece p;
+  p.segment = seg;
+  p.length_mm = std::max(length, bin);
+  if (const auto* e = segment_entry(scan, seg)) {
+    if (e->contains("x0_end") && (*e)["x0_end"].is_string()) p.x0_end = (*e)["x0_end"];
+    if (e->contains("x1_end") && (*e)["x1_end"].is_string()) p.x1_end = (*e)["x1_end"];
+  }
+  p.centre = piece_centre(scan, seg, p.length_mm, bin);
+  return p;
+}
+
+// A side branch of colon length as a piece hanging at `neck` (band, mm): flipped when its own mm runs
+// towards its neck (its last centre point nearer to the neck than its first). The neck is FlatSegments
+// attach_lps_mm (the centre of the neck's vertices; flatten's "neck"/"tip" labels do not say which
+// end its centreline mm starts at), else the band's centre point just before the neck (the band
+// after it may continue next to the branch's tip where the branch is a loop of the colon).
+ColonPiece branch_piece(const ColonScan& scan, int seg, double length, const std::pair<int, double>& neck,
+                        const std::vector<ColonPiece>& bands, double bin) {
+  ColonPiece p = band_piece(scan, seg, length, bin);
+  p.branch = true, p.parent = neck.first, p.attach_mm = neck.second;
+  Eigen::Vector3d at = p.centre.front();
+  const auto* e = segment_entry(scan, seg);
+  if (e && e->contains("attach_lps_mm") && (*e)["attach_lps_mm"].is_array() && (*e)["attach_lps_mm"].size() == 3) {
+    for (int k = 0; k < 3; ++k) at[k] = (*e)["attach_lps_mm"][size_t(k)].get<double>();
+  } else {
+    for (const auto& b : bands)
+      if (b.segment == neck.first) at = b.centre[std::min(b.centre.size() - 1, size_t(std::max(0.0, neck.second / bin - 1)))];
+  }
+  p.flipped = (p.centre.back() - at).norm() < (p.centre.front() - at).norm();
+  return p;
+}
+
+// Cuts every placed piece whose projections turn back along the reference into its two runs
+// (piece_split.h; each run at least a side branch of colon length). True when one was cut.
+bool split_where_turning(std::vector<ColonPiece>& other, const std::vector<Projection>& proj, const PieceOptions& o) {
+  std::vector<ColonPiece> out;
+  for (size_t p = 0; p < other.size(); ++p) {
+    const double cut = other[p].registered ? reversal_cut_mm(proj[p].local, proj[p].sref, o.min_branch_piece_mm) : kNaN;
+    if (std::isnan(cut)) out.push_back(other[p]);
+    else for (auto& piece : split_piece(other[p], cut)) out.push_back(std::move(piece));
+  }
+  const bool cut = out.size() > other.size();
+  other = std::move(out);
+  return cut;
+}
+
 }  // namespace
 
 bool has_pieces(const ColonScan& scan) {
@@ -290,21 +396,16 @@ std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& 
   std::vector<std::pair<int, ColonPiece>> keyed;
   for (const auto& [seg, len] : length) {
     if (is_branch(scan, seg)) continue;
-    ColonPiece p;
-    p.segment = seg;
-    p.length_mm = std::max(len, o.bin_mm);
-    int order = seg;
-    if (const auto* e = segment_entry(scan, seg)) {
-      order = e->value("order", seg);
-      if (e->contains("x0_end") && (*e)["x0_end"].is_string()) p.x0_end = (*e)["x0_end"];
-      if (e->contains("x1_end") && (*e)["x1_end"].is_string()) p.x1_end = (*e)["x1_end"];
-    }
-    p.centre = piece_centre(scan, seg, p.length_mm, o.bin_mm);
-    keyed.push_back({order, p});
+    ColonPiece p = band_piece(scan, seg, len, o.bin_mm);
+    const auto* e = segment_entry(scan, seg);
+    keyed.push_back({e ? e->value("order", seg) : seg, p});
   }
   std::stable_sort(keyed.begin(), keyed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<ColonPiece> out;
   for (auto& [k, p] : keyed) out.push_back(std::move(p));
+  for (const auto& [seg, neck] : branch_necks(scan))
+    if (const auto it = length.find(seg); it != length.end() && it->second >= o.min_branch_piece_mm)
+      out.push_back(branch_piece(scan, seg, it->second, neck, out, o.bin_mm));
   return out;
 }
 
@@ -329,20 +430,27 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
   auto& other = L.supine_is_reference ? L.prone : L.supine;
   const Eigen::Vector3d shift = L.supine_is_reference ? L.prone_to_supine : Eigen::Vector3d(-L.prone_to_supine);
   chain(ref);
-  const std::vector<BranchLine> branches = branch_lines(L.supine_is_reference ? supine : prone, o.bin_mm);
+  const std::vector<BranchLine> branches = branch_lines(L.supine_is_reference ? supine : prone, ref, o.bin_mm);
   for (int pass = 0;; ++pass) {  // place, lengthen the reference gaps the other scan spans, again
     const std::vector<RefPoint> pts = ref_points(ref, branches, o.bin_mm);
     std::vector<Projection> proj;
     for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
+    if (pass == 0 && split_where_turning(other, proj, o)) {
+      proj.clear();
+      for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
+    }
     if (pass == 3) break;
-    const std::vector<double> ext = gap_extensions(other, proj, ref.size());
+    const std::vector<double> ext = gap_extensions(other, proj, ref);
     double added = 0, largest = 0;
-    for (size_t k = 0; k < ref.size(); ++k) added += ext[k], largest = std::max(largest, ext[k]), ref[k].start_mm += added;
+    for (size_t k = 0; k < ref.size(); ++k)
+      if (!ref[k].branch) added += ext[k], largest = std::max(largest, ext[k]), ref[k].start_mm += added;
+    seat_branches(ref);
     if (largest < 2 * o.bin_mm) break;
   }
-  std::stable_sort(other.begin(), other.end(), [](const ColonPiece& x, const ColonPiece& y) {
-    return x.registered != y.registered ? x.registered : x.first_mm() < y.first_mm();
-  });
+  for (auto* side : {&ref, &other})
+    std::stable_sort(side->begin(), side->end(), [](const ColonPiece& x, const ColonPiece& y) {
+      return x.registered != y.registered ? x.registered : x.first_mm() < y.first_mm();
+    });
   double lo = 0;  // the other scan may reach beyond the reference's first end (rectum cut short)
   for (const auto& p : other)
     if (p.registered) lo = std::min(lo, p.first_mm());
@@ -352,34 +460,34 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
 }
 
 std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
-  std::map<int, const ColonPiece*> by_segment;
-  for (const auto& p : pieces) by_segment[p.segment] = &p;
-  const std::map<int, std::pair<int, double>> neck = branch_necks(scan);  // branch band -> (colon band, attach mm)
+  std::multimap<int, const ColonPiece*> by_segment;
+  std::set<int> ids;
+  for (const auto& p : pieces) by_segment.insert({p.segment, &p}), ids.insert(p.segment);
+  const std::map<int, std::pair<int, double>> neck = branch_necks(scan, ids);  // short branch -> (piece, attach mm)
   std::vector<double> s(scan.lps.size(), kNaN);
   for (size_t v = 0; v < s.size(); ++v) {
     int seg = scan.segment[v];
     double local = scan.centreline_mm[v];
-    if (auto it = neck.find(seg); it != neck.end()) seg = it->second.first, local = it->second.second;
-    const auto p = by_segment.find(seg);
-    if (p == by_segment.end() || !p->second->registered || !std::isfinite(local) || local < 0) continue;
-    s[v] = p->second->s_of(std::min(local, p->second->length_mm));
+    if (auto it = neck.find(seg); it != neck.end() && !ids.count(seg)) seg = it->second.first, local = it->second.second;
+    const ColonPiece* p = piece_at(by_segment, seg, local);
+    if (!p || !p->registered || !std::isfinite(local) || local < 0) continue;
+    s[v] = p->s_of(std::clamp(local - p->from_mm, 0.0, p->length_mm));
   }
   return s;
 }
 
 std::vector<char> held_at_neck(const ColonScan& scan, const std::vector<ColonPiece>& pieces) {
-  std::map<int, const ColonPiece*> by_segment;
+  std::multimap<int, const ColonPiece*> by_segment;
   for (const auto& p : pieces)
-    if (p.registered && !p.s_bin.empty()) by_segment[p.segment] = &p;
+    if (p.registered && !p.s_bin.empty()) by_segment.insert({p.segment, &p});
   std::vector<char> held(scan.lps.size(), 0);
   for (size_t v = 0; v < held.size(); ++v) {
-    const auto p = by_segment.find(scan.segment[v]);
-    const double c = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
-    if (p == by_segment.end() || !std::isfinite(c)) continue;
-    const double h = p->second->bin_mm;  // a colon stretch does not halve its length between the positions
-    const size_t k = std::min(p->second->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
-    held[v] = std::abs(p->second->s_of(c + h) - p->second->s_of(c - h)) < 0.5 * 2 * h ||
-              (!p->second->on_branch.empty() && p->second->on_branch[k]);
+    const double own = v < scan.centreline_mm.size() ? scan.centreline_mm[v] : kNaN;
+    const ColonPiece* p = std::isfinite(own) ? piece_at(by_segment, scan.segment[v], own) : nullptr;
+    if (!p) continue;
+    const double c = own - p->from_mm, h = p->bin_mm;  // a colon stretch does not halve its length between the positions
+    const size_t k = std::min(p->on_branch.size() - 1, size_t(std::max(0.0, c / h)));
+    held[v] = std::abs(p->s_of(c + h) - p->s_of(c - h)) < 0.5 * 2 * h || (!p->on_branch.empty() && p->on_branch[k]);
   }
   return held;
 }

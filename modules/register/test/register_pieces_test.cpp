@@ -122,70 +122,132 @@ TEST(RegisterPieces, EachScanMissesADifferentStretch) {
   expect_targets(o, 3);
 }
 
-// The supine keeps material [from, to) as a side-branch band hanging at `from` (flatten cut that
-// stretch off behind a neck): its vertices get their own centreline_mm and the colon band's
-// centreline_mm skips it, as the real CTC mask's supine colon does with a stretch behind a 12 mm neck.
-void make_side_branch(SyntheticPair& pair, double from, double to) {
-  ColonScan& s = pair.supine;
+// One scan keeps material [from, to) as a side-branch band hanging at `from` (flatten cut that
+// stretch off behind a neck): its vertices get their own centreline_mm (from the neck, or with
+// `towards_neck` from the tip) and the colon band's centreline_mm skips it, as the real CTC mask's
+// supine colon does with a 204 mm stretch behind a 12 mm neck.
+void make_side_branch(ColonScan& s, const std::vector<double>& sigma, double from, double to, bool towards_neck = false) {
   double at_from = 1e18, at_to = 1e18;
+  Eigen::Vector3d neck = Eigen::Vector3d::Zero();  // the centre of the wall at the neck
+  int at_neck = 0;
   for (size_t v = 0; v < s.lps.size(); ++v) {
-    if (pair.supine_sigma[v] >= from) at_from = std::min(at_from, s.centreline_mm[v]);
-    if (pair.supine_sigma[v] >= to) at_to = std::min(at_to, s.centreline_mm[v]);
+    if (sigma[v] >= from && s.segment[v] == 0) at_from = std::min(at_from, s.centreline_mm[v]);
+    if (sigma[v] >= to && s.segment[v] == 0) at_to = std::min(at_to, s.centreline_mm[v]);
+    if (std::abs(sigma[v] - from) < 1) neck += s.lps[v], ++at_neck;
   }
+  neck /= std::max(1, at_neck);
+  const int id = int(s.segments.size()) + 10;
   for (size_t v = 0; v < s.lps.size(); ++v) {
-    if (pair.supine_sigma[v] >= to) s.centreline_mm[v] -= at_to - at_from;
-    else if (pair.supine_sigma[v] >= from) s.segment[v] = 1, s.centreline_mm[v] -= at_from;
+    if (s.segment[v] != 0) continue;
+    if (sigma[v] >= to) s.centreline_mm[v] -= at_to - at_from;
+    else if (sigma[v] >= from)
+      s.segment[v] = id, s.centreline_mm[v] = towards_neck ? at_to - s.centreline_mm[v] : s.centreline_mm[v] - at_from;
   }
   nlohmann::json branch = s.segments.at(0);
-  branch["id"] = 1, branch["order"] = 1, branch["kind"] = "branch", branch["parent"] = 0, branch["attach_mm"] = at_from;
-  branch.erase("x0_end"), branch.erase("x1_end");
+  branch["id"] = id, branch["order"] = id, branch["kind"] = "branch", branch["parent"] = 0, branch["attach_mm"] = at_from;
+  branch["attach_lps_mm"] = {neck.x(), neck.y(), neck.z()};
+  branch["x0_end"] = "neck", branch["x1_end"] = "tip";  // as flatten labels every branch, whichever way its mm runs
   s.segments.push_back(branch);
-  for (auto& q : pair.polyps) q.in_supine = q.in_supine && (q.sigma_mm < from || q.sigma_mm >= to);
 }
 
-// Polyps within `margin` mm of [from, to) left out of the count "seen in both": next to a stretch held
-// at a neck the prone piece's map follows its projections' running median (PieceOptions::follow_mm)
-// and is held there too, so a polyp there is listed unaligned (docs/register.md, Limits).
-void exclude_near(SyntheticPair& pair, double from, double to, double margin) {
-  for (auto& q : pair.polyps) q.in_supine = q.in_supine && (q.sigma_mm < from - margin || q.sigma_mm >= to + margin);
+// The supine's common s of a vertex on material sigma (the supine is the reference from 0: s =
+// sigma up to the gaps' straight-line shortening, none here before `sigma`).
+double supine_s_error(const SyntheticPair& pair, const ColonRegistration& reg, double from, double to) {
+  std::vector<double> err;
+  const ScanCoordinates& sc = reg.supine_coordinates();
+  for (size_t v = 0; v < sc.s.size(); v += 5)
+    if (pair.supine_sigma[v] >= from && pair.supine_sigma[v] < to) err.push_back(std::abs(sc.s[v] - pair.supine_sigma[v]));
+  return err.empty() ? INFINITY : median(err);
 }
 
-// The real-mask split +3 failure (docs/register.md): a stretch the supine holds as a side branch
-// (150 mm, placed at its neck) is colon inside a prone piece, the prone split into 3 more pieces.
-// The prone piece's own length over-measures the supine colon by the stretch; placed at its own
-// length it pushed every later piece late. Placed by its projections (the branch's centre points
-// at the neck): no wrong pair (none of the polyps held at the neck is paired), >= 90 % of the
-// polyps seen in both (20 mm or more from the branch) paired, median <= 10 mm, and the later
-// pieces start within 25 mm of the supine's s of the same material.
-TEST(RegisterPieces, StretchHeldAsSideBranchInOneScan) {
+// The real-mask split +3 failure (docs/register.md): a 150 mm stretch the supine keeps as a side
+// branch is colon inside a prone piece, the prone split into 3 more pieces. The branch is of colon
+// length, so it is a piece: inserted into the supine's course at its neck (the band after it moves
+// on by 150 mm) whichever way its own mm runs, the prone pieces placed on it. Every target of the
+// issue on all polyps seen in both, the polyps on the branch included (before: held at the neck,
+// never paired, 8 of 10), the branch's vertices within 10 mm of their material place along the
+// colon, each prone piece's first wall (next to a cut, where the alignment has one side only) mapped
+// within 15 mm (the pair's wall slide) of the supine wall of the same material.
+TEST(RegisterPieces, StretchKeptAsSideBranchInOneScanIsLaidOutAlongTheColon) {
+  for (const bool towards_neck : {false, true}) {
+    SyntheticPairOptions o = long_pair(3);
+    o.prone_removed = {{150, 160}, {420, 432}, {600, 610}};
+    SyntheticPair pair = make_synthetic_pair(o);
+    make_side_branch(pair.supine, pair.supine_sigma, 220, 370, towards_neck);
+    ColonRegistration reg(pair.supine, pair.prone);
+    reg.run();
+    ASSERT_TRUE(reg.piecewise());
+    ASSERT_EQ(reg.pieces().prone.size(), 4u);
+    ASSERT_EQ(reg.pieces().supine.size(), 2u);  // the band and the branch
+    int on_branch = 0;
+    for (const auto& q : pair.polyps) on_branch += q.in_supine && q.in_prone && q.sigma_mm >= 220 && q.sigma_mm < 370;
+    ASSERT_GT(on_branch, 0);
+    const PairScore p = score(pair, reg);
+    EXPECT_EQ(p.wrong, 0);
+    EXPECT_GE(p.right, int(std::ceil(0.9 * p.seen_in_both))) << p.right << " of " << p.seen_in_both;
+    EXPECT_LE(p.along_median_mm, 10.0);
+    EXPECT_LT(supine_s_error(pair, reg, 230, 360), 10.0) << "towards neck " << towards_neck;
+    const ScanCoordinates &sc = reg.supine_coordinates(), &pc = reg.prone_coordinates();
+    for (const auto& piece : reg.pieces().prone) {  // each prone piece's first wall mapped to the supine
+      double error = NAN;
+      for (size_t v = 0; v < pair.prone.lps.size() && std::isnan(error); ++v)
+        if (pair.prone.segment[v] == piece.segment && pair.prone.centreline_mm[v] < 2)
+          for (size_t w = 0; w < pair.supine.lps.size(); ++w)
+            if (std::abs(pair.supine_sigma[w] - pair.prone_sigma[v]) < 1) {  // the same material
+              double s2, t2;
+              reg.map_coordinates(Direction::kProneToSupine, pc.s[v], pc.theta[v], s2, t2);
+              error = std::abs(s2 - sc.s[w]);
+              break;
+            }
+      ASSERT_FALSE(std::isnan(error)) << "piece " << piece.segment;
+      EXPECT_LT(error, 15.0) << "piece " << piece.segment << ", towards neck " << towards_neck;
+    }
+  }
+}
+
+// Both scans keep the same 150 mm stretch as a side branch (the real mask's uncut pair): the prone
+// branch is placed on the supine one, branch to branch, and the band across the neck keeps both
+// sides of the jump: every polyp seen in both paired right, the polyps on the branch included,
+// median error <= 10 mm.
+TEST(RegisterPieces, SideBranchInBothScansIsMappedBranchToBranch) {
   SyntheticPairOptions o = long_pair(3);
-  o.prone_removed = {{150, 160}, {420, 432}, {600, 610}};
   SyntheticPair pair = make_synthetic_pair(o);
-  make_side_branch(pair, 220, 370);
-  exclude_near(pair, 220, 370, 20);
+  make_side_branch(pair.supine, pair.supine_sigma, 220, 370);
+  make_side_branch(pair.prone, pair.prone_sigma, 220, 370, true);
   ColonRegistration reg(pair.supine, pair.prone);
   reg.run();
-  ASSERT_TRUE(reg.piecewise());
-  ASSERT_EQ(reg.pieces().prone.size(), 4u);
+  ASSERT_EQ(reg.pieces().prone.size(), 2u);
   const PairScore p = score(pair, reg);
-  ASSERT_GT(p.seen_in_both, 5);
   EXPECT_EQ(p.wrong, 0);
-  EXPECT_GE(p.right, int(std::ceil(0.9 * p.seen_in_both))) << p.right << " of " << p.seen_in_both;
+  EXPECT_EQ(p.right, p.seen_in_both);
   EXPECT_LE(p.along_median_mm, 10.0);
-  // the prone pieces after the branch (material 432 and 610 on) against the supine's s there
-  for (const auto& piece : reg.pieces().prone) {
-    if (piece.first_mm() < reg.pieces().supine[0].s_of(300)) continue;
-    double supine_s = NAN;  // the supine s of the prone piece's first centre point (same material)
-    for (size_t v = 0; v < pair.prone.lps.size(); ++v)
-      if (pair.prone.segment[v] == piece.segment && pair.prone.centreline_mm[v] < 2)
-        for (size_t w = 0; w < pair.supine.lps.size(); ++w)
-          if (std::abs(pair.supine_sigma[w] - pair.prone_sigma[v]) < 1 && pair.supine.segment[w] == 0) {
-            supine_s = reg.pieces().supine[0].s_of(pair.supine.centreline_mm[w]);
-            break;
-          }
-    ASSERT_FALSE(std::isnan(supine_s)) << "piece " << piece.segment;
-    EXPECT_NEAR(piece.s_of(0), supine_s, 25.0) << "piece " << piece.segment;
+  EXPECT_LT(supine_s_error(pair, reg, 230, 360), 10.0);
+}
+
+// The prone colon band runs from the rectum to material 400 mm, then on from the cecal end (800 mm)
+// back to 400 mm (flatten's band passing from one stretch into another where their walls touch, as
+// the painted supine's band does): one direction per piece held the whole second half at the turn
+// (no polyp there paired). Cut where its projections turn, both halves are placed: every polyp seen
+// in both paired right, median error <= 10 mm, the band laid out as two pieces.
+TEST(RegisterPieces, BandTurningBackAlongTheColonIsCutInTwo) {
+  SyntheticPairOptions o = long_pair(2);
+  SyntheticPair pair = make_synthetic_pair(o);
+  ColonScan& p = pair.prone;
+  double turn = 1e18, end = 0;  // centreline mm at material 400 and at the band's end
+  for (size_t v = 0; v < p.lps.size(); ++v) {
+    if (pair.prone_sigma[v] >= 400) turn = std::min(turn, p.centreline_mm[v]);
+    end = std::max(end, p.centreline_mm[v]);
   }
+  for (size_t v = 0; v < p.lps.size(); ++v)
+    if (pair.prone_sigma[v] >= 400) p.centreline_mm[v] = turn + (end - p.centreline_mm[v]);
+  p.segments.at(0)["x1_end"] = "end B";  // the band's far end is no longer the cecum
+  ColonRegistration reg(pair.supine, pair.prone);
+  reg.run();
+  EXPECT_EQ(reg.pieces().prone.size(), 2u);
+  const PairScore s = score(pair, reg);
+  EXPECT_EQ(s.wrong, 0);
+  EXPECT_EQ(s.right, s.seen_in_both);
+  EXPECT_LE(s.along_median_mm, 10.0);
 }
 
 // Where the prone scan has no wall (a dropped stretch) the alignment is marked unsupported (80 %

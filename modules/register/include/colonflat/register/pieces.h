@@ -18,8 +18,16 @@
 //      counted as colon length. Each placed piece maps its own mm to the common s through its
 //      projections (running median, monotone), so its own centreline's length errors do not push
 //      the pieces after it.
+// A side-branch band of colon length (longer than `min_branch_piece_mm`) is a piece too: flatten
+// cuts a colon stretch off as a side branch where the lumen touches itself or forks (the real mask's
+// 204 mm stretch behind a 12 mm neck, the painted supine's 407, 481 and 207 mm stretches). In the
+// reference it is inserted into the colon's course at its neck (the colon runs out along the branch
+// from the neck, then on along its band: the band's s after the neck moves by the branch's length);
+// in the other scan it is placed by its projections like any piece. Shorter branches (pouches,
+// diverticula, a polyp on a stalk) stay at their neck.
 #include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,6 +43,13 @@ struct PieceOptions {
   double follow_mm = 40;          // mm; half window of the running median of a placed piece's projections:
                                   // it must outvote a neighbouring loop lying alongside over a colon's
                                   // diameter or more (10 mm lost a phantom polyp: 4/5 on seed 1, 25 % dropped)
+  double min_branch_piece_mm = 60;  // mm; a side branch this long is a piece of the colon's course: longer
+                                    // than a haustral pouch or a diverticulum (< 3 cm deep) or a polyp on
+                                    // a stalk, twice the colon's diameter
+  double jump_mm = 30;            // mm; the two halves of a placed piece's follow window differing by more
+                                  // is a jump of its map (a stretch one scan holds as an inserted branch
+                                  // or skips): more than the wall slides along between the positions
+                                  // (1-2 cm) and than the colon's diameter
 };
 
 struct ColonPiece {
@@ -45,6 +60,13 @@ struct ColonPiece {
   bool registered = true;         // false: no counterpart in the other scan
   double placed_fraction = 1;     // share of its centre points that projected onto the reference
   std::string x0_end, x1_end;     // FlatSegments labels ("" when absent)
+  bool branch = false;            // a side-branch band of colon length (PieceOptions::min_branch_piece_mm)
+  int parent = -1;                // branch: the colon band it hangs on (a branch of a branch: its ancestor's)
+  double attach_mm = 0;           // branch: the neck's centreline mm on `parent`
+  double from_mm = 0;             // own mm of its band where it starts (a band cut where it turns back, piece_split.h)
+  // Reference band: its long branches inserted at their necks (own mm of the neck, branch length);
+  // the band's s after a neck moves on by the branch's length.
+  std::vector<std::pair<double, double>> inserts;
   std::vector<Eigen::Vector3d> centre;  // LPS mm, centroid per bin of its own centreline_mm
   // Common s per centre bin where the piece was placed by its projections (empty: the reference,
   // s = start_mm + own mm). A stretch of it that the reference holds as a side branch sits at the
@@ -56,6 +78,7 @@ struct ColonPiece {
   double s_of(double local_mm) const;
   double first_mm() const { return std::min(s_of(0), s_of(length_mm)); }  // common s range it covers
   double end_mm() const { return std::max(s_of(0), s_of(length_mm)); }
+  double span_mm() const;   // common s it spans in the reference: its length plus its inserts
   void move_by(double mm);  // moves the piece along the common s
 };
 
@@ -69,15 +92,17 @@ struct PieceLayout {
 // True when the scan can be laid out as pieces (per-vertex centreline_mm present).
 bool has_pieces(const ColonScan& scan);
 
-// The colon bands of a scan in the flat map's order (FlatSegments "order", else segment id),
-// side-branch bands excluded. Precondition: has_pieces(scan).
+// The colon bands of a scan in the flat map's order (FlatSegments "order", else segment id), then
+// its side-branch bands of colon length (branch = true, flipped when their own mm runs towards the
+// neck); shorter side branches excluded. Precondition: has_pieces(scan).
 std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& opts);
 
 // Both scans' pieces on the common axis (steps 1-3 above).
 PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const PieceOptions& opts);
 
 // Common s per vertex of a scan laid out as `pieces` (NaN: unregistered piece or no centreline);
-// side-branch vertices sit at their neck on the parent band (FlatSegments attach_mm).
+// the vertices of a side branch that is no piece sit at their neck on the nearest ancestor that is
+// one (FlatSegments parent, attach_mm).
 std::vector<double> common_s(const ColonScan& scan, const std::vector<ColonPiece>& pieces);
 
 // Per vertex: 1 when it lies on a stretch of a placed piece that the layout holds at one common s

@@ -1,0 +1,55 @@
+#include "piece_split.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cf {
+namespace {
+
+// Correlation of x and y over [a, b).
+double correlation(const std::vector<double>& x, const std::vector<double>& y, size_t a, size_t b) {
+  const double n = double(b - a);
+  double mx = 0, my = 0;
+  for (size_t i = a; i < b; ++i) mx += x[i] / n, my += y[i] / n;
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = a; i < b; ++i) sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx), syy += (y[i] - my) * (y[i] - my);
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+}
+
+}  // namespace
+
+double reversal_cut_mm(const std::vector<double>& local, const std::vector<double>& sref, double min_run_mm) {
+  constexpr double kMonotone = 0.9;  // each side clearly runs one way (a wiggle or a loop alongside does not)
+  double best = 0, cut = std::numeric_limits<double>::quiet_NaN();
+  const size_t n = local.size();
+  for (size_t i = 1; i + 1 < n; ++i) {
+    if (local[i] - local.front() < min_run_mm || local.back() - local[i] < min_run_mm) continue;
+    const double a = correlation(local, sref, 0, i), b = correlation(local, sref, i, n);
+    const double clear = std::min(std::abs(a), std::abs(b));
+    if (a * b < 0 && clear >= kMonotone && clear > best) best = clear, cut = 0.5 * (local[i - 1] + local[i]);
+  }
+  return cut;
+}
+
+std::vector<ColonPiece> split_piece(const ColonPiece& p, double cut_mm) {
+  const size_t k = std::clamp(size_t(std::lround(cut_mm / p.bin_mm)), size_t(1), p.centre.size() - 1);
+  ColonPiece a = p, b = p;
+  a.centre.assign(p.centre.begin(), p.centre.begin() + long(k));
+  b.centre.assign(p.centre.begin() + long(k), p.centre.end());
+  a.length_mm = double(k) * p.bin_mm, b.length_mm = p.length_mm - a.length_mm;
+  b.from_mm = p.from_mm + a.length_mm;
+  a.x1_end.clear(), b.x0_end.clear();
+  a.s_bin.clear(), b.s_bin.clear(), a.on_branch.clear(), b.on_branch.clear();
+  return {a, b};
+}
+
+const ColonPiece* piece_at(const std::multimap<int, const ColonPiece*>& by_segment, int seg, double c) {
+  const ColonPiece* found = nullptr;
+  for (auto [it, end] = by_segment.equal_range(seg); it != end; ++it)
+    if (const ColonPiece* p = it->second; !found || (p->from_mm <= c && (found->from_mm > c || p->from_mm > found->from_mm)))
+      found = p;
+  return found;
+}
+
+}  // namespace cf

@@ -1,0 +1,28 @@
+#pragma once
+// A placed piece whose course runs back along the reference (docs/register.md, Pieces step 3):
+// flatten's colon band can pass from one stretch of the colon into another where their walls touch
+// and then run the other way along the colon (the painted supine's band: cecum -> 1288 mm of the
+// course, then 405 -> 870 mm). One direction per piece would hold the second stretch at the turn;
+// the band is cut there into two pieces, each placed by its own projections.
+#include <map>
+#include <vector>
+
+#include "colonflat/register/pieces.h"
+
+namespace cf {
+
+// Own mm where the projections (own mm `local`, reference s `sref`, in order along the piece) turn:
+// the cut whose two sides each run one way along the reference (correlation of own mm and reference
+// s beyond 0.9 in size, opposite signs) over at least `min_run_mm` of projections; the clearest such
+// cut (largest smaller correlation), NaN when there is none.
+double reversal_cut_mm(const std::vector<double>& local, const std::vector<double>& sref, double min_run_mm);
+
+// The two pieces of `p` before and after own mm `cut_mm` (each with its share of the centre line;
+// from_mm says where it starts in the band's own mm; the labels stay at their ends).
+std::vector<ColonPiece> split_piece(const ColonPiece& p, double cut_mm);
+
+// The piece of band `seg` holding its own mm `c` (the last one starting at or before it, else the
+// first): a band cut where it turns is several pieces of one segment.
+const ColonPiece* piece_at(const std::multimap<int, const ColonPiece*>& by_segment, int seg, double c);
+
+}  // namespace cf
