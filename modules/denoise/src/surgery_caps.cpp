@@ -202,13 +202,6 @@ bool Surgery::try_triangulated_caps() {
       if (gave_up_ || !place_checked(tr)) continue;
       const bool done = collar ? try_collar_caps() : triangulate_both(avoid, &tri_right, &tri_left);
       if (collar && !done) break;  // the first clean placement only: a lift moves the rings far more than a placement
-      // A trial (another loop of the same handle, kept only when clean) gets its restricted
-      // triangulations in its first clean placement only: the placements move a ring by 0.08-0.4
-      // of an edge, which changes a cap's first triangles, not whether the loop's disk clears the
-      // surface further in. On the real CT surface the failing trials (211 and 242 vertices) ran
-      // them in 4-5 placements (10-18 s each, 2 cores shared) and failed in every one; the trials
-      // kept were clean in their first placement.
-      if (avoid && opts_.trial && !done) break;
       if (!done) continue;
       if (!collar) add_triangulated_caps(tri_right, tri_left);
       cap_kind_ = kind;
