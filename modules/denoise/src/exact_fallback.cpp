@@ -93,9 +93,7 @@ void ExactGreedy::revert_cut(const SurgeryResult& sr) {
 std::vector<Mesh::VertexHandle> ExactGreedy::crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit) {
   Stopwatch sw;
   const std::vector<std::uint8_t> cochain = crossing_cochain(st_.mesh, loop);
-  search_->set_cochain(&cochain);
-  const std::vector<Mesh::VertexHandle> found = shortest_from_spread(loop, limit, nullptr);
-  search_->set_cochain(nullptr);
+  const std::vector<Mesh::VertexHandle> found = shortest_from_spread(loop, limit, nullptr, &cochain, nullptr);
   st_.t.search += sw.seconds();
   fallback_s_ += sw.seconds();
   return found;
@@ -118,33 +116,62 @@ std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<M
     span_.reduce(cls.data());
     return cls == reduced;
   };
-  search_->set_cochain(nullptr);
-  search_->set_avoid(&avoid);
   std::vector<Mesh::VertexHandle> sources;
   for (int v : rim) sources.push_back(Mesh::VertexHandle(v));
   const std::vector<Mesh::VertexHandle> found =
-      shortest_from_spread(sources, 3.0 * loop_length(st_.mesh, loop) + 4.0 * tube, &same_class);
-  search_->set_avoid(nullptr);
+      shortest_from_spread(sources, 3.0 * loop_length(st_.mesh, loop) + 4.0 * tube, &same_class, nullptr, &avoid);
   st_.t.search += sw.seconds();
   fallback_s_ += sw.seconds();
   return found;
 }
 
-// The shortest fundamental cycle of value below `limit` (in the search's current mode, approved
-// by `accept` when given) from up to kFallbackSources of `sources`, spread evenly; empty if none.
+// The shortest fundamental cycle of value below `limit` (with `cochain`: crossing it oddly,
+// else of a class outside the span; approved by `accept` when given; never entering `avoid`)
+// from up to kFallbackSources of `sources`, spread evenly; empty if none. The sources are
+// searched kBatchLanes at a time, each to the best value known before its batch, on the
+// worker's threads; the results are then taken in source order, a strictly shorter one
+// replacing the best. A search to a higher limit finds the same shortest cycle through its
+// source when one lies below the lower limit, so the loop found is the one searching the
+// sources one after the other finds, for any thread count.
 std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources,
                                                                   double limit,
-                                                                  const FundamentalCycleSearch::Accept* accept) {
+                                                                  const FundamentalCycleSearch::Accept* accept,
+                                                                  const std::vector<std::uint8_t>* cochain,
+                                                                  const std::vector<std::uint8_t>* avoid) {
+  std::vector<Mesh::VertexHandle> picked;
+  const std::size_t stride = std::max<std::size_t>(1, sources.size() / kFallbackSources);
+  for (std::size_t i = 0; i < sources.size(); i += stride) picked.push_back(sources[i]);
+  const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), kBatchLanes)) : 1;
+  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
+    searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
   double best = limit;
   std::vector<Mesh::VertexHandle> found;
-  const std::size_t stride = std::max<std::size_t>(1, sources.size() / kFallbackSources);
-  for (std::size_t i = 0; i < sources.size(); i += stride) {
-    const CycleCandidate c = search_->run(sources[i], best, accept);
-    ++searches_;
-    settled_ += static_cast<long long>(search_->last_settled());
-    if (c.found && c.value < best) {
-      best = c.value;
-      found = search_->extract(c);
+  for (std::size_t b = 0; b < picked.size(); b += kBatchLanes) {
+    const std::size_t n = std::min(kBatchLanes, picked.size() - b);
+    std::vector<CycleCandidate> result(n);
+    std::vector<std::vector<Mesh::VertexHandle>> cycle(n);
+    std::vector<std::size_t> settled(n);
+    auto lane = [&](int t) {
+      FundamentalCycleSearch& search = t == 0 ? *search_ : *searches_extra_[t - 1];
+      search.set_cochain(cochain);
+      search.set_avoid(avoid);
+      for (std::size_t j = t; j < n; j += lanes) {
+        result[j] = search.run(picked[b + j], best, accept);
+        settled[j] = search.last_settled();
+        if (result[j].found && result[j].value < best) cycle[j] = search.extract(result[j]);
+      }
+      search.set_cochain(nullptr);
+      search.set_avoid(nullptr);
+    };
+    if (lanes > 1) worker_->run(lanes, lane);
+    else lane(0);
+    for (std::size_t j = 0; j < n; ++j) {
+      ++searches_;
+      settled_ += static_cast<long long>(settled[j]);
+      if (result[j].found && result[j].value < best) {
+        best = result[j].value;
+        found = std::move(cycle[j]);
+      }
     }
   }
   return found;

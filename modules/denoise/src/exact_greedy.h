@@ -125,7 +125,9 @@ class ExactGreedy {
                             int iteration, std::vector<std::uint64_t>* cut_class);
   std::vector<Mesh::VertexHandle> crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit);
   std::vector<Mesh::VertexHandle> shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources, double limit,
-                                                       const FundamentalCycleSearch::Accept* accept);
+                                                       const FundamentalCycleSearch::Accept* accept,
+                                                       const std::vector<std::uint8_t>* cochain,
+                                                       const std::vector<std::uint8_t>* avoid);
   SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration,
                              CapAttempt attempt = CapAttempt::kFull);
   void revert_cut(const SurgeryResult& sr);

@@ -26,11 +26,13 @@ FaceGrid::Key FaceGrid::key(const Vec3& p) const {
 namespace {
 void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::array<int, 3>& ids,
               std::array<Vec3, 3>& pts) {
-  int k = 0;
-  for (auto v : mesh.fv_range(f)) {
+  // The face's halfedge cycle read directly (the order of fv_range): this runs for every
+  // candidate face of every grid query, and the circulator's bookkeeping was most of its cost.
+  auto h = mesh.halfedge_handle(f);
+  for (int k = 0; k < 3; ++k, h = mesh.next_halfedge_handle(h)) {
+    const auto v = mesh.to_vertex_handle(h);
     ids[k] = v.idx();
     pts[k] = mesh.point(v);
-    ++k;
   }
   lo = hi = pts[0];
   for (int i = 1; i < 3; ++i)

@@ -153,6 +153,17 @@ TEST(DenoiseThreads, CrossingLoopFallbackIsTheSameForAnyThreadCount) {
   expect_same_result(a, denoise_with_threads(m, 2));
 }
 
+// A handle removed through a loop of the same class away from the blocked meridian (the
+// fallback's searches run two sources at a time on the worker's threads): identical loops and
+// mesh with 1 and 2 threads.
+TEST(DenoiseThreads, SameClassFallbackIsTheSameForAnyThreadCount) {
+  const Mesh m = bench::blocked_torus(bench::Blocker::kRod);
+  const DenoiseResult a = denoise_with_threads(m, 1);
+  EXPECT_EQ(a.report["search"]["loops_replaced_for_clean_caps"], 1);
+  EXPECT_EQ(a.report["genus_after"], 0);
+  expect_same_result(a, denoise_with_threads(m, 2));
+}
+
 // The real GCA large-intestine surfaces (genus 1): one loop, clean caps (whole-mesh CGAL).
 TEST(DenoiseReal, GcaLargeIntestine) {
   for (const char* f : {"gca_large_intestine_20k.vtk", "gca_large_intestine_100k.vtk"}) {
