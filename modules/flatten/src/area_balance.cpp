@@ -195,9 +195,9 @@ constexpr double kMinOutOfBoundsGain = 0.01, kMinAngleGain = 0.001;
 // Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps), until
 // the energy converges or a step no longer lowers measure_region() (kMinOutOfBoundsGain, kMinAngleGain).
 int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3,
-                    double lo, double hi) {
+                    double lo, double hi, const std::vector<int>* vertex_order) {
   RegionSystem sys;
-  if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces))) return 0;
+  if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces), vertex_order)) return 0;
   std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
   for (int f : r.faces)
     if (emb.area2(s, f) > 0) unfolded.push_back(f);
@@ -271,7 +271,7 @@ double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V
 
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                            const std::vector<char>& fixed, const std::vector<char>& degenerate,
-                           const FlattenOptions& o) {
+                           const FlattenOptions& o, const std::vector<int>* vertex_order) {
   BalanceResult res;
   std::vector<double> area3(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
@@ -279,7 +279,7 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
   for (int pass = 0; pass < 2; ++pass) {
     const Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
     if (r.faces.empty()) break;
-    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high));
+    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high, vertex_order));
     res.faces = std::max(res.faces, r.faces.size());
     for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || r.free_vertex[v];
   }

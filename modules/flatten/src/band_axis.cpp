@@ -189,9 +189,9 @@ static std::function<bool()> whole_band_done(const SegmentWork& w, const std::ve
 // Runs one area correction pass (COLONFLAT_FLATTEN_DEBUG: what it did).
 static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                         const std::vector<char>& degenerate, const FlattenOptions& o, bool local, bool grow = false,
-                        const std::function<bool()>& enough = {}) {
+                        const std::function<bool()>& enough = {}, const std::vector<int>* vertex_order = nullptr) {
   const Stopwatch sw;
-  const AreaCorrection corr = correct_area(w.ann, vf, w.emb, fixed, degenerate, local, o, grow, enough);
+  const AreaCorrection corr = correct_area(w.ann, vf, w.emb, fixed, degenerate, local, o, grow, enough, vertex_order);
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
     std::fprintf(stderr, "flatten debug area correction (%s): %zu faces, %d iterations, energy %.6g -> %.6g (%s), %.2f s\n",
                  local ? "local" : "whole band", corr.faces, corr.iterations, corr.energy_before, corr.energy_after,
@@ -237,8 +237,11 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   debug_stats("reparametrised", w, degenerate);
   debug_pockets("reparametrised", w, degenerate);
   CorrectionNeed need = needs_correction(w, degenerate, o);
+  const std::vector<int> order = w.band_order();  // a large band's nested dissection order, for its systems
+  const std::vector<int>* band_order = order.empty() ? nullptr : &order;
   if (need.global) {
-    w.seg.corrected_iterations = correct_pass(w, vf, fixed, degenerate, o, false, false, whole_band_done(w, degenerate, o));
+    w.seg.corrected_iterations =
+        correct_pass(w, vf, fixed, degenerate, o, false, false, whole_band_done(w, degenerate, o), band_order);
     need.local = needs_correction(w, degenerate, o).local;
   }
   for (bool grow : {false, true}) {  // pockets; then, grown until they have room, those left
@@ -247,7 +250,7 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
     need.local = !grow && needs_correction(w, degenerate, o).local;
   }
   const Stopwatch sw;
-  const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o);
+  const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug balance: %zu faces, %zu iterations, %.2f s\n", bal.faces, bal.iterations,

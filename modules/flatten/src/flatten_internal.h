@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -115,6 +116,15 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
 // A fill-reducing elimination order (AMD) of the vertices of the edge graph E (nv vertices); its
 // restriction to part of the surface is one for that part (the annulus once the ends are opened).
 std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
+// Nested dissection's (METIS) order of the same graph (E.ev read): about half the factorisation's
+// operations of AMD's on a colon band, for about 5 x its ordering time (SpdSolver).
+std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv);
+// A colon segment from this many vertices on has its nested dissection order computed beside its
+// first conformal map, for the systems solved after it on the whole band (the re-solve after
+// cutting side branches, the whole-band area correction, the balancing). Below it the ordering
+// (~5 x AMD's time) costs about what it saves: on a 94 k-vertex side branch 4e8 flops saved (~0.3
+// s) for ~0.8 s of ordering (session 12).
+constexpr std::size_t kNestedDissectionMinVertices = 200000;
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.
@@ -172,8 +182,10 @@ class RegionSystem {
  public:
   // `free_vertex[v]` true for unknowns; `faces`: faces with at least one free vertex; `w`: per face
   // of `faces`, the weight of the edge opposite each corner (> 0).
+  // `vertex_order` (optional): a fill-reducing order of the surface's vertices, restricted to the
+  // unknowns (else AMD's on the system).
   bool build(const Surface& s, const std::vector<char>& free_vertex, const std::vector<int>& faces,
-             const std::vector<std::array<double, 3>>& w);
+             const std::vector<std::array<double, 3>>& w, const std::vector<int>* vertex_order = nullptr);
   // New positions of the free vertices for targets t (per face of `faces`, per corner k: the
   // target of c_{k+1} - c_{k+2}); returns them as a full-size copy of emb.pos.
   std::vector<V2> solve(const Surface& s, const Embedding& emb, const std::vector<std::array<V2, 3>>& t) const;
@@ -221,9 +233,10 @@ void label_ends(std::vector<FlatSegment>& segs, double midline_x, std::vector<ch
 struct BalanceResult {
   std::size_t vertices = 0, faces = 0, iterations = 0;
 };
+// `vertex_order` (optional): a fill-reducing order of the band's vertices for the regions' systems.
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                            const std::vector<char>& fixed, const std::vector<char>& degenerate,
-                           const FlattenOptions& o);
+                           const FlattenOptions& o, const std::vector<int>* vertex_order = nullptr);
 
 // Largest t in [0, 1] such that moving the vertices along pos + t (next - pos) keeps every face of
 // `faces` that is positive now above min(half its area, floor_ratio x its 3D area `area3[f]`).
@@ -256,9 +269,12 @@ struct AreaCorrection {
 // `grow` (local): a piece whose region has no room (2D area < 0.6 x 3D) grows by 12 rings more, up
 // to 3 times (the second local pass, for pockets the first one could not open).
 // `enough` (whole band only, optional): asked after each step; true ends the pass (its goal met).
+// `vertex_order` (whole band only, optional): a fill-reducing order of the band's vertices for its
+// system (else AMD's).
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
-                            const FlattenOptions& o, bool grow = false, const std::function<bool()>& enough = {});
+                            const FlattenOptions& o, bool grow = false, const std::function<bool()>& enough = {},
+                            const std::vector<int>* vertex_order = nullptr);
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
@@ -306,6 +322,18 @@ struct SegmentWork {
   bool branch = false;        // a side branch's band (flattened from its neck)
   bool folds_pending = false; // the map's folds are not untangled yet (a colon map that may be re-solved)
   PriorSolve prior;           // the last conformal solve's order and factor, for the next one
+  // A large segment's nested dissection order (vertices of its closed surface; invalid: none) and
+  // each of those vertices' id on the annulus now (-1: removed with a cap or a side branch).
+  std::shared_future<std::vector<int>> dissection;
+  std::vector<int> dissection_to_annulus;
+  // The nested dissection order restricted to the annulus now (empty: none).
+  std::vector<int> band_order() const {
+    std::vector<int> order;
+    if (!dissection.valid()) return order;
+    for (int v : dissection.get())
+      if (dissection_to_annulus[std::size_t(v)] >= 0) order.push_back(dissection_to_annulus[std::size_t(v)]);
+    return order;
+  }
 };
 
 // Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.

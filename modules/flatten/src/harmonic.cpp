@@ -5,10 +5,13 @@
 #include <Eigen/SparseCore>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <queue>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 #include "conformal_factor.h"
@@ -240,8 +243,12 @@ UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::
   const std::vector<int> by_vertex =
       vertex_order ? *vertex_order : vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
   const std::vector<int> order = loops_last(by_vertex, vs.unknown_of, mark, f->leading);
+  const Stopwatch sw;
   f->solver.analyze(vs.A, &order);
   if (!f->solver.factorize(vs.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug conformal factorisation: %ld unknowns, %.3g flops, %.2f s\n", long(vs.A.rows()),
+                 f->solver.factor_flops(), sw.seconds());
   UvSolution sol;
   solve_with(*f, E, w, eta, mark, vs.unknown_of, sol);
   sol.vertex_order = vertex_order_of(order, vs.unknown_of);
@@ -304,10 +311,23 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   return h;
 }
 
-std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
+namespace {
+
+// The graph Laplacian (unit weights) of all nv vertices: the pattern the orders are computed on.
+SpMat unit_laplacian(const Edges& E, int nv) {
   std::vector<int> identity(nv);
   for (int v = 0; v < nv; ++v) identity[v] = v;
-  return SpdSolver::fill_reducing_order(laplacian_lower(E, std::vector<double>(E.ev.size(), 1.0), identity, nv));
+  return laplacian_lower(E, std::vector<double>(E.ev.size(), 1.0), identity, nv);
+}
+
+}  // namespace
+
+std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
+  return SpdSolver::fill_reducing_order(unit_laplacian(E, nv));
+}
+
+std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv) {
+  return SpdSolver::nested_dissection_order(unit_laplacian(E, nv));
 }
 
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {

@@ -16,7 +16,7 @@ struct RegionSystem::Impl {
 };
 
 bool RegionSystem::build(const Surface& s, const std::vector<char>& free_vertex, const std::vector<int>& faces,
-                         const std::vector<std::array<double, 3>>& w) {
+                         const std::vector<std::array<double, 3>>& w, const std::vector<int>* vertex_order) {
   faces_ = faces;
   w_ = w;
   index_.assign(s.p.size(), -1);
@@ -47,7 +47,12 @@ bool RegionSystem::build(const Surface& s, const std::vector<char>& free_vertex,
   trip = {};
   impl_ = std::make_shared<Impl>();
   if (n == 0) return true;
-  return impl_->solver.compute(A);
+  if (!vertex_order) return impl_->solver.compute(A);
+  std::vector<int> order;  // the given order restricted to the unknowns
+  order.reserve(vars_.size());
+  for (int v : *vertex_order)
+    if (index_[std::size_t(v)] >= 0) order.push_back(index_[std::size_t(v)]);
+  return impl_->solver.compute(A, order.size() == vars_.size() ? &order : nullptr);
 }
 
 std::vector<V2> RegionSystem::solve(const Surface& s, const Embedding& emb,

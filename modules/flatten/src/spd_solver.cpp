@@ -132,17 +132,30 @@ Eigen::MatrixXd take_dense(cholmod_dense*& x, cholmod_common& common) {
   return out;
 }
 
-}  // namespace
-
-std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
+// CHOLMOD's AMD (`nested` false) or METIS nested dissection order of A; empty when it fails.
+std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
   use_huge_pages_for_cholmod();
   cholmod_common common;
   cholmod_start(&common);
+  common.print = 0;
   cholmod_sparse view = view_lower(A);
   std::vector<int> order(std::size_t(A.rows()));
-  const bool ok = cholmod_amd(&view, nullptr, 0, order.data(), &common);
+  const bool ok = nested ? cholmod_metis(&view, nullptr, 0, 1, order.data(), &common)
+                         : cholmod_amd(&view, nullptr, 0, order.data(), &common);
   cholmod_finish(&common);
-  return ok ? order : Fallback::eigen_amd(A);
+  return ok ? order : std::vector<int>();
+}
+
+}  // namespace
+
+std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
+  std::vector<int> order = cholmod_order(A, false);
+  return order.empty() ? Fallback::eigen_amd(A) : order;
+}
+
+std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) {
+  std::vector<int> order = cholmod_order(A, true);
+  return order.empty() ? fill_reducing_order(A) : order;
 }
 
 void SpdSolver::release() {
@@ -288,6 +301,8 @@ std::vector<int> SpdSolver::order() const {
 #else  // Eigen only: the order is Eigen's AMD unless one is given
 
 std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) { return Fallback::eigen_amd(A); }
+
+std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) { return Fallback::eigen_amd(A); }
 
 void SpdSolver::release() {}
 
