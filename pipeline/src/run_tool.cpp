@@ -14,6 +14,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/stage_runner.h"
 #include "colonflat/pipeline/registry.h"
+#include "artifact_parking.h"
 #include "run_plan.h"
 
 namespace fs = std::filesystem;
@@ -182,6 +183,8 @@ class RunTool : public Tool {
     // Each stage's files are written on a second thread while the next stage runs (the
     // artifacts stay in the bag unchanged); all are written before the finishers, which may take them.
     BackgroundOutputWriter writer;
+    ParkedArtifacts parked;  // e.g. the CT in 16 bits from reconstruct to the review report
+    nlohmann::json parked_log = nlohmann::json::array();
     for (std::size_t i = 0; i < plan.stages.size(); ++i) {
       Stage& st = *plan.stages[i];
       if (log) *log << "[" << (i + 1) << "/" << plan.stages.size() << "] " << st.spec().name << ": " << st.spec().summary << "\n";
@@ -193,6 +196,7 @@ class RunTool : public Tool {
       PendingOutputs outputs = stage_outputs(st, bag, targets, tx);
       record["outputs"] = outputs.files;
       writer.submit(std::move(outputs));
+      parked.park_unread(plan, i, bag, parked_log);
       if (!o.debug_dir.empty()) write_debug(st, bag, record, fs::path(o.debug_dir) / (std::to_string(plan.first_index + i + 1) + "_" + st.spec().name), tx);
       all_params[st.spec().name] = st.params_json();
       if (log) *log << "    done in " << std::fixed << std::setprecision(2) << record["time_s"].get<double>()
@@ -200,6 +204,8 @@ class RunTool : public Tool {
       report["stages"].push_back(record);
     }
     writer.wait();
+    parked.restore(bag);
+    if (!parked_log.empty()) report["held_compact"] = parked_log;
     return all_params;
   }
 

@@ -100,8 +100,7 @@ void write_loops_to(const LoopSet& loops, const fs::path& file, const fs::path& 
   vtkNew<vtkXMLPolyDataWriter> w;
   w->SetFileName(file.c_str());
   w->SetInputData(pd);
-  w->SetDataModeToAppended();
-  w->SetCompressorTypeToZLib();
+  use_fast_compression(w);
   if (!w->Write() || !capture.errors().empty())
     throw Error(target.string() + ": cannot write loops: " + capture.write_problem(w, file.string()));
 }

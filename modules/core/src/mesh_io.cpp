@@ -282,8 +282,7 @@ void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) 
         writer = w.GetPointer();
         w->SetFileName(tmp.c_str());
         w->SetInputData(pd);
-        w->SetDataModeToAppended();
-        w->SetCompressorTypeToZLib();
+        use_fast_compression(w);
         ok = w->Write();
       } else {
         vtkNew<vtkPolyDataWriter> w;

@@ -7,6 +7,7 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
+#include <vtkXMLWriter.h>
 
 namespace cf {
 
@@ -74,6 +75,12 @@ void tag_polydata_space(vtkPolyData* pd, const std::string& units, const std::st
   };
   set("Units", units);
   set("CoordinateSystem", space);
+}
+
+void use_fast_compression(vtkXMLWriter* writer) {
+  writer->SetDataModeToAppended();
+  writer->SetCompressorTypeToZLib();
+  writer->SetCompressionLevel(1);
 }
 
 }  // namespace cf

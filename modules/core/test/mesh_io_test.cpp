@@ -7,6 +7,8 @@
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
+#include <vtkXMLPolyDataWriter.h>
+#include <vtkZLibDataCompressor.h>
 
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
+#include "colonflat/core/vtk_convert.h"
 #include "colonflat/testing/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -83,6 +86,23 @@ TEST_F(MeshIo, VtpRecordsUnitsAndSpace) {
   ASSERT_NE(space, nullptr);
   EXPECT_EQ(units->GetValue(0), "mm");
   EXPECT_EQ(space->GetValue(0), "LPS");
+}
+
+// Every .vtp is appended binary, deflated at zlib level 1 (use_fast_compression), and a written
+// mesh file says so in its header.
+TEST_F(MeshIo, VtpIsAppendedZlibLevelOne) {
+  vtkNew<vtkXMLPolyDataWriter> w;
+  use_fast_compression(w);
+  EXPECT_EQ(w->GetDataMode(), vtkXMLWriter::Appended);
+  EXPECT_NE(vtkZLibDataCompressor::SafeDownCast(w->GetCompressor()), nullptr);
+  EXPECT_EQ(w->GetCompressionLevel(), 1);
+  EXPECT_EQ(w->GetCompressor()->GetCompressionLevel(), 1);
+  write_mesh(synthetic::to_mesh(synthetic::sphere(1, 8, 4)), file("s.vtp"));
+  std::ifstream in(file("s.vtp"));
+  std::string header;
+  while (std::getline(in, header) && header.find("<VTKFile") == std::string::npos) {
+  }
+  EXPECT_NE(header.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos) << header;
 }
 
 // A missing file is an InputError that names the file.

@@ -200,9 +200,7 @@ void write_flat(const FlatMap& flat, const std::filesystem::path& path) {
     vtkNew<vtkXMLPolyDataWriter> w;
     w->SetFileName(tmp.c_str());
     w->SetInputData(pd);
-    w->SetDataModeToAppended();
-    w->SetCompressorTypeToZLib();
-    w->SetCompressionLevel(1);  // the fastest deflate: level 5 (VTK's default) took 3 s on a 1.4 M-face map
+    use_fast_compression(w);
     if (!w->Write() || !msgs.first_problem().empty())
       throw Error(path.string() + ": cannot write flat map: " + msgs.write_problem(w, tmp.string()));
   });

@@ -170,7 +170,13 @@ const ArtifactType& volume_artifact() {
       [](const std::any& v, const fs::path& tmp, const fs::path& target) {
         write_ct_file(std::any_cast<const CtImage::Pointer&>(v).GetPointer(), tmp, target);
       },
-      {".nrrd", ".nii", ".nii.gz", ".mha"}};
+      {".nrrd", ".nii", ".nii.gz", ".mha"},
+      [](const std::any& v) -> std::optional<std::any> {
+        CompactCtImage::Pointer c = compact_ct(*std::any_cast<const CtImage::Pointer&>(v));
+        if (!c) return std::nullopt;
+        return std::any(c);
+      },
+      [](const std::any& v) { return std::any(expand_ct(*std::any_cast<const CompactCtImage::Pointer&>(v))); }};
   return t;
 }
 

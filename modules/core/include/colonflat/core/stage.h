@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -32,6 +33,12 @@ struct ArtifactType {
   // Output extensions the writer knows (lower case with the dot, e.g. ".vtp", ".nii.gz"); empty =
   // not declared (then the writer itself refuses an unknown one, after the work).
   std::vector<std::string> extensions = {};
+  // Optional, for `colonflat run`: a smaller stand-in of a value that no later stage reads (kept
+  // while the other stages run, so their peak memory is lower), or nothing when the value cannot
+  // be held smaller without loss; and the value back from its stand-in, equal to the original
+  // (voxel for voxel, same geometry and header). Both empty: never compacted.
+  std::function<std::optional<std::any>(const std::any&)> compact = {};
+  std::function<std::any(const std::any&)> expand = {};
 };
 
 struct Port {

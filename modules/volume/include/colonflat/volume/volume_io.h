@@ -100,7 +100,17 @@ bool try_volume_info(const std::string& path, bool json, std::ostream& out);
 // The same with a DICOM series chosen by UID (for `colonflat info DIR --series UID`).
 bool try_volume_info(const std::string& path, bool json, std::ostream& out, const std::string& series_uid);
 
-// Pipeline artifacts: "volume" (std::any holding CtImage::Pointer) and "mask" (MaskImage::Pointer).
+// A CT held in 16 bits: HU of CT scanners are integers in [-32768, 32767] (DICOM and NRRD store
+// them as 16-bit integers), so a CtImage (float) whose voxels all are such integers is held
+// exactly in half the memory. compact_ct: that image (geometry and header dictionary kept), or
+// null when a voxel is not such an integer (e.g. a resampled or filtered CT). expand_ct: the float
+// image back, equal voxel for voxel, with the same geometry and dictionary.
+using CompactCtImage = itk::Image<short, 3>;
+CompactCtImage::Pointer compact_ct(const CtImage& ct);
+CtImage::Pointer expand_ct(const CompactCtImage& compact);
+
+// Pipeline artifacts: "volume" (std::any holding CtImage::Pointer; compactable to a
+// CompactCtImage::Pointer by compact_ct) and "mask" (MaskImage::Pointer).
 const ArtifactType& volume_artifact();
 const ArtifactType& mask_artifact();
 

@@ -1,0 +1,84 @@
+// compact_ct / expand_ct: a CT of 16-bit integer HU is held in 16 bits and comes back voxel for
+// voxel with its geometry and header; any other CT is not compacted.
+#include <gtest/gtest.h>
+
+#include <itkMetaDataObject.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "colonflat/volume/volume_io.h"
+
+namespace cf {
+namespace {
+
+// 6 x 5 x 4 voxels, oblique (30 degrees about z), HU spanning the whole 16-bit range, and a
+// PatientPosition in the header dictionary.
+CtImage::Pointer small_ct() {
+  auto im = CtImage::New();
+  im->SetRegions(CtImage::SizeType{{6, 5, 4}});
+  const double sp[3] = {0.7, 0.8, 1.25}, org[3] = {-100.5, 20.25, -300};
+  im->SetSpacing(sp);
+  im->SetOrigin(org);
+  CtImage::DirectionType dir;
+  dir.SetIdentity();
+  dir[0][0] = dir[1][1] = std::sqrt(3.0) / 2;
+  dir[0][1] = -0.5;
+  dir[1][0] = 0.5;
+  im->SetDirection(dir);
+  im->Allocate();
+  const std::size_t n = im->GetLargestPossibleRegion().GetNumberOfPixels();
+  for (std::size_t i = 0; i < n; ++i) im->GetBufferPointer()[i] = float(int(i * 997 % 4096) - 1024);
+  im->GetBufferPointer()[0] = -32768.0f;
+  im->GetBufferPointer()[1] = 32767.0f;
+  itk::EncapsulateMetaData<std::string>(im->GetMetaDataDictionary(), "PatientPosition", "HFP");
+  return im;
+}
+
+std::string patient_position(const itk::ImageBase<3>& im) {
+  std::string v;
+  itk::ExposeMetaData<std::string>(im.GetMetaDataDictionary(), "PatientPosition", v);
+  return v;
+}
+
+// Integer HU over the whole 16-bit range: held as short, expanded back equal voxel for voxel with
+// the same grid and header.
+TEST(CompactCt, IntegerHuComeBackExactly) {
+  const CtImage::Pointer ct = small_ct();
+  const CompactCtImage::Pointer c = compact_ct(*ct);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->GetBufferPointer()[0], -32768);
+  EXPECT_EQ(patient_position(*c), "HFP");
+  const CtImage::Pointer back = expand_ct(*c);
+  ASSERT_EQ(back->GetLargestPossibleRegion(), ct->GetLargestPossibleRegion());
+  EXPECT_EQ(back->GetSpacing(), ct->GetSpacing());
+  EXPECT_EQ(back->GetOrigin(), ct->GetOrigin());
+  EXPECT_EQ(back->GetDirection(), ct->GetDirection());
+  EXPECT_EQ(patient_position(*back), "HFP");
+  const std::size_t n = ct->GetLargestPossibleRegion().GetNumberOfPixels();
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(back->GetBufferPointer()[i], ct->GetBufferPointer()[i]) << i;
+}
+
+// One voxel that is not a 16-bit integer (a fraction, out of range, NaN) keeps the CT in float.
+TEST(CompactCt, AnyOtherValueIsNotCompacted) {
+  for (float bad : {0.5f, 32768.0f, -32769.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    CtImage::Pointer ct = small_ct();
+    ct->GetBufferPointer()[37] = bad;
+    EXPECT_FALSE(compact_ct(*ct)) << bad;
+  }
+}
+
+// The volume artifact's hooks use them: its stand-in is the 16-bit image, and expand gives the CT.
+TEST(CompactCt, VolumeArtifactCompactsAndExpands) {
+  const CtImage::Pointer ct = small_ct();
+  const std::optional<std::any> stand_in = volume_artifact().compact(std::any(ct));
+  ASSERT_TRUE(stand_in);
+  ASSERT_NE(std::any_cast<CompactCtImage::Pointer>(&*stand_in), nullptr);
+  const auto back = std::any_cast<CtImage::Pointer>(volume_artifact().expand(*stand_in));
+  EXPECT_EQ(back->GetBufferPointer()[1], 32767.0f);
+  EXPECT_FALSE(mask_artifact().compact);
+}
+
+}  // namespace
+}  // namespace cf

@@ -1,0 +1,29 @@
+#pragma once
+// `colonflat run` holds an artifact that no later stage reads in its type's smaller stand-in
+// (ArtifactType::compact, e.g. the CT in 16 bits once reconstruct has read it), so the stages in
+// between run with less memory, and puts it back before the finishers (the review report) read it.
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/stage.h"
+#include "run_plan.h"
+
+namespace cf {
+
+class ParkedArtifacts {
+ public:
+  // After plan.stages[done] ran: every artifact in `bag` with a compactable type that none of
+  // the stages after it reads and none of the plan's stages writes (an output may still be on the
+  // background writer) is replaced by its stand-in; each one parked is appended to `log`
+  // ({"artifact", "after_stage", "time_s"}).
+  void park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log);
+  // Every parked artifact back in `bag`, equal to what was parked.
+  void restore(ArtifactBag& bag);
+
+ private:
+  std::map<std::string, const ArtifactType*> parked_;  // name -> its type (whose expand restores it)
+};
+
+}  // namespace cf

@@ -1,0 +1,50 @@
+// `colonflat run` holds the CT in 16 bits from reconstruct to the review report
+// (artifact_parking.h): the run report says so, and the report built from the run's memory (the
+// CT expanded back) equals, file for file, the one `colonflat report` builds from the CT on disk.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "colonflat/core/stage.h"
+#include "colonflat/pipeline/registry.h"
+#include "colonflat/testing/command.h"
+#include "colonflat/testing/files.h"
+#include "colonflat/testing/temp_dir.h"
+
+namespace fs = std::filesystem;
+
+namespace cf {
+namespace {
+
+// The CT is parked after reconstruct (the last stage that reads it) and the review page and every
+// image of report_files/ made from the restored CT are byte-identical to those made from the file.
+TEST(ArtifactParking, CtHeldCompactAndRestoredExactlyForTheReport) {
+  for (const char* s : {"segment", "reconstruct", "denoise", "flatten", "render"})
+    if (!find_stage(s)) GTEST_SKIP() << "this build has no " << s << " stage";
+  testing::TempDir dir;
+  auto ph = testing::run_colonflat({"phantom", "--size", "small", "--seed", "2", "-o", dir.str("ph"), "-q"});
+  ASSERT_EQ(ph.code, 0) << ph.err;
+  auto run = testing::run_colonflat({"run", dir.str("ph/ct.nrrd"), "-o", dir.str("out"), "-q", "--set",
+                                     "render.snapshots=false"});
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = read_json_file(dir / "out" / "run_report.json");
+  ASSERT_TRUE(report.contains("held_compact")) << report.dump(1).substr(0, 2000);
+  ASSERT_EQ(report["held_compact"].size(), 1u);
+  EXPECT_EQ(report["held_compact"][0]["artifact"], "ct");
+  EXPECT_EQ(report["held_compact"][0]["after_stage"], "reconstruct");
+  fs::copy(dir / "out" / "report_files", dir / "from_memory", fs::copy_options::recursive);
+  const std::string page = testing::slurp(dir / "out" / "report.html");
+  auto again = testing::run_colonflat({"report", dir.str("out"), "-q"});
+  ASSERT_EQ(again.code, 0) << again.err;
+  std::size_t images = 0;
+  for (const auto& e : fs::directory_iterator(dir / "from_memory")) {
+    if (e.path().extension() != ".png") continue;
+    ++images;
+    EXPECT_EQ(testing::slurp(e.path()), testing::slurp(dir / "out" / "report_files" / e.path().filename()))
+        << e.path().filename();
+  }
+  EXPECT_GT(images, 10u);  // CT planes and segmentation montages at least
+}
+
+}  // namespace
+}  // namespace cf
