@@ -46,9 +46,4 @@ void ParkedArtifacts::park_unread(const RunPlan& plan, std::size_t done, Artifac
   }
 }
 
-void ParkedArtifacts::restore(ArtifactBag& bag) {
-  for (const auto& [name, type] : parked_) bag.put(name, type->expand(bag.raw(name)));
-  parked_.clear();
-}
-
 }  // namespace cf

@@ -1,7 +1,9 @@
 #pragma once
 // `colonflat run` holds an artifact that no later stage reads in its type's smaller stand-in
-// (ArtifactType::compact, e.g. the CT in 16 bits once reconstruct has read it), so the stages in
-// between run with less memory, and puts it back before the finishers (the review report) read it.
+// (ArtifactType::compact, e.g. the CT in 16 bits once reconstruct has read it), so the stages after
+// it run with less memory. It stays so through the finishers: a finisher that reads it expands it
+// (ArtifactType::expand) when it needs it, the review report after freeing the meshes, so that the
+// full-size value never meets the meshes in memory.
 #include <map>
 #include <string>
 
@@ -19,11 +21,9 @@ class ParkedArtifacts {
   // background writer) is replaced by its stand-in; each one parked is appended to `log`
   // ({"artifact", "after_stage", "time_s"}).
   void park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log);
-  // Every parked artifact back in `bag`, equal to what was parked.
-  void restore(ArtifactBag& bag);
 
  private:
-  std::map<std::string, const ArtifactType*> parked_;  // name -> its type (whose expand restores it)
+  std::map<std::string, const ArtifactType*> parked_;  // name -> its type
 };
 
 }  // namespace cf

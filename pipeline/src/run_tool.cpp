@@ -204,7 +204,6 @@ class RunTool : public Tool {
       report["stages"].push_back(record);
     }
     writer.wait();
-    parked.restore(bag);
     if (!parked_log.empty()) report["held_compact"] = parked_log;
     return all_params;
   }
