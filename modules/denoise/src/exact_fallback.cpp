@@ -141,9 +141,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vec
   std::vector<Mesh::VertexHandle> picked;
   const std::size_t stride = std::max<std::size_t>(1, sources.size() / kFallbackSources);
   for (std::size_t i = 0; i < sources.size(); i += stride) picked.push_back(sources[i]);
-  const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), kBatchLanes)) : 1;
-  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
-    searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
+  const int lanes = search_lanes(kBatchLanes);
   double best = limit;
   std::vector<Mesh::VertexHandle> found;
   for (std::size_t b = 0; b < picked.size(); b += kBatchLanes) {
@@ -152,7 +150,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vec
     std::vector<std::vector<Mesh::VertexHandle>> cycle(n);
     std::vector<std::size_t> settled(n);
     auto lane = [&](int t) {
-      FundamentalCycleSearch& search = t == 0 ? *search_ : *searches_extra_[t - 1];
+      FundamentalCycleSearch& search = lane_search(t);
       search.set_cochain(cochain);
       search.set_avoid(avoid);
       for (std::size_t j = t; j < n; j += lanes) {

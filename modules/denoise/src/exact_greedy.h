@@ -105,6 +105,10 @@ class ExactGreedy {
   std::size_t batch_size() const;
   void run_group(GroupRun& g, FundamentalCycleSearch& search) const;
   void run_groups(std::vector<GroupRun>& runs);
+  // Threads for `tasks` independent searches: min(worker threads, tasks), 1 without a worker;
+  // makes the search objects lanes 1.. use. lane_search(t): lane t's (lane 0: search_).
+  int search_lanes(std::size_t tasks);
+  FundamentalCycleSearch& lane_search(int t) { return t == 0 ? *search_ : *searches_extra_[std::size_t(t) - 1]; }
   void finish_group(const GroupRun& g, double best);
   int next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken);
   bool near_group(int seed, const GroupRun& g) const;

@@ -162,18 +162,22 @@ void ExactGreedy::run_group(GroupRun& g, FundamentalCycleSearch& search) const {
 // threads, thread t searches runs t, t + T, ... with its own search object. A run's result does
 // not depend on the search object or thread that computes it.
 void ExactGreedy::run_groups(std::vector<GroupRun>& runs) {
-  const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), runs.size())) : 1;
+  const int lanes = search_lanes(runs.size());
   if (lanes == 1) {
     for (GroupRun& g : runs) run_group(g, *search_);
     return;
   }
-  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
-    searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
   parallel_pairs_ += static_cast<long long>(runs.size() / 2);
   worker_->run(lanes, [&](int t) {
-    FundamentalCycleSearch& search = t == 0 ? *search_ : *searches_extra_[t - 1];
-    for (std::size_t i = t; i < runs.size(); i += lanes) run_group(runs[i], search);
+    for (std::size_t i = t; i < runs.size(); i += lanes) run_group(runs[i], lane_search(t));
   });
+}
+
+int ExactGreedy::search_lanes(std::size_t tasks) {
+  const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), tasks)) : 1;
+  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
+    searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
+  return lanes;
 }
 
 // Bounds after a group search of value `own`: F >= own for every member, F >= own - 2d for
