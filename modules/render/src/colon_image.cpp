@@ -39,8 +39,14 @@ double choose_roll(const FlatSegment& s, const std::vector<ImageMarker>& markers
 
 }  // namespace
 
+std::mutex& freetype_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int font_size, const double color[3],
                double bg_opacity) {
+  const std::lock_guard<std::mutex> lock(freetype_mutex());
   vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
   if (!tr) throw Error("no FreeType text renderer in this VTK build");
   vtkNew<vtkTextProperty> tp;

@@ -1,5 +1,7 @@
 #include "colonflat/render/snapshot.h"
 
+#include "colonflat/render/colon_image.h"
+
 #include <vtkAutoInit.h>
 VTK_MODULE_INIT(vtkRenderingOpenGL2);
 VTK_MODULE_INIT(vtkRenderingFreeType);
@@ -280,12 +282,15 @@ void SnapshotScene::place_camera() {
 }
 
 ImagePtr SnapshotScene::grab() {
+  // The caption's text actor renders with FreeType, in Render() and again in the grabber's render.
+  std::unique_lock<std::mutex> text(freetype_mutex());
   window_->Render();
   vtkNew<vtkWindowToImageFilter> grabber;
   grabber->SetInput(window_);
   grabber->SetInputBufferTypeToRGB();
   grabber->ReadFrontBufferOff();
   grabber->Update();
+  text.unlock();
   if (!messages_.errors().empty()) throw Error("off-screen rendering failed: " + messages_.errors().front());
   ImagePtr img = ImagePtr::New();
   img->DeepCopy(grabber->GetOutput());

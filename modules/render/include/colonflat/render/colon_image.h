@@ -9,6 +9,7 @@
 // end, hatching where the wall is strongly compressed (blue) or missing from the map (red), and
 // a scale bar in mm (valid at the mean, area-preserving scale). Each band is rolled around the colon so that
 // its cut runs as far as possible from every marker.
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -67,7 +68,14 @@ ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, 
 ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& shape_index,
                               std::vector<ImageMarker>& markers, const ColonImageOptions& opts);
 
-// Draws `text` into an RGB image at column x, row-from-top y (top-left corner), with FreeType.
+// VTK's FreeType text rendering (vtkTextRenderer, vtkFreeTypeTools and its font cache) is one
+// process-wide instance and not thread-safe; the snapshot before denoising is rendered on a second
+// thread while the colon image draws its labels. draw_text and a snapshot's render (its caption is
+// a text actor) hold this lock while they use it.
+std::mutex& freetype_mutex();
+
+// Draws `text` into an RGB image at column x, row-from-top y (top-left corner), with FreeType
+// (under freetype_mutex()).
 void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_from_top, int font_size,
                const double color[3], double background_opacity = 0.0);
 
