@@ -193,6 +193,7 @@ class RunTool : public Tool {
       nlohmann::json record = run_stage_recorded(st, bag, ctx);
       std::map<std::string, fs::path> targets;
       for (const Port& p : st.spec().outputs) targets[p.name] = outdir / p.file_name;
+      for (auto& tool : plan.finishers) as_finisher(*tool).stage_done(st.spec().name, bag, record);
       PendingOutputs outputs = stage_outputs(st, bag, targets, tx);
       record["outputs"] = outputs.files;
       writer.submit(std::move(outputs));

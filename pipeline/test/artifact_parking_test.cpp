@@ -16,8 +16,9 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-// The CT is parked after reconstruct (the last stage that reads it) and the review page and every
-// image of report_files/ made from the restored CT are byte-identical to those made from the file.
+// The CT is parked after reconstruct (the last stage that reads it), the Segmentation montages are
+// drawn beside the stages, and every image of report_files/ made from the run's memory is
+// byte-identical to those `colonflat report` makes from the files.
 TEST(ArtifactParking, CtHeldCompactAndRestoredExactlyForTheReport) {
   for (const char* s : {"segment", "reconstruct", "denoise", "flatten", "render"})
     if (!find_stage(s)) GTEST_SKIP() << "this build has no " << s << " stage";
@@ -32,18 +33,25 @@ TEST(ArtifactParking, CtHeldCompactAndRestoredExactlyForTheReport) {
   ASSERT_EQ(report["held_compact"].size(), 1u);
   EXPECT_EQ(report["held_compact"][0]["artifact"], "ct");
   EXPECT_EQ(report["held_compact"][0]["after_stage"], "reconstruct");
+  bool drawn_beside = false;
+  for (const auto& finisher : report["after_stages"])
+    for (const auto& phase : finisher.value("phases", nlohmann::json::array()))
+      drawn_beside = drawn_beside || phase.value("phase", "").find("drawn beside the stages") != std::string::npos;
+  EXPECT_TRUE(drawn_beside) << report["after_stages"].dump(1);
   fs::copy(dir / "out" / "report_files", dir / "from_memory", fs::copy_options::recursive);
   const std::string page = testing::slurp(dir / "out" / "report.html");
   auto again = testing::run_colonflat({"report", dir.str("out"), "-q"});
   ASSERT_EQ(again.code, 0) << again.err;
-  std::size_t images = 0;
+  std::size_t images = 0, montages = 0;
   for (const auto& e : fs::directory_iterator(dir / "from_memory")) {
     if (e.path().extension() != ".png") continue;
     ++images;
+    montages += e.path().filename().string().rfind("seg_", 0) == 0;
     EXPECT_EQ(testing::slurp(e.path()), testing::slurp(dir / "out" / "report_files" / e.path().filename()))
         << e.path().filename();
   }
   EXPECT_GT(images, 10u);  // CT planes and segmentation montages at least
+  EXPECT_GE(montages, 12u);  // at least 4 slices in each of the 3 planes
 }
 
 }  // namespace

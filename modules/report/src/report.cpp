@@ -87,7 +87,7 @@ struct Builder {
   }
 
   // The Segmentation section: montages with the lumen and the bodies segment rejected.
-  void add_segmentation() {
+  void add_segmentation(const SegmentationQcDrawing* drawn) {
     if (!run.ct || !run.lumen) {
       data["segmentation"] = {{"missing", run.volume_is_mask ? "the run started from a lumen mask (no segmentation)"
                                                              : "no CT or no lumen_mask.nrrd in the run folder"}};
@@ -96,8 +96,9 @@ struct Builder {
     nlohmann::json seg = nlohmann::json::object();
     for (const auto& s : run.run_report.value("stages", nlohmann::json::array()))
       if (s.value("stage", "") == "segment") seg = s.value("result", nlohmann::json::object());
-    data["segmentation"] = write_segmentation_qc(run.ct.GetPointer(), run.lumen.GetPointer(), seg, files_dir,
-                                                 "report_files/", &result.images);
+    data["segmentation"] = drawn ? write_segmentation_qc(*drawn, files_dir, "report_files/", &result.images)
+                                 : write_segmentation_qc(run.ct.GetPointer(), run.lumen.GetPointer(), seg, files_dir,
+                                                         "report_files/", &result.images);
   }
 
   void add_findings() {
@@ -197,7 +198,7 @@ nlohmann::json report_page_data(const fs::path& html) {
 }
 
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
-                                 std::ostream* log) {
+                                 std::ostream* log, const SegmentationQcDrawing* segmentation) {
   Stopwatch clock;
   ProgressScope scope(log, "report");
   const fs::path dir = run.dir;
@@ -213,8 +214,9 @@ ReportResult build_review_report(const RunData& run, const ReportOptions& opts, 
   b.add_ct();
   phase_done(std::string(b.run.volume_is_mask ? "mask" : "CT") + " planes (" + std::to_string(b.result.images) + " images)");
   const int before = b.result.images;
-  b.add_segmentation();
-  phase_done("segmentation montages (" + std::to_string(b.result.images - before) + " images)");
+  b.add_segmentation(segmentation);
+  phase_done("segmentation montages (" + std::to_string(b.result.images - before) + " images" +
+             (segmentation ? ", drawn beside the stages)" : ")"));
   b.add_findings();
   phase_done(std::to_string(b.result.candidates) + " candidate and " + std::to_string(b.result.known_polyps) +
              " known-polyp cards");

@@ -1,14 +1,17 @@
 #include "colonflat/report/report_tool.h"
 
+#include <future>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_finisher.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/report/run_data.h"
+#include "colonflat/report/segmentation_qc.h"
 
 namespace cf {
 
@@ -79,6 +82,23 @@ class ReportTool : public Tool, public RunFinisher {
   std::vector<std::filesystem::path> planned_folders(const std::filesystem::path& dir) const override {
     return {dir / "report_files"};
   }
+  // After segment: the Segmentation section is drawn on a second thread while the later stages
+  // run (it needs only the CT, the lumen and segment's decisions). The thread drops its CT and
+  // lumen references when done, so the run can park the CT after reconstruct as before.
+  void stage_done(const std::string& stage, const ArtifactBag& bag, const nlohmann::json& record) override {
+    if (stage != "segment" || !bag.has("ct") || !bag.has("mask")) return;
+    const std::any& ct_held = bag.raw("ct");
+    const auto* ct = std::any_cast<CtImage::Pointer>(&ct_held);
+    if (!ct) return;  // not the float CT: the report draws the section itself
+    segmentation_ = std::async(std::launch::async,
+                               [ct = *ct, lumen = bag.get<MaskImage::Pointer>("mask"),
+                                result = record.value("result", nlohmann::json::object())]() mutable {
+                                 SegmentationQcDrawing d = draw_segmentation_qc(ct.GetPointer(), lumen.GetPointer(), result);
+                                 ct = nullptr, lumen = nullptr;
+                                 return d;
+                               });
+  }
+
   nlohmann::json finish(FinishedRun& run, OutputTransaction& tx) override {
     Stopwatch clock;
     ProgressScope scope(run.log, "report");
@@ -89,7 +109,9 @@ class ReportTool : public Tool, public RunFinisher {
     for (const auto& target : tx.targets())
       if (target.parent_path() == run.dir) data->staged_files.push_back(target.filename().string());
     phase_done("run data from memory");
-    const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log);
+    std::optional<SegmentationQcDrawing> drawn;
+    if (segmentation_.valid()) drawn = segmentation_.get();
+    const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log, drawn ? &*drawn : nullptr);
     // Left for what follows on the same memory (`colonflat run --prone`: the supine-prone review);
     // the lumen mask is not needed any more when the views show the CT.
     if (!data->volume_is_mask) run.artifacts->erase("mask");
@@ -102,6 +124,9 @@ class ReportTool : public Tool, public RunFinisher {
             {"known_polyps", r.known_polyps}, {"images", r.images}, {"endoluminal_views", r.endoluminal_views},
             {"warnings", r.warnings}};
   }
+
+ private:
+  std::future<SegmentationQcDrawing> segmentation_;  // drawn beside the stages after segment
 };
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "colonflat/core/threads.h"
 #include "colonflat/report/ct_views.h"
 
 namespace fs = std::filesystem;
@@ -34,7 +35,7 @@ class SegmentationQc {
     for (int d = 0; d < 3; ++d) n_[d] = sz[d];
     voxel_ml_ = ct->GetSpacing()[0] * ct->GetSpacing()[1] * ct->GetSpacing()[2] / 1000.0;
   }
-  nlohmann::json run(const fs::path& dir, const std::string& prefix, int* images);
+  SegmentationQcDrawing run();
 
  private:
   void thresholds();
@@ -56,7 +57,7 @@ class SegmentationQc {
     for (int d = 0; d < 3; ++d) lo_[d] = std::min(lo_[d], p[d]), hi_[d] = std::max(hi_[d], p[d]);
   }
   std::vector<double> slice_positions(Plane p) const;
-  nlohmann::json draw(Plane p, double fixed, int n, const fs::path& dir, const std::string& prefix);
+  nlohmann::json draw(Plane p, double fixed, int n, QcMontage& out) const;
   nlohmann::json tables() const;
 
   const CtImage* ct_;
@@ -192,23 +193,39 @@ void SegmentationQc::find_bodies() {
   std::sort(body_voxels_.begin(), body_voxels_.end());
 }
 
-nlohmann::json SegmentationQc::run(const fs::path& dir, const std::string& prefix, int* images) {
+// The montages' slices are drawn on the threads, each into its own slot: the same drawing for
+// any thread count.
+SegmentationQcDrawing SegmentationQc::run() {
   thresholds();
   scan_lumen();
   find_bodies();
-  if (lo_[0] > hi_[0]) return {{"missing", "the lumen mask is empty and no rejected body was found"}};
+  SegmentationQcDrawing out;
+  if (lo_[0] > hi_[0]) {
+    out.section = {{"missing", "the lumen mask is empty and no rejected body was found"}};
+    return out;
+  }
   double ext = 0;
   for (int d = 0; d < 3; ++d) ext = std::max(ext, hi_[d] - lo_[d] + 2 * o_.margin_mm);
   pix_ = std::max({ext / o_.max_pixels, ct_->GetSpacing()[0], ct_->GetSpacing()[1]});
-  nlohmann::json j = tables();
+  struct Slice {
+    Plane plane;
+    double fixed;
+    int n;
+  };
+  std::vector<Slice> slices;
   for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) {
-    nlohmann::json list = nlohmann::json::array();
     int n = 0;
-    for (double f : slice_positions(p)) list.push_back(draw(p, f, n++, dir, prefix));
-    *images += n;
-    j["planes"][plane_name(p)] = list;
+    for (double f : slice_positions(p)) slices.push_back({p, f, n++});
   }
-  return j;
+  std::vector<nlohmann::json> entries(slices.size());
+  out.montages.resize(slices.size());
+  parallel_for(slices.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) entries[i] = draw(slices[i].plane, slices[i].fixed, slices[i].n, out.montages[i]);
+  });
+  out.section = tables();
+  for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) out.section["planes"][plane_name(p)] = nlohmann::json::array();
+  for (std::size_t i = 0; i < slices.size(); ++i) out.section["planes"][plane_name(slices[i].plane)].push_back(entries[i]);
+  return out;
 }
 
 // Slices through the largest bodies (where each has most voxels along the axis) and through the
@@ -250,7 +267,7 @@ std::vector<double> SegmentationQc::slice_positions(Plane p) const {
 
 // One montage image: the CT plane (lung window), rejected bodies tinted and outlined red, the lumen
 // outlined green; a label per body where it shows (its pixels' centre).
-nlohmann::json SegmentationQc::draw(Plane p, double fixed, int n, const fs::path& dir, const std::string& prefix) {
+nlohmann::json SegmentationQc::draw(Plane p, double fixed, int n, QcMontage& out) const {
   const PlaneAxes a = plane_axes(p);
   const auto range = [&](int axis, int sign) {
     const double x = sign * lo_[axis], y = sign * hi_[axis];
@@ -295,13 +312,13 @@ nlohmann::json SegmentationQc::draw(Plane p, double fixed, int n, const fs::path
       if (body_edge) std::copy_n(kBodyRgb, 3, &rgb[3 * px]);
       if (body[px]) centre[std::size_t(body[px])][0] += c, centre[std::size_t(body[px])][1] += r, centre[std::size_t(body[px])][2] += 1;
     }
-  const std::string name = std::string("seg_") + plane_name(p) + "_" + std::to_string(n) + ".png";
-  write_png_pixels(w, h, 3, rgb, dir / name);
+  out.name = std::string("seg_") + plane_name(p) + "_" + std::to_string(n) + ".png";
+  out.w = w, out.h = h, out.rgb = std::move(rgb);
   nlohmann::json labels = nlohmann::json::array();
   for (std::size_t b = 1; b < centre.size(); ++b)
     if (centre[b][2] > 0)
       labels.push_back({{"id", int(b)}, {"col", centre[b][0] / centre[b][2]}, {"row", centre[b][1] / centre[b][2]}, {"pixels", centre[b][2]}});
-  return {{"file", prefix + name}, {"position_mm", std::round(fixed * 10) / 10}, {"axis", std::string(1, "LPS"[a.fixed_axis])},
+  return {{"position_mm", std::round(fixed * 10) / 10}, {"axis", std::string(1, "LPS"[a.fixed_axis])},
           {"w", w}, {"h", h}, {"pixel_mm", pix_}, {"labels", labels}};
 }
 
@@ -329,16 +346,44 @@ nlohmann::json SegmentationQc::tables() const {
 
 }  // namespace
 
+SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                                           const SegmentationQcOptions& opts) {
+  SegmentationQcDrawing missing;
+  if (!ct || !lumen) {
+    missing.section = {{"missing", "no CT or no lumen mask in the run folder"}};
+    return missing;
+  }
+  bool same_grid = ct->GetLargestPossibleRegion().GetSize() == lumen->GetLargestPossibleRegion().GetSize();
+  for (int d = 0; d < 3; ++d)
+    same_grid = same_grid && std::abs(ct->GetOrigin()[d] - lumen->GetOrigin()[d]) <= 1e-3 &&
+                std::abs(ct->GetSpacing()[d] - lumen->GetSpacing()[d]) <= 1e-6;
+  if (!same_grid) {
+    missing.section = {{"missing", "the lumen mask is not on the CT's grid"}};
+    return missing;
+  }
+  return SegmentationQc(ct, lumen, segment_result, opts).run();
+}
+
+nlohmann::json write_segmentation_qc(const SegmentationQcDrawing& drawing, const fs::path& dir,
+                                     const std::string& rel_prefix, int* images) {
+  nlohmann::json section = drawing.section;
+  std::size_t k = 0;
+  for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) {
+    if (!section.contains("planes") || !section["planes"].contains(plane_name(p))) continue;
+    for (auto& entry : section["planes"][plane_name(p)]) {
+      const QcMontage& m = drawing.montages.at(k++);
+      write_png_pixels(m.w, m.h, 3, m.rgb, dir / m.name);
+      entry["file"] = rel_prefix + m.name;
+      ++*images;
+    }
+  }
+  return section;
+}
+
 nlohmann::json write_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
                                      const fs::path& dir, const std::string& rel_prefix, int* images,
                                      const SegmentationQcOptions& opts) {
-  if (!ct || !lumen) return {{"missing", "no CT or no lumen mask in the run folder"}};
-  if (ct->GetLargestPossibleRegion().GetSize() != lumen->GetLargestPossibleRegion().GetSize())
-    return {{"missing", "the lumen mask is not on the CT's grid"}};
-  for (int d = 0; d < 3; ++d)
-    if (std::abs(ct->GetOrigin()[d] - lumen->GetOrigin()[d]) > 1e-3 || std::abs(ct->GetSpacing()[d] - lumen->GetSpacing()[d]) > 1e-6)
-      return {{"missing", "the lumen mask is not on the CT's grid"}};
-  return SegmentationQc(ct, lumen, segment_result, opts).run(dir, rel_prefix, images);
+  return write_segmentation_qc(draw_segmentation_qc(ct, lumen, segment_result, opts), dir, rel_prefix, images);
 }
 
 }  // namespace cf

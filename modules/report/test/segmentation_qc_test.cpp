@@ -11,8 +11,11 @@
 
 #include <vtkImageData.h>
 
+#include "colonflat/core/stage.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/render/artifacts.h"
 #include "colonflat/report/report.h"
+#include "colonflat/report/segmentation_qc.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
 
@@ -119,6 +122,29 @@ TEST(ReportSegmentation, DroppedBodyIsOutlinedLabelledAndListed) {
     }
     EXPECT_GE(labelled, 1) << plane << ": no slice through the rejected body";
     EXPECT_GT(green, 50) << plane;
+  }
+}
+
+// The montages are drawn on the threads, each slice into its own slot: the section and every
+// montage's pixels are the same for 1 and 2 threads.
+TEST(ReportSegmentation, DrawingIsTheSameForOneAndTwoThreads) {
+  testing::TempDir tmp;
+  double fluid_ml = 0;
+  make_run(tmp / "run", &fluid_ml);
+  const auto ct = read_ct_volume(tmp / "run" / "ct.nrrd");
+  const auto mask = read_mask(tmp / "run" / "lumen_mask.nrrd");
+  const nlohmann::json result = read_json_file(tmp / "run" / "run_report.json")["stages"][0]["result"];
+  set_thread_count(1);
+  const SegmentationQcDrawing one = draw_segmentation_qc(ct.GetPointer(), mask.GetPointer(), result);
+  set_thread_count(2);
+  const SegmentationQcDrawing two = draw_segmentation_qc(ct.GetPointer(), mask.GetPointer(), result);
+  set_thread_count(0);
+  ASSERT_GE(one.montages.size(), 12u);
+  EXPECT_EQ(one.section, two.section);
+  ASSERT_EQ(one.montages.size(), two.montages.size());
+  for (std::size_t i = 0; i < one.montages.size(); ++i) {
+    EXPECT_EQ(one.montages[i].name, two.montages[i].name);
+    EXPECT_EQ(one.montages[i].rgb, two.montages[i].rgb) << one.montages[i].name;
   }
 }
 

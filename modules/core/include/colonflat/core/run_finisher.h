@@ -34,6 +34,14 @@ class RunFinisher {
   // starts, with the run's other outputs).
   virtual std::vector<std::filesystem::path> planned_outputs(const std::filesystem::path& run_dir) const = 0;
   virtual std::vector<std::filesystem::path> planned_folders(const std::filesystem::path& run_dir) const = 0;
+  // Called by the run right after each of its stages, on the run's thread, before the next stage
+  // starts: `record` is the stage's run_report entry ({"stage", "result", ...}). A finisher may
+  // start work on the artifacts there in the background (its own references, never changing the
+  // bag), to be awaited in finish(); it must let go of them when that work ends, so that the run
+  // can free or park them. Default: nothing.
+  virtual void stage_done(const std::string& stage, const ArtifactBag& bag, const nlohmann::json& record) {
+    (void)stage, (void)bag, (void)record;
+  }
   // Writes them through `tx` (targets in run.dir; the run commits). Returns its record for
   // run_report.json: {"time_s", "phases", ...}. Throws cf::Error.
   virtual nlohmann::json finish(FinishedRun& run, OutputTransaction& tx) = 0;

@@ -18,6 +18,7 @@
 namespace cf {
 
 struct RunData;
+struct SegmentationQcDrawing;
 class OutputTransaction;
 
 struct ReportOptions {
@@ -52,8 +53,10 @@ ReportResult write_review_report(const std::filesystem::path& run_dir, const Rep
 // The report of a loaded run (load_run() from files, or run_from_artifacts() from the memory of
 // `colonflat run`): report.html, polyps.mrk.json, known_polyps.mrk.json (with truth) and the
 // folder report_files/ in run.dir, staged through `tx`; nothing appears until the caller commits.
+// `segmentation`: the Segmentation section drawn already from the run's CT, lumen and segment
+// result (`colonflat run` draws it beside its later stages); null: drawn here.
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
-                                 std::ostream* log = nullptr);
+                                 std::ostream* log = nullptr, const SegmentationQcDrawing* segmentation = nullptr);
 
 // A report page: the shared skeleton (resources/page.html: head, footer, scripts) titled `title`
 // around `body_html`, with the report's style sheet followed by `page_css`, `window.REPORT = data`,

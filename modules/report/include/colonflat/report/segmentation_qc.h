@@ -7,6 +7,7 @@
 // what, volume_ml, position_lps_mm, decision, reason), grown to at most 3x its volume.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -22,7 +23,34 @@ struct SegmentationQcOptions {
   double search_mm = 25;      // a body's voxels are looked for this far from its decision's position
 };
 
-// Writes the montage PNGs `<dir>/seg_<plane>_<n>.png` and returns the section's data:
+// One montage drawn in memory: RGB pixels, 3 bytes a pixel, row 0 at the top.
+struct QcMontage {
+  std::string name;  // file name, seg_<plane>_<n>.png
+  int w = 0, h = 0;
+  std::vector<unsigned char> rgb;
+};
+
+// The Segmentation section drawn, nothing written yet: `section` as write_segmentation_qc()
+// returns it but without the montages' "file" entries, and the montages in plane order
+// (coronal, axial, sagittal), each plane's slices in order (`section.planes.<plane>[i]` is
+// montages[k] for consecutive k).
+struct SegmentationQcDrawing {
+  nlohmann::json section = nlohmann::json::object();
+  std::vector<QcMontage> montages;
+};
+
+// Draws the section (pure: reads the volumes, writes no file; the slices are drawn on the
+// threads, the same pixels for any thread count). `ct` and `lumen` are only read during the call.
+// Pre: the lumen is on the CT's grid, else section = {"missing": why} and no montage.
+SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                                           const SegmentationQcOptions& opts = {});
+
+// Writes a drawing's montages as `<dir>/<name>` and returns its section with each montage's
+// "file" (`rel_prefix` + name) filled in; `images` += PNGs written.
+nlohmann::json write_segmentation_qc(const SegmentationQcDrawing& drawing, const std::filesystem::path& dir,
+                                     const std::string& rel_prefix, int* images);
+
+// Both in one call: writes the montage PNGs `<dir>/seg_<plane>_<n>.png` and returns the section's data:
 // {planes: {axial|coronal|sagittal: [{file, position_mm, axis, w, h, labels: [{id, col, row}]}]},
 //  bodies: [{id, what, reason, volume_ml, position_lps_mm, outlined, measured_ml, colour}], kept: [...],
 //  lumen_ml, thresholds_hu}. `segment_result` is the segment stage's result object (may be empty).
