@@ -54,11 +54,13 @@ ImagePtr snapshot_before(const Mesh& m, vtkPolyData* loops, SnapshotOptions so) 
 
 }  // namespace
 
-// Snapshots on: orients the snapshot inputs, builds the loops' polylines and starts the snapshot
-// before denoising on a second thread. It needs only the surface and the loops, the colon image
-// drawn meanwhile on this thread needs no OpenGL, and the display is set up here first (Xvfb is
-// forked before any second thread runs). Where no display can be had, `error` says why.
-RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, RunContext& ctx) const {
+// Snapshots on: orients the snapshot inputs, builds the loops' polylines and renders both
+// snapshots on a second thread, one after the other: they need only the surfaces (or the flat
+// map's) and the loops; the colon image drawn meanwhile on this thread needs no OpenGL, and the
+// display is set up here first (Xvfb is forked before any second thread runs). The snapshot after
+// denoising is rendered without its caption, which counts the candidates found meanwhile. Where no
+// display can be had, `error` says why.
+RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const {
   Snapshots s;
   for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
     if (bag.has(port)) ctx.report["orientation"][port] = orient_mesh_input(bag, port, ctx, "render");
@@ -70,27 +72,30 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, RunContext
     s.error = e.what();
     return s;
   }
-  if (bag.has("surface"))
-    s.before = std::async(std::launch::async, snapshot_before, std::cref(bag.get<Mesh>("surface")), s.loops.Get(), s.options);
+  const Mesh* surface = bag.has("surface") ? &bag.get<Mesh>("surface") : nullptr;
+  const Mesh* denoised = bag.has("denoised") ? &bag.get<Mesh>("denoised") : nullptr;
+  s.images = std::async(std::launch::async, [surface, denoised, &flat, loops = s.loops.Get(), so = s.options] {
+    SnapshotImages im;
+    if (surface) im.before = snapshot_before(*surface, loops, so);
+    im.after = render_snapshot(denoised ? to_triangle_list(*denoised) : flat_to_surface(flat), loops, so);
+    return im;
+  });
   return s;
 }
 
-// Waits for the snapshot before denoising, renders the one after (its caption counts the
-// candidates) and puts both into the bag; a snapshot error is reported, never fatal.
-void RenderStage::finish_snapshots(Snapshots& s, const FlatMap& flat, std::size_t candidates, ArtifactBag& bag,
-                                   RunContext& ctx) const {
+// Waits for the snapshots, captions the one after denoising (with the candidate count) and puts
+// both into the bag; a snapshot error is reported, never fatal.
+void RenderStage::finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const {
   try {
     if (!s.error.empty()) throw Error(s.error);
-    if (s.before.valid()) {
-      bag.put("snapshot_before", s.before.get());
-      phase_done("3D snapshot before denoising (beside the colon image)");
-    }
-    TriangleList after = bag.has("denoised") ? to_triangle_list(bag.get<Mesh>("denoised")) : flat_to_surface(flat);
-    s.options.caption = std::string(bag.has("denoised") ? "after denoising" : "flattened surface") + ", " +
-                        std::to_string(candidates) + " polyp candidates" +
-                        (s.loops ? ", cut loops highlighted" : std::string());
-    bag.put("snapshot_after", render_snapshot(after, s.loops, s.options));
-    phase_done("3D snapshot after denoising");
+    SnapshotImages im = s.images.get();
+    phase_done("3D snapshots before and after denoising (beside the colon image)");
+    if (im.before) bag.put("snapshot_before", im.before);
+    const bool denoised = bag.has("denoised");
+    caption_snapshot(im.after, std::string(denoised ? "after denoising" : "flattened surface") + ", " +
+                                   std::to_string(candidates) + " polyp candidates" +
+                                   (s.loops ? ", cut loops highlighted" : std::string()));
+    bag.put("snapshot_after", im.after);
     ctx.report["display"] = s.display;
   } catch (const Error& e) {
     ctx.report["snapshot_error"] = e.what();
@@ -101,7 +106,7 @@ void RenderStage::finish_snapshots(Snapshots& s, const FlatMap& flat, std::size_
 void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   const FlatMap& flat = bag.get<FlatMap>("flat");
   Snapshots snapshots;
-  if (opts_.snapshots) snapshots = start_snapshots(bag, ctx);
+  if (opts_.snapshots) snapshots = start_snapshots(bag, flat, ctx);
   Stopwatch sw;
   RenderResult r = render_flat(flat, opts_);
   phase_done("colon image and candidates");
@@ -113,7 +118,7 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
                " px, " + std::to_string(r.candidates.size()) + " polyp candidates");
   bag.put("colon_image", r.colon.image);
   bag.put("candidates", r.candidates_json);
-  if (opts_.snapshots) finish_snapshots(snapshots, flat, r.candidates.size(), bag, ctx);
+  if (opts_.snapshots) finish_snapshots(snapshots, r.candidates.size(), bag, ctx);
 }
 
 std::unique_ptr<Stage> make_render_stage() { return std::make_unique<RenderStage>(); }

@@ -23,8 +23,6 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
 #include <vtkIdList.h>
-#include <vtkTextActor.h>
-#include <vtkTextProperty.h>
 #include <vtkTubeFilter.h>
 #include <vtkWindowToImageFilter.h>
 
@@ -143,8 +141,8 @@ vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook&
 
 namespace {
 
-// render_snapshot() as named steps: the scene (surface, loops as tubes with a ball around each,
-// caption), the camera, and the off-screen grab.
+// render_snapshot() as named steps: the scene (surface, loops as tubes with a ball around each),
+// the camera, and the off-screen grab.
 class SnapshotScene {
  public:
   SnapshotScene(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts)
@@ -155,7 +153,6 @@ class SnapshotScene {
   void add_surface();
   void add_loop_tubes();
   void add_loop_balls();
-  void add_caption();
   void place_camera();
   ImagePtr grab();
 
@@ -177,7 +174,6 @@ ImagePtr SnapshotScene::run() {
     add_loop_tubes();
     add_loop_balls();
   }
-  add_caption();
   window_->SetOffScreenRendering(1);
   window_->SetMultiSamples(0);
   window_->AddRenderer(renderer_);
@@ -257,16 +253,6 @@ void SnapshotScene::add_loop_balls() {
   }
 }
 
-void SnapshotScene::add_caption() {
-  if (opts_.caption.empty()) return;
-  vtkNew<vtkTextActor> ta;
-  ta->SetInput(opts_.caption.c_str());
-  ta->GetTextProperty()->SetFontSize(20);
-  ta->GetTextProperty()->SetColor(1, 1, 1);
-  ta->SetDisplayPosition(12, opts_.height - 34);
-  renderer_->AddViewProp(ta);
-}
-
 // Looking at the box centre from the front (anterior, LPS -y) or the patient's left (+x),
 // superior up, the whole surface in view.
 void SnapshotScene::place_camera() {
@@ -282,15 +268,12 @@ void SnapshotScene::place_camera() {
 }
 
 ImagePtr SnapshotScene::grab() {
-  // The caption's text actor renders with FreeType, in Render() and again in the grabber's render.
-  std::unique_lock<std::mutex> text(freetype_mutex());
   window_->Render();
   vtkNew<vtkWindowToImageFilter> grabber;
   grabber->SetInput(window_);
   grabber->SetInputBufferTypeToRGB();
   grabber->ReadFrontBufferOff();
   grabber->Update();
-  text.unlock();
   if (!messages_.errors().empty()) throw Error("off-screen rendering failed: " + messages_.errors().front());
   ImagePtr img = ImagePtr::New();
   img->DeepCopy(grabber->GetOutput());
@@ -301,7 +284,14 @@ ImagePtr SnapshotScene::grab() {
 
 ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
   ensure_display();
-  return SnapshotScene(surface, loops, o).run();
+  ImagePtr img = SnapshotScene(surface, loops, o).run();
+  caption_snapshot(img, o.caption);
+  return img;
+}
+
+void caption_snapshot(vtkImageData* snapshot, const std::string& caption) {
+  static const double white[3] = {1, 1, 1};
+  if (!caption.empty()) draw_text(snapshot, caption, 12, 12, 20, white);
 }
 
 }  // namespace cf

@@ -69,9 +69,9 @@ ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& sh
                               std::vector<ImageMarker>& markers, const ColonImageOptions& opts);
 
 // VTK's FreeType text rendering (vtkTextRenderer, vtkFreeTypeTools and its font cache) is one
-// process-wide instance and not thread-safe; the snapshot before denoising is rendered on a second
-// thread while the colon image draws its labels. draw_text and a snapshot's render (its caption is
-// a text actor) hold this lock while they use it.
+// process-wide instance and not thread-safe; the snapshots are rendered on a second thread while
+// the colon image draws its labels. Only draw_text uses FreeType (a snapshot's caption is drawn
+// with it onto the grabbed image, its scene has no text actor), and it holds this lock.
 std::mutex& freetype_mutex();
 
 // Draws `text` into an RGB image at column x, row-from-top y (top-left corner), with FreeType

@@ -50,15 +50,18 @@ class RenderStage : public StageWithOptions<RenderOptions> {
  private:
   // The 3D snapshots of one run: the one before denoising renders on a second thread while the
   // colon image is drawn.
+  struct SnapshotImages {
+    ImagePtr before;  // null without a surface before denoising
+    ImagePtr after;   // without its caption (it counts the candidates)
+  };
   struct Snapshots {
     vtkSmartPointer<vtkPolyData> loops;
     SnapshotOptions options;
     std::string display, error;
-    std::future<ImagePtr> before;
+    std::future<SnapshotImages> images;
   };
-  Snapshots start_snapshots(ArtifactBag& bag, RunContext& ctx) const;
-  void finish_snapshots(Snapshots& s, const FlatMap& flat, std::size_t candidates, ArtifactBag& bag,
-                        RunContext& ctx) const;
+  Snapshots start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const;
+  void finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const;
 };
 
 std::unique_ptr<Stage> make_render_stage();

@@ -10,6 +10,7 @@
 #include "colonflat/render/artifacts.h"
 
 class vtkActor;
+class vtkImageData;
 class vtkPolyData;
 
 namespace cf {
@@ -19,7 +20,7 @@ std::string ensure_display();
 
 struct SnapshotOptions {
   int width = 900, height = 900;
-  std::string caption;
+  std::string caption;  // drawn at the top left after the grab (caption_snapshot); empty: none
   std::string view = "anterior";  // "anterior" (from -y, LPS) or "left" (from +x)
 };
 
@@ -37,7 +38,13 @@ struct SurfaceLook {
 vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook& look);
 
 // The surface (LPS mm) seen from outside, with `loops` (polylines; may be null) as thick tubes
-// (handles red, tunnels blue when cell data "type" is there, else orange).
+// (handles red, tunnels blue when cell data "type" is there, else orange). The scene holds no
+// text: OpenGL never runs FreeType here, so a snapshot may render on one thread while another
+// draws text (draw_text); the caption is drawn onto the grabbed image.
 ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts);
+
+// Draws `caption` at the top left of a snapshot (white, 20 px; draw_text). Used by
+// render_snapshot, and for a caption known only after the snapshot was rendered.
+void caption_snapshot(vtkImageData* snapshot, const std::string& caption);
 
 }  // namespace cf
