@@ -144,18 +144,17 @@ nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<
                       {"u0", ur[0]}, {"v0", vr[0]}, {"pixel_mm", o.pixel_mm}, {"w", w}, {"h", h},
                       {"positions", nlohmann::json::array()}, {"files", nlohmann::json::array()}};
   auto fixed_of = [&](int i) { return f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm; };
-  // The planes are sampled on the threads; the PNGs are written in order on this one (VTK's
-  // message capture around each writer is process-wide).
-  std::vector<PlaneImage> planes(static_cast<std::size_t>(n));
-  parallel_for(planes.size(), [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) planes[i] = sample_plane(ct, plane, fixed_of(int(i)), ur[0], vr[0], w, h, o.pixel_mm);
+  // Each plane is sampled and written on the threads (a VtkMessageCapture collects its own
+  // thread's messages); the list is made in order here.
+  const CtWindow& window = o.window ? *o.window : lung_window();
+  const auto name_of = [&](int i) { return std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png"; };
+  parallel_for(std::size_t(n), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      write_windowed_png(sample_plane(ct, plane, fixed_of(int(i)), ur[0], vr[0], w, h, o.pixel_mm), window, dir / name_of(int(i)));
   });
   for (int i = 0; i < n; ++i) {
-    const double fixed = fixed_of(i);
-    const std::string name = std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png";
-    write_windowed_png(planes[std::size_t(i)], o.window ? *o.window : lung_window(), dir / name);
-    j["positions"].push_back(std::round(fixed * 100) / 100);
-    j["files"].push_back(rel_prefix + name);
+    j["positions"].push_back(std::round(fixed_of(i) * 100) / 100);
+    j["files"].push_back(rel_prefix + name_of(i));
   }
   return j;
 }

@@ -370,13 +370,15 @@ nlohmann::json write_segmentation_qc(const SegmentationQcDrawing& drawing, const
   std::size_t k = 0;
   for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) {
     if (!section.contains("planes") || !section["planes"].contains(plane_name(p))) continue;
-    for (auto& entry : section["planes"][plane_name(p)]) {
-      const QcMontage& m = drawing.montages.at(k++);
-      write_png_pixels(m.w, m.h, 3, m.rgb, dir / m.name);
-      entry["file"] = rel_prefix + m.name;
-      ++*images;
-    }
+    for (auto& entry : section["planes"][plane_name(p)]) entry["file"] = rel_prefix + drawing.montages.at(k++).name;
   }
+  parallel_for(k, [&](std::size_t b, std::size_t e) {  // each thread's VtkMessageCapture is its own
+    for (std::size_t i = b; i < e; ++i) {
+      const QcMontage& m = drawing.montages[i];
+      write_png_pixels(m.w, m.h, 3, m.rgb, dir / m.name);
+    }
+  });
+  *images += int(k);
   return section;
 }
 
