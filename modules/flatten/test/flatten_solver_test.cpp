@@ -324,3 +324,31 @@ TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
   EXPECT_LT((full * x[1] - b).norm(), 1e-9 * b.norm());
   EXPECT_EQ(std::memcmp(x[0].data(), x[1].data(), sizeof(double) * std::size_t(x[0].size())), 0);
 }
+
+// The islands a ring of faces encloses on a grid (the faces inside it), found from the ring's
+// border, are the faces keep_largest_component drops from the ring's complement, whether no piece,
+// one piece or every piece of the complement reaches the flood budget.
+TEST(FlattenSolver, EnclosedFacesAreTheIslandsKeepLargestComponentDrops) {
+  const int nx = 40;
+  const std::vector<Tri> t = grid_faces(nx, nx, 23);
+  const auto E = cf::flat_detail::build_edges(t);
+  std::vector<char> in(t.size(), 0);
+  std::vector<int> island;
+  for (std::size_t f = 0; f < t.size(); ++f) {
+    double x = 0, y = 0;
+    for (int v : t[f]) x += (v % nx) / 3.0, y += (v / nx) / 3.0;
+    const double r = std::hypot(x - 20, y - 20);
+    in[f] = r >= 5 && r < 8;
+    if (r < 5) island.push_back(int(f));
+  }
+  std::vector<char> keep(t.size());
+  for (std::size_t f = 0; f < t.size(); ++f) keep[f] = !in[f];
+  cf::flat_detail::keep_largest_component(E, keep);
+  std::vector<int> dropped;
+  for (std::size_t f = 0; f < t.size(); ++f)
+    if (!in[f] && !keep[f]) dropped.push_back(int(f));
+  ASSERT_EQ(dropped, island);
+  ASSERT_GT(island.size(), 100u);
+  for (std::size_t budget : {std::size_t(1), std::size_t(400), t.size()})
+    EXPECT_EQ(cf::flat_detail::enclosed_by(E, in, budget), island) << "budget " << budget;
+}
