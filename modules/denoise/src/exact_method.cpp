@@ -49,6 +49,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   so.cap_rings = o.method == "paper" && o.ring_pull == 0 ? 1 : so.cap_rings;
   so.trial = attempt != CapAttempt::kFull;
   so.restricted = attempt != CapAttempt::kPlainTrial;
+  so.front = o.front_caps;
   if (o.check_caps) {
     if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * st.mean_edge);
     so.guard = st.guard.get();

@@ -195,16 +195,22 @@ bool Surgery::try_triangulated_caps() {
   ring_faces_ = faces_around_rings();
   query_budget_ = kMaxGridQueries;
   std::vector<std::array<int, 3>> tri_right, tri_left;
-  for (const char* kind : {"plain", "collar", "restricted"}) {
-    const bool avoid = kind[0] == 'r', collar = kind[0] == 'c';
+  for (const char* kind : {"plain", "collar", "front", "restricted"}) {
+    const bool avoid = kind[0] == 'r', lifted = kind[0] == 'c' || kind[0] == 'f';
     if (avoid && !opts_.restricted) break;
-    for (const Placement& tr : placements()) {
+    if (kind[0] == 'f' && !opts_.front) continue;
+    const std::vector<Placement> tried = placements();
+    for (std::size_t index = 0; index < tried.size(); ++index) {
+      const Placement& tr = tried[index];
       if (gave_up_ || !place_checked(tr)) continue;
-      const bool done = collar ? try_collar_caps() : triangulate_both(avoid, &tri_right, &tri_left);
-      if (collar && !done) break;  // the first clean placement only: a lift moves the rings far more than a placement
+      const bool done = kind[0] == 'c'   ? try_collar_caps()
+                        : kind[0] == 'f' ? try_front_caps()
+                                         : triangulate_both(avoid, &tri_right, &tri_left);
+      if (lifted && !done) break;  // the first clean placement only: a lift moves the rings far more than a placement
       if (!done) continue;
-      if (!collar) add_triangulated_caps(tri_right, tri_left);
+      if (!lifted) add_triangulated_caps(tri_right, tri_left);
       cap_kind_ = kind;
+      result_.placement = static_cast<int>(index);
       return true;
     }
   }

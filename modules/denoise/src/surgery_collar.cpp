@@ -147,6 +147,18 @@ void Surgery::set_collar_classes(const std::vector<Mesh::VertexHandle>& ring,
     }
 }
 
+// The side of the surface where a disk of the loop lies first: -1 (against the normals, into the
+// enclosed solid) for a handle loop (sum of n_i . (p_i - centroid) > 0: the normals point away
+// from the loop's centre), +1 for a tunnel loop. Precondition: normal_right_ is set.
+double Surgery::disk_side() const {
+  Vec3 centre(0, 0, 0);
+  for (auto v : result_.right_ring) centre += mesh_.point(v);
+  centre /= double(k_);
+  double spread = 0;
+  for (std::size_t i = 0; i < k_; ++i) spread += OpenMesh::dot(normal_right_[i], mesh_.point(result_.right_ring[i]) - centre);
+  return spread > 0 ? -1.0 : 1.0;
+}
+
 // 7b. Collar caps in the current placement: lifted into the side where a disk of the loop lies
 //     first (against the normals for a handle loop, whose disk is inside the enclosed solid:
 //     sum of n_i . (p_i - centroid) > 0; along them for a tunnel loop), then the other way; each
@@ -155,12 +167,7 @@ void Surgery::set_collar_classes(const std::vector<Mesh::VertexHandle>& ring,
 bool Surgery::try_collar_caps() {
   normal_right_ = unit_normals(result_.right_ring);
   normal_left_ = unit_normals(result_.left_ring);
-  Vec3 centre(0, 0, 0);
-  for (auto v : result_.right_ring) centre += mesh_.point(v);
-  centre /= double(k_);
-  double spread = 0;
-  for (std::size_t i = 0; i < k_; ++i) spread += OpenMesh::dot(normal_right_[i], mesh_.point(result_.right_ring[i]) - centre);
-  const double first = spread > 0 ? -1.0 : 1.0;
+  const double first = disk_side();
   for (double sign : {first, -first}) {
     const std::vector<double> h_right = collar_heights(result_.right_ring, normal_right_, sign);
     const std::vector<double> h_left = collar_heights(result_.left_ring, normal_left_, sign);

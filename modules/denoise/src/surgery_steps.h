@@ -65,6 +65,7 @@ class Surgery {
     double right_frac, left_frac;  // fraction of each ring's collar height used
   };
   bool try_collar_caps();
+  double disk_side() const;
   std::vector<Vec3> unit_normals(const std::vector<Mesh::VertexHandle>& ring) const;
   std::vector<double> collar_heights(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Vec3>& normals,
                                      double sign) const;
@@ -72,6 +73,30 @@ class Surgery {
   std::vector<std::array<int, 3>> collar_right_triangles(const std::vector<Mesh::VertexHandle>& collar);
   bool clean(const std::vector<std::array<int, 3>>& tris) const;
   void set_collar_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::VertexHandle>& collar);
+  // Front caps (surgery_front.cpp). Sides: the unit normals of both rings at a loop vertex,
+  // times the side of the surface the cap's disk lies on.
+  using Sides = std::array<Vec3, 2>;
+  bool try_front_caps();
+  bool front_caps(double sign);
+  struct FrontCap {
+    std::vector<std::array<int, 3>> tris;  // mesh vertex ids, in ear order
+    std::vector<Mesh::VertexHandle> inner;  // interior vertices
+  };
+  bool front_cap_pair(double sign, FrontCap* right, FrontCap* left);
+  bool close_front(const std::vector<std::array<int, 3>>& disk, FrontCap* right, FrontCap* left);
+  bool left_front_cap(const FrontCap& right, double fraction, FrontCap* left);
+  std::vector<Vec3> front_inward(const std::vector<Mesh::VertexHandle>& f, const std::vector<std::array<int, 3>>& disk) const;
+  std::vector<Vec3> front_directions(const std::vector<Mesh::VertexHandle>& f, const std::vector<std::array<int, 3>>& disk,
+                                     double step, const std::vector<Sides>& side) const;
+  double front_free(const Vec3& p, const Vec3& d, double step) const;
+  static std::vector<int> front_groups(const std::vector<Vec3>& g, double step);
+  std::vector<Mesh::VertexHandle> advance_front(const std::vector<Mesh::VertexHandle>& f, const std::vector<Vec3>& dir,
+                                                const std::vector<double>& scale, double step,
+                                                std::vector<std::array<int, 3>>* strip);
+  std::vector<Mesh::VertexHandle> clean_layer(const std::vector<Mesh::VertexHandle>& f, const std::vector<Vec3>& dir,
+                                              double step, std::vector<std::array<int, 3>>* tris);
+  bool clean_from(const std::vector<std::array<int, 3>>& tris, std::size_t from,
+                  const std::vector<std::array<int, 3>>& others) const;
   ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void shape_concentric_cap(ConcentricCap& cap, double dome);

@@ -102,14 +102,29 @@ void expect_two_clean_spheres(const Mesh& mesh) {
   EXPECT_EQ(testing::count_self_intersections(mesh), 0u);
 }
 
+// Front caps bend around the tip of a rod inside the tube: the thinnest meridian, whose flat,
+// collar and restricted caps all cross the rod, is cut and capped cleanly in the first placement
+// (no replacement loop), 0 intersecting pairs (CGAL), genus 0 per component.
+TEST(DenoiseCapIntersections, FrontCapsGoAroundABlockingRod) {
+  const Mesh m = bench::blocked_torus(bench::Blocker::kRod);
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 1u);
+  EXPECT_NEAR(r.loops[0].length, 2 * kPi * 0.85, 0.05 * 2 * kPi * 0.85);  // the thinnest meridian itself
+  EXPECT_EQ(r.loops[0].cap_intersections, 0u);
+  EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 0);
+  expect_two_clean_spheres(r.mesh);
+}
+
 // When every placement of the shortest loop's caps crosses the surface (a rod inside the tube
-// pierces every cap of the thinnest meridian), the surgery is undone and another loop of the
-// same class away from the rod is cut instead: 0 intersecting pairs (CGAL), genus 0 per
-// component, and the report names the loop it replaced.
+// pierces every cap of the thinnest meridian; front caps off, which would bend around its tip),
+// the surgery is undone and another loop of the same class away from the rod is cut instead: 0
+// intersecting pairs (CGAL), genus 0 per component, and the report names the loop it replaced.
 TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
   const Mesh m = bench::blocked_torus(bench::Blocker::kRod);
   ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
-  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  DenoiseOptions o;
+  o.front_caps = false;
+  const DenoiseResult r = denoise(m, o);
   ASSERT_EQ(r.loops.size(), 1u);
   const LoopRecord& loop = r.loops[0];
   EXPECT_EQ(loop.cap_intersections, 0u);

@@ -35,7 +35,8 @@ std::vector<std::array<double, 2>> washer_profile(double ripple) {
   std::vector<std::array<double, 2>> profile;  // (r, z), counter-clockwise
   const int steps = 40;                         // 0.1 mm
   for (int s = 0; s < steps; ++s) profile.push_back({2.0 + 0.1 * s, -kThickness / 2});         // bottom, outwards
-  for (int s = 0; s < 3; ++s) profile.push_back({6.0, -kThickness / 2 + kThickness * s / 3});  // outer wall, up
+  const double rise = top_face(6.0, ripple) + kThickness / 2;  // the outer wall up to the top face
+  for (int s = 0; s < 3; ++s) profile.push_back({6.0, -kThickness / 2 + rise * s / 3});  // outer wall, up
   for (int s = steps; s > 0; --s) profile.push_back({2.0 + 0.1 * s, top_face(2.0 + 0.1 * s, ripple)});  // top, in
   for (int s = 0; s < 3; ++s) profile.push_back({2.0, top_face(2.0, ripple) - kThickness * s / 3});      // rim, down
   return profile;
@@ -60,9 +61,14 @@ struct Cut {
   SurgeryResult result;
 };
 
-Cut cut_top_loop(int nu, HomologyBasis* homology = nullptr) {
+// The steep ripple: a crest 0.175 mm above the loop half a millimetre inside it, higher than a
+// collar may rise there (a third of the 0.45 mm between the loop and the plate).
+constexpr double kGentleRipple = 0.02, kSteepRipple = 0.1;
+double plate_gap(double ripple) { return ripple == kSteepRipple ? 0.15 : 0.3; }
+
+Cut cut_top_loop(int nu, HomologyBasis* homology = nullptr, double ripple = kGentleRipple) {
   Cut c;
-  c.mesh = rippled_washer_under_a_plate(0.02, 0.3, nu);
+  c.mesh = rippled_washer_under_a_plate(ripple, plate_gap(ripple), nu);
   if (homology) homology->build(c.mesh);
   FaceGrid grid(c.mesh, 3 * testing::mean_edge(c.mesh));
   SurgeryOptions o;
@@ -121,10 +127,10 @@ TEST(DenoiseCollarCaps, CollarStaysWithinAThirdOfTheGap) {
 // edge classes sum to zero, except one closing face per cap, which sums to the cut loop's class
 // (the class the exact method quotients out after the cut). Without this the searches after a
 // collar cap would see wrong classes.
-TEST(DenoiseCollarCaps, CapEdgesKeepFacesCocycles) {
+void expect_cap_edges_keep_faces_cocycles(double ripple, const char* caps) {
   HomologyBasis hb;
   const int nu = 96;
-  Mesh before = rippled_washer_under_a_plate(0.02, 0.3, nu);
+  Mesh before = rippled_washer_under_a_plate(ripple, plate_gap(ripple), nu);
   hb.build(before);
   std::vector<std::uint64_t> loop_class(hb.words(), 0);
   const auto loop = top_loop(nu);
@@ -132,8 +138,8 @@ TEST(DenoiseCollarCaps, CapEdgesKeepFacesCocycles) {
     xor_into(loop_class.data(), hb.edge_class(before.edge_handle(before.find_halfedge(loop[i], loop[(i + 1) % nu]))),
              hb.words());
   ASSERT_FALSE(is_zero(loop_class.data(), hb.words()));
-  const Cut c = cut_top_loop(nu, &hb);
-  ASSERT_STREQ(c.result.caps, "collar");
+  const Cut c = cut_top_loop(nu, &hb, ripple);
+  ASSERT_STREQ(c.result.caps, caps);
   int zero = 0, loop_sum = 0, other = 0;
   for (auto f : c.mesh.faces()) {
     std::vector<std::uint64_t> sum(hb.words(), 0);
@@ -147,13 +153,15 @@ TEST(DenoiseCollarCaps, CapEdgesKeepFacesCocycles) {
   EXPECT_GT(zero, 0);
 }
 
+TEST(DenoiseCollarCaps, CapEdgesKeepFacesCocycles) { expect_cap_edges_keep_faces_cocycles(kGentleRipple, "collar"); }
+
 // The same caps for one and two threads, point by point and face by face.
-TEST(DenoiseCollarCaps, SameCapsForAnyThreadCount) {
+void expect_same_caps_for_any_thread_count(double ripple) {
   const int before = thread_count();
   set_thread_count(1);
-  const Cut one = cut_top_loop(96);
+  const Cut one = cut_top_loop(96, nullptr, ripple);
   set_thread_count(2);
-  const Cut two = cut_top_loop(96);
+  const Cut two = cut_top_loop(96, nullptr, ripple);
   set_thread_count(before);
   ASSERT_EQ(one.mesh.n_vertices(), two.mesh.n_vertices());
   ASSERT_EQ(one.mesh.n_faces(), two.mesh.n_faces());
@@ -164,6 +172,42 @@ TEST(DenoiseCollarCaps, SameCapsForAnyThreadCount) {
     for (int k = 0; k < 3; ++k, ++a, ++b) EXPECT_EQ(a->idx(), b->idx());
   }
 }
+
+TEST(DenoiseCollarCaps, SameCapsForAnyThreadCount) { expect_same_caps_for_any_thread_count(kGentleRipple); }
+
+// The test surface with the steep ripple is what it claims: embedded, genus 1 per washer, the
+// loop in the trough, and a crest inside the loop 0.175 mm above it.
+TEST(DenoiseFrontCaps, SteepRippleSurfaceIsEmbeddedWithACrestInsideTheLoop) {
+  const Mesh m = rippled_washer_under_a_plate(kSteepRipple, plate_gap(kSteepRipple), 96);
+  EXPECT_EQ(analyze_topology(m).genus, 2);
+  EXPECT_EQ(testing::count_self_intersections(m), 0u);
+  EXPECT_NEAR(top_face(3.5, kSteepRipple) - m.point(top_loop(96)[0])[2], 0.175, 1e-9);
+}
+
+// A loop in the wall's own tangent plane with a crest inside it higher than any collar may rise:
+// the flat caps, the collar caps and the caps of every placement cross the crest; a front cap
+// (interior vertices steered off the wall) is clean in the first placement. The result is closed,
+// manifold, genus 0 on that component, and CGAL finds no intersecting pair.
+TEST(DenoiseFrontCaps, LoopUnderACrestIsCappedCleanlyInTheFirstPlacement) {
+  for (int nu : {96}) {
+    const Cut c = cut_top_loop(nu, nullptr, kSteepRipple);
+    EXPECT_STREQ(c.result.caps, "front") << nu;
+    EXPECT_EQ(c.result.placement, 0) << nu;
+    EXPECT_EQ(c.result.intersections, 0u) << nu;
+    const TopologyReport t = analyze_topology(c.mesh);
+    EXPECT_EQ(t.genus, 1) << nu;  // the plate above keeps its handle
+    EXPECT_TRUE(t.closed);
+    EXPECT_TRUE(t.manifold);
+    EXPECT_EQ(t.components.size(), 2u);
+    EXPECT_EQ(testing::count_self_intersections(c.mesh), 0u) << nu;
+  }
+}
+
+// The front caps' new edges keep every face a cocycle (one closing face per cap sums to the loop's class).
+TEST(DenoiseFrontCaps, CapEdgesKeepFacesCocycles) { expect_cap_edges_keep_faces_cocycles(kSteepRipple, "front"); }
+
+// The same front caps for one and two threads, point by point and face by face.
+TEST(DenoiseFrontCaps, SameCapsForAnyThreadCount) { expect_same_caps_for_any_thread_count(kSteepRipple); }
 
 }  // namespace
 }  // namespace cf

@@ -23,6 +23,9 @@ namespace cf::flat_detail {
 namespace {
 
 constexpr double kCollapsedRatio = 0.01;  // 2D/3D area ratio below which a face is collapsed
+// Islands of a candidate branch's outside are looked for from its border, each piece flooded up to
+// twice the branch's faces + this many (enclosed_by: the budget sets only the speed, not the result).
+constexpr std::size_t kIslandBudgetMin = 4096;
 constexpr int kRadii = 64;                 // radii sampled between the cluster's extent and the limit
 
 struct Cluster {
@@ -160,11 +163,11 @@ class BranchFinder {
         for (int g : E_.ef[e])
           if (g >= 0 && !in[g] && !taken_[g] && within(g)) in[g] = 1, stack.push_back(g);
     }
-    // The outside must be one piece holding the annulus' own boundary: other pieces are islands.
-    std::vector<char> out(s_.t.size());
-    for (std::size_t f = 0; f < s_.t.size(); ++f) out[f] = !in[f];
-    keep_largest_component(E_, out);
-    for (std::size_t f = 0; f < s_.t.size(); ++f) in[f] = !out[f];
+    // The outside must be one piece holding the annulus' own boundary: other pieces are islands
+    // (found from the region's border: a flood of the whole band per candidate branch was 7 % of
+    // the real CT colon's flatten CPU, on the path before the re-solve).
+    const std::size_t faces_in = std::size_t(std::count(in.begin(), in.end(), 1));
+    for (int f : enclosed_by(E_, in, 2 * faces_in + kIslandBudgetMin)) in[std::size_t(f)] = 1;
     return in;
   }
 

@@ -82,6 +82,13 @@ struct Opened {
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
 // Keeps the largest edge-connected set of faces among `keep`.
 void keep_largest_component(const Edges& E, std::vector<char>& keep);
+// The faces keep_largest_component would drop from the complement of `in` (the pieces of !in other
+// than its largest: islands `in` encloses), ascending. Pre: the surface is edge-connected. The
+// complement is flooded only from the faces next to `in`, each piece up to `budget` faces: when
+// exactly one piece reaches it, that piece is the largest and is walked no further (for a pouch
+// the complement is the whole band); else, or when pieces are left unwalked, the whole complement
+// is searched as keep_largest_component does. The same faces either way.
+std::vector<int> enclosed_by(const Edges& E, const std::vector<char>& in, std::size_t budget);
 // The kept faces (`keep[f]`), reindexed; src carried over; `new_of_old` (optional): new vertex id
 // of each old one, -1 when dropped.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old = nullptr);

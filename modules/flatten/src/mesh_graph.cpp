@@ -118,6 +118,89 @@ void keep_largest_component(const Edges& E, std::vector<char>& keep) {
   for (std::size_t f = 0; f < nf; ++f) keep[f] = keep[f] && comp[f] == best;
 }
 
+namespace {
+
+// Floods of the complement of a face set from its border (enclosed_by): each flood a piece, or
+// part of a piece that reached the budget ("big"; floods that meet are one piece: union-find).
+struct BorderFloods {
+  const Edges& E;
+  const std::vector<char>& in;
+  std::vector<int> label, root;          // per face: its flood (-1: none); per flood: union-find parent
+  std::vector<char> big;                 // per flood
+  std::vector<std::vector<int>> faces;   // per flood: the faces it labelled
+
+  int find(int a) {
+    while (root[std::size_t(a)] != a) a = root[std::size_t(a)] = root[std::size_t(root[std::size_t(a)])];
+    return a;
+  }
+  // Floods the piece of `seed` until it is complete, reaches `budget` faces or meets a big flood.
+  void flood(int seed, std::size_t budget) {
+    const int id = int(root.size());
+    root.push_back(id), big.push_back(0), faces.emplace_back(1, seed);
+    label[std::size_t(seed)] = id;
+    std::vector<int> stack{seed};
+    while (!stack.empty() && !big[std::size_t(id)]) {
+      const int f = stack.back();
+      stack.pop_back();
+      for (int e : E.fe[std::size_t(f)])
+        for (int g : E.ef[std::size_t(e)]) {
+          if (g < 0 || in[std::size_t(g)] || label[std::size_t(g)] == id) continue;
+          if (label[std::size_t(g)] >= 0) {  // another flood's face: only big floods stop unfinished
+            root[std::size_t(find(id))] = find(label[std::size_t(g)]);
+            big[std::size_t(id)] = 1;
+            continue;
+          }
+          label[std::size_t(g)] = id, stack.push_back(g), faces[std::size_t(id)].push_back(g);
+        }
+      if (faces[std::size_t(id)].size() >= budget) big[std::size_t(id)] = 1;
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<int> enclosed_by(const Edges& E, const std::vector<char>& in, std::size_t budget) {
+  BorderFloods fl{E, in, std::vector<int>(in.size(), -1), {}, {}, {}};
+  for (std::size_t f = 0; f < in.size(); ++f)
+    if (in[f])
+      for (int e : E.fe[f])
+        for (int g : E.ef[std::size_t(e)])
+          if (g >= 0 && !in[std::size_t(g)] && fl.label[std::size_t(g)] < 0) fl.flood(g, budget);
+  std::vector<int> big_roots;
+  std::size_t walked = 0, outside = 0;
+  for (std::size_t id = 0; id < fl.root.size(); ++id) {
+    walked += fl.faces[id].size();
+    if (fl.big[id]) big_roots.push_back(fl.find(int(id)));
+  }
+  std::sort(big_roots.begin(), big_roots.end());
+  big_roots.erase(std::unique(big_roots.begin(), big_roots.end()), big_roots.end());
+  for (char c : in) outside += !c;
+  int largest = -1;  // the flood that is the largest piece
+  if (big_roots.size() == 1) {
+    largest = big_roots[0];
+  } else if (big_roots.empty() && walked == outside) {  // every piece complete: keep_largest_component's choice
+    std::size_t best = 0, best_first = in.size();       // (largest; ties: the piece with the first face)
+    for (std::size_t id = 0; id < fl.faces.size(); ++id) {
+      const std::size_t first = std::size_t(*std::min_element(fl.faces[id].begin(), fl.faces[id].end()));
+      if (fl.faces[id].size() > best || (fl.faces[id].size() == best && first < best_first))
+        best = fl.faces[id].size(), best_first = first, largest = int(id);
+    }
+  }
+  std::vector<int> out;
+  if (largest >= 0 || fl.faces.empty()) {
+    for (std::size_t id = 0; id < fl.faces.size(); ++id)
+      if (!fl.big[id] && int(id) != largest) out.insert(out.end(), fl.faces[id].begin(), fl.faces[id].end());
+  } else {  // several pieces reached the budget: the whole complement
+    std::vector<char> keep(in.size());
+    for (std::size_t f = 0; f < in.size(); ++f) keep[f] = !in[f];
+    keep_largest_component(E, keep);
+    for (std::size_t f = 0; f < in.size(); ++f)
+      if (!in[f] && !keep[f]) out.push_back(int(f));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 // Surface made of the kept faces, reindexed.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old) {
   Surface r;

@@ -6,13 +6,17 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <functional>
 #include <mutex>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/huge_pages.h"
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
+#include "factor_schedule.h"
 
 namespace cf::flat_detail {
 
@@ -146,6 +150,113 @@ std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
   return ok ? order : std::vector<int>();
 }
 
+// A cholmod_common of the calling thread's own (CHOLMOD's statistics and workspace live there):
+// solves with a finished factor, and rows of one factorisation, may then run on several threads.
+struct ThreadCommon {
+  cholmod_common c{};
+  ThreadCommon() {
+    cholmod_start(&c);
+    c.print = 0;
+  }
+  ~ThreadCommon() { cholmod_finish(&c); }
+};
+
+// A factorisation from this many unknowns on has its rows split over the worker threads (below it
+// one factorisation takes a few tens of milliseconds).
+constexpr std::size_t kThreadedFactorMinRows = 20000;
+
+// Whether every column of the numeric factor L can hold its column count (then cholmod_rowfac never
+// reallocates L, which would move the arrays other threads write).
+bool columns_have_room(const cholmod_factor* L) {
+  const int* Lp = static_cast<const int*>(L->p);
+  const int* next = static_cast<const int*>(L->next);
+  const int* count = static_cast<const int*>(L->ColCount);
+  for (std::size_t j = 0; j < L->n; ++j)
+    if (Lp[next[j]] - Lp[j] < count[j]) return false;
+  return true;
+}
+
+// CPU seconds of the calling thread (COLONFLAT_FLATTEN_DEBUG: the threaded factorisation's parts).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// cholmod_rowfac over `rows` (ascending), one call per run of consecutive rows; `cpu` (optional):
+// the thread's CPU seconds it took.
+bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_factor* L, cholmod_common& common,
+                 double* cpu = nullptr) {
+  const double start = cpu ? thread_cpu_seconds() : 0.0;
+  double beta[2] = {0.0, 0.0};
+  bool ok = true;
+  for (std::size_t i = 0; i < rows.size() && ok;) {
+    std::size_t j = i + 1;
+    while (j < rows.size() && rows[j] == rows[j - 1] + 1) ++j;
+    ok = cholmod_rowfac(upper, nullptr, beta, std::size_t(rows[i]), std::size_t(rows[j - 1]) + 1, L, &common) &&
+         common.status >= CHOLMOD_OK;
+    i = j;
+  }
+  if (cpu) *cpu = thread_cpu_seconds() - start;
+  return ok;
+}
+
+// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))), each
+// column's work estimated as its squared column count.
+RowSchedule factor_schedule(cholmod_sparse* upper, const cholmod_factor* L, int parts) {
+  const std::vector<int> parent = elimination_tree(int(upper->ncol), static_cast<const int*>(upper->p),
+                                                   static_cast<const int*>(upper->i));
+  const int* count = static_cast<const int*>(L->ColCount);
+  std::vector<double> work(L->n);
+  for (std::size_t j = 0; j < L->n; ++j) work[j] = double(count[j]) * double(count[j]);
+  return schedule_rows(parent, work, parts);
+}
+
+// cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
+// cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over all
+// rows), with the rows split over the worker threads (factor_schedule.h): parts of whole subtrees
+// side by side, each with its own cholmod_common, then the rows above them. Row k reads only the
+// columns of its subtree and each column gets its entries in increasing row order, so the factor is
+// bit for bit cholmod_factorize's for any thread count. Returns -1 (nothing done) when this does
+// not apply, 0 when the factorisation failed, 1 when it succeeded.
+int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common) {
+  const int parts = thread_count();
+  if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
+  const Stopwatch sw;
+  cholmod_sparse* upper =
+      cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
+  if (!upper) return -1;
+  RowSchedule schedule = factor_schedule(upper, L, parts);
+  L->is_ll = common.final_ll ? 1 : 0;
+  const std::size_t grow2 = common.grow2;
+  if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
+  const bool numeric = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
+  common.grow2 = grow2;
+  if (numeric && !columns_have_room(L)) {  // (not expected) every row here, in order
+    schedule.parts.clear();
+    schedule.rest.resize(L->n);
+    for (std::size_t k = 0; k < L->n; ++k) schedule.rest[k] = int(k);
+  }
+  std::vector<char> ok(schedule.parts.size(), 0);
+  std::vector<double> cpu(schedule.parts.size() + 1, 0.0);  // per part, then the rest
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t p = 0; p < schedule.parts.size() && numeric; ++p)
+    tasks.push_back([&, p] {
+      ThreadCommon tc;
+      ok[p] = rowfac_rows(upper, schedule.parts[p], L, tc.c, &cpu[p]);
+    });
+  parallel_tasks(tasks);
+  const bool done = numeric && std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size()) &&
+                    rowfac_rows(upper, schedule.rest, L, common, &cpu.back()) && L->minor == L->n;
+  cholmod_free_sparse(&upper, &common);
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, largest part %.3f, rest %.3f of the "
+                 "estimated work; CPU s: parts %.2f / %.2f, rest %.2f; %.2f s\n", parts, L->n,
+                 schedule.largest_part / schedule.total_work, schedule.rest_work / schedule.total_work, cpu[0],
+                 cpu.size() > 2 ? cpu[1] : 0.0, cpu.back(), sw.seconds());
+  return done ? 1 : 0;
+}
+
 }  // namespace
 
 std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
@@ -190,23 +301,13 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
 bool SpdSolver::factorize(const SpMat& A) {
   if (factor_) {
     cholmod_sparse view = view_lower(A);
-    cholmod_factorize(&view, factor_, &common_);
-    cholmod_ok_ = common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;
+    const int threaded = factorize_on_threads(&view, factor_, common_);
+    if (threaded < 0) cholmod_factorize(&view, factor_, &common_);
+    cholmod_ok_ = threaded != 0 && common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;
     if (cholmod_ok_) return true;
   }
   return fall_back(A);
 }
-
-// A cholmod_common of the calling thread's own for solves with a finished factor (CHOLMOD's
-// statistics and workspace live there): solves may then run at the same time on several threads.
-struct SolveCommon {
-  cholmod_common c{};
-  SolveCommon() {
-    cholmod_start(&c);
-    c.print = 0;
-  }
-  ~SolveCommon() { cholmod_finish(&c); }
-};
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   if (!cholmod_ok_) return fallback_->solve(b);
@@ -216,7 +317,7 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   std::vector<std::function<void()>> columns;
   for (Eigen::Index c = 0; c < b.cols(); ++c)
     columns.push_back([&, c] {
-      SolveCommon common;
+      ThreadCommon common;
       const Eigen::MatrixXd column = b.col(c);
       cholmod_dense rhs = view_dense(column);
       cholmod_dense* xc = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common.c);
@@ -229,7 +330,7 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
 
 // P, L, (the rows past the leading block zeroed), D, L^T, P^T: one step at a time.
 Eigen::MatrixXd SpdSolver::cholmod_leading(const Eigen::MatrixXd& b, int leading) const {
-  SolveCommon common;
+  ThreadCommon common;
   cholmod_dense rhs = view_dense(b);
   cholmod_dense* y = cholmod_solve(CHOLMOD_P, factor_, &rhs, &common.c);
   for (int system : {CHOLMOD_L, CHOLMOD_D, CHOLMOD_Lt, CHOLMOD_Pt}) {

@@ -6,10 +6,14 @@
 #include <map>
 #include <cmath>
 #include <random>
+#include <cstring>
+#include <utility>
 
+#include "../src/factor_schedule.h"
 #include "../src/flatten_internal.h"
 #include "../src/spd_solver.h"
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 
 namespace {
 
@@ -246,4 +250,105 @@ TEST(FlattenSolver, NestedDissectionOrderSolvesWithFewerOperationsThanAmd) {
   const double amd_residual = (full * amd.solve(b) - b).norm();
   EXPECT_LT((full * nd.solve(b) - b).norm(), std::max(10 * amd_residual, 1e-12 * b.norm()));
   if (amd.factor_flops() > 0) EXPECT_LT(nd.factor_flops(), 0.9 * amd.factor_flops());
+}
+
+namespace {
+
+// The system of a 150 x 150 grid (22 500 unknowns: above the threaded factorisation's threshold)
+// and its nested dissection order.
+struct NestedGrid {
+  SpdSolver::SpMat A;
+  std::vector<int> order;
+};
+NestedGrid nested_grid() {
+  const int nx = 150, nv = nx * nx;
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 17));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  NestedGrid g{grid_system(E, nx, all, nv), {}};
+  g.order = SpdSolver::nested_dissection_order(g.A);
+  return g;
+}
+
+}  // namespace
+
+// The rows of a nested dissection factor split into two parts of whole elimination subtrees (each
+// row's parent in its own part or above both, every row once) that are about even, with little
+// left above them: the split the threaded factorisation computes side by side.
+TEST(FlattenSolver, RowScheduleSplitsTheEliminationTreeIntoIndependentEvenParts) {
+  const NestedGrid g = nested_grid();
+  const int n = int(g.A.rows());
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> place(n);  // unknown -> its place
+  for (int k = 0; k < n; ++k) place.indices()[g.order[std::size_t(k)]] = k;
+  SpdSolver::SpMat permuted, upper;
+  permuted = g.A.selfadjointView<Eigen::Lower>().twistedBy(place);
+  upper = permuted.triangularView<Eigen::Upper>();
+  upper.makeCompressed();
+  const std::vector<int> parent = cf::flat_detail::elimination_tree(n, upper.outerIndexPtr(), upper.innerIndexPtr());
+  const cf::flat_detail::RowSchedule s = cf::flat_detail::schedule_rows(parent, std::vector<double>(n, 1.0), 2);
+  ASSERT_EQ(s.parts.size(), 2u);
+  std::vector<int> where(n, -2);  // part of each row, -1: the rest
+  for (int p = 0; p < 2; ++p)
+    for (int k : s.parts[p]) EXPECT_EQ(std::exchange(where[k], p), -2) << "row " << k << " twice";
+  for (int k : s.rest) EXPECT_EQ(std::exchange(where[k], -1), -2) << "row " << k << " twice";
+  for (int k = 0; k < n; ++k) {
+    ASSERT_NE(where[k], -2) << "row " << k << " in no part";
+    if (parent[k] < 0) continue;
+    if (where[k] >= 0) {
+      EXPECT_TRUE(where[parent[k]] == where[k] || where[parent[k]] == -1) << k;
+    } else {
+      EXPECT_EQ(where[parent[k]], -1) << k;
+    }
+  }
+  EXPECT_DOUBLE_EQ(s.total_work, double(n));
+  EXPECT_LT(s.largest_part, 0.6 * n);
+  EXPECT_LT(s.rest_work, 0.05 * n);
+}
+
+// The factorisation with its rows on two threads is bit for bit CHOLMOD's sequential one (one
+// thread): the same solution to the last bit, and it solves the system.
+TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
+  const NestedGrid g = nested_grid();
+  const int n = int(g.A.rows());
+  Eigen::MatrixXd b(n, 2);
+  for (int i = 0; i < n; ++i) b(i, 0) = std::sin(0.013 * i) + 0.3, b(i, 1) = std::cos(0.007 * i);
+  Eigen::MatrixXd x[2];
+  for (int threads : {1, 2}) {
+    cf::set_thread_count(threads);
+    SpdSolver solver;
+    ASSERT_TRUE(solver.compute(g.A, &g.order));
+    x[threads - 1] = solver.solve(b);
+  }
+  cf::set_thread_count(0);
+  const SpdSolver::SpMat full = g.A.selfadjointView<Eigen::Lower>();
+  EXPECT_LT((full * x[1] - b).norm(), 1e-9 * b.norm());
+  EXPECT_EQ(std::memcmp(x[0].data(), x[1].data(), sizeof(double) * std::size_t(x[0].size())), 0);
+}
+
+// The islands a ring of faces encloses on a grid (the faces inside it), found from the ring's
+// border, are the faces keep_largest_component drops from the ring's complement, whether no piece,
+// one piece or every piece of the complement reaches the flood budget.
+TEST(FlattenSolver, EnclosedFacesAreTheIslandsKeepLargestComponentDrops) {
+  const int nx = 40;
+  const std::vector<Tri> t = grid_faces(nx, nx, 23);
+  const auto E = cf::flat_detail::build_edges(t);
+  std::vector<char> in(t.size(), 0);
+  std::vector<int> island;
+  for (std::size_t f = 0; f < t.size(); ++f) {
+    double x = 0, y = 0;
+    for (int v : t[f]) x += (v % nx) / 3.0, y += (v / nx) / 3.0;
+    const double r = std::hypot(x - 20, y - 20);
+    in[f] = r >= 5 && r < 8;
+    if (r < 5) island.push_back(int(f));
+  }
+  std::vector<char> keep(t.size());
+  for (std::size_t f = 0; f < t.size(); ++f) keep[f] = !in[f];
+  cf::flat_detail::keep_largest_component(E, keep);
+  std::vector<int> dropped;
+  for (std::size_t f = 0; f < t.size(); ++f)
+    if (!in[f] && !keep[f]) dropped.push_back(int(f));
+  ASSERT_EQ(dropped, island);
+  ASSERT_GT(island.size(), 100u);
+  for (std::size_t budget : {std::size_t(1), std::size_t(400), t.size()})
+    EXPECT_EQ(cf::flat_detail::enclosed_by(E, in, budget), island) << "budget " << budget;
 }

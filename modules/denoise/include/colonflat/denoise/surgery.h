@@ -29,6 +29,7 @@ struct SurgeryOptions {
   FaceGrid* guard = nullptr;  // when set: try placements until the new geometry intersects
                               // nothing (see SurgeryResult::intersections), and update the grid
   bool restricted = true;  // with a guard: also the triangulations restricted to clean triangles
+  bool front = true;       // with a guard: also front caps (grown from the ring, steered off the surface)
   bool trial = false;      // with a guard: the caller keeps the result only when it intersects
                            // nothing, so concentric caps stay in their first placement (their
                            // pairs counted, not minimised over the placements)
@@ -49,7 +50,8 @@ struct SurgeryResult {
   std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
   Mesh::VertexHandle left_cap, right_cap;                 // cap centres
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
-  const char* caps = "concentric";  // which step made the caps: plain, collar, restricted or concentric
+  const char* caps = "concentric";  // which step made the caps: plain, collar, front, restricted or concentric
+  int placement = -1;  // index of the ring placement the triangulated caps were made in (0 = the first); -1: concentric
   SurgeryUndo undo;
 };
 

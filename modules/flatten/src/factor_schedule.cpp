@@ -1,0 +1,165 @@
+// Rows of a sparse factor split over threads along the elimination tree (see factor_schedule.h).
+#include "factor_schedule.h"
+
+#include <algorithm>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
+
+namespace cf::flat_detail {
+
+std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind) {
+  std::vector<int> parent(std::size_t(n), -1), ancestor(std::size_t(n), -1);
+  for (int k = 0; k < n; ++k)
+    for (int p = colptr[k]; p < colptr[k + 1]; ++p)
+      for (int i = rowind[p]; i >= 0 && i < k;) {  // climb from i to its root, compressing the path to k
+        const int next = ancestor[std::size_t(i)];
+        ancestor[std::size_t(i)] = k;
+        if (next < 0) {
+          parent[std::size_t(i)] = k;
+          break;
+        }
+        i = next;
+      }
+  return parent;
+}
+
+namespace {
+
+// The elimination tree with child lists (ascending) and the work of every subtree.
+struct Tree {
+  std::vector<int> start, child, roots;  // children of k: child[start[k] .. start[k + 1])
+  std::vector<double> subtree;
+};
+
+Tree build_tree(const std::vector<int>& parent, const std::vector<double>& work) {
+  const std::size_t n = parent.size();
+  Tree t;
+  t.start.assign(n + 1, 0);
+  for (std::size_t k = 0; k < n; ++k)
+    if (parent[k] >= 0) ++t.start[std::size_t(parent[k]) + 1];
+  for (std::size_t k = 0; k < n; ++k) t.start[k + 1] += t.start[k];
+  t.child.resize(std::size_t(t.start[n]));
+  std::vector<int> fill(t.start.begin(), t.start.end() - 1);
+  t.subtree = work;
+  for (std::size_t k = 0; k < n; ++k) {  // children come before their parent: k's subtree is complete here
+    if (parent[k] < 0) {
+      t.roots.push_back(int(k));
+      continue;
+    }
+    const std::size_t p = std::size_t(parent[k]);
+    t.child[std::size_t(fill[p]++)] = int(k);
+    t.subtree[p] += t.subtree[k];
+  }
+  return t;
+}
+
+// Heaviest subtree first, ties by row index.
+struct Heavier {
+  const Tree* t;
+  bool operator()(int a, int b) const {
+    const double wa = t->subtree[std::size_t(a)], wb = t->subtree[std::size_t(b)];
+    return wa != wb ? wa > wb : a < b;
+  }
+};
+
+// The subtrees dealt largest first, each to the lightest part (ties: the lowest part); returns the
+// largest part's work and, when asked, each subtree's part (in the order of `roots` sorted).
+double deal(const Tree& t, std::vector<int>& roots, int parts, std::vector<int>* owner = nullptr) {
+  std::sort(roots.begin(), roots.end(), Heavier{&t});
+  using Load = std::pair<double, int>;
+  std::priority_queue<Load, std::vector<Load>, std::greater<Load>> lightest;
+  for (int p = 0; p < parts; ++p) lightest.push({0.0, p});
+  double largest = 0;
+  if (owner) owner->clear();
+  for (int r : roots) {
+    Load l = lightest.top();
+    lightest.pop();
+    l.first += t.subtree[std::size_t(r)];
+    largest = std::max(largest, l.first);
+    if (owner) owner->push_back(l.second);
+    lightest.push(l);
+  }
+  return largest;
+}
+
+// Splitting stops when the heaviest subtree is below this share of one part's ideal work (the
+// dealing is then within it of the best), after kMaxSplits splits, or with more than
+// kMaxSubtreesPerPart subtrees per part (each step deals them all again).
+constexpr double kFineEnough = 0.05;
+constexpr int kMaxSplits = 20000, kMaxSubtreesPerPart = 64;
+
+// The subtrees dealt and the rows moved to the rest after `splits` splits of the heaviest subtree.
+struct Split {
+  std::vector<int> heap, rest;  // heap: the subtrees (a max-heap by Heavier's order reversed)
+  double rest_work = 0;
+};
+
+void split_heaviest(const Tree& t, const std::vector<double>& work, Split& s) {
+  const auto lighter = [&t](int a, int b) { return Heavier{&t}(b, a); };
+  std::pop_heap(s.heap.begin(), s.heap.end(), lighter);
+  const int k = s.heap.back();
+  s.heap.pop_back();
+  s.rest.push_back(k);
+  s.rest_work += work[std::size_t(k)];
+  for (int c = t.start[std::size_t(k)]; c < t.start[std::size_t(k) + 1]; ++c) {
+    s.heap.push_back(t.child[std::size_t(c)]);
+    std::push_heap(s.heap.begin(), s.heap.end(), lighter);
+  }
+}
+
+// How many splits give the smallest largest part + rest.
+int best_split_count(const Tree& t, const std::vector<double>& work, double total, int parts) {
+  const auto lighter = [&t](int a, int b) { return Heavier{&t}(b, a); };
+  Split s{t.roots, {}, 0.0};
+  std::make_heap(s.heap.begin(), s.heap.end(), lighter);
+  double best = std::numeric_limits<double>::infinity();
+  int best_count = 0;
+  for (int count = 0;; ++count) {
+    std::vector<int> roots = s.heap;
+    const double makespan = deal(t, roots, parts) + s.rest_work;
+    if (makespan < best) best = makespan, best_count = count;
+    if (s.heap.empty() || count >= kMaxSplits || s.heap.size() > std::size_t(kMaxSubtreesPerPart * parts)) break;
+    if (t.subtree[std::size_t(s.heap.front())] * parts < kFineEnough * total) break;
+    split_heaviest(t, work, s);
+  }
+  return best_count;
+}
+
+}  // namespace
+
+RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<double>& work, int parts) {
+  RowSchedule out;
+  parts = std::max(1, parts);
+  const Tree t = build_tree(parent, work);
+  for (double w : work) out.total_work += w;
+  const int splits = best_split_count(t, work, out.total_work, parts);
+  const auto lighter = [&t](int a, int b) { return Heavier{&t}(b, a); };
+  Split s{t.roots, {}, 0.0};
+  std::make_heap(s.heap.begin(), s.heap.end(), lighter);
+  for (int i = 0; i < splits; ++i) split_heaviest(t, work, s);
+  std::vector<int> roots = s.heap, owner;
+  deal(t, roots, parts, &owner);
+  out.parts.assign(std::size_t(parts), {});
+  std::vector<double> part_work(std::size_t(parts), 0.0);
+  for (std::size_t r = 0; r < roots.size(); ++r) {  // each subtree's rows into its part
+    std::vector<int>& rows = out.parts[std::size_t(owner[r])];
+    part_work[std::size_t(owner[r])] += t.subtree[std::size_t(roots[r])];
+    std::vector<int> stack{roots[r]};
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      rows.push_back(k);
+      for (int c = t.start[std::size_t(k)]; c < t.start[std::size_t(k) + 1]; ++c) stack.push_back(t.child[std::size_t(c)]);
+    }
+  }
+  for (std::vector<int>& rows : out.parts) std::sort(rows.begin(), rows.end());
+  out.rest = std::move(s.rest);
+  std::sort(out.rest.begin(), out.rest.end());
+  out.rest_work = s.rest_work;
+  out.largest_part = *std::max_element(part_work.begin(), part_work.end());
+  return out;
+}
+
+}  // namespace cf::flat_detail

@@ -1,0 +1,35 @@
+#pragma once
+// Rows of a sparse LDL^T factor split over threads. CHOLMOD's simplicial factorisation is
+// up-looking: row k of L is computed from A's column k and the columns of L of k's descendants in
+// the elimination tree, and writes only those columns and its own. Rows of disjoint subtrees are
+// therefore independent: several threads may compute them at once on one factor, and the rows
+// above them (their ancestors) follow. Every row's arithmetic is the same whoever computes it and
+// every column still receives its entries in increasing row order, so the factor is bit for bit
+// the factor of the sequential factorisation, for any split (see spd_solver.cpp).
+#include <vector>
+
+namespace cf::flat_detail {
+
+struct RowSchedule {
+  // Rows computed side by side: each part a union of whole elimination subtrees, rows ascending.
+  std::vector<std::vector<int>> parts;
+  // The rows computed after every part (ancestors of the parts' subtrees), ascending.
+  std::vector<int> rest;
+  // Estimated work (sum of the `work` given) of the largest part, of `rest` and of all rows.
+  double largest_part = 0, rest_work = 0, total_work = 0;
+};
+
+// Elimination tree of a symmetric matrix given by its upper triangle in compressed columns (column
+// k: rows <= k, colptr[n + 1], rowind[colptr[n]]): parent[k] > k, or -1 for a root (Liu's algorithm
+// with path compression).
+std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind);
+
+// Splits the rows of the elimination tree `parent` into `parts` unions of whole subtrees and the
+// rest above them, so that the largest part plus the rest (the time with `parts` threads) is as
+// small as this search finds: starting from the roots, the heaviest subtree is repeatedly replaced
+// by its children (its own row goes to the rest), the subtrees dealt to the parts largest first,
+// each to the lightest part; the best split seen is kept. `work[k]` >= 0: the estimated cost of
+// row k's column (the caller: its squared column count). Deterministic (ties by row index).
+RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<double>& work, int parts);
+
+}  // namespace cf::flat_detail
