@@ -42,6 +42,7 @@
 #include "colonflat/phantom/mask_phantom.h"
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/segment/segment.h"
+#include "segment_bench_links.h"
 
 namespace fs = std::filesystem;
 
@@ -352,7 +353,6 @@ const PaintedCase kPaintedCases[] = {
     {"bowel", "supine", true, 0, false, true, 0},       {"hard", "supine", true, 200, true, true, 0.6},
     {"hard", "prone", false, 200, true, true, 1.5},     {"hard", "left-down", false, 200, true, true, 1.0}};
 
-
 double long_stretch_kept(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
   if (p.bodies.empty() || p.bodies[0].kind != "stretch" || p.bodies[0].to_mm - p.bodies[0].from_mm < 150) return -1;
   return 100 * cf::score_fluid_bodies(seg, p).at(0).kept;
@@ -406,6 +406,7 @@ void painted_table(const std::string& mask_file, int downsample, const std::stri
                   100 * s.fluid_kept, long_stretch_kept(p, seg), s.outside_ml, s.small_bowel_ml, st.gravity.c_str(),
                   st.gravity_source.c_str());
       print_lost_bodies(p, seg);
+      dump_links(st, p, seed, std::string(c.name) + " " + c.position);
       std::fflush(stdout);
     }
   }
@@ -461,9 +462,8 @@ BENCHMARK(BM_GenerateSmallPhantom)->Unit(benchmark::kMillisecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false;
+  bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false, seeds_given = false;
   int pad_to = 0, downsample = 1;
-  bool seeds_given = false;
   std::string mask_file = std::string(COLONFLAT_SHARED_DIR) + "/real/ctc_lumen_mask_a.nii.gz";
   std::string size = "full", real, cases;
   std::vector<int> seeds = {1, 2, 3, 4, 5};

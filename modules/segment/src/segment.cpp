@@ -23,7 +23,7 @@
 namespace cf {
 
 nlohmann::json SegmentStats::to_json() const {
-  return {{"segments", segments},
+  nlohmann::json j = {{"segments", segments},
           {"segment_volumes_ml", segment_volumes_ml},
           {"lumen_volume_ml", lumen_volume_ml},
           {"fluid_volume_ml", fluid_volume_ml},
@@ -46,6 +46,8 @@ nlohmann::json SegmentStats::to_json() const {
           {"timings_s", timings},
           {"cpu_time_s", cpu_time_s},
           {"cpu_timings_s", cpu_timings}};
+  if (!links.empty()) j["links"] = links;
+  return j;
 }
 
 void validate(const SegmentOptions& o) {
@@ -97,6 +99,7 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
     if (std::abs(D[a][grav_axis_]) > std::abs(D[lps][grav_axis_])) lps = a;
   st_.gravity = names[lps][D[lps][grav_axis_] * grav_sign_ > 0 ? 1 : 0];
   summarize_decisions();
+  st_.links = link_log_;
   if (stats) *stats = st_;
   return out;
 }

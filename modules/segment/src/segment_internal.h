@@ -208,6 +208,11 @@ class ColonSegmenter {
   void link_tagged_stretches();
   std::size_t link_pass(std::vector<unsigned char>& eligible, std::vector<std::string>& why, std::vector<double>& kept_gap);
   bool continues_colon(const Contact& c, std::string& why) const;
+  bool judge_link(const Contact& c, const LocalShape& sg, const LocalShape& sf, std::string& why) const;
+  void sample_candidates(const RunLabels& cl, const std::vector<BodyStats>& bodies);
+  void log_link(const Contact& c, const LocalShape& sg, const LocalShape& sf, bool ok, const std::string& why) const;
+  std::pair<std::size_t, std::size_t> facing_cells(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
+  nlohmann::json gap_profile(const Contact& c) const;
   bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
   double gap_fat_mm(const Contact& c) const;
   void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
@@ -252,6 +257,9 @@ class ColonSegmenter {
   std::vector<std::size_t> gas_voxels_;  // per crop gas component: its voxels
   std::map<std::uint32_t, std::vector<std::size_t>> ends_;  // per linked body: the link-grid cells of the ends its links use
   std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> interfaces_;  // (candidate, gas body) -> columns (linking)
+  mutable nlohmann::json link_log_ = nlohmann::json::array();  // COLONFLAT_SEGMENT_LINKS
+  std::vector<std::vector<std::array<double, 3>>> cand_samples_;
+  std::vector<double> cand_ml_;  // per candidate: LPS of some of its voxels (link log)
   std::vector<std::uint32_t> kept_id_;     // per candidate: link-grid id of the colon body it belongs to (0: not kept)
   std::unique_ptr<LinkGrid> grid_;         // coarse cells of the linking step (select_segments .. link_tagged_stretches)
   Bytes state_;                        // crop: final 0/1 (after the graph cut)

@@ -32,6 +32,14 @@ constexpr std::size_t kContactsPerPair = 3;
 // the two bodies are separate bowels with pericolic or mesenteric fat between them.
 constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
 constexpr double kContactSeparationMm = 20;
+// How far a body narrows toward a contact: its nearest front's cross-section (cells) over its widest
+// front's within the shape radius (1: full calibre up to the contact). At a collapsed neck the colon
+// narrows into the neck from both sides (one tube, its wall folded in), so both bodies narrow alike.
+double narrowing(const LocalShape& s) {
+  std::size_t widest = 0;
+  for (const Front& f : s.fronts) widest = std::max(widest, f.cells);
+  return widest ? double(s.fronts.front().cells) / double(widest) : 1.0;
+}
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
   std::ostringstream s;
@@ -147,6 +155,7 @@ void ColonSegmenter::link_tagged_stretches() {
     else if (bodies[l].touches_face) why[l] = "reaches beyond the colon's region (bone, vessel, bladder)";
     else eligible[l] = 1, why[l] = "no colon segment end within --link-gap";
   }
+  if (std::getenv("COLONFLAT_SEGMENT_LINKS")) sample_candidates(cl, bodies);
   interfaces_ = gas_fluid_interfaces(RunLookup(cl));
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_interfaces(bodies);
   std::vector<double> kept_gap(n + 1, -1);
@@ -169,6 +178,23 @@ void ColonSegmenter::link_tagged_stretches() {
     for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
       for (std::size_t q = r->start; q < r->start + r->length; ++q) lab_[q] = keep[l] ? (hu_[q] < opts_.air_threshold ? kGas : kPool) : 0;
   grid_.reset();
+}
+
+// Per candidate its volume and the LPS of up to about 24 of its voxels (run middles), for the link log.
+void ColonSegmenter::sample_candidates(const RunLabels& cl, const std::vector<BodyStats>& bodies) {
+  const std::uint32_t n = cl.count();
+  cand_samples_.assign(n + 1, {});
+  cand_ml_.assign(n + 1, 0);
+  for (std::uint32_t l = 1; l <= n; ++l) {
+    cand_ml_[l] = double(bodies[l].voxels) * voxel_ml_;
+    const std::size_t runs = std::size_t(cl.end(l) - cl.begin(l)), step = std::max<std::size_t>(1, runs / 24);
+    for (const Run* r = cl.begin(l); r < cl.end(l); r += step) {
+      std::size_t i, j, k;
+      d_.coords(r->start + r->length / 2, i, j, k);
+      const double v[3] = {double(i), double(j), double(k)};
+      cand_samples_[l].push_back(lps_of(v));
+    }
+  }
 }
 
 // One pass over the contacts, nearest first: a candidate whose contact passes continues_colon at a
@@ -222,8 +248,14 @@ bool ColonSegmenter::end_is_free(std::uint32_t segment, const LocalShape& near) 
 bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   const LocalShape sg = grid_->segment_shape(c.segment, c.to, kShapeRadiusMm);
   const LocalShape sf = grid_->candidate_shape(c.candidate, c.from, kShapeRadiusMm);
-  const Eigen::Vector3d link = grid_->mm(c.from) - grid_->mm(c.to);
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_link(c, sg, sf);
+  const bool ok = judge_link(c, sg, sf, why);
+  if (std::getenv("COLONFLAT_SEGMENT_LINKS")) log_link(c, sg, sf, ok, ok ? std::string("linked") : why);
+  return ok;
+}
+
+bool ColonSegmenter::judge_link(const Contact& c, const LocalShape& sg, const LocalShape& sf, std::string& why) const {
+  const Eigen::Vector3d link = grid_->mm(c.from) - grid_->mm(c.to);
   if (sg.fronts.empty() || sf.fronts.empty()) return why = "too small near the link", false;
   for (const Front& f : sg.fronts)
     if (f.pieces >= 2) return why = "lies beside a colon segment, not at its end", false;
@@ -240,6 +272,8 @@ bool ColonSegmenter::continues_colon(const Contact& c, std::string& why) const {
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
   const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
   if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
+  const double ng = narrowing(sg), nf = narrowing(sf);
+  if (std::min(ng, nf) < kMinCalibreRatio * std::max(ng, nf)) return why = "a blunt end beside a tapering colon end (not a collapsed neck)", false;
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
   if (ug.dot(uf) < 0.3) return why = "does not continue the colon's direction", false;
   const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});
@@ -272,6 +306,78 @@ double ColonSegmenter::gap_fat_mm(const Contact& c) const {
     best = std::max(best, run);
   }
   return best;
+}
+
+// Each body's cells (its shape region near the contact) within gap + one cell of the other body's
+// (link log): a neck meets tip to tip, a loop lying along an end cap faces it over a larger area.
+std::pair<std::size_t, std::size_t> ColonSegmenter::facing_cells(const Contact& c, const LocalShape& sg, const LocalShape& sf) const {
+  const double cell = std::max({grid_->dims().sp[0], grid_->dims().sp[1], grid_->dims().sp[2]});
+  const double reach = c.gap_mm + cell + 1e-6;
+  const Eigen::Vector3d a = grid_->mm(c.to), b = grid_->mm(c.from);
+  std::vector<Eigen::Vector3d> ps, pf;
+  for (const auto& e : sg.region)
+    if ((grid_->mm(e.first) - a).norm() <= reach + 25) ps.push_back(grid_->mm(e.first));
+  for (const auto& e : sf.region)
+    if ((grid_->mm(e.first) - b).norm() <= reach + 25) pf.push_back(grid_->mm(e.first));
+  auto facing = [&](const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y) {
+    std::size_t n = 0;
+    for (const auto& p : x)
+      n += std::any_of(y.begin(), y.end(), [&](const Eigen::Vector3d& q) { return (p - q).norm() <= reach; });
+    return n;
+  };
+  return {facing(ps, pf), facing(pf, ps)};
+}
+
+// HU (nearest voxel) at 25 points on the straight line between the contact's two cell centres (link log).
+nlohmann::json ColonSegmenter::gap_profile(const Contact& c) const {
+  const Eigen::Vector3d fa = grid_->fine_centre(c.to), fb = grid_->fine_centre(c.from);
+  nlohmann::json prof = nlohmann::json::array();
+  for (int t = 0; t <= 24; ++t) {
+    const Eigen::Vector3d p = fa + (fb - fa) * (double(t) / 24);
+    long x[3];
+    for (int k = 0; k < 3; ++k) x[k] = std::clamp(std::lround(p[k]), 0L, long(d_.n[k]) - 1);
+    prof.push_back(std::lround(hu_[d_.idx(std::size_t(x[0]), std::size_t(x[1]), std::size_t(x[2]))]));
+  }
+  return prof;
+}
+
+// The link log (COLONFLAT_SEGMENT_LINKS=1, stats.links): every judged contact with the measures
+// considered for telling a collapsed neck from a loop pressed on a colon end (issue 25, session 14).
+void ColonSegmenter::log_link(const Contact& c, const LocalShape& sg, const LocalShape& sf, bool ok, const std::string& why) const {
+  nlohmann::json j;
+  j["candidate"] = c.candidate;
+  j["segment"] = c.segment;
+  j["segment_is_candidate"] = c.segment >= kKeptCandidateId;
+  j["gap_mm"] = c.gap_mm;
+  j["ok"] = ok;
+  j["why"] = why;
+  j["fat_mm"] = gap_fat_mm(c);
+  auto fronts = [](const LocalShape& s) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const Front& f : s.fronts) a.push_back({f.cells, f.pieces, f.centroid.norm() / f.radius_mm});
+    return a;
+  };
+  j["seg_fronts"] = fronts(sg);
+  j["cand_fronts"] = fronts(sf);
+  const Eigen::Vector3d a = grid_->mm(c.to), b = grid_->mm(c.from);
+  const double pa[3] = {grid_->fine_centre(c.to)[0], grid_->fine_centre(c.to)[1], grid_->fine_centre(c.to)[2]};
+  const double pb[3] = {grid_->fine_centre(c.from)[0], grid_->fine_centre(c.from)[1], grid_->fine_centre(c.from)[2]};
+  j["seg_lps"] = lps_of(pa);
+  j["cand_lps"] = lps_of(pb);
+  if (!sg.fronts.empty() && !sf.fronts.empty()) {
+    const Eigen::Vector3d ug = -sg.fronts[0].centroid.normalized(), uf = sf.fronts[0].centroid.normalized();
+    j["dir"] = ug.dot(uf);
+    if ((b - a).norm() > 0) j["seg_axis_link"] = ug.dot((b - a).normalized()), j["cand_axis_link"] = uf.dot((b - a).normalized());
+  }
+  const auto [facing_seg, facing_cand] = facing_cells(c, sg, sf);
+  j["facing_seg"] = facing_seg;
+  j["facing_cand"] = facing_cand;
+  j["profile"] = gap_profile(c);
+  if (c.candidate < cand_ml_.size()) j["cand_ml"] = cand_ml_[c.candidate];
+  if (c.candidate < cand_samples_.size()) j["cand_samples"] = cand_samples_[c.candidate];
+  if (c.segment >= kKeptCandidateId && c.segment - kKeptCandidateId < cand_samples_.size())
+    j["seg_samples"] = cand_samples_[c.segment - kKeptCandidateId];
+  link_log_.push_back(j);
 }
 
 void ColonSegmenter::debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const {

@@ -178,6 +178,29 @@ TEST(SegmentRules, TubeAcrossFatFromColonEndRejected) {
   }
 }
 
+// Issue 25, session 14 (painted seed 3 "bowel" supine, reduced): a gas colon narrowing to a tip over
+// 60 mm, and 5 mm of soft tissue beyond the tip a contrast tube of constant calibre with a blunt end,
+// in line (calibre, direction, no fat: every other link test passes). A collapsed neck narrows from
+// both sides, so the blunt tube is rejected; the same tube narrowing to its own tip is kept.
+TEST(SegmentRules, BluntTubeAtTaperingColonTipRejected) {
+  for (bool tapering : {false, true}) {
+    SCOPED_TRACE(tapering);
+    auto ct = make_volume(140, [&](double x, double y, double z) {
+      const double d = tube_dist(y, z, 70, 70);
+      if (x >= 8 && x <= 70 && d < 1 + 0.01 * std::pow(70 - x, 1.7)) return -1000.0;
+      const double loop_r = tapering ? std::min(8.0, 1 + 0.01 * std::pow(std::max(0.0, x - 75), 1.7)) : 6.0;
+      if (x >= 75 && x <= 132 && d < loop_r) return 500.0;
+      if (tube_dist(x, y, 128, 25) < 5 && std::abs(z - 70) < 5) return -1000.0;  // a bubble: the crop (gas + 45 mm) holds the tube
+      return kKeep;
+    }, 0.6, 10);
+    auto [m, st] = segment_small(ct, tagged_options(1));
+    EXPECT_EQ(st.tagged_stretches, tapering ? 1 : 0) << st.to_json()["decisions"].dump(1);
+    EXPECT_EQ(at(m, 110, 70, 70), tapering);
+    EXPECT_TRUE(at(m, 20, 70, 70));
+    if (!tapering) EXPECT_TRUE(has_decision(st, "rejected", "blunt end beside a tapering colon end")) << st.to_json()["decisions"].dump(1);
+  }
+}
+
 // A catheter (air channel 2 mm, plastic wall to 3.5 mm at 150 HU) enters from the inferior face
 // and runs 20 mm up inside the rectal gas with an open tip: neither its channel nor its wall is
 // lumen, the rectal gas beside it is.

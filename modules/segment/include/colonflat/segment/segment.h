@@ -44,6 +44,7 @@ struct SegmentStats {
   double rectal_tube_trimmed_ml = 0;          // thin gas channel trimmed at the inferior face
   nlohmann::json decisions = nlohmann::json::array();  // kept/rejected bodies >= 1 mL: what, volume, LPS, reason
   nlohmann::json decision_counts = nlohmann::json::array();  // every decision, grouped by reason: count, mL
+  nlohmann::json links = nlohmann::json::array();  // COLONFLAT_SEGMENT_LINKS=1: every contact the linking step judged
   double time_s = 0, graph_cut_time_s = 0;
   double peak_memory_mib = 0;
   nlohmann::json timings;  // seconds per step (wall clock)
