@@ -1,5 +1,6 @@
 #include "colonflat/register/pieces.h"
 
+#include "branch_order.h"
 #include "piece_split.h"
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <tuple>
 
 namespace cf {
 
@@ -83,7 +85,7 @@ std::vector<Eigen::Vector3d> piece_centre(const ColonScan& scan, int seg, double
 }
 
 // A reference branch piece starts at its neck's s on its band, after the branches inserted at the
-// band's earlier necks (at one neck: the lower segment id first); without its band it is unregistered.
+// band's earlier necks (at one neck: in the order of branch_order.h); without its band it is unregistered.
 void seat_branches(std::vector<ColonPiece>& ref) {
   for (auto& b : ref) {
     if (!b.branch) continue;
@@ -94,7 +96,7 @@ void seat_branches(std::vector<ColonPiece>& ref) {
       double before = 0;
       for (const auto& o : ref)
         if (o.branch && o.parent == b.parent && o.segment != b.segment &&
-            std::make_pair(std::min(o.attach_mm, band.length_mm), o.segment) < std::make_pair(neck, b.segment))
+            std::make_tuple(std::min(o.attach_mm, band.length_mm), o.neck_rank, o.segment) < std::make_tuple(neck, b.neck_rank, b.segment))
           before += o.length_mm;
       b.start_mm = band.start_mm + neck + before, b.registered = true;
     }
@@ -333,6 +335,7 @@ ColonPiece band_piece(const ColonScan& scan, int seg, double length, double bin)
   ColonPiece p;
   p.segment = seg;
   p.length_mm = std::max(length, bin);
+  p.bin_mm = bin;
   if (const auto* e = segment_entry(scan, seg)) {
     if (e->contains("x0_end") && (*e)["x0_end"].is_string()) p.x0_end = (*e)["x0_end"];
     if (e->contains("x1_end") && (*e)["x1_end"].is_string()) p.x1_end = (*e)["x1_end"];
@@ -350,6 +353,7 @@ ColonPiece branch_piece(const ColonScan& scan, int seg, double length, const std
                         const std::vector<ColonPiece>& bands, double bin) {
   ColonPiece p = band_piece(scan, seg, length, bin);
   p.branch = true, p.parent = neck.first, p.attach_mm = neck.second;
+  p.on_band = segment_entry(scan, seg) && segment_entry(scan, seg)->value("parent", -1) == neck.first;
   Eigen::Vector3d at = p.centre.front();
   const auto* e = segment_entry(scan, seg);
   if (e && e->contains("attach_lps_mm") && (*e)["attach_lps_mm"].is_array() && (*e)["attach_lps_mm"].size() == 3) {
@@ -406,6 +410,7 @@ std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& 
   for (const auto& [seg, neck] : branch_necks(scan))
     if (const auto it = length.find(seg); it != length.end() && it->second >= o.min_branch_piece_mm)
       out.push_back(branch_piece(scan, seg, it->second, neck, out, o.bin_mm));
+  order_branches_at_necks(out, o.same_neck_mm);
   return out;
 }
 

@@ -254,6 +254,31 @@ TEST(RegisterPieces, BandTurningBackAlongTheColonIsCutInTwo) {
   expect_every_polyp_paired(s);
 }
 
+// The supine keeps material 220-290 and 290-370 mm as two side branches hanging at one neck (220),
+// the second with the lower segment id (flatten's ids say nothing of the course), the prone split
+// into 3 more pieces (the supine the reference): the colon runs out along the first branch and on
+// along the second, so both are inserted in that order (branch_order.h): each branch's vertices
+// within 10 mm of their material place, every polyp seen in both paired right, median <= 10 mm
+// (e375ce1 inserted them by segment id: 290-370 first, each stretch 70-80 mm off).
+TEST(RegisterPieces, TwoBranchesAtOneNeckAreInsertedInTheirCourse) {
+  SyntheticPairOptions o = long_pair(3);
+  o.prone_removed = {{150, 160}, {420, 432}, {600, 610}};
+  SyntheticPair pair = make_synthetic_pair(o);
+  ColonScan& s = pair.supine;
+  make_side_branch(s, pair.supine_sigma, 290, 370);
+  make_side_branch(s, pair.supine_sigma, 220, 290);
+  const nlohmann::json neck = s.segments.back();  // both hang at the neck at material 220 (the second cut)
+  for (auto& seg : s.segments)
+    if (seg.value("kind", std::string()) == "branch") seg["attach_mm"] = neck["attach_mm"], seg["attach_lps_mm"] = neck["attach_lps_mm"];
+  ColonRegistration reg(pair.supine, pair.prone);
+  reg.run();
+  ASSERT_EQ(reg.pieces().supine.size(), 3u);
+  ASSERT_EQ(reg.pieces().prone.size(), 4u);
+  EXPECT_LT(supine_s_error(pair, reg, 225, 285), 10.0);
+  EXPECT_LT(supine_s_error(pair, reg, 295, 365), 10.0);
+  expect_every_polyp_paired(score(pair, reg));
+}
+
 // Where the prone scan has no wall (a dropped stretch) the alignment is marked unsupported (80 %
 // of the stretch), the supine polyps there are never paired, and only polyps of that stretch are
 // listed as unaligned; elsewhere it is supported.

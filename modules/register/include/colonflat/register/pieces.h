@@ -46,6 +46,9 @@ struct PieceOptions {
   double min_branch_piece_mm = 60;  // mm; a side branch this long is a piece of the colon's course: longer
                                     // than a haustral pouch or a diverticulum (< 3 cm deep) or a polyp on
                                     // a stalk, twice the colon's diameter
+  double same_neck_mm = 50;       // mm; long side branches whose necks lie this close along their band hang
+                                  // at one neck (one opening where the walls touch: at most the colon's
+                                  // diameter wide) and are ordered as one tour (branch_order.h)
   double jump_mm = 30;            // mm; the two halves of a placed piece's follow window differing by more
                                   // is a jump of its map (a stretch one scan holds as an inserted branch
                                   // or skips): more than the wall slides along between the positions
@@ -63,6 +66,8 @@ struct ColonPiece {
   bool branch = false;            // a side-branch band of colon length (PieceOptions::min_branch_piece_mm)
   int parent = -1;                // branch: the colon band it hangs on (a branch of a branch: its ancestor's)
   double attach_mm = 0;           // branch: the neck's centreline mm on `parent`
+  int neck_rank = 0;              // branch: its place among the long branches inserted at one neck
+  bool on_band = true;            // branch: FlatSegments parent is its band (not another branch)
   double from_mm = 0;             // own mm of its band where it starts (a band cut where it turns back, piece_split.h)
   // Reference band: its long branches inserted at their necks (own mm of the neck, branch length);
   // the band's s after a neck moves on by the branch's length.
