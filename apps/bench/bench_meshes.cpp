@@ -231,6 +231,9 @@ Mesh blocked_torus(Blocker kind) {
   if (kind == Blocker::kRod) {
     blocker = synthetic::sphere(1, 16, 8);
     for (auto& p : blocker.points) p = {4 + 0.15 * p[0], 1.4 * p[1], 0.15 * p[2]};
+  } else if (kind == Blocker::kCoreBlob) {
+    blocker = synthetic::sphere(1, 16, 8);
+    for (auto& p : blocker.points) p = {4 + 0.3 * p[0], 0.6 * p[1], 0.3 * p[2]};
   } else {
     blocker = varying_torus(4, 0.15, 0.15, kPi, 64, 8);
   }

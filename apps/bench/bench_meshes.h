@@ -40,13 +40,15 @@ Mesh colon_like_surface(const ColonLikeOptions& options);
 // loop is the meridian there; 64 x 16 quads) with a blocker inside its tube that every cap of
 // that meridian must cross:
 //  - kRod: a thin ellipsoid along the tube core (0.15 mm thick, +-1.4 mm along the tube);
+//  - kCoreBlob: a small ellipsoid at the tube core (0.6 mm across the tube, +-0.6 mm along it):
+//    a disk of the meridian bulged along the tube by more than 0.6 mm at its centre passes it;
 //  - kCoreRing: a thin torus along the whole core (tube 0.15 mm - 15 % at u = pi, so it is cut
 //    there): it links every meridian, so no meridian has a clean cap; the longitude's has;
 //  - kCoreAndLinkRings: that ring and a second thin ring (radius 2.5 mm, tube 0.15 mm) around the
 //    tube at u = 0, through the hole: it links every loop crossing a meridian, so no loop that
 //    removes the torus' handle has a clean cap.
 // Closed and embedded; genus 1 + one per ring.
-enum class Blocker { kRod, kCoreRing, kCoreAndLinkRings };
+enum class Blocker { kRod, kCoreBlob, kCoreRing, kCoreAndLinkRings };
 Mesh blocked_torus(Blocker blocker);
 
 }  // namespace cf::bench

@@ -13,7 +13,8 @@
 // most). After each layer the front is closed by its minimum-area triangulation when that is
 // clean and the left cap mirrored from the right one is clean too: its interior vertices are the
 // right cap's moved by the rings' separation (or a half, a quarter of it) along the right cap's
-// normal, towards the left side. A front that stalls or meets anything fails (nothing is added).
+// normal, towards the left side; else by a relaxed disk with interior vertices
+// (surgery_relaxed.cpp). A front that stalls or meets anything fails (nothing is added).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -216,9 +217,10 @@ bool Surgery::clean_from(const std::vector<std::array<int, 3>>& tris, std::size_
 }
 
 // Both front caps: layers from the right ring inwards until the front's minimum-area disk is
-// clean (after at least one layer) and so is the left cap mirrored from it (left_front_cap(), its
-// offset the rings' separation, then a half and a quarter of it); the right cap's triangles in ear
-// order and its interior vertices, the left one's likewise.
+// clean (after at least one layer), or its relaxed disk with interior vertices
+// (close_front_relaxed(), from the ring itself on), and so is the left cap mirrored from it
+// (left_front_cap(), its offset the rings' separation, then a half and a quarter of it); the
+// right cap's triangles in ear order and its interior vertices, the left one's likewise.
 bool Surgery::front_cap_pair(double sign, FrontCap* right, FrontCap* left) {
   std::vector<Sides> side(k_);
   for (std::size_t i = 0; i < k_; ++i) side[i] = {sign * normal_right_[i], sign * normal_left_[i]};
@@ -230,6 +232,7 @@ bool Surgery::front_cap_pair(double sign, FrontCap* right, FrontCap* left) {
   for (int layer = 0; layer <= kMaxLayers; ++layer) {
     const std::vector<std::array<int, 3>> disk = triangulate_ring(mesh_, front, none);
     if (layer > 0 && !disk.empty() && close_front(disk, right, left)) return true;
+    if (close_front_relaxed(front, right, left)) return true;
     if (layer == kMaxLayers || front.size() <= 3) return false;
     front = clean_layer(front, front_directions(front, disk, step, layer == 0 ? side : std::vector<Sides>{}), step,
                         &right->tris);

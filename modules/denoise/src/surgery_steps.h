@@ -18,6 +18,9 @@ struct ConcentricCap {
   std::vector<Mesh::FaceHandle> faces;
 };
 
+// Mean distance of the closed polygon p's points from their centroid, and its mean edge length.
+void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* edge);
+
 // Sum of the cross products of v's faces (twice their vector area): v's normal, not normalised.
 Vec3 vertex_area_normal(const Mesh& mesh, Mesh::VertexHandle v);
 
@@ -85,6 +88,11 @@ class Surgery {
   bool front_cap_pair(double sign, FrontCap* right, FrontCap* left);
   bool close_front(const std::vector<std::array<int, 3>>& disk, FrontCap* right, FrontCap* left);
   bool left_front_cap(const FrontCap& right, double fraction, FrontCap* left);
+  // Relaxed closings (surgery_relaxed.cpp).
+  static std::vector<std::vector<Vec3>> relaxed_rows(const std::vector<Vec3>& p, int m);
+  void add_relaxed_disk(const std::vector<Mesh::VertexHandle>& front, const std::vector<std::vector<Vec3>>& rows,
+                        FrontCap* right);
+  bool close_front_relaxed(const std::vector<Mesh::VertexHandle>& front, FrontCap* right, FrontCap* left);
   std::vector<Vec3> front_inward(const std::vector<Mesh::VertexHandle>& f, const std::vector<std::array<int, 3>>& disk) const;
   std::vector<Vec3> front_directions(const std::vector<Mesh::VertexHandle>& f, const std::vector<std::array<int, 3>>& disk,
                                      double step, const std::vector<Sides>& side) const;
