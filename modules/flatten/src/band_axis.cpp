@@ -39,8 +39,10 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
 }
 
 // COLONFLAT_FLATTEN_DEBUG=1: the faces shown below 0.1 (at the band's area scale) by decade of
-// their area ratio, and their largest vertex-connected pockets (faces, mm2, smallest ratio, LPS).
-void debug_pockets(const char* step, const SegmentWork& w, const std::vector<char>& degenerate) {
+// their area ratio, and their largest vertex-connected pockets (faces, mm2, smallest ratio, LPS,
+// the band x they span, how many of their vertices are fixed: an end loop or a cut branch's rim).
+void debug_pockets(const char* step, const SegmentWork& w, const std::vector<char>& degenerate,
+                   const std::vector<char>& fixed) {
   if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
   const Surface& s = w.ann;
   double a2 = 0, a3 = 0;
@@ -62,7 +64,11 @@ void debug_pockets(const char* step, const SegmentWork& w, const std::vector<cha
   for (int d = 1; d <= 8; ++d)
     std::fprintf(stderr, "flatten debug pockets %s: ratio in [1e-%d, 1e-%d): %zu faces, %.0f mm2\n", step, d + 1, d,
                  decade_faces[d], decade_area[d]);
-  struct Pocket { std::size_t faces = 0, below3 = 0; double area = 0, min_ratio = 1; V3 c = V3::Zero(); };
+  struct Pocket {
+    std::size_t faces = 0, below3 = 0, fixed = 0;
+    double area = 0, min_ratio = 1, x0 = 1e300, x1 = -1e300, rim3 = 0, rim2 = 0;
+    V3 c = V3::Zero();
+  };
   std::unordered_map<std::uint32_t, Pocket> pockets;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
     if (degenerate[f] || !(ratio[f] < 0.1)) continue;
@@ -70,6 +76,14 @@ void debug_pockets(const char* step, const SegmentWork& w, const std::vector<cha
     const double a = face_area_3d(s, int(f));
     ++p.faces, p.area += a, p.min_ratio = std::min(p.min_ratio, ratio[f]), p.below3 += ratio[f] < 1e-3;
     p.c += a * (s.p[s.t[f][0]] + s.p[s.t[f][1]] + s.p[s.t[f][2]]) / 3;
+    const auto c = w.emb.corners(s, int(f));
+    for (int k = 0; k < 3; ++k) {
+      const int v = s.t[f][k], u = s.t[f][(k + 1) % 3];
+      p.x0 = std::min(p.x0, w.emb.pos[v].x()), p.x1 = std::max(p.x1, w.emb.pos[v].x());
+      p.fixed += fixed[v] != 0;  // counted once per face corner
+      if (fixed[v] && fixed[u])  // an edge on the boundary: its 3D and 2D (area-preserving scale) lengths
+        p.rim3 += (s.p[v] - s.p[u]).norm(), p.rim2 += std::sqrt(scale) * (c[k] - c[(k + 1) % 3]).norm();
+    }
   }
   std::vector<Pocket> list;
   for (auto& [root, p] : pockets) list.push_back(p);
@@ -77,8 +91,9 @@ void debug_pockets(const char* step, const SegmentWork& w, const std::vector<cha
   for (std::size_t i = 0; i < std::min<std::size_t>(list.size(), 25); ++i) {
     const Pocket& p = list[i];
     const V3 c = p.c / std::max(p.area, 1e-300);
-    std::fprintf(stderr, "flatten debug pocket %s: %zu faces (%zu below 1e-3), %.1f mm2, min ratio %.2g, LPS %.1f %.1f %.1f\n",
-                 step, p.faces, p.below3, p.area, p.min_ratio, c.x(), c.y(), c.z());
+    std::fprintf(stderr, "flatten debug pocket %s: %zu faces (%zu below 1e-3), %.1f mm2, min ratio %.2g, LPS %.1f %.1f %.1f, "
+                 "x %.1f..%.1f, %zu fixed corners, boundary edges %.1f mm long in 3D, %.1f mm in the map\n",
+                 step, p.faces, p.below3, p.area, p.min_ratio, c.x(), c.y(), c.z(), p.x0, p.x1, p.fixed, p.rim3, p.rim2);
   }
 }
 
@@ -196,8 +211,15 @@ static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf,
     std::fprintf(stderr, "flatten debug area correction (%s): %zu faces, %d iterations, energy %.6g -> %.6g (%s), %.2f s\n",
                  local ? "local" : "whole band", corr.faces, corr.iterations, corr.energy_before, corr.energy_after,
                  corr.stop, sw.seconds());
+    const StepTimes& t = corr.times;
+    std::fprintf(stderr, "flatten debug area correction (%s) parts: %s %zu faces, %d steps, %.2f s: system %.2f s, "
+                 "gradients %.2f, solves %.2f, step limit %.2f, line search %.2f (%d energies), check %.2f; "
+                 "%zu pieces, %.2f s summed, the longest started %zu-th\n",
+                 local ? "local" : "whole band", local ? "longest piece" : "band", corr.longest_faces, corr.longest_steps,
+                 corr.longest_s, corr.build_s, t.gradient, t.solve, t.step_limit, t.line_search, t.energy_evals, t.check,
+                 corr.pieces, corr.pieces_s, corr.longest_place + 1);
     debug_stats(local ? "local area correction" : "area correction", w, degenerate);
-    debug_pockets(local ? "local area correction" : "area correction", w, degenerate);
+    debug_pockets(local ? "local area correction" : "area correction", w, degenerate, fixed);
   }
   return corr.iterations;
 }
@@ -235,7 +257,7 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   w.seg.period = period;
   w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
   debug_stats("reparametrised", w, degenerate);
-  debug_pockets("reparametrised", w, degenerate);
+  debug_pockets("reparametrised", w, degenerate, fixed);
   CorrectionNeed need = needs_correction(w, degenerate, o);
   const std::vector<int> order = w.band_order();  // a large band's nested dissection order, for its systems
   const std::vector<int>* band_order = order.empty() ? nullptr : &order;

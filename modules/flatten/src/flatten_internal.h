@@ -263,11 +263,24 @@ double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V
 // 2D positions plus area_weight x sum_f A3_f (log ratio outside the bounds)^2, at most
 // area_correction_iterations Newton steps on the quadratic part, each cut so that no face folds.
 // Fixed vertices (the band's ends, the rims of cut-off branches) stay. Post: bijective if `emb` was.
+// Wall seconds of the parts of descent steps (proxy_descent.h): gradients (per face and gathered),
+// solves, largest fold-free step, line search (energy_evals energies), the caller's stop check.
+struct StepTimes {
+  double gradient = 0, solve = 0, step_limit = 0, line_search = 0, check = 0;
+  int energy_evals = 0;
+};
 struct AreaCorrection {
   int iterations = 0;
   std::size_t faces = 0;  // faces the correction worked on
   double energy_before = 0, energy_after = 0;
   const char* stop = "";  // why the (last) descent stopped (proxy_descent.h)
+  // COLONFLAT_FLATTEN_DEBUG: wall seconds of the system build (assembly, order, factorisation) and
+  // of the steps, of the whole band or of the local piece that took longest (its faces, steps and
+  // place in the order the pieces start), and the pieces' wall seconds summed.
+  double build_s = 0, longest_s = 0, pieces_s = 0;
+  StepTimes times;
+  std::size_t longest_faces = 0, longest_place = 0, pieces = 0;
+  int longest_steps = 0;
 };
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to

@@ -12,6 +12,7 @@
 // Every per-face loop runs on all worker threads in fixed blocks (face_blocks.h): the steps are
 // the same for any thread count.
 #include <algorithm>
+#include <chrono>
 #include <functional>
 
 #include "face_blocks.h"
@@ -26,7 +27,16 @@ struct DescentResult {
   // (no step lowers E, or the direction does not descend), "not injective" (E infinite at the start),
   // "bounds met" (the caller's `enough` said so after a step).
   const char* stop = "steps";
+  StepTimes times;  // where the steps' wall time went (COLONFLAT_FLATTEN_DEBUG prints it)
 };
+
+// Seconds since `t` (steady clock), and `t` moved to now.
+inline double lap(std::chrono::steady_clock::time_point& t) {
+  const auto now = std::chrono::steady_clock::now();
+  const double s = std::chrono::duration<double>(now - t).count();
+  t = now;
+  return s;
+}
 
 // The gradient over the unknowns of a region system from per-face corner gradients: each unknown
 // sums the corners it is, in face order (the order a sequential scatter over the faces adds them).
@@ -75,9 +85,12 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     });
   };
   for (; res.steps < max_steps; ++res.steps) {
+    auto clock = std::chrono::steady_clock::now();
     energy.face_gradients(emb.pos, face_gradients);
     const Eigen::MatrixXd g = gather.sum(face_gradients);
+    res.times.gradient += lap(clock);
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
+    res.times.solve += lap(clock);
     const double slope = (g.array() * d.array()).sum();
     if (!(slope < 0)) {
       res.stop = "no descent";
@@ -85,12 +98,15 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     }
     move_to(d, 1.0);
     double t = std::min(1.0, 0.9 * max_area_step(s, emb, trial, judged, area3, 0.0));
+    res.times.step_limit += lap(clock);
     double e1 = Energy::kHuge;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
       move_to(d, t);
       e1 = energy.energy(trial);
+      ++res.times.energy_evals;
       if (e1 <= e0 + 1e-4 * t * slope) break;
     }
+    res.times.line_search += lap(clock);
     if (!(e1 < e0)) {
       res.stop = "no descent";
       break;
@@ -102,7 +118,9 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       res.stop = "converged";
       break;
     }
-    if (enough && enough()) {
+    const bool met = enough && enough();
+    res.times.check += lap(clock);
+    if (met) {
       ++res.steps;
       res.stop = "bounds met";
       break;

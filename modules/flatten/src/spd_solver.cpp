@@ -309,20 +309,31 @@ bool SpdSolver::factorize(const SpMat& A) {
   return fall_back(A);
 }
 
+std::size_t SpdSolver::factor_entries() const { return factor_ ? std::size_t(factor_->nzmax) : 0; }
+
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   if (!cholmod_ok_) return fallback_->solve(b);
-  // Column by column, the columns on the worker threads: each column's arithmetic is the same
-  // whoever solves it, so the result does not depend on the thread count.
+  // Column by column, on the worker threads for a large factor: each column's arithmetic is the
+  // same whoever solves it (the same one-column call), so the result does not depend on the thread
+  // count nor on the threshold.
   Eigen::MatrixXd x(b.rows(), b.cols());
+  auto solve_column = [&](Eigen::Index c, cholmod_common& common) {
+    const Eigen::MatrixXd column = b.col(c);
+    cholmod_dense rhs = view_dense(column);
+    cholmod_dense* xc = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common);
+    if (!xc) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.status) + ")");
+    x.col(c) = take_dense(xc, common);
+  };
+  if (factor_entries() < kThreadedSolveMinEntries) {
+    ThreadCommon common;
+    for (Eigen::Index c = 0; c < b.cols(); ++c) solve_column(c, common.c);
+    return x;
+  }
   std::vector<std::function<void()>> columns;
   for (Eigen::Index c = 0; c < b.cols(); ++c)
     columns.push_back([&, c] {
       ThreadCommon common;
-      const Eigen::MatrixXd column = b.col(c);
-      cholmod_dense rhs = view_dense(column);
-      cholmod_dense* xc = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common.c);
-      if (!xc) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.c.status) + ")");
-      x.col(c) = take_dense(xc, common.c);
+      solve_column(c, common.c);
     });
   parallel_tasks(columns);
   return x;
@@ -420,6 +431,8 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const { return fallba
 bool SpdSolver::modify(const SpMat&, bool) { return false; }
 
 double SpdSolver::factor_flops() const { return 0.0; }
+
+std::size_t SpdSolver::factor_entries() const { return 0; }
 
 double SpdSolver::modify_flops(const std::vector<const SpMat*>&, double) const { return 0.0; }
 

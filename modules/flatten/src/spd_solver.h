@@ -58,8 +58,19 @@ class SpdSolver {
     analyze(A, order);
     return factorize(A);
   }
-  // x = A^-1 b (b: n x k).
+  // x = A^-1 b (b: n x k), column by column: the columns on the worker threads when the factor has
+  // at least kThreadedSolveMinEntries entries, else one after the other on the calling thread. A
+  // column's result is the same bits either way (the same one-column solve).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  // A column's solve reads L twice (about 24 bytes an entry): at 10^6 entries some 10 ms (an
+  // estimate at a few GB/s), far above what starting a thread for it costs (tens of microseconds
+  // idle; on a loaded machine the new thread also waits for a core). The local area-correction
+  // pieces (a few thousand unknowns, 10^4-10^5 entries) solve hundreds to thousands of times each:
+  // the real CT colon band's longest piece, 1 248 solves, 1.64 s -> 0.46 s wall at load 11-14
+  // (docs/flatten.md, session 15).
+  static constexpr std::size_t kThreadedSolveMinEntries = 1000000;
+  // Entries the numeric factor holds (0 without CHOLMOD or before factorize()).
+  std::size_t factor_entries() const;
   // x_I = A_II^-1 b_I for I = the first `leading` unknowns of the order given to analyze(), and
   // x = 0 off I (b's entries off I are not read). Throws Error without a given order.
   Eigen::MatrixXd solve_leading(const Eigen::MatrixXd& b, int leading) const;

@@ -325,6 +325,34 @@ TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
   EXPECT_EQ(std::memcmp(x[0].data(), x[1].data(), sizeof(double) * std::size_t(x[0].size())), 0);
 }
 
+// A two-column solve is each column's own one-column solve to the last bit, for 1 and 2 threads,
+// with a factor below the threaded-solve threshold (columns on the calling thread) and one above
+// it (columns on the threads): the threshold cannot change a map.
+TEST(FlattenSolver, TwoColumnSolveIsEachColumnsOwnSolveBelowAndAboveTheThreadedThreshold) {
+  for (const int nx : {40, 300}) {
+    const int nv = nx * nx;
+    const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 17));
+    std::vector<int> all(nv);
+    for (int v = 0; v < nv; ++v) all[v] = v;
+    const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+    const std::vector<int> order = SpdSolver::nested_dissection_order(A);
+    Eigen::MatrixXd b(nv, 2);
+    for (int i = 0; i < nv; ++i) b(i, 0) = std::sin(0.013 * i) + 0.3, b(i, 1) = std::cos(0.007 * i);
+    for (int threads : {1, 2}) {
+      cf::set_thread_count(threads);
+      SpdSolver solver;
+      ASSERT_TRUE(solver.compute(A, &order));
+      EXPECT_EQ(solver.factor_entries() >= SpdSolver::kThreadedSolveMinEntries, nx == 300) << nx;
+      const Eigen::MatrixXd x = solver.solve(b);
+      for (int c = 0; c < 2; ++c) {
+        const Eigen::MatrixXd one = solver.solve(b.col(c));
+        EXPECT_EQ(std::memcmp(x.col(c).data(), one.data(), sizeof(double) * std::size_t(nv)), 0) << nx << " " << c;
+      }
+    }
+    cf::set_thread_count(0);
+  }
+}
+
 // The islands a ring of faces encloses on a grid (the faces inside it), found from the ring's
 // border, are the faces keep_largest_component drops from the ring's complement, whether no piece,
 // one piece or every piece of the complement reaches the flood budget.
