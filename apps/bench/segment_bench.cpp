@@ -12,13 +12,14 @@
 //                                     of the inferior slice (pelvic floor, thighs' soft tissue, the rectal
 //                                     tube's channel) below the volume so the scan has N slices (the 512 x 512
 //                                     x 450 case of issue 13: --pad-to 450); Dice on the original slices.
-//   segment_bench --painted [--mask FILE] [--downsample N] [--cases easy,stretch,pools,bowel,hard] [--seeds 1,2]
+//   segment_bench --painted [--mask FILE] [--downsample N] [--cases easy,stretch,pools,bowel,hard/left-down] [--seeds 1,2]
 //                                     issue 25: CTs painted around a real lumen mask (colonflat phantom
 //                                     --from-mask; default ../shared/real/ctc_lumen_mask_a.nii.gz, full resolution
 //                                     unless --downsample N (N x N in-plane)): easy and hard cases (a 200-250 mm
 //                                     stretch filled beside other segments, pools over the folds, loops pressed
 //                                     against the colon, slices 0.6-1.5 mm), supine / prone / left-down, with and
 //                                     without PatientPosition; Dice, colon fluid kept, mL outside the colon.
+//                                     --keep DIR: each case's CT, truth and segmentation stay in DIR/SEED-CASE-POSITION/.
 //   segment_bench --real CT [--pad-to N]  a CT file without ground truth (e.g. ../shared/real/ctc_prone_a.nrrd):
 //                                     read and segmentation time, CPU, peak memory, lumen / fluid / fully
 //                                     tagged mL kept, segments (issue 25).
@@ -43,6 +44,7 @@
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/segment/segment.h"
 #include "segment_bench_links.h"
+#include "segment_bench_painted.h"
 
 namespace fs = std::filesystem;
 
@@ -334,39 +336,8 @@ void realistic_table(const std::string& size, const std::vector<int>& seeds, int
               "ao_vox, tube = segmented voxels that are small bowel (contrast or gas), bladder, aorta, rectal tube\n");
 }
 
-// Issue 25: segmentation of CTs painted around a real lumen mask (ground truth = the mask). "easy":
-// pools in each pocket and one 60-120 mm stretch; "stretch": + a 200 mm stretch filled where the colon
-// lies beside other parts of itself; "pools": pools over the folds (30-50 % of the pocket); "bowel":
-// loops pressed against the colon wall; "hard": all three; slice spacing resampled where given.
-struct PaintedCase {
-  const char* name;
-  const char* position;
-  bool header;
-  double long_mm;
-  bool deep, pressed;
-  double slice_mm;  // 0: the mask's own
-};
-const PaintedCase kPaintedCases[] = {
-    {"easy", "supine", true, 0, false, false, 0},       {"easy", "prone", false, 0, false, false, 0},
-    {"stretch", "supine", true, 200, false, false, 0},  {"stretch", "prone", false, 250, false, false, 0},
-    {"pools", "supine", true, 0, true, false, 0},       {"pools", "prone", false, 0, true, false, 0},
-    {"bowel", "supine", true, 0, false, true, 0},       {"hard", "supine", true, 200, true, true, 0.6},
-    {"hard", "prone", false, 200, true, true, 1.5},     {"hard", "left-down", false, 200, true, true, 1.0}};
-
-double long_stretch_kept(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
-  if (p.bodies.empty() || p.bodies[0].kind != "stretch" || p.bodies[0].to_mm - p.bodies[0].from_mm < 150) return -1;
-  return 100 * cf::score_fluid_bodies(seg, p).at(0).kept;
-}
-
-// Every colon fluid body of >= 5 mL kept less than 95 % (and the long stretch): kind, mL, share kept, centroid (LPS).
-void print_lost_bodies(const cf::MaskPhantom& p, const cf::MaskImage* seg) {
-  for (const cf::MaskBodyScore& b : cf::score_fluid_bodies(seg, p))
-    if ((b.ml >= 5 && b.kept < 0.95) || (b.body == 1 && long_stretch_kept(p, seg) >= 0))
-      std::printf("   %s: %s %zu, %.1f mL, %.1f %% kept, LPS (%.0f %.0f %.0f)\n", b.kept < 0.95 ? "lost" : "long", p.bodies[b.body - 1].kind.c_str(),
-                  b.body, b.ml, 100 * b.kept, b.centroid_lps[0], b.centroid_lps[1], b.centroid_lps[2]);
-}
-
-void painted_table(const std::string& mask_file, int downsample, const std::string& only, const std::vector<int>& seeds) {
+void painted_table(const std::string& mask_file, int downsample, const std::string& only, const std::vector<int>& seeds,
+                   const std::string& keep) {
   const fs::path tmp = fs::temp_directory_path() / ("colonflat_segment_bench_p" + std::to_string(::getpid()));
   cf::MaskImage::Pointer mask = cf::read_binary_mask(mask_file);
   if (downsample > 1) mask = cf::downsample_mask(mask, {downsample, downsample, 1});
@@ -377,7 +348,7 @@ void painted_table(const std::string& mask_file, int downsample, const std::stri
               "seg_s", "seg_cpu", "load", "seg_MiB", "dice", "fluid_mL", "kept_%", "long_%", "out_mL", "sb_mL", "gravity");
   for (int seed : seeds) {
     for (const PaintedCase& c : kPaintedCases) {
-      if (!only.empty() && only.find(c.name) == std::string::npos) continue;
+      if (!case_selected(only, c)) continue;
       fs::remove_all(tmp);
       cf::Stopwatch t;
       cf::MaskPhantomOptions o;
@@ -390,16 +361,18 @@ void painted_table(const std::string& mask_file, int downsample, const std::stri
       cf::MaskImage::Pointer m = c.slice_mm > 0 ? cf::resample_mask_slices(mask, c.slice_mm) : mask;
       cf::MaskPhantom p = cf::paint_phantom_from_mask(m, o);
       const double paint_s = t.seconds();
-      cf::write_phantom(p.phantom, tmp, "nrrd");
+      const fs::path dir = keep.empty() ? tmp : fs::path(keep) / (std::to_string(seed) + "-" + c.name + "-" + c.position);
+      cf::write_phantom(p.phantom, dir, "nrrd");
       p.phantom.ct = nullptr;
       reset_peak_memory();
-      cf::CtImage::Pointer ct = cf::read_ct_volume(tmp / "ct.nrrd");
+      cf::CtImage::Pointer ct = cf::read_ct_volume(dir / "ct.nrrd");
       cf::SegmentStats st;
       const double load = load_average();
       t.restart();
       cf::MaskImage::Pointer seg = cf::segment_colon(ct, {}, &st);
       const double seg_s = t.seconds(), seg_mib = cf::peak_memory_mib();
       ct = nullptr;
+      if (!keep.empty()) cf::write_mask(seg, dir / "segmentation.nrrd");
       const cf::MaskSegmentationScore s = cf::score_segmentation(seg, p.phantom);
       std::printf("%4d %-8s %-10s %4s %5.2f %7.2f %7.2f %7.2f %5.1f %7.0f %7.4f %8.1f %7.1f %7.1f %7.1f %6.1f %s (%s)\n", seed, c.name, c.position,
                   c.header ? "yes" : "no", m->GetSpacing()[2], paint_s, seg_s, st.cpu_time_s, load, seg_mib, s.dice, s.fluid_ml,
@@ -465,7 +438,7 @@ int main(int argc, char** argv) {
   bool table_only = false, dicom = true, collapsed = false, realistic = false, painted = false, seeds_given = false;
   int pad_to = 0, downsample = 1;
   std::string mask_file = std::string(COLONFLAT_SHARED_DIR) + "/real/ctc_lumen_mask_a.nii.gz";
-  std::string size = "full", real, cases;
+  std::string size = "full", real, cases, keep;
   std::vector<int> seeds = {1, 2, 3, 4, 5};
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
@@ -477,6 +450,7 @@ int main(int argc, char** argv) {
     else if (a == "--painted") painted = true;
     else if (a == "--mask" && i + 1 < argc) mask_file = argv[++i];
     else if (a == "--cases" && i + 1 < argc) cases = argv[++i];
+    else if (a == "--keep" && i + 1 < argc) keep = argv[++i];
     else if (a == "--downsample" && i + 1 < argc) downsample = std::stoi(argv[++i]);
     else if (a == "--real" && i + 1 < argc) real = argv[++i];
     else if (a == "--pad-to" && i + 1 < argc) pad_to = std::stoi(argv[++i]);
@@ -488,7 +462,7 @@ int main(int argc, char** argv) {
       for (std::string x; std::getline(s, x, ',');) seeds.push_back(std::stoi(x));
     } else rest.push_back(argv[i]);
   }
-  if (painted) painted_table(mask_file, downsample, cases, seeds_given ? seeds : std::vector<int>{1});
+  if (painted) painted_table(mask_file, downsample, cases, seeds_given ? seeds : std::vector<int>{1}, keep);
   else if (!real.empty()) real_table(real, pad_to);
   else if (realistic) realistic_table(size, seeds, pad_to);
   else table(size, seeds, dicom, collapsed);

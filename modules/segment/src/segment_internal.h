@@ -194,6 +194,7 @@ class ColonSegmenter {
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
   void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
+  RunLabels candidate_bodies(const Bytes& candidate) const;
   void scan_contacts(int axis, Bytes* contact, bool layer);
   std::vector<std::array<std::size_t, 2>> level_contacts(int axis, std::size_t min_gas_voxels);
   void gravity_from_levels();

@@ -143,7 +143,7 @@ void ColonSegmenter::mark_grid(const std::vector<std::pair<Run, std::uint32_t>>&
 void ColonSegmenter::link_tagged_stretches() {
   Bytes candidate(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) candidate[q] = lab_[q] == kCandidate;
-  const RunLabels cl = component_runs(candidate.data(), d_);
+  const RunLabels cl = candidate_bodies(candidate);
   Bytes().swap(candidate);
   const std::uint32_t n = cl.count();
   const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });

@@ -9,14 +9,17 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <vector>
 
+#include "colonflat/core/union_find.h"
 #include "segment_internal.h"
 
 namespace cf::segment_detail {
 namespace {
 constexpr double kCoreRadiusMm = 3.0;
 constexpr double kMinCoreVoxels = 1.5;  // the ball must span this many voxels along every axis
+constexpr double kMinFluidPairShare = 0.5;  // two pieces are one lumen when this share of their boundary is fluid
 }
 
 // Erosion of `m` (0/1) by the ball of radius r_mm (an ellipsoid in voxels): voxels outside the
@@ -91,6 +94,64 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   for (std::uint32_t l = 1; l <= thin.count(); ++l)
     for (const Run* r = thin.begin(l); r != thin.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, fluid_count_ + l);
   fluid_count_ += thin.count();
+}
+
+}  // namespace cf::segment_detail
+
+namespace cf::segment_detail {
+
+// Candidate bodies (docs/segment.md step 6): face-connected candidate voxels, where two fluid pieces
+// (split_fluid_bodies) are one body only when the fluid itself continues between them: at least
+// kMinFluidPairShare of the face pairs across their boundary hold fluid (>= fluid-threshold) in both
+// voxels' own values, not only in the 3 x 3 x 3 mean. Inside one lumen two pieces meet where the fluid
+// narrows below the core ball, and the voxels there are fluid; a bridge across the walls of two
+// pressed bowels is bright only in the mean (its voxels are wall). Voxels of no piece (gas and layer
+// of a refused segment) join every body they touch. Labels follow the components' order, each
+// component's bodies in raster order of their first voxel (no cut: the components' labels).
+RunLabels ColonSegmenter::candidate_bodies(const Bytes& candidate) const {
+  const RunLabels cl = component_runs(candidate.data(), d_);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> unit;  // (component, piece) -> unit
+  std::map<std::array<std::uint32_t, 3>, std::array<std::size_t, 2>> border;  // (component, piece, piece) -> pairs, fluid pairs
+  auto unit_of = [&](std::uint32_t l, std::uint32_t piece) { return unit.emplace(std::make_pair(l, piece), std::uint32_t(unit.size())).first->second; };
+  for (std::uint32_t l = 1; l <= cl.count(); ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) {
+        if (q == r->start || fluid_label_[q] != fluid_label_[q - 1]) unit_of(l, fluid_label_[q]);
+        std::size_t c[3];
+        d_.coords(q, c[0], c[1], c[2]);
+        for (int a = 0; a < 3; ++a) {
+          if (c[a] + 1 >= d_.n[a] || !candidate[q + d_.stride[a]]) continue;
+          const std::uint32_t p0 = fluid_label_[q], p1 = fluid_label_[q + d_.stride[a]];
+          if (p0 == p1) continue;
+          auto& b = border[{l, std::min(p0, p1), std::max(p0, p1)}];
+          ++b[0];
+          b[1] += std::min(hu_[q], hu_[q + d_.stride[a]]) >= opts_.fluid_threshold;
+        }
+      }
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
+    for (const auto& [key, b] : border)
+      if (key[1]) std::fprintf(stderr, "pieces %u and %u: %zu boundary pairs, %zu fluid in both voxels\n", key[1], key[2], b[0], b[1]);
+  UnionFind uf(unit.size());
+  for (const auto& [key, b] : border)
+    if (key[1] == 0 || double(b[1]) >= kMinFluidPairShare * double(b[0])) uf.unite(unit_of(key[0], key[1]), unit_of(key[0], key[2]));
+  std::vector<std::uint32_t> label(unit.size(), 0);
+  std::vector<std::vector<Run>> runs;
+  for (std::uint32_t l = 1; l <= cl.count(); ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
+      for (std::size_t q = r->start, end = r->start + r->length; q < end;) {
+        std::size_t e = q + 1;
+        while (e < end && fluid_label_[e] == fluid_label_[q]) ++e;
+        std::uint32_t& lab = label[uf.find(unit.at({l, fluid_label_[q]}))];
+        if (!lab) lab = std::uint32_t(runs.size() + 1), runs.emplace_back();
+        runs[lab - 1].push_back({q, e - q});
+        q = e;
+      }
+  RunLabels out;
+  for (const auto& v : runs) {
+    out.runs.insert(out.runs.end(), v.begin(), v.end());
+    out.first.push_back(out.runs.size());
+  }
+  return out;
 }
 
 }  // namespace cf::segment_detail

@@ -69,6 +69,29 @@ TEST(SegmentFluid, FluidBetweenGasPocketsAtDifferentLevelsKept) {
   EXPECT_EQ(components(m), 1u);
 }
 
+// A colon tube along x whose gas (x 10..45) meets a fully tagged stretch (600 HU, x 46..85) across
+// the lumen (supine: no level, kept by its open interface with the gas), and a loop of oral contrast
+// (300 HU, radius 6 mm, along z) crossing under the stretch with one voxel of wall at the crossing:
+// one bright body in the 3 x 3 x 3 mean, whose two pieces meet at the wall. The stretch is kept
+// whole, the loop is not (fails on a84c05a: the two pieces were one candidate, kept together).
+TEST(SegmentFluid, LoopPressedOnOpenStretchNotKeptWithIt) {
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (x >= 10 && x <= 85 && radial(y, z, 34, 48) < 10) return x <= 45 ? -1000.0 : 600.0;  // colon: gas, then fluid
+    if (z >= 14 && z <= 82 && radial(x, y, 65, 50) < 6) return 300.0;                      // small-bowel loop
+    return kKeep;
+  }, 0.3, 10);
+  SegmentOptions o = fluid_options();
+  o.position = "supine";
+  SegmentStats st;
+  auto m = segment_colon(ct, o, &st);
+  const auto stretch = kept_in(m, 50, 82, 26, 42, 40, 56, [](int, int y, int z) { return radial(y, z, 34, 48) < 8; });
+  EXPECT_EQ(stretch.second, stretch.first) << st.to_json()["decisions"].dump(1);
+  EXPECT_TRUE(has_reason(st, "kept", "no wall between")) << st.to_json()["decisions"].dump(1);
+  const auto loop = kept_in(m, 60, 70, 45, 55, 16, 80, [](int x, int y, int) { return radial(x, y, 65, 50) < 4; });
+  EXPECT_GT(loop.first, 2000u);
+  EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
 // A dense bright blob (900 HU, like a vertebral body) 3 mm beside the colon's gas: it has no level
 // under gas and does not continue the colon; it is not kept.
 TEST(SegmentFluid, BoneLikeBlobsRejected) {
