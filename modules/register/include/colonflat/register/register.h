@@ -34,6 +34,10 @@ struct RegisterOptions {
   double match_along_mm = 30;        // mm; largest distance along the colon of a candidate pair
   double match_around_deg = 45;      // degrees; largest angle around the colon of a pair
   double match_size_ratio = 2.0;     // largest size ratio of a pair (larger / smaller)
+  double min_place_reach_mm = 3;     // mm; a candidate's other places on the course (locations()) lie this much,
+                                     //   or half its size if larger, beyond its nearest wall vertex: the wall a
+                                     //   polyp stands on reaches its radius around it (3 mm: half the smallest
+                                     //   polyp reported, 6 mm)
   PieceOptions pieces;               // colons with centreline_mm: laid out piece by piece (pieces.h)
   LandmarkOptions landmarks;
   double support_radius_mm = 100;    // mm; centre points farther apart after the shift do not support the map
@@ -98,6 +102,12 @@ class ColonRegistration {
   // (s, theta) of an LPS point of a scan: s of its nearest wall vertex, theta of the point about
   // the centre line there (NaN when that vertex is not registered).
   std::pair<double, double> locate(const Eigen::Vector3d& p, Direction from) const;
+  // locate() first, then every other place of the point on the colon's course: where the course passes
+  // it more than once (a neck with a long branch inserted into the course before it, walls of two loops
+  // touching) the wall within `reach_mm` beyond the nearest vertex's distance belongs to several
+  // stretches; each is represented by its vertex nearest to p that lies more than match_along_mm along
+  // from the places already found (nearest first). Post: size >= 1; entries NaN when not registered.
+  std::vector<std::pair<double, double>> locations(const Eigen::Vector3d& p, Direction from, double reach_mm) const;
 
   const ScanCoordinates& supine_coordinates() const { return sup_; }
   const ScanCoordinates& prone_coordinates() const { return pro_; }
@@ -138,6 +148,12 @@ class ColonRegistration {
   int twist_windows_ = 0;
   std::vector<int> sup_to_pro_, pro_to_sup_;
   std::vector<char> sup_held_, pro_held_;  // per vertex: held at a neck (pieces.h held_at_neck)
+  struct Place {
+    double s, theta, gap;  // gap: mm along to supported alignment (infinite: held at a neck)
+  };
+  std::vector<Place> places(const ScanCandidate& c, Direction from) const;
+  bool pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
+                      const std::vector<Place>& pb, CandidateMatch& best, double& cost) const;
   CandidateMatching matching_;
   std::unique_ptr<Index> sup_index_, pro_index_;
   nlohmann::json timing_ = nlohmann::json::object();
