@@ -33,6 +33,33 @@ std::vector<ColonRegistration::Place> ColonRegistration::places(const ScanCandid
   return out;
 }
 
+size_t ColonRegistration::shown_place(const std::vector<Place>& pl) const {
+  for (size_t k = 0; k < pl.size(); ++k)
+    if (pl[k].gap <= opts_.max_unsupported_mm) return k;
+  return 0;
+}
+
+std::pair<double, double> ColonRegistration::candidate_place(int id, Direction from) const {
+  const bool sup = from == Direction::kSupineToProne;
+  for (const auto& m : matching_.pairs)
+    if ((sup ? m.supine_id : m.prone_id) == id)
+      return sup ? std::pair{m.supine_s_mm, m.supine_theta} : std::pair{m.prone_s_mm, m.prone_theta};
+  for (const auto& c : (sup ? supine_ : prone_).candidates)
+    if (c.id == id) {
+      const std::vector<Place> pl = places(c, from);
+      const Place& p = pl[shown_place(pl)];
+      return {p.s, p.theta};
+    }
+  return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+}
+
+Eigen::Vector3d ColonRegistration::map_candidate(int id, Direction d) const {
+  const auto [s, theta] = candidate_place(id, d);
+  const int v = std::isnan(s) ? -1 : map_vertex(d, s, theta);
+  if (v < 0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return (d == Direction::kSupineToProne ? prone_ : supine_).lps[size_t(v)];
+}
+
 // Supine candidate `a` (at one of its places `pa`) and prone `b` (`pb`): the combination of places
 // within the match limits with the lowest cost (along^2 + around^2 + log-size^2, each over its
 // limit) in `best` and `cost`; false when none is within them or a place has no support.
@@ -58,6 +85,7 @@ bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector
                        size_term * size_term;
       if (found && c >= cost) continue;
       m.supine_gap_mm = x.gap, m.prone_gap_mm = y.gap;
+      m.supine_s_mm = x.s, m.supine_theta = x.theta, m.prone_s_mm = y.s, m.prone_theta = y.theta;
       m.anchor_mm = support_.supine_anchor_mm.empty() ? 0.0 : support_.supine_anchor_mm[size_t(sup_.profile.bin_of(x.s))];
       m.score = 1 - (1 - std::clamp(a.score, 0.0, 1.0)) * (1 - std::clamp(b.score, 0.0, 1.0));
       found = true, cost = c, best = m;
@@ -91,12 +119,12 @@ CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
   for (size_t i = 0; i < cs.size(); ++i)
     if (!used_s[i]) {
       out.supine_only.push_back(cs[i].id);
-      if (ps[i][0].gap > opts_.max_unsupported_mm) out.supine_unaligned.push_back(cs[i].id);
+      if (ps[i][shown_place(ps[i])].gap > opts_.max_unsupported_mm) out.supine_unaligned.push_back(cs[i].id);
     }
   for (size_t j = 0; j < cp.size(); ++j)
     if (!used_p[j]) {
       out.prone_only.push_back(cp[j].id);
-      if (pp[j][0].gap > opts_.max_unsupported_mm) out.prone_unaligned.push_back(cp[j].id);
+      if (pp[j][shown_place(pp[j])].gap > opts_.max_unsupported_mm) out.prone_unaligned.push_back(cp[j].id);
     }
   return out;
 }

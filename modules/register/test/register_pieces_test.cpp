@@ -441,7 +441,8 @@ TEST(RegisterPieces, SmallTableRotationKeepsPairsRight) {
 // the colon 200 mm or more further on lies against the polyp, its wall half as far from the polyp's point as
 // the polyp's own (so locate() puts the polyp on that stretch, which the prone has elsewhere: no
 // support there). The polyp is still paired with itself at its other place on the course, every
-// polyp seen in both is paired right (a84c05a: located on the stretch only, never paired).
+// polyp seen in both is paired right (a84c05a: located on the stretch only, never paired), and the
+// pair is shown and mapped at that place (s15 a0895e0: at the stretch, mapped 376 mm off).
 TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
   SyntheticPair pair = make_synthetic_pair(long_pair(1));
   const SyntheticPolyp& q = pair.polyps[2];
@@ -472,6 +473,12 @@ TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
   ASSERT_GT(reg.locate(q.supine_lps, Direction::kSupineToProne).first, from - 20);  // the first place is the stretch
   EXPECT_GE(reg.locations(q.supine_lps, Direction::kSupineToProne, 3).size(), 2u);
   expect_every_polyp_paired(score(pair, reg));
+  // What is shown for the pair (check-here position, side-by-side marker) is at the polyp's own place:
+  // mapped within 5 mm of the prone polyp (its first place, the stretch, maps far from it).
+  const Eigen::Vector3d shown = reg.map_candidate(q.id, Direction::kSupineToProne);
+  const Eigen::Vector3d nearest = reg.map_lps(q.supine_lps, Direction::kSupineToProne);
+  EXPECT_LT((shown - q.prone_lps).norm(), 5.0) << "first place maps " << (nearest - q.prone_lps).norm() << " mm off";
+  EXPECT_LT(std::abs(reg.candidate_place(q.id, Direction::kSupineToProne).first - q.sigma_mm), 5.0);
 }
 
 }  // namespace

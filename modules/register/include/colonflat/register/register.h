@@ -11,6 +11,7 @@
 // rotation around the colon from the wall relief; (4) per-vertex correspondence in both
 // directions (nearest vertex in (s, r theta) of the other scan); (5) candidate matching.
 // The two scans are borrowed: they must outlive the registration.
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,6 +62,10 @@ struct CandidateMatch {
   double supine_gap_mm = 0, prone_gap_mm = 0;  // mm along to the nearest supported bin (0: supported)
   double anchor_mm = 0;     // mm along (supine) to the nearest shared landmark or other anchor pair
   bool unique = true;       // no other partner within the match limits for either candidate
+  // The places of the two candidates the pair was matched at (locations(): one of each candidate's
+  // places on its course); everything shown for the pair uses them (candidate_place()).
+  double supine_s_mm = std::numeric_limits<double>::quiet_NaN(), supine_theta = std::numeric_limits<double>::quiet_NaN();
+  double prone_s_mm = std::numeric_limits<double>::quiet_NaN(), prone_theta = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CandidateMatching {
@@ -96,6 +101,14 @@ class ColonRegistration {
   // An LPS point of one scan to the other: nearest wall vertex, its (s, theta), mapped, the
   // target's wall vertex there; returns its LPS position (NaN when the point is not registered).
   Eigen::Vector3d map_lps(const Eigen::Vector3d& p, Direction d) const;
+  // (s, theta) where candidate `id` of the scan `from` is shown and mapped: the place its pair was
+  // matched at (CandidateMatch::supine_s_mm ...); unpaired, its first place (locations()) with support
+  // along, else its nearest (locate()). The same place decides the "not aligned" lists.
+  // Post: NaN when the scan has no candidate `id` or the place is not registered.
+  std::pair<double, double> candidate_place(int id, Direction from) const;
+  // The other scan's LPS position of candidate `id` of the scan `d` maps from: its candidate_place()
+  // mapped, the target's wall vertex there (NaN when not registered).
+  Eigen::Vector3d map_candidate(int id, Direction d) const;
   // True when a candidate at this LPS point of one scan, or its image in the other, lies on a stretch
   // held at a neck (pieces.h): never paired there.
   bool held_at_neck(const Eigen::Vector3d& p, Direction from) const;
@@ -152,6 +165,7 @@ class ColonRegistration {
     double s, theta, gap;  // gap: mm along to supported alignment (infinite: held at a neck)
   };
   std::vector<Place> places(const ScanCandidate& c, Direction from) const;
+  size_t shown_place(const std::vector<Place>& pl) const;  // first supported place, else 0
   bool pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
                       const std::vector<Place>& pb, CandidateMatch& best, double& cost) const;
   CandidateMatching matching_;
