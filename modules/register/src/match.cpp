@@ -188,6 +188,7 @@ nlohmann::json ColonRegistration::summary() const {
                      {"around_deg", m.around_deg}, {"size_ratio", m.size_ratio}, {"score", m.score},
                      {"distance_3d_mm", m.distance_3d_mm}, {"supine_gap_mm", m.supine_gap_mm},
                      {"prone_gap_mm", m.prone_gap_mm}, {"anchor_mm", finite_or_null(m.anchor_mm)},
+                     {"supine_s_mm", finite_or_null(m.supine_s_mm)}, {"prone_s_mm", finite_or_null(m.prone_s_mm)},
                      {"unique", m.unique}});
   return {{"units", "mm"},
           {"coordinate_system", "LPS"},
