@@ -8,7 +8,9 @@
 //                               (collapse, tagged stretches dropped, split +3, rectum cut; issue 27).
 //   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG] [--painted] [--cases K...]
 //                               the real lumen mask with 10 synthetic polyps, cut as --cuts (by path
-//                               distance through the lumen), the prone mask moved on the table.
+//                               distance through the lumen), the prone mask moved on the table; a
+//                               polyp counts as seen in a scan only with that scan's wall within its
+//                               diameter (on_wall: a cut can take the wall around a polyp away).
 //   register_bench --write-synthetic DIR [--twist DEG]     a small synthetic pair as run folders.
 //   register_bench --pair SUP_RUN PRO_RUN [--truth SUP_PHANTOM PRO_PHANTOM]   one pair of run folders.
 // Columns: polyps >= 6 mm seen in both; matched = truth polyps paired with themselves when the two
@@ -345,7 +347,8 @@ void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskO
     cf::ColonRegistration reg(sup, pro);
     reg.run();
     r.seconds = clock.seconds(), r.pieces = piece_counts(reg);
-    const auto cs = seen_polyps(polyps, c.supine, course, {0, 0, 0}, 0), cp = seen_polyps(polyps, c.prone, course, shift, turn);
+    const auto cs = on_wall(seen_polyps(polyps, c.supine, course, {0, 0, 0}, 0), sup);
+    const auto cp = on_wall(seen_polyps(polyps, c.prone, course, shift, turn), pro);
     r.polyps = 0;
     std::vector<double> along;
     for (const auto& q : cs)

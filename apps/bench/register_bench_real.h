@@ -2,6 +2,7 @@
 // register_bench --real-mask: the options of the real-mask pairs, and (--show-pieces) where each
 // piece of the two scans was laid out against the truth of the pair (mask_pair.h) and where each
 // polyp went.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -52,6 +53,38 @@ inline std::vector<cf::ScanCandidate> seen_polyps(const std::vector<cf::MaskPoly
   return out;
 }
 
+// Where the course passes a point: per stretch of s (places more than 30 mm apart, nearest first)
+// within 20 mm beyond the nearest wall vertex, its s and distance (the places locations() finds).
+inline void show_places(const cf::ColonScan& scan, const cf::ScanCoordinates& c, const Eigen::Vector3d& p) {
+  std::vector<std::pair<double, size_t>> by_distance;
+  for (size_t v = 0; v < scan.lps.size(); ++v)
+    if (!std::isnan(c.s[v])) by_distance.push_back({(scan.lps[v] - p).norm(), v});
+  std::sort(by_distance.begin(), by_distance.end());
+  std::vector<double> seen;
+  for (const auto& [d, v] : by_distance) {
+    if (d > by_distance.front().first + 20) break;
+    bool known = false;
+    for (double s : seen) known |= std::abs(s - c.s[v]) <= 30;
+    if (!known) seen.push_back(c.s[v]), std::printf(" s %.0f at %.1f mm;", c.s[v], d);
+  }
+}
+
+// The polyps whose centre lies within their diameter of the scan's flat-map wall: a cut by path distance
+// can take the wall around a polyp away although the polyp's own path distance is beyond the cut (the
+// path distance crosses where the colon's walls touch; painted split +3: the prone's nearest wall to
+// polyp 3 was 11.5 mm away on another loop, its own loop's 25 mm), and a polyp without wall is not
+// on that scan's colon surface. Each polyp left out is printed.
+inline std::vector<cf::ScanCandidate> on_wall(const std::vector<cf::ScanCandidate>& polyps, const cf::ColonScan& scan) {
+  std::vector<cf::ScanCandidate> out;
+  for (const auto& q : polyps) {
+    double nearest = INFINITY;
+    for (const auto& v : scan.lps) nearest = std::min(nearest, (v - q.lps).squaredNorm());
+    if (std::sqrt(nearest) <= q.size_mm) out.push_back(q);
+    else std::printf("  polyp %d not on the %s wall: nearest wall vertex %.1f mm\n", q.id, scan.name.c_str(), std::sqrt(nearest));
+  }
+  return out;
+}
+
 // One polyp seen in both scans: its common s in each, the supine s mapped, support gaps, error.
 inline void show_polyp(const cf::ColonRegistration& reg, const cf::ScanCandidate& q, const cf::ScanCandidate& p, double path_mm,
                        double along_mm, double distance_mm) {
@@ -63,6 +96,11 @@ inline void show_polyp(const cf::ColonRegistration& reg, const cf::ScanCandidate
   std::printf("  polyp %d path %.0f: supine s %.0f (%.0f deg) -> %.0f (%.0f deg), prone s %.0f (%.0f deg) (gap %.0f / %.0f), "
               "along %.1f, 3-D %.1f mm\n", q.id, path_mm, ss, st * deg, ms, mt * deg, ps, pt * deg, reg.support_gap_mm(true, ss),
               reg.support_gap_mm(false, ps), along_mm, distance_mm);
+  std::printf("   places: supine");
+  show_places(reg.supine(), reg.supine_coordinates(), q.lps);
+  std::printf(" prone");
+  show_places(reg.prone(), reg.prone_coordinates(), p.lps);
+  std::printf("\n");
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 // colon length at their necks, flatten's own course of the colon) is the truth along the colon; the
 // prone scan is the same mask moved on the table by (15, -30, 40) mm and cut along that centre line
 // (lumen_cut.h) the way the kinds differ: a quarter of the colon dropped, and the colon split
-// into 3 more pieces. The targets: 0 wrong pairs and median error <= 10 mm along the colon on
-// each pair, >= 90 % of the polyps >= 6 mm seen in both paired over the two pairs.
+// into 3 more pieces. The targets on each pair: 0 wrong pairs, median error <= 10 mm along
+// the colon, >= 90 % of the polyps >= 6 mm seen in both paired.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -88,9 +88,10 @@ PhantomTruth truth(const std::vector<MaskPolyp>& polyps, const PhantomCentreline
   return t;
 }
 
-// The quarter dropped and the split +3 kinds of segmentation_cut_cases on the real colon: 0 wrong and
-// median <= 10 mm per pair, >= 90 % paired over both (split +3 missed 1 of 10 before a band turning
-// back along the colon was cut in two, piece_split.h).
+// The quarter dropped and the split +3 kinds of segmentation_cut_cases on the real colon: 0 wrong,
+// median <= 10 mm and >= 90 % paired on each pair (split +3 missed 1 of 10 before a band turning back
+// along the colon was cut in two, piece_split.h; the quarter dropped 8 of 9 on a84c05a: a polyp at a
+// neck where the course passes twice, paired at its other place since session 15).
 TEST(RealMaskPairs, QuarterDroppedAndSplitIntoThreeMoreMeetTheTargets) {
   if (!fs::exists(kMask)) GTEST_SKIP() << "../shared/real absent";
   testing::TempDir dir;
@@ -103,7 +104,7 @@ TEST(RealMaskPairs, QuarterDroppedAndSplitIntoThreeMoreMeetTheTargets) {
   const PhantomCentreline line = flat_course(sup);
   ASSERT_GT(line.arc_mm.back(), 1000.0);  // the real colon's course, about 2 m
   const PhantomTruth ts = truth(polyps, line, Eigen::Vector3d::Zero()), tp = truth(polyps, line, kTable);
-  int checked = 0, seen = 0, right = 0;
+  int checked = 0;
   for (const CutCase& c : segmentation_cut_cases(line.arc_mm.back())) {
     if (!c.within_targets || (c.name.find("25 %") == std::string::npos && c.name.find("split") == std::string::npos)) continue;
     SCOPED_TRACE(c.name);
@@ -120,12 +121,10 @@ TEST(RealMaskPairs, QuarterDroppedAndSplitIntoThreeMoreMeetTheTargets) {
     ASSERT_GE(f.seen_in_both, 5);
     EXPECT_EQ(f.wrong, 0);
     EXPECT_LE(f.along_median_mm(), 10.0);
-    seen += f.seen_in_both, right += f.right, ++checked;
+    EXPECT_GE(f.right, int(std::ceil(0.9 * f.seen_in_both))) << f.right << " of " << f.seen_in_both;
+    ++checked;
   }
   EXPECT_EQ(checked, 2);
-  // >= 90 % over both pairs: with 9-10 polyps per pair one miss is 89-90 %; the quarter-dropped pair
-  // misses one (8 of 9, docs/register.md: a polyp where two side branches hang at one neck)
-  EXPECT_GE(right, int(std::ceil(0.9 * seen))) << right << " of " << seen;
 }
 
 }  // namespace

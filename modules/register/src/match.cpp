@@ -18,56 +18,94 @@ double angle_difference(double a, double b) {
 
 nlohmann::json finite_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
-struct Located {
-  double s, theta;
-};
-
 }  // namespace
 
 void ColonRegistration::match_candidates() { matching_ = match(supine_.candidates, prone_.candidates); }
 
-CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
-                                           const std::vector<ScanCandidate>& cp) const {
-  CandidateMatching out;
-  std::vector<Located> where_p;
-  for (const auto& c : cp) {
-    const auto [s, t] = locate(c.lps, Direction::kProneToSupine);
-    where_p.push_back({s, t});
-  }
-  std::vector<double> gap_s(cs.size()), gap_p(cp.size());
+// The places of a candidate on its scan's course (locations(): more than one where the course passes
+// it twice, reach: its radius, at least min_place_reach_mm) with their support gaps.
+std::vector<ColonRegistration::Place> ColonRegistration::places(const ScanCandidate& c, Direction from) const {
   constexpr double kHeld = std::numeric_limits<double>::infinity();  // held at a neck: no support along
-  for (size_t j = 0; j < cp.size(); ++j)
-    gap_p[j] = held_at_neck(cp[j].lps, Direction::kProneToSupine) ? kHeld : support_gap_mm(false, where_p[j].s);
-  struct Option { double cost; size_t i, j; CandidateMatch m; };
-  std::vector<Option> options;
-  for (size_t i = 0; i < cs.size(); ++i) {
-    const auto [s, t] = locate(cs[i].lps, Direction::kSupineToProne);
-    gap_s[i] = held_at_neck(cs[i].lps, Direction::kSupineToProne) ? kHeld : support_gap_mm(true, s);
-    if (std::isnan(s) || gap_s[i] > opts_.max_unsupported_mm) continue;  // no support: never paired
-    double s2, t2;
-    map_coordinates(Direction::kSupineToProne, s, t, s2, t2);
-    for (size_t j = 0; j < cp.size(); ++j) {
-      if (std::isnan(where_p[j].s) || gap_p[j] > opts_.max_unsupported_mm) continue;
+  const bool held = held_at_neck(c.lps, from);
+  std::vector<Place> out;
+  for (const auto& [s, t] : locations(c.lps, from, std::max(opts_.min_place_reach_mm, c.size_mm / 2)))
+    out.push_back({s, t, held || std::isnan(s) ? kHeld : support_gap_mm(from == Direction::kSupineToProne, s)});
+  return out;
+}
+
+size_t ColonRegistration::shown_place(const std::vector<Place>& pl) const {
+  for (size_t k = 0; k < pl.size(); ++k)
+    if (pl[k].gap <= opts_.max_unsupported_mm) return k;
+  return 0;
+}
+
+std::pair<double, double> ColonRegistration::candidate_place(int id, Direction from) const {
+  const bool sup = from == Direction::kSupineToProne;
+  for (const auto& m : matching_.pairs)
+    if ((sup ? m.supine_id : m.prone_id) == id)
+      return sup ? std::pair{m.supine_s_mm, m.supine_theta} : std::pair{m.prone_s_mm, m.prone_theta};
+  for (const auto& c : (sup ? supine_ : prone_).candidates)
+    if (c.id == id) {
+      const std::vector<Place> pl = places(c, from);
+      const Place& p = pl[shown_place(pl)];
+      return {p.s, p.theta};
+    }
+  return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+}
+
+Eigen::Vector3d ColonRegistration::map_candidate(int id, Direction d) const {
+  const auto [s, theta] = candidate_place(id, d);
+  const int v = std::isnan(s) ? -1 : map_vertex(d, s, theta);
+  if (v < 0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return (d == Direction::kSupineToProne ? prone_ : supine_).lps[size_t(v)];
+}
+
+// Supine candidate `a` (at one of its places `pa`) and prone `b` (`pb`): the combination of places
+// within the match limits with the lowest cost (along^2 + around^2 + log-size^2, each over its
+// limit) in `best` and `cost`; false when none is within them or a place has no support.
+bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
+                                       const std::vector<Place>& pb, CandidateMatch& best, double& cost) const {
+  bool found = false;
+  for (const Place& x : pa)
+    for (const Place& y : pb) {
+      if (x.gap > opts_.max_unsupported_mm || y.gap > opts_.max_unsupported_mm) continue;  // never paired
+      double s2, t2;
+      map_coordinates(Direction::kSupineToProne, x.s, x.theta, s2, t2);
       CandidateMatch m;
-      m.supine_id = cs[i].id;
-      m.prone_id = cp[j].id;
-      m.along_mm = std::abs(where_p[j].s - s2);
-      m.around_deg = angle_difference(where_p[j].theta, t2) * 180 / kPi;
-      const double a = cs[i].size_mm, b = cp[j].size_mm;
-      m.size_ratio = a > 0 && b > 0 ? std::max(a, b) / std::min(a, b) : 1.0;
-      m.distance_3d_mm = (cs[i].lps - cp[j].lps - b_to_a_).norm();
+      m.supine_id = a.id, m.prone_id = b.id;
+      m.along_mm = std::abs(y.s - s2);
+      m.around_deg = angle_difference(y.theta, t2) * 180 / kPi;
+      m.size_ratio = a.size_mm > 0 && b.size_mm > 0 ? std::max(a.size_mm, b.size_mm) / std::min(a.size_mm, b.size_mm) : 1.0;
+      m.distance_3d_mm = (a.lps - b.lps - b_to_a_).norm();
       if (m.along_mm > opts_.match_along_mm || m.around_deg > opts_.match_around_deg ||
           m.size_ratio > opts_.match_size_ratio || m.distance_3d_mm > opts_.match_3d_mm)
         continue;
-      m.supine_gap_mm = gap_s[i], m.prone_gap_mm = gap_p[j];
-      m.anchor_mm = support_.supine_anchor_mm.empty() ? 0.0 : support_.supine_anchor_mm[size_t(sup_.profile.bin_of(s))];
-      m.score = 1 - (1 - std::clamp(cs[i].score, 0.0, 1.0)) * (1 - std::clamp(cp[j].score, 0.0, 1.0));
       const double size_term = std::log(m.size_ratio) / std::log(std::max(1.0001, opts_.match_size_ratio));
-      const double cost = std::pow(m.along_mm / opts_.match_along_mm, 2) +
-                          std::pow(m.around_deg / opts_.match_around_deg, 2) + size_term * size_term;
-      options.push_back({cost, i, j, m});
+      const double c = std::pow(m.along_mm / opts_.match_along_mm, 2) + std::pow(m.around_deg / opts_.match_around_deg, 2) +
+                       size_term * size_term;
+      if (found && c >= cost) continue;
+      m.supine_gap_mm = x.gap, m.prone_gap_mm = y.gap;
+      m.supine_s_mm = x.s, m.supine_theta = x.theta, m.prone_s_mm = y.s, m.prone_theta = y.theta;
+      m.anchor_mm = support_.supine_anchor_mm.empty() ? 0.0 : support_.supine_anchor_mm[size_t(sup_.profile.bin_of(x.s))];
+      m.score = 1 - (1 - std::clamp(a.score, 0.0, 1.0)) * (1 - std::clamp(b.score, 0.0, 1.0));
+      found = true, cost = c, best = m;
     }
-  }
+  return found;
+}
+
+CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
+                                           const std::vector<ScanCandidate>& cp) const {
+  CandidateMatching out;
+  std::vector<std::vector<Place>> ps, pp;
+  for (const auto& c : cs) ps.push_back(places(c, Direction::kSupineToProne));
+  for (const auto& c : cp) pp.push_back(places(c, Direction::kProneToSupine));
+  struct Option { double cost; size_t i, j; CandidateMatch m; };
+  std::vector<Option> options;
+  for (size_t i = 0; i < cs.size(); ++i)
+    for (size_t j = 0; j < cp.size(); ++j) {
+      Option o{0, i, j, {}};
+      if (pair_at_places(cs[i], ps[i], cp[j], pp[j], o.m, o.cost)) options.push_back(o);
+    }
   std::vector<int> per_s(cs.size(), 0), per_p(cp.size(), 0);
   for (const auto& o : options) ++per_s[o.i], ++per_p[o.j];
   std::sort(options.begin(), options.end(), [](const Option& x, const Option& y) { return x.cost < y.cost; });
@@ -81,12 +119,12 @@ CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
   for (size_t i = 0; i < cs.size(); ++i)
     if (!used_s[i]) {
       out.supine_only.push_back(cs[i].id);
-      if (gap_s[i] > opts_.max_unsupported_mm) out.supine_unaligned.push_back(cs[i].id);
+      if (ps[i][shown_place(ps[i])].gap > opts_.max_unsupported_mm) out.supine_unaligned.push_back(cs[i].id);
     }
   for (size_t j = 0; j < cp.size(); ++j)
     if (!used_p[j]) {
       out.prone_only.push_back(cp[j].id);
-      if (gap_p[j] > opts_.max_unsupported_mm) out.prone_unaligned.push_back(cp[j].id);
+      if (pp[j][shown_place(pp[j])].gap > opts_.max_unsupported_mm) out.prone_unaligned.push_back(cp[j].id);
     }
   return out;
 }
@@ -150,6 +188,7 @@ nlohmann::json ColonRegistration::summary() const {
                      {"around_deg", m.around_deg}, {"size_ratio", m.size_ratio}, {"score", m.score},
                      {"distance_3d_mm", m.distance_3d_mm}, {"supine_gap_mm", m.supine_gap_mm},
                      {"prone_gap_mm", m.prone_gap_mm}, {"anchor_mm", finite_or_null(m.anchor_mm)},
+                     {"supine_s_mm", finite_or_null(m.supine_s_mm)}, {"prone_s_mm", finite_or_null(m.prone_s_mm)},
                      {"unique", m.unique}});
   return {{"units", "mm"},
           {"coordinate_system", "LPS"},

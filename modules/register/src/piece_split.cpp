@@ -52,4 +52,26 @@ const ColonPiece* piece_at(const std::multimap<int, const ColonPiece*>& by_segme
   return found;
 }
 
+// A colon does not run back along itself: of the bins with an offset, keep the largest set whose common s
+// (offset + own mm) runs forward along the piece's direction (longest monotone subsequence), the others
+// (a few bins projecting onto a neighbouring loop) lose their offset and are interpolated over.
+void keep_forward_run(std::vector<double>& offset, bool flipped, double bin_mm) {
+  std::vector<int> at;
+  std::vector<double> v;
+  for (size_t k = 0; k < offset.size(); ++k)
+    if (!std::isnan(offset[k])) at.push_back(int(k)), v.push_back((flipped ? -1 : 1) * (offset[k] + (flipped ? -1 : 1) * (double(k) + 0.5) * bin_mm));
+  const size_t m = v.size();
+  std::vector<int> len(m, 1), prev(m, -1);
+  int best = -1;
+  for (size_t i = 0; i < m; ++i) {
+    for (size_t j = 0; j < i; ++j)
+      if (v[j] <= v[i] && len[j] + 1 > len[i]) len[i] = len[j] + 1, prev[i] = int(j);
+    if (best < 0 || len[i] > len[size_t(best)]) best = int(i);
+  }
+  std::vector<char> keep(m, 0);
+  for (int i = best; i >= 0; i = prev[size_t(i)]) keep[size_t(i)] = 1;
+  for (size_t i = 0; i < m; ++i)
+    if (!keep[i]) offset[size_t(at[i])] = std::numeric_limits<double>::quiet_NaN();
+}
+
 }  // namespace cf

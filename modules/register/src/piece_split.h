@@ -25,4 +25,9 @@ std::vector<ColonPiece> split_piece(const ColonPiece& p, double cut_mm);
 // first): a band cut where it turns is several pieces of one segment.
 const ColonPiece* piece_at(const std::multimap<int, const ColonPiece*>& by_segment, int seg, double c);
 
+// Of the bins of a placed piece with an offset (common s - own mm, flipped: + own mm; NaN: none), keeps
+// the largest set whose common s runs forward along the piece (longest monotone subsequence); the
+// others lose their offset (NaN). Post: the kept offsets' common s is monotone along the piece.
+void keep_forward_run(std::vector<double>& offset, bool flipped, double bin_mm);
+
 }  // namespace cf

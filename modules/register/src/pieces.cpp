@@ -193,9 +193,8 @@ std::vector<RefPoint> ref_points(const std::vector<ColonPiece>& ref, const std::
   return pts;
 }
 
-// Common s per centre bin of a placed piece: the running median (half window `follow_mm`) of its
-// projections' offsets from its own mm (sref - own mm; flipped: sref + own mm), linear between bins
-// that project, the piece's own mm beyond them; then made monotone along its direction.
+// Common s per centre bin of a placed piece: running median (+-`follow_mm`) of its projections' offsets (sref - own
+// mm; flipped: + own mm), their largest forward run kept, linear between, own mm beyond; then monotone along it.
 std::vector<double> follow_projections(const ColonPiece& piece, const std::vector<double>& local,
                                        const std::vector<double>& sref, const PieceOptions& o) {
   const int n = int(piece.centre.size());
@@ -220,7 +219,7 @@ std::vector<double> follow_projections(const ColonPiece& piece, const std::vecto
     const bool sides = 2 * std::min(before.size(), after.size()) >= size_t(half);
     offset[size_t(bin[i])] = sides && std::abs(b - a) > o.jump_mm ? (std::abs(b - own) <= std::abs(a - own) ? b : a) : median(near);
   }
-  std::vector<double> s(static_cast<size_t>(n));
+  keep_forward_run(offset, piece.flipped, o.bin_mm);
   int last = -1;
   for (int k = 0; k < n; ++k) {
     if (std::isnan(offset[size_t(k)])) continue;
@@ -229,6 +228,7 @@ std::vector<double> follow_projections(const ColonPiece& piece, const std::vecto
     last = k;
   }
   for (int j = last + 1; j < n; ++j) offset[size_t(j)] = offset[size_t(last)];
+  std::vector<double> s(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) s[size_t(k)] = offset[size_t(k)] + dir * (double(k) + 0.5) * o.bin_mm;
   for (int k = 1; k < n; ++k)  // a colon does not run back along itself
     s[size_t(k)] = piece.flipped ? std::min(s[size_t(k)], s[size_t(k) - 1]) : std::max(s[size_t(k)], s[size_t(k) - 1]);

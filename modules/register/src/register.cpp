@@ -1,5 +1,6 @@
 #include "colonflat/register/register.h"
 
+#include <vtkIdList.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -241,6 +242,32 @@ std::pair<double, double> ColonRegistration::locate(const Eigen::Vector3d& p, Di
   double radial = 0;
   const double theta = angle_about_centre(c.profile, c.s[size_t(v)], p, &radial);
   return {c.s[size_t(v)], radial > 0 ? theta : c.theta[size_t(v)]};
+}
+
+std::vector<std::pair<double, double>> ColonRegistration::locations(const Eigen::Vector3d& p, Direction from,
+                                                                   double reach_mm) const {
+  std::vector<std::pair<double, double>> out{locate(p, from)};
+  const bool sup = from == Direction::kSupineToProne;
+  const Index& idx = sup ? *sup_index_ : *pro_index_;
+  const ScanCoordinates& c = sup ? sup_ : pro_;
+  const std::vector<Eigen::Vector3d>& wall = (sup ? supine_ : prone_).lps;
+  const vtkIdType v = idx.lps->FindClosestPoint(p.data());
+  if (v < 0 || std::isnan(out[0].first)) return out;
+  vtkNew<vtkIdList> near;
+  idx.lps->FindPointsWithinRadius((wall[size_t(v)] - p).norm() + reach_mm, p.data(), near);
+  std::vector<std::pair<double, size_t>> by_distance;  // registered vertices within reach, nearest first
+  for (vtkIdType k = 0; k < near->GetNumberOfIds(); ++k)
+    if (const size_t w = size_t(near->GetId(k)); !std::isnan(c.s[w])) by_distance.push_back({(wall[w] - p).squaredNorm(), w});
+  std::sort(by_distance.begin(), by_distance.end());
+  for (const auto& [d2, w] : by_distance) {
+    bool known = false;
+    for (const auto& place : out) known |= std::abs(c.s[w] - place.first) <= opts_.match_along_mm;
+    if (known) continue;
+    double radial = 0;
+    const double theta = angle_about_centre(c.profile, c.s[w], p, &radial);
+    out.push_back({c.s[w], radial > 0 ? theta : c.theta[w]});
+  }
+  return out;
 }
 
 Eigen::Vector3d ColonRegistration::map_lps(const Eigen::Vector3d& p, Direction d) const {

@@ -179,6 +179,16 @@ class ReviewBuilder {
   // (s, angle) of an LPS point of `own`, and where the registration maps it in the other scan.
   nlohmann::json registered(const ReviewScan& own, const std::array<double, 3>& lps) const {
     const auto [s, theta] = reg_.locate(Eigen::Vector3d(lps[0], lps[1], lps[2]), own.from);
+    return registered_at(own, s, theta);
+  }
+
+  // The same for a candidate of `own`: at the place it was matched at (candidate_place()).
+  nlohmann::json registered_candidate(const ReviewScan& own, int id) const {
+    const auto [s, theta] = reg_.candidate_place(id, own.from);
+    return registered_at(own, s, theta);
+  }
+
+  nlohmann::json registered_at(const ReviewScan& own, double s, double theta) const {
     if (std::isnan(s)) return nullptr;
     double s2 = 0, theta2 = 0;
     reg_.map_coordinates(own.from, s, theta, s2, theta2);
@@ -201,14 +211,14 @@ class ReviewBuilder {
 
   nlohmann::json own_card(ReviewScan& s, const ReportFinding& f) {
     nlohmann::json fj = card_with_images(s, f, s.name + "_" + f.key, opts_.views);
-    fj["registered"] = registered(s, f.lps_mm);
+    fj["registered"] = registered_candidate(s, f.id);
     return fj;
   }
 
   // The other scan's views at the registered position of `f`, with the nearest candidate there.
   nlohmann::json probe_card(ReviewScan& own, ReviewScan& other, const ReportFinding& f) {
-    const auto [s, theta] = reg_.locate(Eigen::Vector3d(f.lps_mm[0], f.lps_mm[1], f.lps_mm[2]), own.from);
-    const int v = reg_.map_vertex(own.from, s, theta);
+    const auto [s, theta] = reg_.candidate_place(f.id, own.from);
+    const int v = std::isnan(s) ? -1 : reg_.map_vertex(own.from, s, theta);
     if (v < 0) return {{"not_registered", true}};
     ReportFinding probe;
     probe.key = f.key;
@@ -234,7 +244,7 @@ class ReviewBuilder {
     nlohmann::json best = nullptr;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const ReportFinding& c : s.run->candidates) {
-      const auto [cs, ct] = reg_.locate(Eigen::Vector3d(c.lps_mm[0], c.lps_mm[1], c.lps_mm[2]), s.from);
+      const auto [cs, ct] = reg_.candidate_place(c.id, s.from);
       if (std::isnan(cs)) continue;
       const double along = std::abs(cs - at["s_mm"].get<double>());
       const double around = std::abs(std::remainder(ct * kDegPerRad - at["angle_deg"].get<double>(), 360.0));

@@ -102,11 +102,12 @@ void ring(vtkImageCanvasSource2D* canvas, const Layout& l, const Marker& m) {
   }
 }
 
-// Each candidate of both scans at its place on the supine length axis (prone ones mapped over).
+// Each candidate of both scans at its place on the supine length axis (prone ones mapped over): the
+// place it was matched at (candidate_place()).
 std::vector<Marker> place_markers(const ColonRegistration& reg, const Layout& l) {
   std::vector<Marker> marks;
   auto place = [&](const ScanCandidate& c, bool supine) {
-    auto [s, theta] = reg.locate(c.lps, supine ? Direction::kSupineToProne : Direction::kProneToSupine);
+    auto [s, theta] = reg.candidate_place(c.id, supine ? Direction::kSupineToProne : Direction::kProneToSupine);
     if (std::isnan(s)) return;
     if (!supine) reg.map_coordinates(Direction::kProneToSupine, s, theta, s, theta);
     const int radius = std::max(4, int(std::lround(0.5 * c.size_mm / l.pixel)) + 3);

@@ -437,5 +437,49 @@ TEST(RegisterPieces, SmallTableRotationKeepsPairsRight) {
   }
 }
 
+// The colon passes one polyp twice (walls of two loops touching): in the supine a 30 mm stretch of
+// the colon 200 mm or more further on lies against the polyp, its wall half as far from the polyp's point as
+// the polyp's own (so locate() puts the polyp on that stretch, which the prone has elsewhere: no
+// support there). The polyp is still paired with itself at its other place on the course, every
+// polyp seen in both is paired right (a84c05a: located on the stretch only, never paired), and the
+// pair is shown and mapped at that place (s15 a0895e0: at the stretch, mapped 376 mm off).
+TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
+  SyntheticPair pair = make_synthetic_pair(long_pair(1));
+  const SyntheticPolyp& q = pair.polyps[2];
+  std::vector<double> at;  // polyps 200 mm or more further on
+  for (const auto& o : pair.polyps)
+    if (o.sigma_mm > q.sigma_mm + 200) at.push_back(o.sigma_mm);
+  std::sort(at.begin(), at.end());
+  ASSERT_GE(at.size(), 2u);
+  size_t widest = 1;  // a 30 mm stretch in the middle of the widest gap between two of them
+  for (size_t k = 2; k < at.size(); ++k)
+    if (at[k] - at[k - 1] > at[widest] - at[widest - 1]) widest = k;
+  const double from = (at[widest] + at[widest - 1]) / 2 - 15;
+  for (const auto& o : pair.polyps) ASSERT_TRUE(o.sigma_mm < from - 10 || o.sigma_mm > from + 40);
+  double own = INFINITY;  // the polyp point's distance to its own wall
+  size_t touch = 0;       // the stretch's vertex nearest to it
+  for (size_t v = 0; v < pair.supine.lps.size(); ++v) {
+    const double d = (pair.supine.lps[v] - q.supine_lps).norm(), sigma = pair.supine_sigma[v];
+    if (sigma < from || sigma > from + 30) own = std::min(own, d);
+    else if (d < (pair.supine.lps[touch] - q.supine_lps).norm() || pair.supine_sigma[touch] < from) touch = v;
+  }
+  ASSERT_GT(own, 0.05);
+  const Eigen::Vector3d inward = (pair.supine.lps[touch] - q.supine_lps).normalized();
+  const Eigen::Vector3d move = q.supine_lps + 0.5 * own * inward - pair.supine.lps[touch];
+  for (size_t v = 0; v < pair.supine.lps.size(); ++v)
+    if (pair.supine_sigma[v] >= from && pair.supine_sigma[v] <= from + 30) pair.supine.lps[v] += move;
+  const auto run = registered(pair);
+  const ColonRegistration& reg = *run;
+  ASSERT_GT(reg.locate(q.supine_lps, Direction::kSupineToProne).first, from - 20);  // the first place is the stretch
+  EXPECT_GE(reg.locations(q.supine_lps, Direction::kSupineToProne, 3).size(), 2u);
+  expect_every_polyp_paired(score(pair, reg));
+  // What is shown for the pair (check-here position, side-by-side marker) is at the polyp's own place:
+  // mapped within 5 mm of the prone polyp (its first place, the stretch, maps far from it).
+  const Eigen::Vector3d shown = reg.map_candidate(q.id, Direction::kSupineToProne);
+  const Eigen::Vector3d nearest = reg.map_lps(q.supine_lps, Direction::kSupineToProne);
+  EXPECT_LT((shown - q.prone_lps).norm(), 5.0) << "first place maps " << (nearest - q.prone_lps).norm() << " mm off";
+  EXPECT_LT(std::abs(reg.candidate_place(q.id, Direction::kSupineToProne).first - q.sigma_mm), 5.0);
+}
+
 }  // namespace
 }  // namespace cf

@@ -11,6 +11,7 @@
 // rotation around the colon from the wall relief; (4) per-vertex correspondence in both
 // directions (nearest vertex in (s, r theta) of the other scan); (5) candidate matching.
 // The two scans are borrowed: they must outlive the registration.
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ struct RegisterOptions {
   double match_along_mm = 30;        // mm; largest distance along the colon of a candidate pair
   double match_around_deg = 45;      // degrees; largest angle around the colon of a pair
   double match_size_ratio = 2.0;     // largest size ratio of a pair (larger / smaller)
+  double min_place_reach_mm = 3;     // mm; a candidate's other places on the course (locations()) lie this much,
+                                     //   or half its size if larger, beyond its nearest wall vertex: the wall a
+                                     //   polyp stands on reaches its radius around it (3 mm: half the smallest
+                                     //   polyp reported, 6 mm)
   PieceOptions pieces;               // colons with centreline_mm: laid out piece by piece (pieces.h)
   LandmarkOptions landmarks;
   double support_radius_mm = 100;    // mm; centre points farther apart after the shift do not support the map
@@ -57,6 +62,10 @@ struct CandidateMatch {
   double supine_gap_mm = 0, prone_gap_mm = 0;  // mm along to the nearest supported bin (0: supported)
   double anchor_mm = 0;     // mm along (supine) to the nearest shared landmark or other anchor pair
   bool unique = true;       // no other partner within the match limits for either candidate
+  // The places of the two candidates the pair was matched at (locations(): one of each candidate's
+  // places on its course); everything shown for the pair uses them (candidate_place()).
+  double supine_s_mm = std::numeric_limits<double>::quiet_NaN(), supine_theta = std::numeric_limits<double>::quiet_NaN();
+  double prone_s_mm = std::numeric_limits<double>::quiet_NaN(), prone_theta = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CandidateMatching {
@@ -92,12 +101,26 @@ class ColonRegistration {
   // An LPS point of one scan to the other: nearest wall vertex, its (s, theta), mapped, the
   // target's wall vertex there; returns its LPS position (NaN when the point is not registered).
   Eigen::Vector3d map_lps(const Eigen::Vector3d& p, Direction d) const;
+  // (s, theta) where candidate `id` of the scan `from` is shown and mapped: the place its pair was
+  // matched at (CandidateMatch::supine_s_mm ...); unpaired, its first place (locations()) with support
+  // along, else its nearest (locate()). The same place decides the "not aligned" lists.
+  // Post: NaN when the scan has no candidate `id` or the place is not registered.
+  std::pair<double, double> candidate_place(int id, Direction from) const;
+  // The other scan's LPS position of candidate `id` of the scan `d` maps from: its candidate_place()
+  // mapped, the target's wall vertex there (NaN when not registered).
+  Eigen::Vector3d map_candidate(int id, Direction d) const;
   // True when a candidate at this LPS point of one scan, or its image in the other, lies on a stretch
   // held at a neck (pieces.h): never paired there.
   bool held_at_neck(const Eigen::Vector3d& p, Direction from) const;
   // (s, theta) of an LPS point of a scan: s of its nearest wall vertex, theta of the point about
   // the centre line there (NaN when that vertex is not registered).
   std::pair<double, double> locate(const Eigen::Vector3d& p, Direction from) const;
+  // locate() first, then every other place of the point on the colon's course: where the course passes
+  // it more than once (a neck with a long branch inserted into the course before it, walls of two loops
+  // touching) the wall within `reach_mm` beyond the nearest vertex's distance belongs to several
+  // stretches; each is represented by its vertex nearest to p that lies more than match_along_mm along
+  // from the places already found (nearest first). Post: size >= 1; entries NaN when not registered.
+  std::vector<std::pair<double, double>> locations(const Eigen::Vector3d& p, Direction from, double reach_mm) const;
 
   const ScanCoordinates& supine_coordinates() const { return sup_; }
   const ScanCoordinates& prone_coordinates() const { return pro_; }
@@ -138,6 +161,13 @@ class ColonRegistration {
   int twist_windows_ = 0;
   std::vector<int> sup_to_pro_, pro_to_sup_;
   std::vector<char> sup_held_, pro_held_;  // per vertex: held at a neck (pieces.h held_at_neck)
+  struct Place {
+    double s, theta, gap;  // gap: mm along to supported alignment (infinite: held at a neck)
+  };
+  std::vector<Place> places(const ScanCandidate& c, Direction from) const;
+  size_t shown_place(const std::vector<Place>& pl) const;  // first supported place, else 0
+  bool pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
+                      const std::vector<Place>& pb, CandidateMatch& best, double& cost) const;
   CandidateMatching matching_;
   std::unique_ptr<Index> sup_index_, pro_index_;
   nlohmann::json timing_ = nlohmann::json::object();
