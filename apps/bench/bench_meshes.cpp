@@ -222,6 +222,34 @@ TriangleList varying_torus(double R, double r0, double amp, double thin_at, int 
   return t;
 }
 
+// A closed tube of radius rt along the circle of radius R in the xy plane, from angle u0 to u1
+// (nu sections of nv vertices), each end closed by a flat fan to a vertex on the circle: a
+// genus-0 surface, oriented like varying_torus.
+TriangleList core_arc(double R, double rt, double u0, double u1, int nu, int nv) {
+  constexpr double kPi = 3.14159265358979323846;
+  TriangleList t;
+  for (int i = 0; i <= nu; ++i) {
+    const double u = u0 + (u1 - u0) * i / nu;
+    for (int j = 0; j < nv; ++j) {
+      const double v = 2 * kPi * j / nv;
+      t.points.push_back({(R + rt * std::cos(v)) * std::cos(u), (R + rt * std::cos(v)) * std::sin(u), rt * std::sin(v)});
+    }
+  }
+  const int tip0 = static_cast<int>(t.points.size()), tip1 = tip0 + 1;
+  t.points.push_back({R * std::cos(u0), R * std::sin(u0), 0});
+  t.points.push_back({R * std::cos(u1), R * std::sin(u1), 0});
+  auto id = [&](int i, int j) { return i * nv + (j % nv); };
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      t.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      t.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+    t.triangles.push_back({tip0, id(0, j), id(0, j + 1)});
+    t.triangles.push_back({tip1, id(nu, j + 1), id(nu, j)});
+  }
+  return t;
+}
+
 }  // namespace
 
 Mesh blocked_torus(Blocker kind) {
@@ -234,10 +262,14 @@ Mesh blocked_torus(Blocker kind) {
   } else if (kind == Blocker::kCoreBlob) {
     blocker = synthetic::sphere(1, 16, 8);
     for (auto& p : blocker.points) p = {4 + 0.3 * p[0], 0.6 * p[1], 0.3 * p[2]};
+  } else if (kind == Blocker::kWaistPlugAndRod) {
+    const double step = 2 * kPi / 64;  // one section of the torus
+    blocker = synthetic::disjoint_union(core_arc(4, 0.72, -step, step, 2, 16),
+                                        core_arc(4, 0.15, 4 * step, 2 * kPi - 4 * step, 56, 8));
   } else {
     blocker = varying_torus(4, 0.15, 0.15, kPi, 64, 8);
   }
-  if (kind == Blocker::kCoreAndLinkRings) {
+  if (kind == Blocker::kCoreAndLinkRings || kind == Blocker::kWaistPlugAndRod) {
     TriangleList link = varying_torus(2.5, 0.15, 0, 0, 48, 8);  // axis z, in the xy plane
     for (auto& p : link.points) p = {4 + p[0], -p[2], p[1]};  // a rotation: axis y, around the tube at u = 0
     blocker = synthetic::disjoint_union(blocker, link);

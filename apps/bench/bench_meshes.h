@@ -46,9 +46,15 @@ Mesh colon_like_surface(const ColonLikeOptions& options);
 //    there): it links every meridian, so no meridian has a clean cap; the longitude's has;
 //  - kCoreAndLinkRings: that ring and a second thin ring (radius 2.5 mm, tube 0.15 mm) around the
 //    tube at u = 0, through the hole: it links every loop crossing a meridian, so no loop that
-//    removes the torus' handle has a clean cap.
+//    removes the torus' handle has a clean cap;
+//  - kWaistPlugAndRod: a plug filling the tube at u = 0 (a tube of radius 0.72 mm between the
+//    sections at u = -+1 of 64, flat ends), a rod of radius 0.15 mm along the core from section 4
+//    to section 60, and the link ring: the meridians one section from the thinnest one (or
+//    closer) cross the plug, those 4 sections or more away the rod, every loop crossing a
+//    meridian the ring; the meridians 2-3 sections away have clean caps (a wall's rim with
+//    remnants beside it, where only a loop a few edges off the rim can be capped).
 // Closed and embedded; genus 1 + one per ring.
-enum class Blocker { kRod, kCoreBlob, kCoreRing, kCoreAndLinkRings };
+enum class Blocker { kRod, kCoreBlob, kCoreRing, kCoreAndLinkRings, kWaistPlugAndRod };
 Mesh blocked_torus(Blocker blocker);
 
 }  // namespace cf::bench

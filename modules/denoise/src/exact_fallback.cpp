@@ -14,8 +14,9 @@ namespace cf::detail {
 // surgery is undone and other loops that remove the same handle are tried as trials (kept only
 // when their caps are clean, so their concentric caps are not searched for the placement with
 // the fewest pairs); the first one capped cleanly is kept and records the loop it replaces:
-//  1. the shortest loop of the same class (modulo the classes cut before) outside a tube of
-//     radius delta around `loop`, for two tube radii;
+//  1. the shortest loop of the same class (modulo the classes cut before) outside a tube
+//     around `loop`, for tube radii of kNearTubeEdges mean edges (a loop on one face of a thin
+//     wall beside the rim `loop` runs along), then delta and 2 delta;
 //  2. the shortest loop crossing `loop` an odd number of times: the handle's other loop, whose
 //     disk is the handle's other disk (where no disk of `loop`'s class avoids the surface, e.g.
 //     something runs through the tube, the other may: it spans the hole). Plain triangulations
@@ -44,10 +45,11 @@ SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& lo
     return true;
   };
   revert_cut(sr);
-  for (double tube : {delta, 2.0 * delta}) {
+  const double edge = st_.mean_edge;
+  for (double tube : {kNearTubeEdges[0] * edge, kNearTubeEdges[1] * edge, delta, 2.0 * delta}) {
     const std::vector<Mesh::VertexHandle> other = same_class_loop(loop, reduced, tube);
-    if (other.empty()) break;
-    if (clean(other, CapAttempt::kTrial, &alternatives_)) return sr;
+    if (other.empty() && tube >= delta) break;
+    if (!other.empty() && clean(other, CapAttempt::kTrial, &alternatives_)) return sr;
   }
   const std::vector<Mesh::VertexHandle> dual = crossing_loop(loop, 3.0 * length + 4.0 * delta);
   if (!dual.empty()) {

@@ -138,6 +138,13 @@ class ExactGreedy {
   std::vector<Mesh::VertexHandle> same_class_loop(const std::vector<Mesh::VertexHandle>& loop,
                                                   const std::vector<std::uint64_t>& reduced, double tube);
   static constexpr std::size_t kFallbackSources = 24;
+  // Tube radii of the same-class fallback tried first, in mean edge lengths (issue 26, session
+  // 16): a loop round a window in a thin wall zigzags between the wall's two faces along the rim
+  // and every disk of it passes through the rim; the wall it crosses lies within 0-3 mm (about
+  // 4 edges) of the loop. A loop of the same class outside a tube of 2, then 4 edges runs on one
+  // face a ring or two off the rim (or round a slit, beside earlier caps lying across it), and
+  // its caps rise from that face. The tubes of L/8 and L/4 come after them.
+  static constexpr double kNearTubeEdges[] = {2.0, 4.0};
   static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
   // exact_method.cpp
   double search_limit(int slot);

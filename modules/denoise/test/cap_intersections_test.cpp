@@ -178,6 +178,30 @@ TEST(DenoiseCapIntersections, UncappableLoopIsReplacedByTheHandlesOtherLoop) {
   expect_two_clean_spheres(r.mesh);
 }
 
+// A plug filling the tube at the thinnest meridian and a rod along the rest of its core: the
+// thinnest meridian (every disk of which crosses the plug, as a rim's disks cross the wall
+// beside it), the same-class loops a quarter of a meridian away (the rod) and the loops crossing
+// it (the link ring) have no clean caps; the meridian two or three sections off the plug has.
+// It is found (a tube of a few edges around the failing loop) and cut: 0 intersecting pairs
+// (CGAL), genus 0 per component. On 8e52242 the thinnest meridian was cut across the plug.
+TEST(DenoiseCapIntersections, LoopBesideAWallIsReplacedByOneAFewEdgesOff) {
+  const Mesh m = bench::blocked_torus(bench::Blocker::kWaistPlugAndRod);
+  ASSERT_EQ(testing::count_self_intersections(m), 0u) << "the input must be embedded";
+  DenoiseOptions o;
+  o.front_caps = false;  // they bend round the rod's tip (FrontCapsGoAroundABlockingRod)
+  const DenoiseResult r = denoise(m, o);
+  const LoopRecord& loop = r.loops.back();  // the torus' handle (the link ring's meridian first)
+  EXPECT_GT(loop.replaced_intersections, 0u) << "the thinnest meridian's caps must have been blocked";
+  EXPECT_NEAR(loop.replaced_length, 2 * kPi * 0.85, 0.05 * 2 * kPi * 0.85);
+  EXPECT_LT(loop.length, 2 * kPi * 0.9);  // a meridian a few sections off (radius 0.86-0.87)
+  EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 1);
+  EXPECT_EQ(r.report["totals"]["cap_intersections"].get<std::size_t>(), 0u);
+  const TopologyReport t = analyze_topology(r.mesh);
+  for (const auto& c : t.components) EXPECT_EQ(c.genus, 0);
+  EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
+  EXPECT_EQ(testing::count_self_intersections(r.mesh), 0u);
+}
+
 // With a second ring through the hole as well, every loop that removes the torus' handle is
 // linked with a ring, so no clean cap exists: the intersecting pairs are reported (never hidden)
 // and --strict turns them into an error.
