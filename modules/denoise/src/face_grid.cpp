@@ -394,13 +394,16 @@ double FaceGrid::free_distance(const Mesh& mesh, const Vec3& origin, const Vec3&
   return best;
 }
 
-std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces) const {
-  return intersecting_pairs(mesh, faces).size();
+std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces,
+                                          std::size_t stop_at) const {
+  return intersecting_pairs(mesh, faces, stop_at).size();
 }
 
 std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
-                                                              const std::vector<Mesh::FaceHandle>& faces) const {
+                                                              const std::vector<Mesh::FaceHandle>& faces,
+                                                              std::size_t stop_at) const {
   std::vector<std::pair<int, int>> pairs;
+  if (stop_at == 0) return pairs;
   std::unordered_set<int> in_set;
   for (auto f : faces) in_set.insert(f.idx());
   std::unordered_set<long long> seen;
@@ -425,8 +428,10 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
       face_box(mesh, g, glo, ghi, gids, q);
       if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
         continue;
-      if (improper_intersection(ids, p, gids, q))
+      if (improper_intersection(ids, p, gids, q)) {
         pairs.emplace_back(f.idx(), gi);
+        if (pairs.size() >= stop_at) return pairs;
+      }
     }
   }
   return pairs;

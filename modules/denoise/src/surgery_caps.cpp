@@ -173,7 +173,7 @@ std::vector<Surgery::Placement> Surgery::placements() const {
 bool Surgery::place_checked(const Placement& tr) {
   place_rings(tr.pull, tr.along_edge ? edge_left_ : target_left_, tr.along_edge ? edge_right_ : target_right_);
   for (auto f : ring_faces_) opts_.guard->insert(mesh_, f);
-  return opts_.guard->count_intersections(mesh_, ring_faces_) == 0;
+  return opts_.guard->count_intersections(mesh_, ring_faces_, 1) == 0;
 }
 
 // The left cap as the right one's mirror: the same triangles on the left copies, reversed (the
@@ -442,7 +442,7 @@ void Surgery::search_concentric_placement() {
         if (pull <= 0 && dome == 0) continue;
         place_concentric(pull, dome);
         refresh();
-        const std::size_t n = opts_.guard->count_intersections(mesh_, moving);
+        const std::size_t n = opts_.guard->count_intersections(mesh_, moving, best);  // only n < best matters
         if (n < best) {
           best = n;
           best_pull = pull;
