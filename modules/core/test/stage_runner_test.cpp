@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/stage_runner.h"
 #include "colonflat/core/vtk_messages.h"
 
@@ -96,6 +97,23 @@ TEST(CoreBackgroundOutputWriter, RunsJobsInOrderAndRethrowsAFailedWrite) {
     EXPECT_EQ(std::string(e.what()), "cannot write: no space left on device");
   }
   writer.wait();  // the error is reported once
+}
+
+// Stopwatch::lap returns the time since the start (or the previous lap) and starts a new interval:
+// consecutive laps split the time a second stopwatch measures over them, without a gap or overlap.
+TEST(CoreStopwatch, LapsSplitTheIntervalAndRestart) {
+  const Stopwatch whole;
+  Stopwatch laps;
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  const double first = laps.lap();
+  EXPECT_GE(first, 0.03);
+  EXPECT_LT(laps.seconds(), first);  // restarted by the lap
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const double second = laps.lap();
+  EXPECT_GE(second, 0.01);
+  const double total = whole.seconds();
+  EXPECT_LE(first + second, total);
+  EXPECT_GT(first + second, total - 0.25);  // a loaded machine may pause the thread between the calls
 }
 
 }  // namespace

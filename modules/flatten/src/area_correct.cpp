@@ -10,11 +10,11 @@
 // no face folds and halved until E decreases (Armijo). The band's ends and the rims of cut-off
 // branches are fixed, so the map stays bijective.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <functional>
 #include <numeric>
 
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/union_find.h"
 #include "face_blocks.h"
@@ -238,15 +238,15 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
               AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
               const std::vector<int>* vertex_order = nullptr) {
   const std::size_t nfaces = faces.size();
-  auto clock = std::chrono::steady_clock::now();
+  Stopwatch clock;
   const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
                                    scale);
   RegionSystem sys;
   if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return;
-  res.build_s = lap(clock);
+  res.build_s = clock.lap();
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch);
-  res.longest_s = res.build_s + lap(clock);
+  res.longest_s = res.build_s + clock.lap();
   res.times = d.times;
   res.longest_faces = nfaces;
   res.longest_steps = d.steps;

@@ -242,6 +242,77 @@ std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E) {
   return loops;
 }
 
+namespace {
+
+// Closes the hole whose rim is `rim` (in the order its fill's faces run) with rings of the rim's
+// vertex count, ring j shrunk towards the rim's vertex mean c by exp(-2 pi j / n) (the log-polar
+// grid: cells as square as the rim's own, so no negative cotangent weight where the fill meets
+// the wall), down to half the rim's size; a fan from the last ring to c closes it.
+void fill_hole(Surface& s, const std::vector<int>& rim) {
+  const std::size_t n = rim.size();
+  V3 c = V3::Zero();
+  for (int v : rim) c += s.p[std::size_t(v)];
+  c /= double(n);
+  const int rings = int(std::ceil(double(n) * std::log(2.0) / (2 * M_PI)));
+  std::vector<int> outer = rim;
+  for (int j = 1; j <= rings; ++j) {
+    const double t = std::exp(-2 * M_PI * j / double(n));
+    std::vector<int> inner(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      inner[i] = int(s.p.size());
+      s.p.push_back(c + t * (s.p[std::size_t(rim[i])] - c));
+      s.src.push_back(-1);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = (i + 1) % n;
+      s.t.push_back(Tri{outer[i], outer[k], inner[k]});
+      s.t.push_back(Tri{outer[i], inner[k], inner[i]});
+    }
+    outer.swap(inner);
+  }
+  const int centre = int(s.p.size());
+  s.p.push_back(c), s.src.push_back(-1);
+  for (std::size_t i = 0; i < n; ++i) s.t.push_back(Tri{outer[i], outer[(i + 1) % n], centre});
+}
+
+}  // namespace
+
+std::size_t close_holes(Surface& s, const Edges& E, const std::vector<char>& ends) {
+  UnionFind uf(s.p.size());
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (E.ef[e][1] < 0) uf.unite(std::uint32_t(E.ev[e][0]), std::uint32_t(E.ev[e][1]));
+  std::vector<char> skip(s.p.size(), 0);  // per root: an end loop, or a rim that is not one simple loop
+  for (std::size_t v = 0; v < s.p.size(); ++v)
+    if (ends[v]) skip[uf.find(std::uint32_t(v))] = 1;
+  std::vector<int> next(s.p.size(), -1), first;  // the fill's order along each rim; a vertex per rim
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {  // edge order: the same surface for any thread count
+    const int a = E.ev[e][0], b = E.ev[e][1];
+    const std::uint32_t root = uf.find(std::uint32_t(a));
+    if (E.ef[e][1] >= 0 || skip[root]) continue;
+    const Tri& f = s.t[std::size_t(E.ef[e][0])];
+    int k = 0;  // the rim edge runs f[k] -> f[k + 1] in its face; the fill runs it backwards
+    while (!((f[k] == a && f[(k + 1) % 3] == b) || (f[k] == b && f[(k + 1) % 3] == a))) ++k;
+    int& to = next[std::size_t(f[(k + 1) % 3])];
+    if (to >= 0) skip[root] = 1;
+    to = f[k];
+    first.push_back(a);
+  }
+  std::size_t closed = 0;
+  std::vector<char> done(s.p.size(), 0);  // per root
+  for (int v0 : first) {
+    const std::uint32_t root = uf.find(std::uint32_t(v0));
+    if (skip[root] || done[root]) continue;
+    done[root] = 1;
+    std::vector<int> rim{v0};
+    for (int v = next[std::size_t(v0)]; v >= 0 && v != v0 && rim.size() < next.size(); v = next[std::size_t(v)])
+      rim.push_back(v);
+    if (next[std::size_t(rim.back())] != v0 || rim.size() < 3) continue;
+    fill_hole(s, rim);
+    ++closed;
+  }
+  return closed;
+}
+
 void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep) {
   // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
   // faces around them and keep the largest piece, until the boundary is clean.

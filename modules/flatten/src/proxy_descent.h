@@ -12,9 +12,9 @@
 // Every per-face loop runs on all worker threads in fixed blocks (face_blocks.h): the steps are
 // the same for any thread count.
 #include <algorithm>
-#include <chrono>
 #include <functional>
 
+#include "colonflat/core/run_stats.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
 
@@ -29,14 +29,6 @@ struct DescentResult {
   const char* stop = "steps";
   StepTimes times;  // where the steps' wall time went (COLONFLAT_FLATTEN_DEBUG prints it)
 };
-
-// Seconds since `t` (steady clock), and `t` moved to now.
-inline double lap(std::chrono::steady_clock::time_point& t) {
-  const auto now = std::chrono::steady_clock::now();
-  const double s = std::chrono::duration<double>(now - t).count();
-  t = now;
-  return s;
-}
 
 // The gradient over the unknowns of a region system from per-face corner gradients: each unknown
 // sums the corners it is, in face order (the order a sequential scatter over the faces adds them).
@@ -85,12 +77,12 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     });
   };
   for (; res.steps < max_steps; ++res.steps) {
-    auto clock = std::chrono::steady_clock::now();
+    Stopwatch clock;
     energy.face_gradients(emb.pos, face_gradients);
     const Eigen::MatrixXd g = gather.sum(face_gradients);
-    res.times.gradient += lap(clock);
+    res.times.gradient += clock.lap();
     const Eigen::MatrixXd d = -sys.solve_raw(g) / 2;
-    res.times.solve += lap(clock);
+    res.times.solve += clock.lap();
     const double slope = (g.array() * d.array()).sum();
     if (!(slope < 0)) {
       res.stop = "no descent";
@@ -98,7 +90,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     }
     move_to(d, 1.0);
     double t = std::min(1.0, 0.9 * max_area_step(s, emb, trial, judged, area3, 0.0));
-    res.times.step_limit += lap(clock);
+    res.times.step_limit += clock.lap();
     double e1 = Energy::kHuge;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
       move_to(d, t);
@@ -106,7 +98,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       ++res.times.energy_evals;
       if (e1 <= e0 + 1e-4 * t * slope) break;
     }
-    res.times.line_search += lap(clock);
+    res.times.line_search += clock.lap();
     if (!(e1 < e0)) {
       res.stop = "no descent";
       break;
@@ -119,7 +111,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       break;
     }
     const bool met = enough && enough();
-    res.times.check += lap(clock);
+    res.times.check += clock.lap();
     if (met) {
       ++res.steps;
       res.stop = "bounds met";

@@ -12,6 +12,14 @@ class Stopwatch {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   void restart() { start_ = std::chrono::steady_clock::now(); }
+  // Seconds since the start (or the last restart/lap), and the start moved to now: consecutive
+  // laps split one interval without a gap.
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - start_).count();
+    start_ = now;
+    return s;
+  }
 
  private:
   std::chrono::steady_clock::time_point start_;
