@@ -206,10 +206,13 @@ Row pair_row(const std::string& name, const fs::path& sup_run, const fs::path& p
         lps_along.push_back(la), lps_around.push_back(lb);
       }
   r.lps_along = median(lps_along), r.lps_around = median(lps_around);
-  if (show)
+  if (show) {
+    const cf::CandidateMatching m = reg.match(cs, cp);
     for (const auto& q : cs)
       for (const auto& p : cp)
-        if (p.id == q.id) show_polyp(reg, q, p, NAN, NAN, (reg.map_lps(q.lps, cf::Direction::kSupineToProne) - p.lps).norm());
+        if (p.id == q.id)
+          show_polyp(reg, m, q, p, NAN, NAN, (reg.map_place(m, q.id, cf::Direction::kSupineToProne) - p.lps).norm());
+  }
   count_detected(reg, cf::all_truth_candidates(ts), cf::all_truth_candidates(tp), r);
   return r;
 }
@@ -351,18 +354,19 @@ void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskO
     const auto cp = on_wall(seen_polyps(polyps, c.prone, course, shift, turn), pro);
     r.polyps = 0;
     std::vector<double> along;
+    const cf::CandidateMatching matching = reg.match(cs, cp);
     for (const auto& q : cs)
       for (const auto& p : cp)
-        if (q.id == p.id) {
+        if (q.id == p.id) {  // the supine polyp mapped from the place it is matched (or shown) at
           ++r.polyps;
-          const Eigen::Vector3d m = reg.map_lps(q.lps, cf::Direction::kSupineToProne);
+          const Eigen::Vector3d m = reg.map_place(matching, q.id, cf::Direction::kSupineToProne);
           const Eigen::Vector3d at = cf::MaskCourse::unmoved(m, course.centroid(), shift, turn);
           if (std::isfinite(m.sum())) along.push_back(std::abs(course.path_at(at) - polyps[size_t(q.id - 1)].path_mm));
           if (o.show)
-            show_polyp(reg, q, p, polyps[size_t(q.id - 1)].path_mm, along.empty() ? NAN : along.back(),
+            show_polyp(reg, matching, q, p, polyps[size_t(q.id - 1)].path_mm, along.empty() ? NAN : along.back(),
                        (at - polyps[size_t(q.id - 1)].lps).norm());
         }
-    count_id_pairs(reg.match(cs, cp), r.matched, r.false_matches);
+    count_id_pairs(matching, r.matched, r.false_matches);
     r.missed = r.polyps - r.matched, r.along = median(along), r.along_max = largest(along);
     count_detected(reg, cs, cp, r);  // the polyps cut out of a scan are not there to hit
     print_row(r);

@@ -53,20 +53,9 @@ inline std::vector<cf::ScanCandidate> seen_polyps(const std::vector<cf::MaskPoly
   return out;
 }
 
-// Where the course passes a point: per stretch of s (places more than 30 mm apart, nearest first)
-// within 20 mm beyond the nearest wall vertex, its s and distance (the places locations() finds).
-inline void show_places(const cf::ColonScan& scan, const cf::ScanCoordinates& c, const Eigen::Vector3d& p) {
-  std::vector<std::pair<double, size_t>> by_distance;
-  for (size_t v = 0; v < scan.lps.size(); ++v)
-    if (!std::isnan(c.s[v])) by_distance.push_back({(scan.lps[v] - p).norm(), v});
-  std::sort(by_distance.begin(), by_distance.end());
-  std::vector<double> seen;
-  for (const auto& [d, v] : by_distance) {
-    if (d > by_distance.front().first + 20) break;
-    bool known = false;
-    for (double s : seen) known |= std::abs(s - c.s[v]) <= 30;
-    if (!known) seen.push_back(c.s[v]), std::printf(" s %.0f at %.1f mm;", c.s[v], d);
-  }
+// Where the course passes a point: its places (locations(), reach 20 mm beyond the nearest wall vertex).
+inline void show_places(const cf::ColonRegistration& reg, const Eigen::Vector3d& p, cf::Direction from) {
+  for (const auto& [s, theta] : reg.locations(p, from, 20)) std::printf(" s %.0f;", s);
 }
 
 // The polyps whose centre lies within their diameter of the scan's flat-map wall: a cut by path distance
@@ -85,21 +74,26 @@ inline std::vector<cf::ScanCandidate> on_wall(const std::vector<cf::ScanCandidat
   return out;
 }
 
-// One polyp seen in both scans: its common s in each, the supine s mapped, support gaps, error.
-inline void show_polyp(const cf::ColonRegistration& reg, const cf::ScanCandidate& q, const cf::ScanCandidate& p, double path_mm,
-                       double along_mm, double distance_mm) {
-  const auto [ss, st] = reg.locate(q.lps, cf::Direction::kSupineToProne);
-  const auto [ps, pt] = reg.locate(p.lps, cf::Direction::kProneToSupine);
+// One polyp seen in both scans: the place of each in its scan the matching `m` shows it at (the pair's,
+// else the first with support), the supine place mapped, support gaps, error; the length map from 100 mm
+// before to 60 mm after the supine place; each polyp's places on the course.
+inline void show_polyp(const cf::ColonRegistration& reg, const cf::CandidateMatching& m, const cf::ScanCandidate& q,
+                       const cf::ScanCandidate& p, double path_mm, double along_mm, double distance_mm) {
+  const auto [ss, st] = m.place(q.id, true);
+  const auto [ps, pt] = m.place(p.id, false);
   double ms, mt;
   reg.map_coordinates(cf::Direction::kSupineToProne, ss, st, ms, mt);
   const double deg = 180 / 3.141592653589793;
   std::printf("  polyp %d path %.0f: supine s %.0f (%.0f deg) -> %.0f (%.0f deg), prone s %.0f (%.0f deg) (gap %.0f / %.0f), "
               "along %.1f, 3-D %.1f mm\n", q.id, path_mm, ss, st * deg, ms, mt * deg, ps, pt * deg, reg.support_gap_mm(true, ss),
               reg.support_gap_mm(false, ps), along_mm, distance_mm);
+  std::printf("   length map (supine s > prone s):");  // the alignment around the polyp's place
+  for (double x = ss - 100; x <= ss + 60; x += 10) std::printf(" %.0f>%.0f", x, reg.length().a_to_b(x));
+  std::printf("\n");
   std::printf("   places: supine");
-  show_places(reg.supine(), reg.supine_coordinates(), q.lps);
+  show_places(reg, q.lps, cf::Direction::kSupineToProne);
   std::printf(" prone");
-  show_places(reg.prone(), reg.prone_coordinates(), p.lps);
+  show_places(reg, p.lps, cf::Direction::kProneToSupine);
   std::printf("\n");
 }
 

@@ -39,26 +39,27 @@ size_t ColonRegistration::shown_place(const std::vector<Place>& pl) const {
   return 0;
 }
 
-std::pair<double, double> ColonRegistration::candidate_place(int id, Direction from) const {
-  const bool sup = from == Direction::kSupineToProne;
-  for (const auto& m : matching_.pairs)
-    if ((sup ? m.supine_id : m.prone_id) == id)
-      return sup ? std::pair{m.supine_s_mm, m.supine_theta} : std::pair{m.prone_s_mm, m.prone_theta};
-  for (const auto& c : (sup ? supine_ : prone_).candidates)
-    if (c.id == id) {
-      const std::vector<Place> pl = places(c, from);
-      const Place& p = pl[shown_place(pl)];
-      return {p.s, p.theta};
-    }
+std::pair<double, double> CandidateMatching::place(int id, bool supine) const {
+  for (const auto& m : pairs)
+    if ((supine ? m.supine_id : m.prone_id) == id)
+      return supine ? std::pair{m.supine_s_mm, m.supine_theta} : std::pair{m.prone_s_mm, m.prone_theta};
+  for (const auto& c : supine ? supine_shown : prone_shown)
+    if (c.id == id) return {c.s_mm, c.theta};
   return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 }
 
-Eigen::Vector3d ColonRegistration::map_candidate(int id, Direction d) const {
-  const auto [s, theta] = candidate_place(id, d);
+std::pair<double, double> ColonRegistration::candidate_place(int id, Direction from) const {
+  return matching_.place(id, from == Direction::kSupineToProne);
+}
+
+Eigen::Vector3d ColonRegistration::map_place(const CandidateMatching& m, int id, Direction d) const {
+  const auto [s, theta] = m.place(id, d == Direction::kSupineToProne);
   const int v = std::isnan(s) ? -1 : map_vertex(d, s, theta);
   if (v < 0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   return (d == Direction::kSupineToProne ? prone_ : supine_).lps[size_t(v)];
 }
+
+Eigen::Vector3d ColonRegistration::map_candidate(int id, Direction d) const { return map_place(matching_, id, d); }
 
 // Supine candidate `a` (at one of its places `pa`) and prone `b` (`pb`): the combination of places
 // within the match limits with the lowest cost (along^2 + around^2 + log-size^2, each over its
@@ -73,7 +74,8 @@ bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector
       map_coordinates(Direction::kSupineToProne, x.s, x.theta, s2, t2);
       CandidateMatch m;
       m.supine_id = a.id, m.prone_id = b.id;
-      m.along_mm = std::abs(y.s - s2);
+      m.along_mm = std::abs(y.s - s2);  // on the length map; laid out as pieces, also on the common s (below)
+      if (piecewise_) m.along_mm = std::min(m.along_mm, std::abs(y.s - x.s));
       m.around_deg = angle_difference(y.theta, t2) * 180 / kPi;
       m.size_ratio = a.size_mm > 0 && b.size_mm > 0 ? std::max(a.size_mm, b.size_mm) / std::min(a.size_mm, b.size_mm) : 1.0;
       m.distance_3d_mm = (a.lps - b.lps - b_to_a_).norm();
@@ -91,6 +93,17 @@ bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector
       found = true, cost = c, best = m;
     }
   return found;
+}
+
+void ColonRegistration::list_unpaired(const std::vector<ScanCandidate>& c, const std::vector<std::vector<Place>>& pl,
+                                      const std::vector<bool>& used, std::vector<int>& only, std::vector<int>& unaligned,
+                                      std::vector<CandidatePlace>& shown) const {
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (used[i]) continue;
+    const Place& p = pl[i][shown_place(pl[i])];
+    only.push_back(c[i].id), shown.push_back({c[i].id, p.s, p.theta});
+    if (p.gap > opts_.max_unsupported_mm) unaligned.push_back(c[i].id);
+  }
 }
 
 CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
@@ -116,16 +129,8 @@ CandidateMatching ColonRegistration::match(const std::vector<ScanCandidate>& cs,
     o.m.unique = per_s[o.i] == 1 && per_p[o.j] == 1;
     out.pairs.push_back(o.m);
   }
-  for (size_t i = 0; i < cs.size(); ++i)
-    if (!used_s[i]) {
-      out.supine_only.push_back(cs[i].id);
-      if (ps[i][shown_place(ps[i])].gap > opts_.max_unsupported_mm) out.supine_unaligned.push_back(cs[i].id);
-    }
-  for (size_t j = 0; j < cp.size(); ++j)
-    if (!used_p[j]) {
-      out.prone_only.push_back(cp[j].id);
-      if (pp[j][shown_place(pp[j])].gap > opts_.max_unsupported_mm) out.prone_unaligned.push_back(cp[j].id);
-    }
+  list_unpaired(cs, ps, used_s, out.supine_only, out.supine_unaligned, out.supine_shown);
+  list_unpaired(cp, pp, used_p, out.prone_only, out.prone_unaligned, out.prone_shown);
   return out;
 }
 

@@ -74,4 +74,27 @@ void keep_forward_run(std::vector<double>& offset, bool flipped, double bin_mm) 
     if (!keep[i]) offset[size_t(at[i])] = std::numeric_limits<double>::quiet_NaN();
 }
 
+bool lay_along_branch(ColonPiece& piece, const std::vector<int>& ref_piece, const std::vector<ColonPiece>& ref,
+                      const Eigen::Vector3d& shift, double reach_mm) {
+  if (!piece.registered || ref_piece.empty() || piece.centre.empty()) return false;
+  const int b = ref_piece.front();
+  if (b < 0 || size_t(b) >= ref.size() || !ref[size_t(b)].branch) return false;
+  for (int r : ref_piece)
+    if (r != b) return false;
+  const ColonPiece& br = ref[size_t(b)];
+  const Eigen::Vector3d& neck = br.flipped ? br.centre.back() : br.centre.front();  // its s: br.start_mm
+  const Eigen::Vector3d& tip = br.flipped ? br.centre.front() : br.centre.back();   // its s: br.start_mm + length
+  const Eigen::Vector3d low = (piece.flipped ? piece.centre.back() : piece.centre.front()) + shift;
+  const Eigen::Vector3d high = (piece.flipped ? piece.centre.front() : piece.centre.back()) + shift;
+  if ((low - neck).norm() > reach_mm || (high - tip).norm() > reach_mm) return false;
+  const double scale = br.length_mm / piece.length_mm;
+  piece.s_bin.resize(piece.centre.size());
+  for (size_t k = 0; k < piece.centre.size(); ++k) {
+    const double own = (double(k) + 0.5) * piece.bin_mm;
+    piece.s_bin[k] = br.start_mm + (piece.flipped ? piece.length_mm - own : own) * scale;
+  }
+  piece.start_mm = br.start_mm;  // s of its x0 end (flipped: of its x1 end), as place() sets it
+  return true;
+}
+
 }  // namespace cf

@@ -30,4 +30,13 @@ const ColonPiece* piece_at(const std::multimap<int, const ColonPiece*>& by_segme
 // others lose their offset (NaN). Post: the kept offsets' common s is monotone along the piece.
 void keep_forward_run(std::vector<double>& offset, bool flipped, double bin_mm);
 
+// A placed piece lying along one side branch b of the reference from its neck to its tip (every projection,
+// `ref_piece`, on b; its end nearer the neck within `reach_mm` of b's neck end and its other end within
+// `reach_mm` of b's tip, after `shift`) is the same blind stretch of colon: it is laid proportionally from
+// b's neck s to its tip s (s_bin, start_mm). Nearest-point projection is biased there: where two centre
+// lines bend differently into the tip's cap it held the real mask's 182 mm supine branch on 176 mm of the
+// prone's 208, its tip 32 mm short. True when laid.
+bool lay_along_branch(ColonPiece& piece, const std::vector<int>& ref_piece, const std::vector<ColonPiece>& ref,
+                      const Eigen::Vector3d& shift, double reach_mm);
+
 }  // namespace cf

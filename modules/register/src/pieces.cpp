@@ -42,7 +42,6 @@ void ColonPiece::move_by(double mm) {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 const nlohmann::json* segment_entry(const ColonScan& scan, int id) {
   for (const auto& seg : scan.segments)
     if (seg.value("id", -1) == id) return &seg;
@@ -444,6 +443,7 @@ PieceLayout layout_pieces(const ColonScan& supine, const ColonScan& prone, const
       proj.clear();
       for (auto& p : other) proj.push_back(place(p, pts, shift, o.bin_mm, o));
     }
+    for (size_t p = 0; p < other.size(); ++p) lay_along_branch(other[p], proj[p].ref_piece, ref, shift, o.place_radius_mm);
     if (pass == 3) break;
     const std::vector<double> ext = gap_extensions(other, proj, ref);
     double added = 0, largest = 0;

@@ -230,28 +230,33 @@ int ColonRegistration::vertex_at(bool supine_scan, double s, double theta) const
   return (supine_scan ? sup_index_ : pro_index_)->nearest(s, theta);
 }
 
+namespace {
+// (s, theta) of the point p at its wall vertex w: s of w and the angle of p itself about the centre line
+// there: a point off the wall (the head of a pedunculated polyp, up to 15 mm across and reaching the
+// colon's axis) is surrounded by its own surface at about the same distance, so its nearest vertex may
+// lie on any side of it. NaN when w is not registered.
+std::pair<double, double> place_at(const ScanCoordinates& c, size_t w, const Eigen::Vector3d& p) {
+  if (std::isnan(c.s[w])) return {kNaN, kNaN};
+  double radial = 0;
+  const double theta = angle_about_centre(c.profile, c.s[w], p, &radial);
+  return {c.s[w], radial > 0 ? theta : c.theta[w]};
+}
+}  // namespace
+
 std::pair<double, double> ColonRegistration::locate(const Eigen::Vector3d& p, Direction from) const {
   const bool sup = from == Direction::kSupineToProne;
-  const Index& idx = sup ? *sup_index_ : *pro_index_;
-  const ScanCoordinates& c = sup ? sup_ : pro_;
-  const vtkIdType v = idx.lps->FindClosestPoint(p.data());
-  if (v < 0 || std::isnan(c.s[size_t(v)])) return {kNaN, kNaN};
-  // The angle of the point itself, not of its nearest vertex: a point off the wall (the head of a
-  // pedunculated polyp, up to 15 mm across and reaching the colon's axis) is surrounded by its own
-  // surface at about the same distance, so the nearest vertex may lie on any side of it.
-  double radial = 0;
-  const double theta = angle_about_centre(c.profile, c.s[size_t(v)], p, &radial);
-  return {c.s[size_t(v)], radial > 0 ? theta : c.theta[size_t(v)]};
+  const vtkIdType v = (sup ? *sup_index_ : *pro_index_).lps->FindClosestPoint(p.data());
+  return v < 0 ? std::pair{kNaN, kNaN} : place_at(sup ? sup_ : pro_, size_t(v), p);
 }
 
 std::vector<std::pair<double, double>> ColonRegistration::locations(const Eigen::Vector3d& p, Direction from,
                                                                    double reach_mm) const {
-  std::vector<std::pair<double, double>> out{locate(p, from)};
   const bool sup = from == Direction::kSupineToProne;
   const Index& idx = sup ? *sup_index_ : *pro_index_;
   const ScanCoordinates& c = sup ? sup_ : pro_;
   const std::vector<Eigen::Vector3d>& wall = (sup ? supine_ : prone_).lps;
-  const vtkIdType v = idx.lps->FindClosestPoint(p.data());
+  const vtkIdType v = idx.lps->FindClosestPoint(p.data());  // locate()'s place first
+  std::vector<std::pair<double, double>> out{v < 0 ? std::pair{kNaN, kNaN} : place_at(c, size_t(v), p)};
   if (v < 0 || std::isnan(out[0].first)) return out;
   vtkNew<vtkIdList> near;
   idx.lps->FindPointsWithinRadius((wall[size_t(v)] - p).norm() + reach_mm, p.data(), near);
@@ -262,10 +267,7 @@ std::vector<std::pair<double, double>> ColonRegistration::locations(const Eigen:
   for (const auto& [d2, w] : by_distance) {
     bool known = false;
     for (const auto& place : out) known |= std::abs(c.s[w] - place.first) <= opts_.match_along_mm;
-    if (known) continue;
-    double radial = 0;
-    const double theta = angle_about_centre(c.profile, c.s[w], p, &radial);
-    out.push_back({c.s[w], radial > 0 ? theta : c.theta[w]});
+    if (!known) out.push_back(place_at(c, w, p));
   }
   return out;
 }

@@ -14,6 +14,7 @@
 
 #include "colonflat/register/pieces.h"
 #include "colonflat/register/register.h"
+#include "colonflat/testdata/phantom_pair.h"
 #include "colonflat/testdata/synthetic_pair.h"
 
 namespace cf {
@@ -281,7 +282,7 @@ TEST(RegisterPieces, TwoBranchesAtOneNeckAreInsertedInTheirCourse) {
 
 // Where the prone scan has no wall (a dropped stretch) the alignment is marked unsupported (80 %
 // of the stretch), the supine polyps there are never paired, and only polyps of that stretch are
-// listed as unaligned; elsewhere it is supported.
+// listed as unaligned; elsewhere it is supported; the unpaired candidates are shown where the matching put them.
 TEST(RegisterPieces, DroppedStretchIsUnsupportedAndNeverPaired) {
   SyntheticPairOptions o = long_pair(1);
   o.prone_removed = {{250, 450}};
@@ -300,9 +301,23 @@ TEST(RegisterPieces, DroppedStretchIsUnsupportedAndNeverPaired) {
     if (q.in_prone) continue;
     ++inside;
     for (const auto& m : reg.matching().pairs) EXPECT_NE(m.supine_id, q.id);
-
   }
   EXPECT_GT(inside, 0);
+  // Each unpaired candidate's shown place is kept by the matching (no point query per call): the first of
+  // its places (locations()) with support along, else its nearest; map_candidate maps that place.
+  const CandidateMatching& m = reg.matching();
+  ASSERT_EQ(m.supine_shown.size(), m.supine_only.size());
+  for (const auto& c : pair.supine.candidates) {
+    if (std::find(m.supine_only.begin(), m.supine_only.end(), c.id) == m.supine_only.end()) continue;
+    const auto pl = reg.locations(c.lps, Direction::kSupineToProne, std::max(reg.options().min_place_reach_mm, c.size_mm / 2));
+    auto want = pl.front();
+    for (auto it = pl.rbegin(); it != pl.rend(); ++it)
+      if (reg.support_gap_mm(true, it->first) <= reg.options().max_unsupported_mm) want = *it;
+    const auto [s, theta] = reg.candidate_place(c.id, Direction::kSupineToProne);
+    EXPECT_DOUBLE_EQ(s, want.first) << "candidate " << c.id;
+    EXPECT_DOUBLE_EQ(theta, want.second) << "candidate " << c.id;
+    EXPECT_EQ(reg.map_candidate(c.id, Direction::kSupineToProne), reg.map_place(m, c.id, Direction::kSupineToProne));
+  }
   const auto& un = reg.matching().supine_unaligned;  // only polyps of the dropped stretch are unaligned
   EXPECT_FALSE(un.empty());
   for (const auto& q : pair.polyps) {
@@ -437,12 +452,36 @@ TEST(RegisterPieces, SmallTableRotationKeepsPairsRight) {
   }
 }
 
+// The polyps of one scan as candidates (score 1), as the benches give truth polyps.
+std::vector<ScanCandidate> truth_list(const SyntheticPair& pair, bool supine) {
+  std::vector<ScanCandidate> out;
+  for (const auto& q : pair.polyps)
+    if (supine ? q.in_supine : q.in_prone) out.push_back({q.id, supine ? q.supine_lps : q.prone_lps, q.size_mm, 1});
+  return out;
+}
+
+// The prone's truth as a phantom's: its polyps and its centre line (wall centroid per 2 mm of material).
+PhantomTruth prone_truth(const SyntheticPair& pair) {
+  PhantomTruth t;
+  std::vector<Eigen::Vector3d> sum;
+  std::vector<int> n;
+  for (size_t v = 0; v < pair.prone.lps.size(); ++v) {
+    const size_t k = size_t(std::max(0.0, pair.prone_sigma[v] / 2));
+    if (k >= sum.size()) sum.resize(k + 1, Eigen::Vector3d::Zero()), n.resize(k + 1, 0);
+    sum[k] += pair.prone.lps[v], ++n[k];
+  }
+  for (size_t k = 0; k < sum.size(); ++k)
+    if (n[k] > 0) t.centreline.points.push_back(sum[k] / n[k]), t.centreline.arc_mm.push_back(2.0 * double(k) + 1);
+  return t;
+}
+
 // The colon passes one polyp twice (walls of two loops touching): in the supine a 30 mm stretch of
 // the colon 200 mm or more further on lies against the polyp, its wall half as far from the polyp's point as
 // the polyp's own (so locate() puts the polyp on that stretch, which the prone has elsewhere: no
 // support there). The polyp is still paired with itself at its other place on the course, every
 // polyp seen in both is paired right (a84c05a: located on the stretch only, never paired), and the
-// pair is shown and mapped at that place (s15 a0895e0: at the stretch, mapped 376 mm off).
+// pair is shown and mapped at that place (s15 a0895e0: at the stretch, mapped 376 mm off), and scored
+// there by the benches' score_truth_pair.
 TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
   SyntheticPair pair = make_synthetic_pair(long_pair(1));
   const SyntheticPolyp& q = pair.polyps[2];
@@ -479,6 +518,14 @@ TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
   const Eigen::Vector3d nearest = reg.map_lps(q.supine_lps, Direction::kSupineToProne);
   EXPECT_LT((shown - q.prone_lps).norm(), 5.0) << "first place maps " << (nearest - q.prone_lps).norm() << " mm off";
   EXPECT_LT(std::abs(reg.candidate_place(q.id, Direction::kSupineToProne).first - q.sigma_mm), 5.0);
+  // The benches score truth polyps at the same place (score_truth_pair, map_place): along error < 5 mm
+  // on the prone's true centre line (8e52242 scored the first place: hundreds of mm).
+  const std::vector<ScanCandidate> ts = truth_list(pair, true);
+  const PairFigures f = score_truth_pair(reg, ts, truth_list(pair, false), prone_truth(pair));
+  EXPECT_EQ(f.right, f.seen_in_both);
+  ASSERT_EQ(f.along_mm.size(), ts.size());  // every polyp in both scans, in the supine list's order
+  for (size_t k = 0; k < ts.size(); ++k)
+    if (ts[k].id == q.id) EXPECT_LT(f.along_mm[k], 5.0);
 }
 
 }  // namespace

@@ -81,16 +81,17 @@ std::vector<CutCase> segmentation_cut_cases(double L) {
 PairFigures score_truth_pair(const ColonRegistration& reg, const std::vector<ScanCandidate>& supine,
                              const std::vector<ScanCandidate>& prone, const PhantomTruth& prone_truth) {
   PairFigures f;
+  const CandidateMatching matching = reg.match(supine, prone);
   for (const auto& q : supine)
     for (const auto& p : prone) {
       if (p.id != q.id) continue;
-      ++f.seen_in_both;
-      const Eigen::Vector3d mapped = reg.map_lps(q.lps, Direction::kSupineToProne);
+      ++f.seen_in_both;  // the supine polyp mapped from the place it is matched (or shown) at, as the review shows it
+      const Eigen::Vector3d mapped = reg.map_place(matching, q.id, Direction::kSupineToProne);
       if (!std::isfinite(mapped.sum())) continue;
       const auto [along, around] = truth_error(prone_truth, mapped, p.lps);
       f.along_mm.push_back(along), f.around_deg.push_back(around);
     }
-  for (const auto& m : reg.match(supine, prone).pairs) (m.supine_id == m.prone_id ? f.right : f.wrong) += 1;
+  for (const auto& m : matching.pairs) (m.supine_id == m.prone_id ? f.right : f.wrong) += 1;
   return f;
 }
 

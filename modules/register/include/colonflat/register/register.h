@@ -54,7 +54,7 @@ enum class Direction { kSupineToProne, kProneToSupine };
 
 struct CandidateMatch {
   int supine_id = 0, prone_id = 0;
-  double along_mm = 0;      // |s_prone - map(s_supine)|
+  double along_mm = 0;      // |s_prone - map(s_supine)|; laid out as pieces, at most |s_prone - s_supine| (common s)
   double around_deg = 0;    // |theta difference| after registration
   double size_ratio = 1;    // larger / smaller (1 when a size is unknown)
   double score = 0;         // raised: 1 - (1 - score_supine)(1 - score_prone)
@@ -68,10 +68,21 @@ struct CandidateMatch {
   double prone_s_mm = std::numeric_limits<double>::quiet_NaN(), prone_theta = std::numeric_limits<double>::quiet_NaN();
 };
 
+// Where an unpaired candidate is shown and mapped: its first place on the course (locations()) with
+// support along, else its nearest.
+struct CandidatePlace {
+  int id = 0;
+  double s_mm = std::numeric_limits<double>::quiet_NaN(), theta = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct CandidateMatching {
   std::vector<CandidateMatch> pairs;
   std::vector<int> supine_only, prone_only;  // candidate ids
   std::vector<int> supine_unaligned, prone_unaligned;  // of those, ids where the alignment has no support
+  std::vector<CandidatePlace> supine_shown, prone_shown;  // of supine_only / prone_only (same order): where shown
+  // (s, theta) of candidate `id` of the supine (or prone) list: its pair's place, else its shown place.
+  // Post: NaN when the id is in neither.
+  std::pair<double, double> place(int id, bool supine) const;
 };
 
 class ColonRegistration {
@@ -103,12 +114,16 @@ class ColonRegistration {
   Eigen::Vector3d map_lps(const Eigen::Vector3d& p, Direction d) const;
   // (s, theta) where candidate `id` of the scan `from` is shown and mapped: the place its pair was
   // matched at (CandidateMatch::supine_s_mm ...); unpaired, its first place (locations()) with support
-  // along, else its nearest (locate()). The same place decides the "not aligned" lists.
+  // along, else its nearest (locate()). The same place decides the "not aligned" lists. Read from
+  // matching() (CandidateMatching::place; kept by match_candidates(), no point query).
   // Post: NaN when the scan has no candidate `id` or the place is not registered.
   std::pair<double, double> candidate_place(int id, Direction from) const;
   // The other scan's LPS position of candidate `id` of the scan `d` maps from: its candidate_place()
   // mapped, the target's wall vertex there (NaN when not registered).
   Eigen::Vector3d map_candidate(int id, Direction d) const;
+  // The same for candidate `id` of a matching `m` of any two lists (match()): m.place() mapped, the
+  // target's wall vertex there (NaN when not registered or not in `m`).
+  Eigen::Vector3d map_place(const CandidateMatching& m, int id, Direction d) const;
   // True when a candidate at this LPS point of one scan, or its image in the other, lies on a stretch
   // held at a neck (pieces.h): never paired there.
   bool held_at_neck(const Eigen::Vector3d& p, Direction from) const;
@@ -166,6 +181,10 @@ class ColonRegistration {
   };
   std::vector<Place> places(const ScanCandidate& c, Direction from) const;
   size_t shown_place(const std::vector<Place>& pl) const;  // first supported place, else 0
+  // The candidates of `c` not `used`: their ids, those without support, and where each is shown.
+  void list_unpaired(const std::vector<ScanCandidate>& c, const std::vector<std::vector<Place>>& pl,
+                     const std::vector<bool>& used, std::vector<int>& only, std::vector<int>& unaligned,
+                     std::vector<CandidatePlace>& shown) const;
   bool pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
                       const std::vector<Place>& pb, CandidateMatch& best, double& cost) const;
   CandidateMatching matching_;

@@ -64,7 +64,8 @@ struct PairFigures {
 };
 
 // Pairs `supine` with `prone` truth candidates through the registration (right = same id) and
-// measures each supine polyp's mapped position against its prone position on the prone truth.
+// measures each supine polyp's mapped position (map_place: from the place it was matched at, else
+// the place it is shown at) against its prone position on the prone truth.
 PairFigures score_truth_pair(const ColonRegistration& reg, const std::vector<ScanCandidate>& supine,
                              const std::vector<ScanCandidate>& prone, const PhantomTruth& prone_truth);
 
