@@ -1,16 +1,8 @@
-// render_colon_image, steps 2-3: each band's triangles rasterised with VTK's probe filter and every
+// render_colon_image, steps 2-3: each band's triangles rasterised at the pixel centres and every
 // pixel shaded from its 3D normal (or hatched where the wall is missing or compressed).
-#include <vtkCellArray.h>
-#include <vtkCharArray.h>
-#include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkImageGaussianSmooth.h>
 #include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkProbeFilter.h>
-#include <vtkStaticCellLocator.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +11,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
+#include "colonflat/core/triangle_raster.h"
 #include "colon_image_steps.h"
 
 namespace cf::detail {
@@ -70,8 +63,7 @@ void colour_of_shape_index(double si, double rgb[3]) {
 void ColonImagePainter::paint_band(const Band& b) {
   const FlatSegment& s = flat_.segments[b.seg];
   out_.roll[b.seg] = b.c0;
-  const vtkSmartPointer<vtkPolyData> rolled = rolled_segment(s, b.c0);
-  const ProbedBand probed = probe_band(b, rolled);
+  const ProbedBand probed = probe_band(b, rolled_segment(s, b.c0));
   ImagePtr view = view_normals(b, probed);
   ImagePtr mean = smoothed_normals(view);
   const auto* vnp = static_cast<const double*>(view->GetScalarPointer());
@@ -95,30 +87,25 @@ void ColonImagePainter::paint_rows(const Band& b, const ProbedBand& probed, cons
       unsigned char* d = pixels_ + (std::size_t(b.row0 + j) * width_ + b.col0 + i) * 3;
       const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
       const bool past_edge = (i + 0.5) * px_ > s.length || (j + 0.5) * px_ > s.period;  // the last column / row (rounding)
-      if (!probed.valid->GetValue(id) && past_edge) continue;
-      if (!probed.valid->GetValue(id)) {
+      if (!probed.valid[id] && past_edge) continue;
+      if (!probed.valid[id]) {
         hatch_missing(stripe, d);
         ++counts[1];
         continue;
       }
       const PixelGeometry g = pixel_geometry(b, probed, view, mean, i, j);
-      // GetComponent, not GetTuple1: the latter shares one buffer per array (not thread-safe).
-      counts[0] += shade_pixel(g, probed.shape_index->GetComponent(id, 0), probed.ratio->GetComponent(id, 0), stripe, d);
+      counts[0] += shade_pixel(g, probed.shape_index[id], probed.ratio[id], stripe, d);
     }
 }
 
 // The triangles of one segment with y rolled into [c0, c0 + P), plus copies across the cut.
-vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_segment(const FlatSegment& s, double c0) const {
+std::vector<RolledTriangle> ColonImagePainter::rolled_segment(const FlatSegment& s, double c0) const {
   const FlatMap& f = flat_;
   const double P = s.period;
   std::vector<RolledTriangle> rolled;
-  std::vector<int> local(f.uv.size(), -1);  // flat vertex -> its index among the segment's vertices
-  int vertices = 0, kmin = 0, kmax = 0;
   for (std::size_t ti = 0; ti < f.triangles.size(); ++ti) {
     const auto& t = f.triangles[ti];
     if (f.segment[t[0]] != s.id) continue;
-    for (int v : t)
-      if (local[v] < 0) local[v] = vertices++;
     const double cy = (f.uv[t[0]][1] + f.uv[t[1]][1] + f.uv[t[2]][1]) / 3;
     const int k = int(std::floor((cy - c0) / P));
     const double ymin = std::min({f.uv[t[0]][1], f.uv[t[1]][1], f.uv[t[2]][1]}) - k * P;
@@ -127,77 +114,53 @@ vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_segment(const FlatSegment
       if (extra == -1 && ymax < c0 + P) continue;  // crosses the top: copy one period down
       if (extra == 1 && ymin > c0) continue;       // crosses the bottom: copy one period up
       rolled.push_back({int(ti), extra - k});
-      kmin = std::min(kmin, extra - k), kmax = std::max(kmax, extra - k);
     }
   }
-  return rolled_polydata(rolled, local, vertices, kmin, kmax, P);
+  return rolled;
 }
 
-// The rolled copies as polydata: one point per (vertex, period) used, with the arrays the
-// shading reads (n, p, si, ratio).
-vtkSmartPointer<vtkPolyData> ColonImagePainter::rolled_polydata(const std::vector<RolledTriangle>& rolled,
-                                                               const std::vector<int>& local, int vertices,
-                                                               int kmin, int kmax, double P) const {
+// The rolled triangles sampled at the band's pixel centres: the flat map's normal, position,
+// shape index and area ratio interpolated linearly in the covering triangle (core rasteriser).
+ProbedBand ColonImagePainter::probe_band(const Band& b, const std::vector<RolledTriangle>& rolled) const {
   const FlatMap& f = flat_;
-  std::vector<vtkIdType> ids(std::size_t(vertices) * (kmax - kmin + 1), -1);  // (local vertex, period) -> point
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  vtkNew<vtkDoubleArray> nrm, pos, shp, rat;
-  nrm->SetName("n");
-  nrm->SetNumberOfComponents(3);
-  pos->SetName("p");
-  pos->SetNumberOfComponents(3);
-  shp->SetName("si");
-  rat->SetName("ratio");
-  vtkNew<vtkCellArray> polys;
-  auto vid = [&](int v, int periods) {
-    vtkIdType& id = ids[std::size_t(local[v]) * (kmax - kmin + 1) + (periods - kmin)];
-    if (id >= 0) return id;
-    id = pts->InsertNextPoint(f.uv[v][0], f.uv[v][1] + periods * P, 0.0);
-    nrm->InsertNextTuple(f.normal[v].data());
-    pos->InsertNextTuple(f.position[v].data());
-    shp->InsertNextValue(shape_index_.empty() ? 0.0 : shape_index_[v]);
-    rat->InsertNextValue(vertex_ratio_[v]);
-    return id;
-  };
-  for (const RolledTriangle& r : rolled) {
-    const auto& t = f.triangles[r.t];
-    vtkIdType c[3] = {vid(t[0], r.periods), vid(t[1], r.periods), vid(t[2], r.periods)};
-    polys->InsertNextCell(3, c);
-  }
-  auto pd = vtkSmartPointer<vtkPolyData>::New();
-  pd->SetPoints(pts);
-  pd->SetPolys(polys);
-  pd->GetPointData()->AddArray(nrm);
-  pd->GetPointData()->AddArray(pos);
-  pd->GetPointData()->AddArray(shp);
-  pd->GetPointData()->AddArray(rat);
-  return pd;
+  const FlatSegment& s = f.segments[b.seg];
+  const RasterGrid grid{s.x0 + 0.5 * px_, b.c0 + 0.5 * px_, px_, b.w, b.h};
+  const std::vector<RasterHit> hits = rasterise_triangles(grid, rolled.size(), [&](std::size_t r) {
+    const auto& t = f.triangles[rolled[r].t];
+    const double shift = rolled[r].periods * s.period;
+    return std::array<std::array<double, 2>, 3>{{{f.uv[t[0]][0], f.uv[t[0]][1] + shift},
+                                                 {f.uv[t[1]][0], f.uv[t[1]][1] + shift},
+                                                 {f.uv[t[2]][0], f.uv[t[2]][1] + shift}}};
+  });
+  ProbedBand r;
+  const std::size_t n = hits.size();
+  r.valid.assign(n, 0);
+  r.normal.assign(3 * n, 0.0);
+  r.position.assign(3 * n, 0.0);
+  r.shape_index.assign(n, 0.0);
+  r.ratio.assign(n, 0.0);
+  parallel_for(n, [&](std::size_t i0, std::size_t i1) {
+    for (std::size_t i = i0; i < i1; ++i) interpolate_hit(hits[i], rolled, r, i);
+  });
+  return r;
 }
 
-// The rolled triangles sampled at the band's pixel centres (probe filter, static cell locator).
-ProbedBand ColonImagePainter::probe_band(const Band& b, vtkPolyData* rolled) const {
-  const FlatSegment& s = flat_.segments[b.seg];
-  vtkNew<vtkImageData> grid;
-  grid->SetDimensions(b.w, b.h, 1);
-  grid->SetOrigin(s.x0 + 0.5 * px_, b.c0 + 0.5 * px_, 0);
-  grid->SetSpacing(px_, px_, 1);
-  ProbedBand r;
-  r.probe = vtkSmartPointer<vtkProbeFilter>::New();
-  r.probe->SetInputData(grid);
-  r.probe->SetSourceData(rolled);
-  vtkNew<vtkStaticCellLocator> loc;
-  r.probe->SetCellLocatorPrototype(loc);
-  r.probe->Update();
-  vtkPointData* pd = r.probe->GetOutput()->GetPointData();
-  r.valid = vtkCharArray::SafeDownCast(pd->GetArray(r.probe->GetValidPointMaskArrayName()));
-  r.normal = pd->GetArray("n");
-  r.position = pd->GetArray("p");
-  r.shape_index = pd->GetArray("si");
-  r.ratio = pd->GetArray("ratio");
-  if (!r.valid || !r.normal || !r.position || !r.shape_index || !r.ratio)
-    throw Error("rasterising the flat map failed: " + messages_.first_problem());
-  return r;
+// Pixel i of `r` from its raster hit: the corner values weighted by the centre's barycentrics.
+void ColonImagePainter::interpolate_hit(const RasterHit& h, const std::vector<RolledTriangle>& rolled, ProbedBand& r,
+                                        std::size_t i) const {
+  if (h.triangle < 0) return;
+  const auto& t = flat_.triangles[rolled[h.triangle].t];
+  r.valid[i] = 1;
+  for (int c = 0; c < 3; ++c) {
+    const int v = t[c];
+    const double w = h.weight[c];
+    for (int k = 0; k < 3; ++k) {
+      r.normal[3 * i + k] += w * flat_.normal[v][k];
+      r.position[3 * i + k] += w * flat_.position[v][k];
+    }
+    r.shape_index[i] += w * (shape_index_.empty() ? 0.0 : shape_index_[v]);
+    r.ratio[i] += w * vertex_ratio_[v];
+  }
 }
 
 // Unit normal into the lumen per pixel (0 where no wall), as a 3-component double image.
@@ -208,10 +171,9 @@ ImagePtr ColonImagePainter::view_normals(const Band& b, const ProbedBand& probed
   auto* vnp = static_cast<double*>(vn->GetScalarPointer());
   const vtkIdType n = vtkIdType(b.w) * b.h;
   for (vtkIdType i = 0; i < n; ++i) {
-    double q[3];
-    probed.normal->GetTuple(i, q);
+    const double* q = &probed.normal[3 * i];
     const double l = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-    for (int k = 0; k < 3; ++k) vnp[3 * i + k] = probed.valid->GetValue(i) && l > 0 ? -q[k] / l : 0.0;
+    for (int k = 0; k < 3; ++k) vnp[3 * i + k] = probed.valid[i] && l > 0 ? -q[k] / l : 0.0;
   }
   return vn;
 }
@@ -236,10 +198,9 @@ PixelGeometry ColonImagePainter::pixel_geometry(const Band& b, const ProbedBand&
   PixelGeometry g;
   g.view = view + 3 * id;
   for (int k = 0; k < 3; ++k) g.mean[k] = mean[3 * id + k];
-  double pa[3], pb[3];
   const vtkIdType ia = j * b.w + std::max(0, i - 1), ib = j * b.w + std::min(b.w - 1, i + 1);
-  probed.position->GetTuple(probed.valid->GetValue(ia) ? ia : id, pa);
-  probed.position->GetTuple(probed.valid->GetValue(ib) ? ib : id, pb);
+  const double* pa = &probed.position[3 * (probed.valid[ia] ? ia : id)];
+  const double* pb = &probed.position[3 * (probed.valid[ib] ? ib : id)];
   for (int k = 0; k < 3; ++k) g.tangent[k] = pb[k] - pa[k];
   return g;
 }

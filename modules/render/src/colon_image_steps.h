@@ -2,7 +2,7 @@
 // Internal to the render module: render_colon_image() as named steps. One ColonImagePainter per
 // call; each method is one step, in the order run() calls them:
 //   colon_image.cpp          lay out the bands (geometry + roll), fill the background;
-//   colon_image_raster.cpp   per band: roll the segment's triangles, probe them on the pixel grid,
+//   colon_image_raster.cpp   per band: roll the segment's triangles, rasterise them on the pixel grid,
 //                            smooth the view normals, shade or hatch every pixel;
 //   colon_image_overlay.cpp  markers, not-shown rings, scale bar and ticks (VTK canvas), then the
 //                            text (scale, tick labels, band captions, legend, title, marker labels).
@@ -13,14 +13,10 @@
 
 #include <vtkSmartPointer.h>
 
-#include "colonflat/core/vtk_messages.h"
+#include "colonflat/core/triangle_raster.h"
 #include "colonflat/render/colon_image.h"
 
-class vtkCharArray;
-class vtkDataArray;
 class vtkImageCanvasSource2D;
-class vtkPolyData;
-class vtkProbeFilter;
 
 namespace cf::detail {
 
@@ -48,14 +44,14 @@ struct Label {
   double bg;
 };
 
-// The probe filter's output on a band's pixel grid (pixel id = row * w + column).
+// A band's rolled triangles sampled at its pixel centres (pixel id = row * w + column): the
+// flat map's per-vertex values interpolated linearly inside the triangle covering the centre.
 struct ProbedBand {
-  vtkSmartPointer<vtkProbeFilter> probe;  // owns the arrays below
-  vtkCharArray* valid = nullptr;          // 1 where a triangle covers the pixel centre
-  vtkDataArray* normal = nullptr;         // outward 3D normal
-  vtkDataArray* position = nullptr;       // LPS mm
-  vtkDataArray* shape_index = nullptr;
-  vtkDataArray* ratio = nullptr;          // 2D/3D area ratio (vertex_area_ratio)
+  std::vector<char> valid;             // 1 where a triangle covers the pixel centre
+  std::vector<double> normal;          // 3 per pixel: outward 3D normal (not unit)
+  std::vector<double> position;        // 3 per pixel: LPS mm
+  std::vector<double> shape_index;
+  std::vector<double> ratio;           // 2D/3D area ratio (vertex_area_ratio)
 };
 
 // The wall seen at one pixel: unit view normal, large-scale normal, tangent along the colon.
@@ -94,11 +90,10 @@ class ColonImagePainter {
   std::array<double, 2> pixel_of(const Band& band, double x, double y) const;
   // Rasterising and shading (colon_image_raster.cpp).
   void paint_band(const Band& band);
-  vtkSmartPointer<vtkPolyData> rolled_segment(const FlatSegment& segment, double c0) const;
-  vtkSmartPointer<vtkPolyData> rolled_polydata(const std::vector<RolledTriangle>& rolled,
-                                               const std::vector<int>& local, int vertices, int kmin, int kmax,
-                                               double P) const;
-  ProbedBand probe_band(const Band& band, vtkPolyData* rolled) const;
+  std::vector<RolledTriangle> rolled_segment(const FlatSegment& segment, double c0) const;
+  ProbedBand probe_band(const Band& band, const std::vector<RolledTriangle>& rolled) const;
+  void interpolate_hit(const RasterHit& hit, const std::vector<RolledTriangle>& rolled, ProbedBand& probed,
+                       std::size_t pixel) const;
   ImagePtr view_normals(const Band& band, const ProbedBand& probed) const;
   ImagePtr smoothed_normals(vtkImageData* view) const;
   PixelGeometry pixel_geometry(const Band& band, const ProbedBand& probed, const double* view, const double* mean,
@@ -121,7 +116,6 @@ class ColonImagePainter {
   void write_legend_and_title();
   std::string automatic_title() const;
 
-  VtkMessageCapture messages_;  // VTK's messages during the whole call (rasterising errors)
   const FlatMap& flat_;
   const std::vector<double>& shape_index_;
   std::vector<ImageMarker>& markers_;

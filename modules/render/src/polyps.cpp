@@ -37,17 +37,45 @@ void neighbourhood(const VertexGraph& g, const TriangleList& s, int c, double r,
   out.push_back(c);
   stamp[c] = tag;
   const V3 pc = P(s, c);
+  const double r2 = r * r;
   for (std::size_t k = 0; k < out.size(); ++k) {
     const int v = out[k];
-    const bool near_ring = k == 0 || (P(s, v) - pc).norm() <= r;
+    const bool near_ring = k == 0 || (P(s, v) - pc).squaredNorm() <= r2;
     if (!near_ring) continue;
     for (int q = g.start[v]; q < g.start[v + 1]; ++q) {
       const int w = g.neighbours[q];
       if (stamp[w] == tag) continue;
       stamp[w] = tag;
-      if ((P(s, w) - pc).norm() <= r || k == 0) out.push_back(w);
+      if ((P(s, w) - pc).squaredNorm() <= r2 || k == 0) out.push_back(w);
     }
   }
+}
+
+// The normal equations of the weighted quadric fit h = q0 x^2/2 + q1 xy + q2 y^2/2 + q3 x + q4 y
+// over the neighbours `nb` of vertex i (weights exp(-d^2 / fit_radius^2)), in the tangent frame
+// (t1, t2, n): A's lower triangle and b. Returns the number of neighbours used.
+int quadric_normal_equations(const TriangleList& s, int i, const std::vector<int>& nb, const V3& t1, const V3& t2,
+                             const V3& n, double fit_radius, Eigen::Matrix<double, 5, 5>& A,
+                             Eigen::Matrix<double, 5, 1>& b) {
+  A.setZero();
+  b.setZero();
+  const V3 pc = P(s, i);
+  const double inv_r2 = 1.0 / (fit_radius * fit_radius);
+  int used = 0;
+  for (int j : nb) {
+    if (j == i) continue;
+    const V3 d = P(s, j) - pc;
+    const double x = d.dot(t1), y = d.dot(t2), h = d.dot(n);
+    const double w = std::exp(-d.squaredNorm() * inv_r2);
+    const double r[5] = {0.5 * x * x, x * y, 0.5 * y * y, x, y};
+    for (int p = 0; p < 5; ++p) {
+      const double wr = w * r[p];
+      b[p] += wr * h;
+      for (int q = p; q < 5; ++q) A(q, p) += wr * r[q];
+    }
+    ++used;
+  }
+  return used;
 }
 
 // Shape index and curvedness of vertex i from a weighted quadric fit of its neighbourhood `nb`
@@ -57,24 +85,11 @@ bool fit_vertex(const TriangleList& s, const std::array<double, 3>& normal, int 
   const V3 n = -V3(normal[0], normal[1], normal[2]).normalized();  // into the lumen
   const V3 t1 = (std::abs(n.x()) < 0.9 ? V3::UnitX() : V3::UnitY()).cross(n).normalized();
   const V3 t2 = n.cross(t1);
-  const V3 pc = P(s, i);
-  Eigen::Matrix<double, 5, 5> A = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> b = Eigen::Matrix<double, 5, 1>::Zero();
-  int used = 0;
-  for (int j : nb) {
-    if (j == i) continue;
-    const V3 d = P(s, j) - pc;
-    const double x = d.dot(t1), y = d.dot(t2), h = d.dot(n);
-    const double w = std::exp(-d.squaredNorm() / (fit_radius * fit_radius));
-    Eigen::Matrix<double, 5, 1> r;
-    r << 0.5 * x * x, x * y, 0.5 * y * y, x, y;
-    A += w * r * r.transpose();
-    b += w * h * r;
-    ++used;
-  }
-  if (used < 5) return false;
+  Eigen::Matrix<double, 5, 5> A;
+  Eigen::Matrix<double, 5, 1> b;
+  if (quadric_normal_equations(s, i, nb, t1, t2, n, fit_radius, A, b) < 5) return false;
   A.diagonal().array() += 1e-12 * (A.trace() + 1e-30);
-  const Eigen::Matrix<double, 5, 1> q = A.ldlt().solve(b);
+  const Eigen::Matrix<double, 5, 1> q = A.selfadjointView<Eigen::Lower>().ldlt().solve(b);
   Eigen::Matrix2d H;
   H << q[0], q[1], q[1], q[2];
   const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(-H).eigenvalues();  // ascending

@@ -1,5 +1,5 @@
 #pragma once
-// The 2D colon-wall image ("virtual dissection"): the flat map rasterised (VTK probe filter) at
+// The 2D colon-wall image ("virtual dissection"): the flat map rasterised (pixel centres located in their triangles) at
 // `pixel_size` mm, one band per segment, x along the colon (end A left), y around it. Each pixel
 // is shaded from the 3D normal against a light tilted from the local large-scale wall normal
 // (Gaussian-smoothed normal image) towards the colon axis, so folds and polyps stand out in
