@@ -148,6 +148,10 @@ struct BodyStats {
   bool touches_face = false;
 };
 
+// Tissue: fat (-190 HU) up to enhanced bowel wall (150 HU). Brighter than kTissueHighHu inside the
+// body is tagged material, bone or an enhanced vessel (segment_open.cpp, dependent films).
+inline constexpr double kTissueLowHu = -190, kTissueHighHu = 150;
+
 // Reasons of candidates kept by an open interface (segment_open.cpp): its fluid meets a colon body's
 // gas, or its gas meets a colon body's fluid, with no wall between.
 inline constexpr const char* kOpenFluidReason = "colon fluid: meets a colon segment's gas with no wall between (one lumen)";
@@ -189,6 +193,7 @@ class ColonSegmenter {
   void crop_to_gas(const unsigned char* gas);
   void class_means();
   void refine_boundary();
+  void add_dependent_films();
   void final_segments();
   MaskImage::Pointer paste() const;
   // Tagged fluid (segment_fluid.cpp).

@@ -15,9 +15,8 @@
 namespace cf::segment_detail {
 namespace {
 constexpr unsigned char kGas = 1, kCandidate = 4;
-// Tissue between gas and fluid: fat (-190 HU) up to enhanced bowel wall (150 HU). A direct gas/fluid
-// interface crosses this range in about 0.6 blur sigma (the blurred step from -1000 to 500-900 HU).
-constexpr double kTissueLowHu = -190, kTissueHighHu = 150;
+// A direct gas/fluid interface crosses the tissue range (kTissueLowHu..kTissueHighHu) in about 0.6
+// blur sigma (the blurred step from -1000 to 500-900 HU).
 constexpr int kSubSamples = 8;  // samples per voxel of the linear profile between voxel centres
 // A column is walled when the profile stays in the tissue range for >= kWallMm: two lumens pressed
 // together are separated by two bowel walls (each 1-3 mm), >= 2 mm; a direct gas/fluid interface

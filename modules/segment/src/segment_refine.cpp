@@ -10,6 +10,11 @@
 namespace cf::segment_detail {
 namespace {
 constexpr unsigned char kExcluded = 5;  // rectal tube channel and wall
+// Dependent films are looked for only at voxels up to kMaxFilmVoxelMm along every axis: a film about
+// one voxel thick is then at most 2 mm, a film of fluid; at coarser voxels a bright layer one voxel
+// thick under gas is as thick as the bone plates lining air spaces (the shared head CT, 3.2 mm
+// pixels: sinus walls under the sinus gas), and the same 2 mm limit stops the fluid split (step 4).
+constexpr double kMaxFilmVoxelMm = 2.0;
 }
 
 // Gas (kept gas below -800 HU), tissue (0-2.5 mm outside the lumen, -150..150 HU), fluid (pools).
@@ -76,9 +81,33 @@ void ColonSegmenter::refine_boundary() {
   st_.graph_cut_time_s = clock.seconds();
 }
 
+// Dependent films (docs/segment.md step 9): a voxel directly below kept gas along gravity (a lumen
+// voxel darker than tissue, < kTissueLowHu: gas or its partial volume), brighter than tissue
+// (> kTissueHighHu) and not above fluid-max, lying on wall (the voxel below it is not fluid,
+// < fluid-threshold: bone under gas continues brighter), is lumen - a film of tagged fluid about one
+// voxel thick on the colon's dependent wall, too thin to be bright in the 3 x 3 x 3 mean (the gas
+// above darkens it). Order-free: a voxel set here is brighter than tissue, so it never qualifies another.
+void ColonSegmenter::add_dependent_films() {
+  if (std::max({d_.sp[0], d_.sp[1], d_.sp[2]}) > kMaxFilmVoxelMm) return;
+  const long up = -long(grav_sign_) * long(d_.stride[grav_axis_]);
+  const std::size_t n = d_.n[grav_axis_];  // the voxels above and below must exist
+  parallel_for(d_.n[2], [&](std::size_t k0, std::size_t k1) {  // a voxel set here is gas to no one: any order
+    for (std::size_t k = k0; k < k1; ++k)
+      for (std::size_t j = 0; j < d_.n[1]; ++j)
+        for (std::size_t i = 0; i < d_.n[0]; ++i) {
+          const std::size_t c[3] = {i, j, k}, q = d_.idx(i, j, k);
+          if (c[grav_axis_] < 1 || c[grav_axis_] + 1 >= n || state_[q] || lab_[q] == kExcluded) continue;
+          if (hu_[q] <= kTissueHighHu || hu_[q] > opts_.fluid_max) continue;
+          const std::size_t a = std::size_t(long(q) + up), b = std::size_t(long(q) - up);
+          if (state_[a] == 1 && hu_[a] < kTissueLowHu && hu_[b] < opts_.fluid_threshold) state_[q] = 1;
+        }
+  });
+}
+
 // Components of the refined lumen that hold initial lumen and at least min(1 mL, half the
 // smallest body the options allow) stay; they are the final segments.
 void ColonSegmenter::final_segments() {
+  add_dependent_films();
   const RunLabels cl = component_runs(state_.data(), d_);
   const std::uint32_t n = cl.count();
   std::vector<std::size_t> count(n + 1, 0), core(n + 1, 0);

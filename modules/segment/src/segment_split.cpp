@@ -4,7 +4,10 @@
 // kCoreRadiusMm fits inside every lumen that holds tagged fluid but not through such a bridge: the
 // bright voxels where the ball fits (the cores) are labelled, and every bright voxel joins the core
 // nearest along paths inside the bright mask (a geodesic Voronoi partition), so each piece is one
-// lumen. Bright components without a core (thin layers) keep their own label.
+// lumen. A core voxel is fluid in its own value too, and the cores grow through fluid voxels before
+// the rest of the mask: a wall of one voxel between two lumens is bright in the mean (the ball fits
+// across it at coarse pixels) but not in its own value, so it separates the cores and their growth.
+// Bright components without a core (thin layers) keep their own label.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -68,7 +71,8 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   // a voxel): no cores, every bright component is one piece.
   const bool resolved = kCoreRadiusMm >= kMinCoreVoxels * std::max({d_.sp[0], d_.sp[1], d_.sp[2]});
   if (resolved) {
-    const Bytes core = erode_ball(bright, d_, kCoreRadiusMm);
+    Bytes core = erode_ball(bright, d_, kCoreRadiusMm);
+    for (std::size_t q = 0; q < d_.total; ++q) core[q] = core[q] && hu_[q] >= opts_.fluid_threshold;  // a wall voxel is no core
     const RunLabels cl = component_runs(core.data(), d_);
     fluid_count_ = cl.count();
     for (std::uint32_t l = 1; l <= fluid_count_; ++l)
@@ -79,14 +83,17 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   } else {
     fluid_count_ = 0;
   }
-  for (std::size_t head = 0; head < queue.size(); ++head) {  // breadth-first: the nearest core along the mask
-    const std::size_t q = queue[head];
-    for_face_neighbours(d_, q, [&](std::size_t r) {
-      if (!bright[r] || fluid_label_[r]) return;
-      fluid_label_[r] = fluid_label_[q];
-      queue.push_back(r);
-    });
-  }
+  // Breadth-first: the nearest core along the mask, first through fluid voxels only (a core does
+  // not reach across a wall into the next lumen's fluid), then into the mask's other voxels.
+  for (const bool own_fluid : {true, false})
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::size_t q = queue[head];
+      for_face_neighbours(d_, q, [&](std::size_t r) {
+        if (!bright[r] || fluid_label_[r] || (own_fluid && hu_[r] < opts_.fluid_threshold)) return;
+        fluid_label_[r] = fluid_label_[q];
+        queue.push_back(r);
+      });
+    }
   std::vector<std::size_t>().swap(queue);
   Bytes rest(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) rest[q] = bright[q] && !fluid_label_[q];

@@ -20,6 +20,13 @@ SegmentOptions fluid_options() {
   return o;
 }
 
+// The mask of `ct` segmented with fluid_options() and gravity fixed to supine (+y).
+MaskImage::Pointer segment_supine(const CtImage* ct, SegmentStats* st) {
+  SegmentOptions o = fluid_options();
+  o.position = "supine";
+  return segment_colon(ct, o, st);
+}
+
 // Voxels of the box [x0,x1] x [y0,y1] x [z0,z1] satisfying `inside`, and how many of them the mask holds.
 std::pair<std::size_t, std::size_t> kept_in(const MaskImage* m, int x0, int x1, int y0, int y1, int z0, int z1,
                                             const std::function<bool(int, int, int)>& inside) {
@@ -80,16 +87,61 @@ TEST(SegmentFluid, LoopPressedOnOpenStretchNotKeptWithIt) {
     if (z >= 14 && z <= 82 && radial(x, y, 65, 50) < 6) return 300.0;                      // small-bowel loop
     return kKeep;
   }, 0.3, 10);
-  SegmentOptions o = fluid_options();
-  o.position = "supine";
   SegmentStats st;
-  auto m = segment_colon(ct, o, &st);
+  auto m = segment_supine(ct, &st);
   const auto stretch = kept_in(m, 50, 82, 26, 42, 40, 56, [](int, int y, int z) { return radial(y, z, 34, 48) < 8; });
   EXPECT_EQ(stretch.second, stretch.first) << st.to_json()["decisions"].dump(1);
   EXPECT_TRUE(has_reason(st, "kept", "no wall between")) << st.to_json()["decisions"].dump(1);
   const auto loop = kept_in(m, 60, 70, 45, 55, 16, 80, [](int x, int y, int) { return radial(x, y, 65, 50) < 4; });
   EXPECT_GT(loop.first, 2000u);
   EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
+// Coarse 1.64 mm voxels (the core ball's radius is one voxel): a colon of square cross-section along
+// z, gas over a pool (550 HU, level at mid-height, supine), and a loop of oral contrast (300 HU)
+// pressed flat against the pool's side with one voxel of wall between. The wall is bright in the
+// 3 x 3 x 3 mean, so the cores crossed it and the loop was part of the pool (fails on 8e52242: the
+// loop kept whole); a core voxel must be fluid in its own value, so the wall now separates them.
+TEST(SegmentFluid, LoopAcrossOneVoxelWallAtCoarsePixelsNotPartOfPool) {
+  auto box = [](double x, double y, double z, double x0, double x1, double y0, double y1, double z0, double z1) {
+    return x >= x0 && x <= x1 && y >= y0 && y <= y1 && z >= z0 && z <= z1;
+  };
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (box(x, y, z, 28, 52, 28, 52, 10, 85)) return y < 40 ? -1000.0 : 550.0;  // colon: gas over fluid
+    if (box(x, y, z, 54, 62, 41, 52, 20, 75)) return 300.0;                     // small-bowel loop
+    return kKeep;
+  }, 0.6, 10);
+  const double sp[3] = {1.64, 1.64, 1.64};
+  ct->SetSpacing(sp);
+  SegmentStats st;
+  auto m = segment_supine(ct, &st);
+  const auto pool = kept_in(m, 30, 50, 41, 50, 14, 81, [](int, int, int) { return true; });
+  EXPECT_EQ(pool.second, pool.first) << st.to_json()["decisions"].dump(1);
+  const auto loop = kept_in(m, 56, 60, 43, 50, 22, 73, [](int, int, int) { return true; });
+  EXPECT_GT(loop.first, 1000u);
+  EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
+// A gas-filled colon tube whose dependent wall (supine: +y) carries a film of tagged fluid one voxel
+// thick (700 HU before the blur, about 200-400 after): too thin to be bright in the 3 x 3 x 3 mean.
+// The film's voxels directly below the gas at the bottom of the tube are lumen; the wall under the
+// film is not (fails on 8e52242: few film voxels kept).
+TEST(SegmentFluid, DependentFilmOneVoxelThickKept) {
+  auto film = [](double x, double y, double z) { return x >= 10 && x <= 85 && y > 44 && radial(y, z, 40, 48) >= 9 && radial(y, z, 40, 48) < 10; };
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (film(x, y, z)) return 700.0;
+    if (x >= 10 && x <= 85 && radial(y, z, 40, 48) < 10) return -1000.0;
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_supine(ct, &st);
+  const auto f = kept_in(m, 12, 83, 44, 52, 36, 60, [&](int x, int y, int z) {
+    return film(x, y, z) && std::abs(z - 48) <= 4 && ct->GetPixel({{std::size_t(x), std::size_t(y - 1), std::size_t(z)}}) < -600;
+  });
+  EXPECT_GT(f.first, 300u);
+  EXPECT_GE(double(f.second), 0.95 * double(f.first)) << f.second << " of " << f.first;
+  const auto wall = kept_in(m, 12, 83, 44, 55, 36, 60, [](int, int y, int z) { return y > 44 && radial(y, z, 40, 48) >= 11; });
+  EXPECT_EQ(wall.second, 0u);
 }
 
 // A dense bright blob (900 HU, like a vertebral body) 3 mm beside the colon's gas: it has no level
