@@ -31,6 +31,9 @@ constexpr long long kMaxGridQueries = 200000;
 // 5 placements, 12-27 s, never clean); the trial pairs that were capped cleanly there needed up
 // to 96 K queries (right 24 K + left 72 K, first placement).
 constexpr long long kMaxTrialGridQueries = 100000;
+// Relaxation sweeps per ring of a concentric disk (uniform Laplacian, ring fixed): enough for the
+// rings to settle into a minimal surface over a non-convex ring.
+constexpr int kSweepsPerRing = 20;
 
 Vec3 area_normal(const Mesh& mesh, Mesh::FaceHandle f) {
   auto it = mesh.cfv_iter(f);
@@ -39,7 +42,7 @@ Vec3 area_normal(const Mesh& mesh, Mesh::FaceHandle f) {
 }
 }  // namespace
 
-void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* edge) {
+void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* edge, Vec3* centroid) {
   const std::size_t n = p.size();
   Vec3 c(0, 0, 0);
   for (const auto& q : p) c += q / double(n);
@@ -48,6 +51,32 @@ void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* ed
     *radius += (p[i] - c).norm() / double(n);
     *edge += (p[(i + 1) % n] - p[i]).norm() / double(n);
   }
+  if (centroid) *centroid = c;
+}
+
+std::vector<std::vector<Vec3>> concentric_disk_rows(const std::vector<Vec3>& p, int m) {
+  const std::size_t n = p.size();
+  double radius = 0, edge = 0;
+  Vec3 c(0, 0, 0);
+  loop_radius_and_edge(p, &radius, &edge, &c);
+  std::vector<std::vector<Vec3>> rows(m, std::vector<Vec3>(n));
+  for (int j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < n; ++i) rows[j][i] = (1.0 - double(j) / m) * p[i] + (double(j) / m) * c;
+  rows.push_back({c});
+  for (int sweep = 0; sweep < kSweepsPerRing * m; ++sweep) {
+    std::vector<std::vector<Vec3>> next = rows;
+    for (int j = 1; j < m; ++j)
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t a = (i + 1) % n, b = (i + n - 1) % n;
+        const Vec3 in = j + 1 < m ? rows[j + 1][i] + rows[j + 1][a] : 2.0 * rows[m][0];
+        next[j][i] = (rows[j][a] + rows[j][b] + rows[j - 1][i] + rows[j - 1][b] + in) / 6.0;
+      }
+    Vec3 centre(0, 0, 0);
+    for (std::size_t i = 0; i < n; ++i) centre += rows[m - 1][i] / double(n);
+    next[m][0] = centre;
+    rows.swap(next);
+  }
+  return rows;
 }
 
 Vec3 vertex_area_normal(const Mesh& mesh, Mesh::VertexHandle v) {
@@ -351,43 +380,21 @@ void Surgery::set_concentric_classes(const ConcentricCap& cap, const std::vector
 }
 
 // 8. Geometry of one concentric cap: interior rings interpolated towards the ring centroid and
-//    relaxed to a discrete minimal surface (uniform Laplacian, ring fixed), then bulged by
+//    relaxed to a discrete minimal surface (concentric_disk_rows(), ring fixed), then bulged by
 //    `dome` (x mean ring edge) against the cap's normal, i.e. into its own side.
 void Surgery::shape_concentric_cap(ConcentricCap& cap, double dome) {
   const auto& first = cap.rings[0];
   const std::size_t n = first.size();
   const int m = static_cast<int>(cap.rings.size());
-  Vec3 c(0, 0, 0);
-  double edge = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    c += mesh_.point(first[i]);
-    edge += (mesh_.point(first[(i + 1) % n]) - mesh_.point(first[i])).norm();
-  }
-  c /= double(n);
-  edge /= double(n);
+  std::vector<Vec3> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = mesh_.point(first[i]);
+  const std::vector<std::vector<Vec3>> rows = concentric_disk_rows(p, m);
   for (int j = 1; j < m; ++j)
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = double(j) / m;
-      mesh_.point(cap.rings[j][i]) = (1 - t) * mesh_.point(first[i]) + t * c;
-    }
-  mesh_.point(cap.centre) = c;
-  std::vector<Mesh::VertexHandle> inner;
-  for (int j = 1; j < m; ++j) inner.insert(inner.end(), cap.rings[j].begin(), cap.rings[j].end());
-  inner.push_back(cap.centre);
-  std::vector<Vec3> next(inner.size());
-  for (int it = 0; it < 20 * m && m > 1; ++it) {
-    for (std::size_t q = 0; q < inner.size(); ++q) {
-      Vec3 sum(0, 0, 0);
-      int deg = 0;
-      for (auto nb : mesh_.vv_range(inner[q])) {
-        sum += mesh_.point(nb);
-        ++deg;
-      }
-      next[q] = sum / double(deg);
-    }
-    for (std::size_t q = 0; q < inner.size(); ++q) mesh_.point(inner[q]) = next[q];
-  }
+    for (std::size_t i = 0; i < n; ++i) mesh_.point(cap.rings[j][i]) = rows[j][i];
+  mesh_.point(cap.centre) = rows[m][0];
   if (dome == 0) return;
+  double radius = 0, edge = 0;
+  loop_radius_and_edge(p, &radius, &edge);
   Vec3 nrm(0, 0, 0);
   for (auto f : cap.faces) nrm += area_normal(mesh_, f);
   if (nrm.norm() > 0) nrm /= nrm.norm();

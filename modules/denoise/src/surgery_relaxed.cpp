@@ -19,36 +19,7 @@ namespace cf::detail {
 namespace {
 // Concentric rings at most (ring spacing about one front edge up to this many).
 constexpr int kMaxRelaxedRings = 16;
-// Relaxation sweeps per ring (uniform Laplacian, front fixed): enough for the rings to settle
-// into a minimal surface over a non-convex front (the concentric caps use the same).
-constexpr int kSweepsPerRing = 20;
 }  // namespace
-
-// Positions of the disk's rings over front points p: rows[j][i] for j = 0..m-1 (row 0 = p) and
-// the centre as the last single row, relaxed with the front fixed.
-std::vector<std::vector<Vec3>> Surgery::relaxed_rows(const std::vector<Vec3>& p, int m) {
-  const std::size_t n = p.size();
-  Vec3 c(0, 0, 0);
-  for (const auto& q : p) c += q / double(n);
-  std::vector<std::vector<Vec3>> rows(m, std::vector<Vec3>(n));
-  for (int j = 0; j < m; ++j)
-    for (std::size_t i = 0; i < n; ++i) rows[j][i] = (1.0 - double(j) / m) * p[i] + (double(j) / m) * c;
-  rows.push_back({c});
-  for (int sweep = 0; sweep < kSweepsPerRing * m; ++sweep) {
-    std::vector<std::vector<Vec3>> next = rows;
-    for (int j = 1; j < m; ++j)
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t a = (i + 1) % n, b = (i + n - 1) % n;
-        const Vec3 in = j + 1 < m ? rows[j + 1][i] + rows[j + 1][a] : 2.0 * rows[m][0];
-        next[j][i] = (rows[j][a] + rows[j][b] + rows[j - 1][i] + rows[j - 1][b] + in) / 6.0;
-      }
-    Vec3 centre(0, 0, 0);
-    for (std::size_t i = 0; i < n; ++i) centre += rows[m - 1][i] / double(n);
-    next[m][0] = centre;
-    rows.swap(next);
-  }
-  return rows;
-}
 
 // The disk of `rows` over `front`: its vertices added to the mesh and to right->inner, its
 // triangles (strips ring by ring, then the fan at the centre: ear order) appended to right->tris.
@@ -85,7 +56,7 @@ bool Surgery::close_front_relaxed(const std::vector<Mesh::VertexHandle>& front, 
   const int m = std::clamp(static_cast<int>(std::lround(radius / edge)), 2, kMaxRelaxedRings);
   const std::size_t n_vertices = mesh_.n_vertices(), n_edges = mesh_.n_edges(), n_faces = mesh_.n_faces();
   const std::size_t tris_before = right->tris.size(), inner_before = right->inner.size();
-  add_relaxed_disk(front, relaxed_rows(p, m), right);
+  add_relaxed_disk(front, concentric_disk_rows(p, m), right);
   if (clean_from(right->tris, tris_before, {}))
     for (double fraction : {1.0, 0.5, 0.25}) {
       const std::size_t with_right = mesh_.n_vertices();

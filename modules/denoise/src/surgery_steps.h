@@ -18,8 +18,16 @@ struct ConcentricCap {
   std::vector<Mesh::FaceHandle> faces;
 };
 
-// Mean distance of the closed polygon p's points from their centroid, and its mean edge length.
-void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* edge);
+// Mean distance of the closed polygon p's points from their centroid, and its mean edge length;
+// the centroid too when `centroid` is given.
+void loop_radius_and_edge(const std::vector<Vec3>& p, double* radius, double* edge, Vec3* centroid = nullptr);
+
+// Positions of a concentric disk over the closed polygon p (n >= 3 points), m >= 1 rings:
+// rows[j][i] for j = 0..m-1 (row 0 = p, fixed) interpolated towards p's centroid (t = j/m) and
+// the centre as the last single row, then relaxed to a discrete minimal surface by 20 m Jacobi
+// sweeps of a uniform Laplacian over the disk's strips (surgery_caps.cpp: the concentric caps of
+// step 8 and the relaxed closings of step 7c). Post: m + 1 rows, rows[m].size() == 1.
+std::vector<std::vector<Vec3>> concentric_disk_rows(const std::vector<Vec3>& p, int m);
 
 // Sum of the cross products of v's faces (twice their vector area): v's normal, not normalised.
 Vec3 vertex_area_normal(const Mesh& mesh, Mesh::VertexHandle v);
@@ -89,7 +97,6 @@ class Surgery {
   bool close_front(const std::vector<std::array<int, 3>>& disk, FrontCap* right, FrontCap* left);
   bool left_front_cap(const FrontCap& right, double fraction, FrontCap* left);
   // Relaxed closings (surgery_relaxed.cpp).
-  static std::vector<std::vector<Vec3>> relaxed_rows(const std::vector<Vec3>& p, int m);
   void add_relaxed_disk(const std::vector<Mesh::VertexHandle>& front, const std::vector<std::vector<Vec3>>& rows,
                         FrontCap* right);
   bool close_front_relaxed(const std::vector<Mesh::VertexHandle>& front, FrontCap* right, FrontCap* left);
