@@ -189,26 +189,6 @@ void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const
   w.seg.period = w.emb.period;
 }
 
-// The conformal map of an annulus with its cut rims closed (close_holes), the fills then
-// dropped: their holes stay empty in the map. The fills' vertices are eliminated last.
-void conformal_holes_closed(SegmentWork& w, const std::vector<std::vector<int>>& loops, Prepared& p,
-                            const FlattenOptions& o) {
-  Surface wall = w.ann;
-  std::vector<char> ends(wall.p.size(), 0);
-  for (const auto& l : loops)
-    for (int v : l) ends[v] = 1;
-  const std::size_t added = close_holes(w.ann, build_edges(w.ann.t), ends);
-  if (added > 0) w.prior.factor.reset(), w.prior.new_of_old.clear();  // a new factorisation: new vertices
-  for (std::size_t v = wall.p.size(); v < w.ann.p.size() && !w.prior.vertex_order.empty(); ++v)
-    w.prior.vertex_order.push_back(int(v));
-  p = prepare(w);
-  conformal(w, loops, p, o);
-  if (added == 0) return;
-  w.ann = std::move(wall);
-  w.emb.pos.resize(w.ann.p.size()), w.emb.dy.resize(w.ann.t.size());
-  p = prepare(w);
-}
-
 double surface_area(const Surface& s) {
   double a = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f) a += face_area_3d(s, int(f));
@@ -308,7 +288,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     if (new_of_old[v] >= 0) order.push_back(new_of_old[v]);
   for (int& v : w.dissection_to_annulus)  // (a large colon: its nested dissection order instead, below)
     if (v >= 0) v = new_of_old[std::size_t(v)];
-  w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factor (no hole closed)
+  w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factorisation
   w.ann = std::move(rest);
   w.prior.vertex_order = w.dissection.valid() ? w.band_order() : std::move(order);
   const double cut_area = annulus_area - surface_area(w.ann);
@@ -320,7 +300,8 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     b.lost_area = cut_area - placed;
     return b;
   });
-  conformal_holes_closed(w, loops, p, o);  // (an exception: the future's destructor joins)
+  p = prepare(w);  // (an exception here waits for the branches: the future's destructor joins)
+  conformal(w, loops, p, o);
   return flattened;
 }
 

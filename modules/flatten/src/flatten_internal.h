@@ -71,14 +71,6 @@ Csr build_csr(const Surface& s, const Edges& E);
 std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources);
 int argmax_finite(const std::vector<double>& d);
 std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E);
-// The holes of an annulus closed for its conformal solve: each boundary loop without a vertex
-// marked in `ends` (the rim of a cut-off branch) that is one simple loop gets a fill of rings
-// shrinking log-polarly towards the rim's vertex mean and a fan at its centre, oriented as the
-// rim's faces. Pre: E = build_edges(s.t). Post: s's vertices and faces keep their indices, the
-// fills' follow; returns the holes closed. Why: with the rim free (Neumann) the conjugate v is
-// constant along it and the hole maps to a slit, whose ends crush the wall beside them
-// (docs/flatten.md, "A cut branch's rim closed for the re-solve").
-std::size_t close_holes(Surface& s, const Edges& E, const std::vector<char>& ends);
 double face_area_3d(const Surface& s, int f);
 
 // The segment opened into an annulus: caps of geodesic radius <= `radius` removed at closed ends.

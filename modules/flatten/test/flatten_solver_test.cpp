@@ -228,65 +228,6 @@ TEST(FlattenSolver, UpdatedFactorisationSolvesTheSurfaceThatRemains) {
   EXPECT_GT(moved, 1e-3);
 }
 
-namespace {
-
-// Smallest area ratio (2D / 3D, at the scale of the wall's whole area) of the faces of `s` with a
-// corner on a hole's rim (a boundary vertex that is on neither end), in the conformal map of
-// `mapped` (s, or s with faces and vertices added after its own).
-double smallest_rim_ratio(const cf::flat_detail::Surface& s, const cf::flat_detail::Surface& mapped,
-                          const std::vector<char>& ends) {
-  using namespace cf::flat_detail;
-  const Edges E = build_edges(mapped.t);
-  std::vector<int> a, b;
-  for (std::size_t v = 0; v < s.p.size(); ++v)
-    if (ends[v]) (s.p[v].z() < 1 ? a : b).push_back(int(v));
-  const Harmonic h = solve_harmonic(mapped, E, a, b, false);
-  double signed_area = 0;
-  const Embedding unit = embed_conformal(mapped, E, h, 1.0, 1.0);
-  for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += unit.area2(s, int(f));
-  const Embedding emb = embed_conformal(mapped, E, h, signed_area >= 0 ? 1.0 : -1.0, 1.0);
-  const Edges Es = build_edges(s.t);
-  std::vector<char> rim(s.p.size(), 0);
-  for (std::size_t e = 0; e < Es.ev.size(); ++e)
-    if (Es.ef[e][1] < 0 && !ends[Es.ev[e][0]]) rim[Es.ev[e][0]] = rim[Es.ev[e][1]] = 1;
-  double a2 = 0, a3 = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) a2 += std::abs(emb.area2(s, int(f))), a3 += face_area_3d(s, int(f));
-  double smallest = 1e300;
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (rim[s.t[f][0]] || rim[s.t[f][1]] || rim[s.t[f][2]])
-      smallest = std::min(smallest, emb.area2(s, int(f)) * a3 / (a2 * face_area_3d(s, int(f))));
-  return smallest;
-}
-
-}  // namespace
-
-// A wide window cut out of a tube (what cutting off a branch with a wide neck leaves): mapped
-// with its rim free, the window becomes a slit whose ends crush the wall beside them; closed by a
-// fill (close_holes, as the re-solve after a cut maps it) the same faces keep room in the map.
-TEST(FlattenSolver, ClosedHoleLeavesTheWallAtItsRimUncrushed) {
-  using namespace cf::flat_detail;
-  const int na = 48, nz = 120;
-  const Surface whole = bumpy_tube(na, nz);
-  std::vector<char> keep(whole.t.size(), 1);
-  for (std::size_t f = 0; f < whole.t.size(); ++f) {
-    const int j = whole.t[f][0] / na, i = whole.t[f][0] % na;
-    if (j >= 40 && j < 70 && i >= 2 && i < 22) keep[f] = 0;
-  }
-  const Surface rest = sub_surface(whole, keep);
-  const Edges E = build_edges(rest.t);
-  ASSERT_EQ(boundary_loops(rest, E).size(), 3u);  // two ends, the window
-  std::vector<char> ends(rest.p.size(), 0);
-  for (std::size_t v = 0; v < rest.p.size(); ++v) ends[v] = rest.p[v].z() < 1 || rest.p[v].z() > 1.3 * (nz - 1) - 1;
-  Surface closed = rest;
-  ASSERT_EQ(close_holes(closed, E, ends), 1u);
-  EXPECT_GT(closed.p.size(), rest.p.size());
-  EXPECT_EQ(boundary_loops(closed, build_edges(closed.t)).size(), 2u);  // the fan closes the window
-  const double open_ratio = smallest_rim_ratio(rest, rest, ends);
-  const double closed_ratio = smallest_rim_ratio(rest, closed, ends);
-  EXPECT_LT(open_ratio, 0.1);  // the slit's ends: crushed
-  EXPECT_GT(closed_ratio, 0.3);
-}
-
 // The nested dissection order (METIS) of a large grid is a permutation of its unknowns whose
 // factorisation solves the system as exactly as AMD's does, with fewer operations (the reason large
 // colon bands use it after their first map).
