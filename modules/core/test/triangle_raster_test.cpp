@@ -23,6 +23,15 @@ std::vector<Corners> fan(double cx, double cy, double r, int n) {
   return t;
 }
 
+// n triangles with corners uniform in [0, size)^2 (either orientation, overlapping).
+std::vector<Corners> random_triangles(unsigned seed, int n, double size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, size);
+  std::vector<Corners> t;
+  for (int k = 0; k < n; ++k) t.push_back({{{u(rng), u(rng)}, {u(rng), u(rng)}, {u(rng), u(rng)}}});
+  return t;
+}
+
 std::vector<RasterHit> raster(const RasterGrid& g, const std::vector<Corners>& t) {
   return rasterise_triangles(g, t.size(), [&](std::size_t i) { return t[i]; });
 }
@@ -71,10 +80,7 @@ TEST(TriangleRaster, CoverageMatchesBruteForceWithoutGapsOnSharedEdges) {
 // The weights reproduce a linear function: sum_k w_k f(corner_k) = f(centre) to 1e-12, and each
 // weight is within [0, 1] up to the edge slack, on random triangles of either orientation.
 TEST(TriangleRaster, WeightsInterpolateLinearFunctionsExactly) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(0, 20);
-  std::vector<Corners> t;
-  for (int k = 0; k < 30; ++k) t.push_back({{{u(rng), u(rng)}, {u(rng), u(rng)}, {u(rng), u(rng)}}});
+  const std::vector<Corners> t = random_triangles(7, 30, 20);
   const RasterGrid g{0.25, 0.25, 0.5, 40, 40};
   const std::vector<RasterHit> hits = raster(g, t);
   auto f = [](double x, double y) { return 3 * x - 2 * y + 1; };
@@ -115,10 +121,7 @@ TEST(TriangleRaster, DegenerateAndOutsideInputCoverNothing) {
 
 // 1, 2 and 3 threads give the same hits, bit for bit, on overlapping random triangles.
 TEST(TriangleRaster, SameHitsForAnyThreadCount) {
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(0, 30);
-  std::vector<Corners> t;
-  for (int k = 0; k < 200; ++k) t.push_back({{{u(rng), u(rng)}, {u(rng), u(rng)}, {u(rng), u(rng)}}});
+  const std::vector<Corners> t = random_triangles(3, 200, 30);
   const RasterGrid g{0.1, 0.2, 0.3, 100, 97};
   std::vector<std::vector<RasterHit>> runs;
   for (int n : {1, 2, 3}) {
