@@ -258,17 +258,13 @@ double face_step_limit(const Surface& s, const Embedding& emb, const std::vector
 double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
                      const std::vector<double>& area3, double floor_ratio);
 
-// Area correction (area_correct.cpp): the map as conformal as possible with every face's area
-// ratio within [area_ratio_low, area_ratio_high]: minimises the cotangent Dirichlet energy of the
-// 2D positions plus area_weight x sum_f A3_f (log ratio outside the bounds)^2, at most
-// area_correction_iterations Newton steps on the quadratic part, each cut so that no face folds.
-// Fixed vertices (the band's ends, the rims of cut-off branches) stay. Post: bijective if `emb` was.
 // Wall seconds of the parts of descent steps (proxy_descent.h): gradients (per face and gathered),
 // solves, largest fold-free step, line search (energy_evals energies), the caller's stop check.
 struct StepTimes {
   double gradient = 0, solve = 0, step_limit = 0, line_search = 0, check = 0;
   int energy_evals = 0;
 };
+// What correct_area() did: steps, faces, energies, why it stopped, and (debug) where its time went.
 struct AreaCorrection {
   int iterations = 0;
   std::size_t faces = 0;  // faces the correction worked on
@@ -282,6 +278,11 @@ struct AreaCorrection {
   std::size_t longest_faces = 0, longest_place = 0, pieces = 0;
   int longest_steps = 0;
 };
+// Area correction (area_correct.cpp): the map as conformal as possible with every face's area
+// ratio within [area_ratio_low, area_ratio_high]: minimises the cotangent Dirichlet energy of the
+// 2D positions plus area_weight x sum_f A3_f (log ratio outside the bounds)^2, at most
+// area_correction_iterations Newton steps on the quadratic part, each cut so that no face folds.
+// Fixed vertices (the band's ends, the rims of cut-off branches) stay. Post: bijective if `emb` was.
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
 // 10 x area_correction_iterations steps there while faces x steps <= 1e7, each vertex-connected
