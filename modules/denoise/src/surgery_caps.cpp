@@ -63,8 +63,8 @@ std::vector<std::vector<Vec3>> concentric_disk_rows(const std::vector<Vec3>& p, 
   for (int j = 0; j < m; ++j)
     for (std::size_t i = 0; i < n; ++i) rows[j][i] = (1.0 - double(j) / m) * p[i] + (double(j) / m) * c;
   rows.push_back({c});
+  std::vector<std::vector<Vec3>> next = rows;  // row 0 stays p in both buffers
   for (int sweep = 0; sweep < kSweepsPerRing * m; ++sweep) {
-    std::vector<std::vector<Vec3>> next = rows;
     for (int j = 1; j < m; ++j)
       for (std::size_t i = 0; i < n; ++i) {
         const std::size_t a = (i + 1) % n, b = (i + n - 1) % n;
