@@ -103,10 +103,6 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   fluid_count_ += thin.count();
 }
 
-}  // namespace cf::segment_detail
-
-namespace cf::segment_detail {
-
 // Candidate bodies (docs/segment.md step 6): face-connected candidate voxels, where two fluid pieces
 // (split_fluid_bodies) are one body only when the fluid itself continues between them: at least
 // kMinFluidPairShare of the face pairs across their boundary hold fluid (>= fluid-threshold) in both
