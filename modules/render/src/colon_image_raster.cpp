@@ -1,7 +1,6 @@
 // render_colon_image, steps 2-3: each band's triangles rasterised at the pixel centres and every
 // pixel shaded from its 3D normal (or hatched where the wall is missing or compressed).
 #include <vtkImageData.h>
-#include <vtkImageGaussianSmooth.h>
 #include <vtkNew.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/triangle_raster.h"
+#include "colonflat/render/image_smooth.h"
 #include "colon_image_steps.h"
 
 namespace cf::detail {
@@ -178,16 +178,10 @@ ImagePtr ColonImagePainter::view_normals(const Band& b, const ProbedBand& probed
   return vn;
 }
 
-// The large-scale wall normal: view normals Gaussian-smoothed with sigma smooth_normal (mm).
+// The large-scale wall normal: view normals Gaussian-smoothed with sigma smooth_normal (mm), on a
+// coarser grid where sigma spans many pixels (smooth_large_scale).
 ImagePtr ColonImagePainter::smoothed_normals(vtkImageData* view) const {
-  vtkNew<vtkImageGaussianSmooth> smooth;
-  smooth->SetInputData(view);
-  smooth->SetDimensionality(2);
-  const double sd = std::max(1.0, opts_.smooth_normal / px_);
-  smooth->SetStandardDeviations(sd, sd, 0);
-  smooth->SetRadiusFactors(2.5, 2.5, 0);
-  smooth->Update();
-  return smooth->GetOutput();
+  return smooth_large_scale(view, std::max(1.0, opts_.smooth_normal / px_));
 }
 
 // The tangent along the colon from the 3D positions of the neighbouring pixels (the pixel itself
