@@ -11,6 +11,10 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkFloatArray.h>
+#include <vtkIdTypeArray.h>
+#include <vtkPointData.h>
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
@@ -38,6 +42,8 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <mutex>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
+#include "colonflat/core/vertex_corners.h"
 #include "colonflat/core/vtk_messages.h"
 
 namespace cf {
@@ -109,28 +115,90 @@ std::string ensure_display() {
   return disp;
 }
 
+// Points and triangles copied in bulk into preallocated arrays (one triangle = 3 ids, fixed-size
+// cell storage), rows split over the threads.
 vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
+  const std::size_t P = surface.points.size(), T = surface.triangles.size();
+  vtkNew<vtkDoubleArray> xyz;
+  xyz->SetNumberOfComponents(3);
+  xyz->SetNumberOfTuples(vtkIdType(P));
+  double* x = xyz->GetPointer(0);
+  parallel_for(P, [&](std::size_t i0, std::size_t i1) {
+    for (std::size_t i = i0; i < i1; ++i) std::copy(surface.points[i].begin(), surface.points[i].end(), x + 3 * i);
+  });
+  vtkNew<vtkIdTypeArray> ids;
+  ids->SetNumberOfValues(vtkIdType(3 * T));
+  vtkIdType* c = ids->GetPointer(0);
+  parallel_for(T, [&](std::size_t t0, std::size_t t1) {
+    for (std::size_t t = t0; t < t1; ++t) std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), c + 3 * t);
+  });
   vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  for (const auto& p : surface.points) pts->InsertNextPoint(p.data());
+  pts->SetData(xyz);
   vtkNew<vtkCellArray> polys;
-  for (const auto& t : surface.triangles) {
-    vtkIdType c[3] = {t[0], t[1], t[2]};
-    polys->InsertNextCell(3, c);
-  }
+  polys->SetData(3, ids);
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetPolys(polys);
   return pd;
 }
 
+namespace {
+
+// Unit normal of triangle t (zero when degenerate).
+std::array<double, 3> face_normal(const TriangleList& s, std::size_t t) {
+  const auto& p0 = s.points[s.triangles[t][0]];
+  const auto& p1 = s.points[s.triangles[t][1]];
+  const auto& p2 = s.points[s.triangles[t][2]];
+  const double a[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, b[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+  std::array<double, 3> n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (l > 0) n[0] /= l, n[1] /= l, n[2] /= l;
+  return n;
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface) {
+  const std::size_t P = surface.points.size(), T = surface.triangles.size();
+  std::vector<std::array<double, 3>> fn(T);
+  parallel_for(T, [&](std::size_t t0, std::size_t t1) {
+    for (std::size_t t = t0; t < t1; ++t) fn[t] = face_normal(surface, t);
+  });
+  const VertexCorners corners = vertex_corners(surface.triangles, P);
+  auto normals = vtkSmartPointer<vtkFloatArray>::New();
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(vtkIdType(P));
+  float* out = normals->GetPointer(0);
+  parallel_for(P, [&](std::size_t v0, std::size_t v1) {
+    for (std::size_t v = v0; v < v1; ++v) {
+      double n[3] = {0, 0, 0};
+      for (const std::uint32_t* c = corners.begin(v); c != corners.begin(v) + corners.degree(v); ++c)
+        for (int k = 0; k < 3; ++k) n[k] += fn[*c / 3][k];
+      const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int k = 0; k < 3; ++k) out[3 * v + k] = float(l > 0 ? n[k] / l : 0.0);
+    }
+  });
+  return normals;
+}
+
+vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface) {
+  vtkSmartPointer<vtkPolyData> pd = surface_polydata(surface);
+  pd->GetPointData()->SetNormals(smooth_point_normals(surface));
+  return pd;
+}
+
 vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook& look) {
-  vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(surface);
-  normals->SplittingOff();
-  normals->ConsistencyOff();
   vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputConnection(normals->GetOutputPort());
+  if (surface->GetPointData()->GetNormals()) {
+    mapper->SetInputData(surface);
+  } else {
+    vtkNew<vtkPolyDataNormals> normals;
+    normals->SetInputData(surface);
+    normals->SplittingOff();
+    normals->ConsistencyOff();
+    mapper->SetInputConnection(normals->GetOutputPort());
+  }
   auto actor = vtkSmartPointer<vtkActor>::New();
   actor->SetMapper(mapper);
   actor->GetProperty()->SetColor(look.color[0], look.color[1], look.color[2]);
@@ -146,7 +214,7 @@ namespace {
 class SnapshotScene {
  public:
   SnapshotScene(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts)
-      : surface_(surface_polydata(surface)), loops_(loops), opts_(opts) {}
+      : surface_(lit_surface_polydata(surface)), loops_(loops), opts_(opts) {}
   ImagePtr run();
 
  private:

@@ -9,6 +9,10 @@
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkPointData.h>
+#include <vtkFloatArray.h>
+#include <vtkIdList.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
@@ -228,6 +232,30 @@ TEST(RenderSnapshot, OffScreenWithoutDisplay) {
       if (q[0] > 150 && q[1] < 90 && q[2] < 90) ++red;
     }
   EXPECT_GT(red, 50);
+}
+
+// The snapshots' own point normals are vtkPolyDataNormals' (no splitting, no reorienting) on a
+// sphere with a degenerate triangle: the same directions within float rounding, and surface_polydata
+// keeps every point and triangle in order.
+TEST(RenderSnapshot, PointNormalsAreVtkPolyDataNormals) {
+  TriangleList sphere = synthetic::sphere(20, 40, 20);
+  sphere.triangles.push_back({0, 0, 1});  // degenerate: adds nothing to its points' normals
+  vtkSmartPointer<vtkPolyData> pd = surface_polydata(sphere);
+  ASSERT_EQ(pd->GetNumberOfPoints(), vtkIdType(sphere.points.size()));
+  ASSERT_EQ(pd->GetNumberOfPolys(), vtkIdType(sphere.triangles.size()));
+  vtkNew<vtkIdList> ids;
+  pd->GetCellPoints(7, ids);
+  EXPECT_EQ(ids->GetId(2), sphere.triangles[7][2]);
+  vtkNew<vtkPolyDataNormals> ref;
+  ref->SetInputData(pd);
+  ref->SplittingOff();
+  ref->ConsistencyOff();
+  ref->Update();
+  vtkDataArray* want = ref->GetOutput()->GetPointData()->GetNormals();
+  vtkSmartPointer<vtkFloatArray> got = smooth_point_normals(sphere);
+  ASSERT_EQ(got->GetNumberOfTuples(), want->GetNumberOfTuples());
+  for (vtkIdType v = 0; v < got->GetNumberOfTuples(); ++v)
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(got->GetComponent(v, k), want->GetComponent(v, k), 1e-6) << v;
 }
 
 testing::CommandResult render_cli(const std::vector<std::string>& args) {

@@ -11,6 +11,7 @@
 
 class vtkActor;
 class vtkImageData;
+class vtkFloatArray;
 class vtkPolyData;
 
 namespace cf {
@@ -26,6 +27,12 @@ struct SnapshotOptions {
 
 // The triangles as a vtkPolyData (double points, triangle cells; point i = surface.points[i]).
 vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface);
+// Smooth point normals as vtkPolyDataNormals makes them without splitting or reorienting: the
+// sum of the unit normals of a point's triangles, normalised (zero for an unused point), as a
+// float array "Normals" (#points x 3). Vertices split over the threads; the same for any count.
+vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface);
+// surface_polydata with smooth_point_normals as its point normals.
+vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface);
 
 // How a wall surface looks: diffuse colour (RGB 0-1) and specular highlight.
 struct SurfaceLook {
@@ -33,8 +40,9 @@ struct SurfaceLook {
   double specular = 0.2;
   double specular_power = 20;
 };
-// A lit actor of the surface: smooth point normals (vtkPolyDataNormals, no splitting, triangle
-// order kept), the look's colour and highlight. The pipeline updates when the actor is rendered.
+// A lit actor of the surface: its point normals when it has them (lit_surface_polydata), else
+// smooth point normals from vtkPolyDataNormals (no splitting, triangle order kept); the look's
+// colour and highlight. The pipeline updates when the actor is rendered.
 vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook& look);
 
 // The surface (LPS mm) seen from outside, with `loops` (polylines; may be null) as thick tubes
