@@ -9,6 +9,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
+#include "denoise_debug.h"
 
 namespace cf {
 
@@ -113,7 +114,7 @@ std::vector<std::array<int, 3>> triangulate_ring(
   };
   auto give_up = [&] { return budget && queries.load() > *budget; };
   std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed, give_up);
-  if (grid && std::getenv("COLONFLAT_DENOISE_DEBUG") && n >= 48)
+  if (grid && detail::denoise_debug() && n >= 48)
     std::fprintf(stderr, "denoise debug: restricted triangulation of %d vertices: %lld grid queries, %s\n", n,
                  queries.load(), t.empty() ? "none" : "found");
   if (budget) *budget -= queries.load();

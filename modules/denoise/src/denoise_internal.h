@@ -60,10 +60,12 @@ struct DenoiseState {
 void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
                    double* t_analysis);
 
-// How hard a surgery looks for clean caps (with --check-caps): kFull, every step; kTrial, an
-// attempt undone unless its caps are clean (concentric caps in one placement: their pairs are
-// only counted); kPlainTrial, a trial without the restricted triangulations.
-enum class CapAttempt { kFull, kTrial, kPlainTrial };
+// How hard a surgery looks for clean caps (with --check-caps): kFull, every step; kFirst, every
+// step, but the concentric placements are only searched for a clean one (a loop's first cut,
+// undone unless clean: if no alternative is clean either, the loop is cut again with kFull);
+// kTrial, an attempt undone unless its caps are clean (concentric caps in one placement: their
+// pairs are only counted); kPlainTrial, a trial without the restricted triangulations.
+enum class CapAttempt { kFull, kFirst, kTrial, kPlainTrial };
 
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,

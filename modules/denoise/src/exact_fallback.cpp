@@ -28,7 +28,7 @@ namespace cf::detail {
 SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& loop,
                                        const std::vector<std::uint64_t>& reduced, int iteration,
                                        std::vector<std::uint64_t>* cut_class) {
-  SurgeryResult sr = cut_recorded(loop, iteration);
+  SurgeryResult sr = cut_recorded(loop, iteration, CapAttempt::kFirst);
   if (sr.intersections == 0 || !opts_.check_caps) return sr;
   const double length = st_.loops.back().length;
   const std::size_t intersections = sr.intersections;
@@ -168,6 +168,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vec
     for (std::size_t j = 0; j < n; ++j) {
       ++searches_;
       settled_ += static_cast<long long>(settled[j]);
+      fallback_settled_ += static_cast<long long>(settled[j]);
       if (result[j].found && result[j].value < best) {
         best = result[j].value;
         found = std::move(cycle[j]);

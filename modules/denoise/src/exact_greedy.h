@@ -204,8 +204,8 @@ class ExactGreedy {
   static constexpr double kRebuildWorkPerCut = 0.25;
   double largest_limit_ = 0;
   Stopwatch debug_clock_;  // COLONFLAT_DENOISE_DEBUG: since the last cut
-  double debug_search_ = 0, fallback_s_ = 0;
-  long long debug_searches_ = 0, debug_settled_ = 0;
+  double debug_search_ = 0, fallback_s_ = 0, debug_cpu_ = 0;
+  long long debug_searches_ = 0, debug_settled_ = 0, fallback_settled_ = 0;
 };
 
 }  // namespace cf::detail

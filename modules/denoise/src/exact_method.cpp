@@ -11,7 +11,9 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/geodesic_ball.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/denoise/loop_search.h"
+#include "denoise_debug.h"
 #include "exact_greedy.h"
 
 namespace cf::detail {
@@ -47,7 +49,8 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   SurgeryOptions so;
   so.ring_pull = o.ring_pull;
   so.cap_rings = o.method == "paper" && o.ring_pull == 0 ? 1 : so.cap_rings;
-  so.trial = attempt != CapAttempt::kFull;
+  so.trial = attempt == CapAttempt::kTrial || attempt == CapAttempt::kPlainTrial;
+  so.probe_concentric = attempt == CapAttempt::kFirst;
   so.restricted = attempt != CapAttempt::kPlainTrial;
   so.front = o.front_caps;
   if (o.check_caps) {
@@ -69,6 +72,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
 ExactGreedy::ExactGreedy(DenoiseState& st, const DenoiseOptions& o, double mean_edge)
     : st_(st), opts_(o), first_radius_(o.initial_radius > 0 ? o.initial_radius : 10.0 * mean_edge) {
   worker_ = st.worker.get();  // null with one thread
+  debug_cpu_ = process_cpu_seconds();
   want_type_ = o.policy != "shortest";
   wanted_ = o.policy == "cut" ? LoopType::kHandle : LoopType::kTunnel;
   accept_ = [this](const std::vector<Mesh::VertexHandle>& loop) { return classify_loop(st_.mesh, loop) == wanted_; };
@@ -181,7 +185,7 @@ void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   const int comp = st_.component[loop.front().idx()];
   const double surgery0 = st_.t.surgery;
   const SurgeryResult sr = cut_cleanly(loop, reduced, iteration, &cls);
-  if (std::getenv("COLONFLAT_DENOISE_DEBUG")) debug_cut(iteration, st_.t.surgery - surgery0);
+  if (denoise_debug()) debug_cut(iteration, st_.t.surgery - surgery0);
   span_.insert(cls.data());  // the class of the loop cut (a same-class replacement: the same span)
   --st_.genus_left[comp];
   if (crossing_) return;  // back to the span family on the new mesh
@@ -195,13 +199,18 @@ void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
 void ExactGreedy::debug_cut(int iteration, double surgery_s) {
   const LoopRecord& L = st_.loops.back();
   std::fprintf(stderr,
-               "denoise debug: cut %d: %.1f mm, %zu vertices, %zu cap pairs%s; since the last cut: %.2f s "
-               "(search %.2f s, %lld searches, %lld settled; same-class fallback %.2f s), surgery %.2f s\n",
+               "denoise debug: cut %d: %.1f mm, %zu vertices, %zu cap pairs%s; since the last cut: %.2f s (CPU %.2f s) "
+               "(search %.2f s, %lld searches, %lld settled; fallback searches %.2f s, %lld settled), surgery %.2f s; "
+               "%zu sources, %d homology builds in all\n",
                iteration, L.length, L.vertex_ids.size(), L.cap_intersections,
-               L.replaced_length > 0 ? " (replaced a loop)" : "", debug_clock_.seconds(), st_.t.search - debug_search_,
-               searches_ - debug_searches_, settled_ - debug_settled_, fallback_s_, surgery_s);
+               L.replaced_length > 0 ? " (replaced a loop)" : "", debug_clock_.seconds(), process_cpu_seconds() - debug_cpu_,
+               st_.t.search - debug_search_,
+               searches_ - debug_searches_, settled_ - debug_settled_, fallback_s_, fallback_settled_, surgery_s,
+               active_.size(), builds_);
   fallback_s_ = 0;
+  fallback_settled_ = 0;
   debug_clock_.restart();
+  debug_cpu_ = process_cpu_seconds();
   debug_search_ = st_.t.search;
   debug_searches_ = searches_;
   debug_settled_ = settled_;

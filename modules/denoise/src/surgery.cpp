@@ -8,6 +8,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
+#include "denoise_debug.h"
 #include "surgery_steps.h"
 
 namespace cf {
@@ -32,7 +33,7 @@ SurgeryResult Surgery::run() {
   const double t_tri = sw.seconds();
   if (!triangulated) concentric_caps();
   result_.caps = cap_kind_;
-  if (std::getenv("COLONFLAT_DENOISE_DEBUG") && (sw.seconds() > 0.2 || !triangulated))
+  if (detail::denoise_debug() && (sw.seconds() > 0.2 || !triangulated))
     std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s, concentric %.2f s\n",
                  k_, cap_kind_, result_.intersections, t_tri, sw.seconds() - t_tri);
   return result_;

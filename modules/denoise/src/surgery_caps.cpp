@@ -9,6 +9,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/denoise/cap_triangulation.h"
 #include "colonflat/denoise/face_grid.h"
+#include "denoise_debug.h"
 #include "surgery_steps.h"
 
 namespace cf::detail {
@@ -449,8 +450,9 @@ void Surgery::search_concentric_placement() {
         if (pull <= 0 && dome == 0) continue;
         place_concentric(pull, dome);
         refresh();
-        const std::size_t n = opts_.guard->count_intersections(mesh_, moving, best);  // only n < best matters
-        if (n < best) {
+        // Only n < best matters; probing, only n == 0 (the first pair ends the count).
+        const std::size_t n = opts_.guard->count_intersections(mesh_, moving, opts_.probe_concentric ? 1 : best);
+        if (n < best && (n == 0 || !opts_.probe_concentric)) {
           best = n;
           best_pull = pull;
           best_dome = dome;
@@ -459,7 +461,7 @@ void Surgery::search_concentric_placement() {
       }
     place_concentric(best_pull, best_dome);
     refresh();
-    if (std::getenv("COLONFLAT_DENOISE_DEBUG"))
+    if (denoise_debug())
       std::fprintf(stderr, "denoise debug: concentric k=%zu: pull %.2f, dome %.2f edges, %zu pairs\n", k_, best_pull, best_dome, best);
   }
   result_.intersections = best;

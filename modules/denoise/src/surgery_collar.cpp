@@ -21,6 +21,7 @@
 
 #include "colonflat/denoise/cap_triangulation.h"
 #include "colonflat/denoise/face_grid.h"
+#include "denoise_debug.h"
 #include "surgery_steps.h"
 
 namespace cf::detail {
@@ -86,7 +87,7 @@ bool Surgery::clean(const std::vector<std::array<int, 3>>& tris) const {
   done.reserve(tris.size());
   for (const auto& t : tris) {
     if (opts_.guard->hits(mesh_, t, done)) {
-      if (std::getenv("COLONFLAT_DENOISE_DEBUG"))
+      if (denoise_debug())
         std::fprintf(stderr, "denoise debug: collar k=%zu: triangle %zu of %zu hits %s\n", k_, done.size(), tris.size(),
                      opts_.guard->hits(mesh_, t, {}) ? "the surface" : "the caps");
       return false;
@@ -171,7 +172,7 @@ bool Surgery::try_collar_caps() {
   for (double sign : {first, -first}) {
     const std::vector<double> h_right = collar_heights(result_.right_ring, normal_right_, sign);
     const std::vector<double> h_left = collar_heights(result_.left_ring, normal_left_, sign);
-    if (std::getenv("COLONFLAT_DENOISE_DEBUG"))
+    if (denoise_debug())
       std::fprintf(stderr, "denoise debug: collar k=%zu sign %+.0f: heights %.3f-%.3f mm (right), %.3f-%.3f (left)\n", k_,
                    sign, *std::min_element(h_right.begin(), h_right.end()), *std::max_element(h_right.begin(), h_right.end()),
                    *std::min_element(h_left.begin(), h_left.end()), *std::max_element(h_left.begin(), h_left.end()));

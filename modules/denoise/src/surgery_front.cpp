@@ -23,6 +23,7 @@
 
 #include "colonflat/denoise/cap_triangulation.h"
 #include "colonflat/denoise/face_grid.h"
+#include "denoise_debug.h"
 #include "surgery_steps.h"
 
 namespace cf::detail {
@@ -237,7 +238,7 @@ bool Surgery::front_cap_pair(double sign, FrontCap* right, FrontCap* left) {
     front = clean_layer(front, front_directions(front, disk, step, layer == 0 ? side : std::vector<Sides>{}), step,
                         &right->tris);
     if (front.empty()) {
-      if (std::getenv("COLONFLAT_DENOISE_DEBUG")) std::fprintf(stderr, "denoise debug: front k=%zu: layer %d failed\n", k_, layer + 1);
+      if (denoise_debug()) std::fprintf(stderr, "denoise debug: front k=%zu: layer %d failed\n", k_, layer + 1);
       return false;
     }
     right->inner.insert(right->inner.end(), front.begin(), front.end());
@@ -338,7 +339,7 @@ bool Surgery::front_caps(double sign) {
   const std::size_t n_vertices = mesh_.n_vertices(), n_edges = mesh_.n_edges(), n_faces = mesh_.n_faces();
   FrontCap right, left;
   const bool ok = front_cap_pair(sign, &right, &left);
-  if (std::getenv("COLONFLAT_DENOISE_DEBUG"))
+  if (denoise_debug())
     std::fprintf(stderr, "denoise debug: front k=%zu sign %+.0f: %s, %zu interior vertices, %zu triangles per cap\n", k_,
                  sign, ok ? "clean" : "failed", right.inner.size(), right.tris.size());
   if (!ok) {

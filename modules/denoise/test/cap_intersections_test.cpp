@@ -148,6 +148,45 @@ TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
   expect_two_clean_spheres(r.mesh);
 }
 
+// The blocked torus's thinnest meridian (the exact method's first loop, cut without the cap
+// check) cut alone on a fresh copy, front caps off, with the given concentric placement rule.
+SurgeryResult cut_thinnest_meridian(bench::Blocker kind, bool trial, bool probe, Mesh* out) {
+  const Mesh m = bench::blocked_torus(kind);
+  DenoiseOptions unchecked;
+  unchecked.check_caps = false;
+  const DenoiseResult first = denoise(m, unchecked);
+  std::vector<Mesh::VertexHandle> loop;
+  for (int id : first.loops.at(0).vertex_ids) loop.push_back(Mesh::VertexHandle(id));
+  *out = m;
+  FaceGrid grid(*out, 3 * testing::mean_edge(*out));
+  SurgeryOptions o;
+  o.guard = &grid;
+  o.front = false;
+  o.trial = trial;
+  o.probe_concentric = probe;
+  return cut_and_cap(*out, loop, o);
+}
+
+// A loop's first cut only probes the concentric placements for a clean one (each count stops at
+// its first pair): where one is clean (the core blob) it gives the full search's caps, point for
+// point; where none is (a rod through every meridian's caps) the caps stay in the first
+// placement and report its pairs (as a trial does), which the full search would have lowered.
+TEST(DenoiseCapIntersections, ProbedConcentricPlacementsOnlyLookForACleanOne) {
+  Mesh full_mesh, probe_mesh, trial_mesh;
+  const SurgeryResult full = cut_thinnest_meridian(bench::Blocker::kCoreBlob, false, false, &full_mesh);
+  const SurgeryResult probe = cut_thinnest_meridian(bench::Blocker::kCoreBlob, false, true, &probe_mesh);
+  ASSERT_EQ(full.intersections, 0u);
+  EXPECT_EQ(probe.intersections, 0u);
+  ASSERT_EQ(probe_mesh.n_vertices(), full_mesh.n_vertices());
+  for (auto v : full_mesh.vertices()) EXPECT_EQ(probe_mesh.point(v), full_mesh.point(v)) << v.idx();
+  const SurgeryResult rod_full = cut_thinnest_meridian(bench::Blocker::kRod, false, false, &full_mesh);
+  const SurgeryResult rod_probe = cut_thinnest_meridian(bench::Blocker::kRod, false, true, &probe_mesh);
+  const SurgeryResult rod_trial = cut_thinnest_meridian(bench::Blocker::kRod, true, false, &trial_mesh);
+  EXPECT_GT(rod_probe.intersections, 0u);
+  EXPECT_EQ(rod_probe.intersections, rod_trial.intersections);
+  EXPECT_LT(rod_full.intersections, rod_probe.intersections) << "the full search must lower the first placement's pairs";
+}
+
 // A blob at the tube core (+-0.6 mm along the tube, 0.6 mm across) is crossed by every flat,
 // collar and restricted cap of the thinnest meridian and by concentric caps bulged by up to one
 // ring edge (0.33 mm); a concentric cap bulged by a fraction of the loop's radius passes over it,

@@ -33,6 +33,10 @@ struct SurgeryOptions {
   bool trial = false;      // with a guard: the caller keeps the result only when it intersects
                            // nothing, so concentric caps stay in their first placement (their
                            // pairs counted, not minimised over the placements)
+  bool probe_concentric = false;  // with a guard, not a trial: the concentric placements are only
+                                  // searched for a clean one (each count stops at its first pair);
+                                  // without one the caps stay in the first placement, whose pairs
+                                  // are reported (the caller undoes such a cut)
 };
 
 // What undo_surgery() needs to put the mesh back as it was before cut_and_cap(): the element
