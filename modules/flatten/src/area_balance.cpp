@@ -42,12 +42,15 @@ Region select_region(const Surface& s, const std::vector<std::vector<int>>& vf, 
                      const std::vector<char>& degenerate, double lo, double hi) {
   Region r;
   std::vector<char> in(s.t.size(), 0);
+  for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {  // each face's own test, any thread
+    for (std::size_t f = begin; f < end; ++f) {
+      const double q = ratio_of(s, emb, area3, int(f));
+      in[f] = !degenerate[f] && (q < lo || q > hi || anisotropy(s, emb, int(f)) > kMaxAnisotropy);
+    }
+  });
   std::vector<int> faces;
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    const double q = ratio_of(s, emb, area3, int(f));
-    if (!degenerate[f] && (q < lo || q > hi || anisotropy(s, emb, int(f)) > kMaxAnisotropy))
-      in[f] = 1, faces.push_back(int(f));
-  }
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (in[f]) faces.push_back(int(f));
   if (faces.empty()) return r;
   std::size_t done = 0;
   for (int rings = 2; rings <= 64; rings *= 2) {

@@ -14,26 +14,38 @@
 namespace cf {
 namespace flat_detail {
 
-FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0,
-                               const V2& q1, const V2& q2) {
+FaceFrame face_frame(const V3& p0, const V3& p1, const V3& p2) {
   const V3 e1 = p1 - p0, e2 = p2 - p0;
   const V3 n = e1.cross(e2);
-  const double a3 = 0.5 * n.norm();
+  FaceFrame fr;
+  fr.area3 = 0.5 * n.norm();
   const double l1 = e1.norm();
-  FaceDistortion d{kInf, a3, 0, false};
+  if (fr.area3 <= 0 || l1 <= 0) return fr;
+  const V3 x = e1 / l1, y = n.normalized().cross(x);
+  Eigen::Matrix2d S;
+  S << l1, e2.dot(x), 0, e2.dot(y);
+  fr.s_inv = S.inverse();
+  fr.valid = true;
+  return fr;
+}
+
+FaceDistortion face_distortion(const FaceFrame& fr, const V2& q0, const V2& q1, const V2& q2) {
+  FaceDistortion d{kInf, fr.area3, 0, false};
   const Eigen::Vector2d d1 = q1 - q0, d2 = q2 - q0;
   d.area2 = 0.5 * (d1.x() * d2.y() - d1.y() * d2.x());
-  if (a3 <= 0 || l1 <= 0) return d;
-  const V3 x = e1 / l1, y = n.normalized().cross(x);
-  Eigen::Matrix2d S, Q;
-  S << l1, e2.dot(x), 0, e2.dot(y);
+  if (!fr.valid) return d;
+  Eigen::Matrix2d Q;
   Q << d1.x(), d2.x(), d1.y(), d2.y();
-  const Eigen::Matrix2d J = Q * S.inverse();
+  const Eigen::Matrix2d J = Q * fr.s_inv;
   const double E_ = (J(0, 0) + J(1, 1)) / 2, F = (J(0, 0) - J(1, 1)) / 2, G = (J(1, 0) + J(0, 1)) / 2,
                H = (J(1, 0) - J(0, 1)) / 2;
   const double Qn = std::hypot(E_, H), R = std::hypot(F, G);
   d.qc = std::abs(Qn - R) > 0 ? (Qn + R) / std::abs(Qn - R) : kInf;
   return d;
+}
+
+FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0, const V2& q1, const V2& q2) {
+  return face_distortion(face_frame(p0, p1, p2), q0, q1, q2);
 }
 
 double percentile(std::vector<double> v, double p) {

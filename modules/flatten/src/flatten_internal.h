@@ -264,17 +264,20 @@ struct StepTimes {
   double gradient = 0, solve = 0, step_limit = 0, line_search = 0, check = 0;
   int energy_evals = 0;
 };
-// What correct_area() did: steps, faces, energies, why it stopped, and (debug) where its time went.
+// What correct_area() did: steps, faces, energies, why it stopped.
 struct AreaCorrection {
   int iterations = 0;
   std::size_t faces = 0;  // faces the correction worked on
   double energy_before = 0, energy_after = 0;
   const char* stop = "";  // why the (last) descent stopped (proxy_descent.h)
-  // COLONFLAT_FLATTEN_DEBUG: wall seconds of the system build (assembly, order, factorisation) and
-  // of the steps, of the whole band or of the local piece that took longest (its faces, steps and
-  // place in the order the pieces start), and the pieces' wall seconds summed.
+};
+// Where a correct_area() call's wall time went (COLONFLAT_FLATTEN_DEBUG; filled only when asked
+// for): seconds of the system build (assembly, order, factorisation) and of the steps, of the
+// whole band or of the local piece that took longest (its faces, steps and place in the order the
+// pieces start), and the pieces' wall seconds summed.
+struct CorrectionTimes {
   double build_s = 0, longest_s = 0, pieces_s = 0;
-  StepTimes times;
+  StepTimes steps;
   std::size_t longest_faces = 0, longest_place = 0, pieces = 0;
   int longest_steps = 0;
 };
@@ -291,11 +294,11 @@ struct AreaCorrection {
 // to 3 times (the second local pass, for pockets the first one could not open).
 // `enough` (whole band only, optional): asked after each step; true ends the pass (its goal met).
 // `vertex_order` (whole band only, optional): a fill-reducing order of the band's vertices for its
-// system (else AMD's).
+// system (else AMD's). `times` (optional): where the time went; the map does not depend on it.
 AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
                             const FlattenOptions& o, bool grow = false, const std::function<bool()>& enough = {},
-                            const std::vector<int>* vertex_order = nullptr);
+                            const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr);
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
@@ -314,6 +317,17 @@ struct FaceDistortion {
   bool degenerate = false;
 };
 FaceDistortion face_distortion(const V3& p0, const V3& p1, const V3& p2, const V2& q0, const V2& q1, const V2& q2);
+// The 3D half of face_distortion (a face's area and the inverse of its edge matrix in its own
+// plane; valid false for a degenerate triangle), for a caller that measures the same faces after
+// every step of a descent: face_distortion(face_frame(p0, p1, p2), q0, q1, q2) is, bit for bit,
+// face_distortion(p0, p1, p2, q0, q1, q2).
+struct FaceFrame {
+  Eigen::Matrix2d s_inv = Eigen::Matrix2d::Zero();
+  double area3 = 0;
+  bool valid = false;
+};
+FaceFrame face_frame(const V3& p0, const V3& p1, const V3& p2);
+FaceDistortion face_distortion(const FaceFrame& frame, const V2& q0, const V2& q1, const V2& q2);
 DistortionStats stats_of(const std::vector<FaceDistortion>& fd);
 // The area ratio 5th / 95th percentiles and the quasi-conformal mean of stats_of(the faces of fd in
 // the map: not degenerate, not too_small_in_map), the same numbers, without copying the faces or
@@ -358,7 +372,11 @@ struct SegmentWork {
 };
 
 // Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.
-std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate);
+// `frames` (optional): face_frame() of every face of the annulus (the same numbers, without the 3D half).
+std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate,
+                                            const std::vector<FaceFrame>* frames = nullptr);
+// face_frame() of every face of the segment's annulus (on the worker threads).
+std::vector<FaceFrame> band_frames(const SegmentWork& w);
 
 // Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
 // their parent and their neck's position on it, labelled "neck" -> "tip". Returns per work whether

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -47,4 +48,29 @@ TEST(FlattenDistortion, BoundStatsEqualStatsOfTheFacesInTheMap) {
     EXPECT_EQ(got.qc_mean, want.qc_mean) << n;
     if (n >= 1000) EXPECT_LT(got.area_p05, 0.5 * got.area_p95) << n;  // the two are not one value
   }
+}
+
+// face_distortion from a face's cached 3D frame (the whole-band stop check's path) gives the same
+// bits as face_distortion from its corners, for ordinary, sliver, folded and degenerate triangles.
+TEST(FlattenDistortion, FrameOfAFaceGivesTheSameBitsAsItsCorners) {
+  using cf::flat_detail::V2;
+  using cf::flat_detail::V3;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5, 5);
+  std::size_t invalid = 0;
+  for (int i = 0; i < 2000; ++i) {
+    V3 p0(u(rng), u(rng), u(rng)), p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    if (i % 50 == 0) p1 = p0;                          // degenerate: a zero edge
+    if (i % 50 == 1) p2 = p0 + 2.0 * (p1 - p0);        // degenerate: collinear
+    if (i % 50 == 2) p2 = p0 + (p1 - p0) + V3(0, 0, 1e-9);  // sliver
+    const V2 q0(u(rng), u(rng)), q1(u(rng), u(rng)), q2(u(rng), u(rng));  // either orientation
+    const FaceDistortion a = cf::flat_detail::face_distortion(p0, p1, p2, q0, q1, q2);
+    const cf::flat_detail::FaceFrame frame = cf::flat_detail::face_frame(p0, p1, p2);
+    const FaceDistortion b = cf::flat_detail::face_distortion(frame, q0, q1, q2);
+    invalid += !frame.valid;
+    EXPECT_EQ(std::memcmp(&a.qc, &b.qc, sizeof(double)), 0) << i << ": " << a.qc << " vs " << b.qc;
+    EXPECT_EQ(std::memcmp(&a.area2, &b.area2, sizeof(double)), 0) << i;
+    EXPECT_EQ(std::memcmp(&a.area3, &b.area3, sizeof(double)), 0) << i;
+  }
+  EXPECT_GE(invalid, 40u);  // the degenerate cases were met (qc infinite in both)
 }
