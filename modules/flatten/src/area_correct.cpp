@@ -82,26 +82,6 @@ class ConformalAreaEnergy {
   }
   static constexpr double kHuge = 1e300;
 
-  // The energy's two terms apart (the Dirichlet term; the penalty without its weight) and whether
-  // any face is shown below `min_ratio` (area ratio at the band's scale), for the local pieces' stop.
-  struct Parts {
-    double dirichlet = 0, penalty = 0;
-    bool hidden = false;
-  };
-  Parts parts(const std::vector<V2>& pos, double min_ratio) const {
-    Parts p;
-    for (std::size_t i = 0; i < faces_.size(); ++i) {  // a local piece: a few thousand faces
-      const auto c = corners(pos, faces_[i]);
-      const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-      for (int k = 0; k < 3; ++k) p.dirichlet += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
-      const int f = faces_[i];
-      const double x = excess(std::log(scale_ * a2 / area3_[f]));
-      p.penalty += area3_[f] * x * x;
-      p.hidden = p.hidden || scale_ * a2 < min_ratio * area3_[f];
-    }
-    return p;
-  }
-
  private:
   std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
     const Tri& t = s_.t[f];
@@ -254,23 +234,6 @@ std::vector<std::size_t> most_work_first(const std::vector<std::vector<int>>& pi
   return order;
 }
 
-// When a local piece has done its job (asked after each of its steps): none of its faces is shown
-// below coverage_min_ratio, and the step lowered neither its penalty (the squared log distances of
-// its area ratios to [lo, hi]) by kMinOutOfBoundsGain nor its Dirichlet (angle) term by
-// kMinAngleGain, relative: the balancing's rule (area_balance.cpp, with its reasons). On the real
-// CT colon band the pieces took hundreds of steps after their pocket was open (10 547 faces: 687
-// steps, 730 -> 0 mm2 shown below 0.1), stopping only at an energy gain of 1e-5 a step.
-constexpr double kMinOutOfBoundsGain = 0.01, kMinAngleGain = 0.001;
-std::function<bool()> piece_done(const ConformalAreaEnergy& energy, const Embedding& emb, double min_ratio) {
-  return [&energy, &emb, min_ratio, last = energy.parts(emb.pos, min_ratio)]() mutable {
-    const ConformalAreaEnergy::Parts now = energy.parts(emb.pos, min_ratio);
-    const bool done = !now.hidden && !(now.penalty < (1 - kMinOutOfBoundsGain) * last.penalty) &&
-                      !(now.dirichlet < (1 - kMinAngleGain) * last.dirichlet);
-    last = now;
-    return done;
-  };
-}
-
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
 // (optional): where its wall time went.
 void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
@@ -286,9 +249,8 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
   const double build_s = clock.lap();
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   StepTimes* step_times = times ? &times->steps : nullptr;
-  const std::function<bool()> stop = local && !enough ? piece_done(energy, emb, o.coverage_min_ratio) : enough;
   const DescentResult d =
-      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, stop, scratch, step_times);
+      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times);
   if (times) {
     times->build_s = build_s, times->longest_s = build_s + clock.lap();
     times->longest_faces = nfaces, times->longest_steps = d.steps;
