@@ -132,6 +132,14 @@ struct GraphCutOutput {
 };
 GraphCutOutput graph_cut_band(const GraphCutInput& in, Bytes& state);
 
+// Face pairs across the boundary of two fluid pieces inside one candidate component
+// (candidate_bodies, segment_split.cpp): key (component, smaller piece, larger piece), the pairs
+// counted and those fluid in both voxels' own values.
+struct PiecePair {
+  std::array<std::uint32_t, 3> key;
+  std::size_t pairs, fluid;
+};
+
 // One decision about a gas or fluid body, for the report.
 struct Decision {
   std::string what;    // "gas body", "fluid body", "segment", "rectal tube"
@@ -199,7 +207,9 @@ class ColonSegmenter {
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
   void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
+  void grow_pieces(const Bytes& bright, std::vector<std::size_t>& queue);
   RunLabels candidate_bodies(const Bytes& candidate) const;
+  std::vector<PiecePair> piece_pairs(const RunLabels& cl, const Bytes& candidate, std::vector<std::uint64_t>& units) const;
   void scan_contacts(int axis, Bytes* contact, bool layer);
   std::vector<std::array<std::size_t, 2>> level_contacts(int axis, std::size_t min_gas_voxels);
   void gravity_from_levels();
@@ -219,6 +229,7 @@ class ColonSegmenter {
   void log_link(const Contact& c, const LocalShape& sg, const LocalShape& sf, bool ok, const std::string& why) const;
   std::pair<std::size_t, std::size_t> facing_cells(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;
   nlohmann::json gap_profile(const Contact& c) const;
+  double fluid_hu_near(const LocalShape& s) const;
   bool end_is_free(std::uint32_t segment, const LocalShape& near) const;
   double gap_fat_mm(const Contact& c) const;
   void debug_link(const Contact& c, const LocalShape& sg, const LocalShape& sf) const;

@@ -26,6 +26,7 @@ constexpr double kMinChord = 0.7;       // last front's distance from the contac
 constexpr double kSameEndMm = 30;       // a used end within this path length of a new contact: the same end
 constexpr double kMinCalibreRatio = 0.3; // cross-sections (front sizes) of the two bodies within this ratio
 constexpr std::size_t kContactsPerPair = 3;
+constexpr double kMinFluidSampleMl = 0.5;  // fluid near a contact measured from this much on
 // Fat (adipose tissue, -190..-30 HU) along a gap: a collapsed neck of colon is its own wall pressed
 // together (soft tissue, 20-60 HU, perhaps a thread of gas or fluid), never fat; a layer of at least
 // kFatRunMm (and at least one voxel's diagonal, beyond the partial volume of a gas/tissue edge) means
@@ -328,6 +329,25 @@ std::pair<std::size_t, std::size_t> ColonSegmenter::facing_cells(const Contact& 
   return {facing(ps, pf), facing(pf, ps)};
 }
 
+// Median HU of the tagged fluid (own value in [fluid-threshold, fluid-max)) in the fine voxels of the
+// cells of `s` (a body's region near a contact); NaN when it holds fewer than kMinFluidSampleMl.
+double ColonSegmenter::fluid_hu_near(const LocalShape& s) const {
+  std::vector<float> v;
+  for (const auto& cell : s.region) {
+    std::size_t lo[3], hi[3];
+    grid_->fine_box(cell.first, d_, lo, hi);
+    for (std::size_t k = lo[2]; k < hi[2]; ++k)
+      for (std::size_t j = lo[1]; j < hi[1]; ++j)
+        for (std::size_t i = lo[0]; i < hi[0]; ++i) {
+          const float h = hu_[d_.idx(i, j, k)];
+          if (h >= opts_.fluid_threshold && h < opts_.fluid_max) v.push_back(h);
+        }
+  }
+  if (double(v.size()) * voxel_ml_ < kMinFluidSampleMl) return std::nan("");
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 // HU (nearest voxel) at 25 points on the straight line between the contact's two cell centres (link log).
 nlohmann::json ColonSegmenter::gap_profile(const Contact& c) const {
   const Eigen::Vector3d fa = grid_->fine_centre(c.to), fb = grid_->fine_centre(c.from);
@@ -373,6 +393,9 @@ void ColonSegmenter::log_link(const Contact& c, const LocalShape& sg, const Loca
   j["facing_seg"] = facing_seg;
   j["facing_cand"] = facing_cand;
   j["profile"] = gap_profile(c);
+  const double hu_seg = fluid_hu_near(sg), hu_cand = fluid_hu_near(sf);  // NaN: no fluid near (null)
+  j["seg_fluid_hu"] = std::isnan(hu_seg) ? nlohmann::json() : nlohmann::json(hu_seg);
+  j["cand_fluid_hu"] = std::isnan(hu_cand) ? nlohmann::json() : nlohmann::json(hu_cand);
   if (c.candidate < cand_ml_.size()) j["cand_ml"] = cand_ml_[c.candidate];
   if (c.candidate < cand_samples_.size()) j["cand_samples"] = cand_samples_[c.candidate];
   if (c.segment >= kKeptCandidateId && c.segment - kKeptCandidateId < cand_samples_.size())
@@ -391,7 +414,7 @@ void ColonSegmenter::debug_link(const Contact& c, const LocalShape& sg, const Lo
   }
   if (!sg.fronts.empty() && !sf.fronts.empty())
     std::fprintf(stderr, " dir %.2f", -sg.fronts[0].centroid.normalized().dot(sf.fronts[0].centroid.normalized()));
-  std::fprintf(stderr, "\n");
+  std::fprintf(stderr, " fluid HU %.0f / %.0f\n", fluid_hu_near(sg), fluid_hu_near(sf));
 }
 
 void ColonSegmenter::report_candidate(const BodyStats& b, double kept_gap, const std::string& why) {

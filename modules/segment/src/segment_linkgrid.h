@@ -79,6 +79,12 @@ class LinkGrid {
   // A kept candidate becomes part of colon segment `segment` (colon for later contacts).
   void absorb(std::uint32_t candidate, std::uint32_t segment);
   Eigen::Vector3d mm(std::size_t cell) const;
+  // The fine voxels of `cell`: [lo, hi) along each axis of `fine`.
+  void fine_box(std::size_t cell, const Dims& fine, std::size_t lo[3], std::size_t hi[3]) const {
+    std::size_t c[3];
+    d_.coords(cell, c[0], c[1], c[2]);
+    for (int a = 0; a < 3; ++a) lo[a] = c[a] * std::size_t(f_[a]), hi[a] = std::min(fine.n[a], lo[a] + std::size_t(f_[a]));
+  }
   // The centre of `cell` in fine voxel coordinates (continuous).
   Eigen::Vector3d fine_centre(std::size_t cell) const {
     std::size_t c[3];

@@ -12,7 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <map>
+#include <array>
 #include <vector>
 
 #include "colonflat/core/union_find.h"
@@ -62,6 +62,36 @@ Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm) {
   return sure;
 }
 
+// Breadth-first from the cores (`queue`, in label order): the nearest core along the mask, first
+// through fluid voxels only (a core does not reach across a wall into the next lumen's fluid), then
+// into the mask's other voxels. The second pass starts from the voxels of the first that have a
+// bright non-fluid neighbour still unlabelled (the first pass never labels one), in the first
+// pass's order: the others would add nothing, so the pieces are those of a rescan of the whole queue.
+void ColonSegmenter::grow_pieces(const Bytes& bright, std::vector<std::size_t>& queue) {
+  std::vector<std::size_t> border;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t q = queue[head];
+    bool wall_next = false;
+    for_face_neighbours(d_, q, [&](std::size_t r) {
+      if (!bright[r] || fluid_label_[r]) return;
+      if (hu_[r] < opts_.fluid_threshold) return void(wall_next = true);
+      fluid_label_[r] = fluid_label_[q];
+      queue.push_back(r);
+    });
+    if (wall_next) border.push_back(q);
+  }
+  queue.swap(border);
+  std::vector<std::size_t>().swap(border);
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t q = queue[head];
+    for_face_neighbours(d_, q, [&](std::size_t r) {
+      if (!bright[r] || fluid_label_[r]) return;
+      fluid_label_[r] = fluid_label_[q];
+      queue.push_back(r);
+    });
+  }
+}
+
 // fluid_label_: the pieces of the bright mask (cores grown along paths inside the mask, then the
 // coreless components); fluid_count_ their number.
 void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
@@ -83,17 +113,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   } else {
     fluid_count_ = 0;
   }
-  // Breadth-first: the nearest core along the mask, first through fluid voxels only (a core does
-  // not reach across a wall into the next lumen's fluid), then into the mask's other voxels.
-  for (const bool own_fluid : {true, false})
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::size_t q = queue[head];
-      for_face_neighbours(d_, q, [&](std::size_t r) {
-        if (!bright[r] || fluid_label_[r] || (own_fluid && hu_[r] < opts_.fluid_threshold)) return;
-        fluid_label_[r] = fluid_label_[q];
-        queue.push_back(r);
-      });
-    }
+  grow_pieces(bright, queue);
   std::vector<std::size_t>().swap(queue);
   Bytes rest(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) rest[q] = bright[q] && !fluid_label_[q];
@@ -113,38 +133,31 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
 // component's bodies in raster order of their first voxel (no cut: the components' labels).
 RunLabels ColonSegmenter::candidate_bodies(const Bytes& candidate) const {
   const RunLabels cl = component_runs(candidate.data(), d_);
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> unit;  // (component, piece) -> unit
-  std::map<std::array<std::uint32_t, 3>, std::array<std::size_t, 2>> border;  // (component, piece, piece) -> pairs, fluid pairs
-  auto unit_of = [&](std::uint32_t l, std::uint32_t piece) { return unit.emplace(std::make_pair(l, piece), std::uint32_t(unit.size())).first->second; };
-  for (std::uint32_t l = 1; l <= cl.count(); ++l)
-    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
-      for (std::size_t q = r->start; q < r->start + r->length; ++q) {
-        if (q == r->start || fluid_label_[q] != fluid_label_[q - 1]) unit_of(l, fluid_label_[q]);
-        std::size_t c[3];
-        d_.coords(q, c[0], c[1], c[2]);
-        for (int a = 0; a < 3; ++a) {
-          if (c[a] + 1 >= d_.n[a] || !candidate[q + d_.stride[a]]) continue;
-          const std::uint32_t p0 = fluid_label_[q], p1 = fluid_label_[q + d_.stride[a]];
-          if (p0 == p1) continue;
-          auto& b = border[{l, std::min(p0, p1), std::max(p0, p1)}];
-          ++b[0];
-          b[1] += std::min(hu_[q], hu_[q + d_.stride[a]]) >= opts_.fluid_threshold;
-        }
-      }
-  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
-    for (const auto& [key, b] : border)
-      if (key[1]) std::fprintf(stderr, "pieces %u and %u: %zu boundary pairs, %zu fluid in both voxels\n", key[1], key[2], b[0], b[1]);
-  UnionFind uf(unit.size());
-  for (const auto& [key, b] : border)
-    if (key[1] == 0 || double(b[1]) >= kMinFluidPairShare * double(b[0])) uf.unite(unit_of(key[0], key[1]), unit_of(key[0], key[2]));
-  std::vector<std::uint32_t> label(unit.size(), 0);
+  std::vector<std::uint64_t> units;  // (component << 32 | piece), sorted: a unit's index is its union-find id
+  std::vector<PiecePair> pairs = piece_pairs(cl, candidate, units);
+  std::sort(units.begin(), units.end());
+  units.erase(std::unique(units.begin(), units.end()), units.end());
+  auto unit_of = [&](std::uint32_t l, std::uint32_t piece) {
+    return std::uint32_t(std::lower_bound(units.begin(), units.end(), (std::uint64_t(l) << 32) | piece) - units.begin());
+  };
+  std::sort(pairs.begin(), pairs.end(), [](const PiecePair& a, const PiecePair& b) { return a.key < b.key; });
+  UnionFind uf(units.size());
+  for (std::size_t g0 = 0, g1; g0 < pairs.size(); g0 = g1) {  // one group per (component, piece, piece)
+    std::size_t all = 0, fluid = 0;
+    for (g1 = g0; g1 < pairs.size() && pairs[g1].key == pairs[g0].key; ++g1) all += pairs[g1].pairs, fluid += pairs[g1].fluid;
+    const auto& [l, p0, p1] = pairs[g0].key;
+    if (std::getenv("COLONFLAT_SEGMENT_DEBUG") && p0)
+      std::fprintf(stderr, "pieces %u and %u: %zu boundary pairs, %zu fluid in both voxels\n", p0, p1, all, fluid);
+    if (p0 == 0 || double(fluid) >= kMinFluidPairShare * double(all)) uf.unite(unit_of(l, p0), unit_of(l, p1));
+  }
+  std::vector<std::uint32_t> label(units.size(), 0);
   std::vector<std::vector<Run>> runs;
   for (std::uint32_t l = 1; l <= cl.count(); ++l)
     for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
       for (std::size_t q = r->start, end = r->start + r->length; q < end;) {
         std::size_t e = q + 1;
         while (e < end && fluid_label_[e] == fluid_label_[q]) ++e;
-        std::uint32_t& lab = label[uf.find(unit.at({l, fluid_label_[q]}))];
+        std::uint32_t& lab = label[uf.find(unit_of(l, fluid_label_[q]))];
         if (!lab) lab = std::uint32_t(runs.size() + 1), runs.emplace_back();
         runs[lab - 1].push_back({q, e - q});
         q = e;
@@ -155,6 +168,32 @@ RunLabels ColonSegmenter::candidate_bodies(const Bytes& candidate) const {
     out.first.push_back(out.runs.size());
   }
   return out;
+}
+
+// The face pairs of candidate voxels of component l whose fluid pieces differ, counted per key (l,
+// smaller piece, larger piece): pairs, and those fluid in both voxels' own values; consecutive pairs
+// of one key share an entry, so a key may have several (unsorted). `units` gets the (component,
+// piece) of every candidate voxel (unsorted; repeats only where not consecutive).
+std::vector<PiecePair> ColonSegmenter::piece_pairs(const RunLabels& cl, const Bytes& candidate, std::vector<std::uint64_t>& units) const {
+  std::vector<PiecePair> pairs;
+  for (std::uint32_t l = 1; l <= cl.count(); ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) {
+        const std::uint64_t unit = (std::uint64_t(l) << 32) | fluid_label_[q];
+        if (units.empty() || units.back() != unit) units.push_back(unit);
+        std::size_t c[3];
+        d_.coords(q, c[0], c[1], c[2]);
+        for (int a = 0; a < 3; ++a) {
+          if (c[a] + 1 >= d_.n[a] || !candidate[q + d_.stride[a]]) continue;
+          const std::uint32_t p0 = fluid_label_[q], p1 = fluid_label_[q + d_.stride[a]];
+          if (p0 == p1) continue;
+          const bool fluid = std::min(hu_[q], hu_[q + d_.stride[a]]) >= opts_.fluid_threshold;
+          const std::array<std::uint32_t, 3> key{l, std::min(p0, p1), std::max(p0, p1)};
+          if (pairs.empty() || pairs.back().key != key) pairs.push_back({key, 0, 0});  // a run's pairs mostly share a key
+          ++pairs.back().pairs, pairs.back().fluid += fluid;
+        }
+      }
+  return pairs;
 }
 
 }  // namespace cf::segment_detail

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "colonflat/segment/segment.h"
 #include "segment_volumes.h"
@@ -176,6 +177,25 @@ TEST(SegmentRules, TubeAcrossFatFromColonEndRejected) {
     EXPECT_EQ(at(m, 70, 50, 50), !fat);
     if (fat) EXPECT_TRUE(has_decision(st, "rejected", "separated from the colon by fat")) << st.to_json()["decisions"].dump(1);
   }
+}
+
+// The link log (COLONFLAT_SEGMENT_LINKS) gives the median tagged-fluid HU near the contact on each
+// side: a 500 HU tube across a 6 mm neck from a dry gas end reads about 500 HU, the gas end none.
+TEST(SegmentRules, LinkLogReportsFluidHuNearContact) {
+  auto ct = make_volume(100, [&](double x, double y, double z) {
+    const double d = tube_dist(y, z, 50, 50);
+    if (x >= 8 && x <= 40 && d < 9) return -1000.0;
+    if (x >= 47 && x <= 80 && d < 8) return 500.0;
+    return kKeep;
+  }, 0.6, 10);
+  ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
+  auto [m, st] = segment_small(ct, tagged_options(1));
+  ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+  ASSERT_FALSE(st.links.empty());
+  const nlohmann::json& j = st.links.front();
+  ASSERT_TRUE(j.contains("cand_fluid_hu") && j["cand_fluid_hu"].is_number()) << j.dump();
+  EXPECT_NEAR(j["cand_fluid_hu"].get<double>(), 500.0, 30.0) << j.dump();
+  EXPECT_TRUE(j.contains("seg_fluid_hu") && j["seg_fluid_hu"].is_null()) << j.dump();
 }
 
 // Issue 25, session 14 (painted seed 3 "bowel" supine, reduced): a gas colon narrowing to a tip over
