@@ -3,10 +3,11 @@
 //                               with stretches left out of one scan (issue 27).
 //   register_bench --phantom 1-5 [--size full|small] --work DIR
 //                               phantom pairs (`colonflat phantom [--position prone]`, `colonflat run`).
-//   register_bench --cuts SEED [--size full|small] --work DIR
+//   register_bench --cuts SEED [--size full|small] --work DIR [--held-out] [--no-cli]
 //                               one phantom patient run from its true lumen masks, the masks cut
 //                               (collapse, tagged stretches dropped, split +3, rectum cut; issue 27).
 //   register_bench --real-mask MASK --work DIR [--table X Y Z] [--turn DEG] [--painted] [--cases K...]
+//                  [--held-out] [--polyp-seed N] [--polyps N]
 //                               the real lumen mask with 10 synthetic polyps, cut as --cuts (by path
 //                               distance through the lumen), the prone mask moved on the table; a
 //                               polyp counts as seen in a scan only with that scan's wall within its
@@ -275,7 +276,7 @@ void register_cli(const fs::path& sup_run, const fs::path& pro_run, const fs::pa
 
 // One phantom patient, both positions run from their true lumen masks, the masks cut along the
 // phantom's centre line (lumen_cut.h) as real segmentations differ.
-void cuts_table(int seed, const std::string& size, const fs::path& work) {
+void cuts_table(int seed, const std::string& size, const fs::path& work, bool held_out, bool no_cli) {
   std::printf("Phantom seed %d (%s), both scans run from the lumen mask (--from reconstruct); masks cut\n", seed,
               size.c_str());
   const fs::path d = work / ("cuts_seed" + std::to_string(seed));
@@ -286,10 +287,11 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
     if (!fs::exists(ph / "polyps.json") && colonflat(a) != 0) return;
   }
   if (!run_mask(d / "supine_phantom" / "lumen_mask.nrrd", d / "supine_run")) return;
-  const auto cases = cf::segmentation_cut_cases(cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back());
+  const double L = cf::read_phantom_centreline(d / "prone_phantom" / "centerline.json").arc_mm.back();
+  const auto cases = held_out ? cf::held_out_cut_cases(L) : cf::segmentation_cut_cases(L);
   print_header();
   for (size_t k = 0; k < cases.size(); ++k) {
-    const std::string n = std::to_string(k);
+    const std::string n = (held_out ? "h" : "") + std::to_string(k);
     fs::path sup_run = d / "supine_run";
     for (const std::string pos : {"supine", "prone"}) {
       const Cuts& cuts = pos == "supine" ? cases[k].supine : cases[k].prone;
@@ -303,7 +305,7 @@ void cuts_table(int seed, const std::string& size, const fs::path& work) {
     const Row r = pair_row(cases[k].name, sup_run, d / ("prone_run" + n), d / "supine_phantom", d / "prone_phantom",
                            cases[k].prone, cases[k].supine);
     print_row(r);
-    register_cli(sup_run, d / ("prone_run" + n), d / ("register" + n), r);
+    if (!no_cli) register_cli(sup_run, d / ("prone_run" + n), d / ("register" + n), r);
   }
 }
 
@@ -328,16 +330,16 @@ void real_table(const fs::path& mask_file, const fs::path& work, const RealMaskO
   cf::MaskImage::Pointer mask = cf::read_mask(mask_file);
   if (o.downsample > 1) mask = cf::downsample_mask(mask, o.downsample);
   cf::MaskCourse course(mask);
-  const auto polyps = course.place_polyps(10, 1);
+  const auto polyps = course.place_polyps(o.polyp_count, std::uint64_t(o.polyp_seed));
   const double L = course.length_mm();
   std::printf("Real mask %s: course %.0f mm, %zu polyps placed (%.1f s); prone moved (%.0f, %.0f, %.0f) mm, %.1f deg\n",
               mask_file.filename().c_str(), L, polyps.size(), prep.seconds(), shift.x(), shift.y(), shift.z(), turn);
   fs::create_directories(work);
   print_header();
-  const auto cases = cf::segmentation_cut_cases(L);
+  const auto cases = o.held_out ? cf::held_out_cut_cases(L) : cf::segmentation_cut_cases(L);
   for (size_t k = 0; k < cases.size(); ++k) {
     if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), int(k)) == o.only.end()) continue;
-    const std::string n = std::to_string(k);
+    const std::string n = (o.held_out ? "h" : "") + std::to_string(k);
     const cf::CutCase& c = cases[k];
     const fs::path sm = work / ("supine" + (c.supine.empty() ? std::string() : n) + ".nrrd"), pm = work / ("prone" + n + ".nrrd");
     if (!fs::exists(sm)) cf::write_mask(course.cut_and_move(c.supine, Eigen::Vector3d::Zero()), sm);
@@ -388,10 +390,13 @@ int main(int argc, char** argv) {
   std::string real_mask;  // the options of --real-mask
   RealMaskOptions real;
   app.add_flag("--painted", real.painted, "with --real-mask: paint each mask into a CT and run from the CT");
-  app.add_flag("--no-cli", real.no_cli, "with --real-mask: no `colonflat register` run per pair");
+  app.add_flag("--no-cli", real.no_cli, "with --real-mask or --cuts: no `colonflat register` run per pair");
   app.add_flag("--show-pieces", real.show,
                "with --real-mask: each piece's own mm -> true path mm -> common s; with --real-mask or --pair: each polyp");
   app.add_option("--downsample", real.downsample, "with --real-mask: the mask at this many times its voxel size");
+  app.add_flag("--held-out", real.held_out, "with --cuts or --real-mask: the held-out cut cases (held_out_cut_cases)");
+  app.add_option("--polyp-seed", real.polyp_seed, "with --real-mask: seed of the polyps' places around the wall");
+  app.add_option("--polyps", real.polyp_count, "with --real-mask: polyps spread along 8-92 % of the course");
   app.add_option("--cases", real.only, "with --real-mask: only these cases (0-6)");
   app.add_option("--real-mask", real_mask, "a real lumen mask: pairs with synthetic polyps, cut and moved (issue 27)");
   app.add_option("--table", real.table, "with --real-mask: prone table shift in LPS mm")->expected(3);
@@ -405,7 +410,7 @@ int main(int argc, char** argv) {
   app.add_option("--truth", truth, "with --pair: the two phantom folders SUP_PHANTOM PRO_PHANTOM")->expected(2);
   return cli.run(argc, argv, [&] {
     if (!real_mask.empty()) real_table(real_mask, work, real);
-    else if (cuts_seed > 0) cuts_table(cuts_seed, size, work);
+    else if (cuts_seed > 0) cuts_table(cuts_seed, size, work, real.held_out, real.no_cli);
     else if (!phantoms.empty()) {
       const auto [first, last] = cf::bench::parse_range(phantoms);
       phantom_table(first, last, size, work);

@@ -17,6 +17,9 @@ struct RealMaskOptions {
   std::vector<double> table = {15, -30, 40};  // prone table shift, LPS mm
   double turn_deg = 0;                         // prone turned about the superior axis
   bool painted = false, no_cli = false, show = false;
+  int polyp_seed = 1;                          // seed of the polyps' places on the mask
+  int polyp_count = 10;                        // polyps along 8-92 % of the course
+  bool held_out = false;                       // held_out_cut_cases instead of segmentation_cut_cases
   int downsample = 1;                          // the mask at this many times its voxel size
   std::vector<int> only;                       // cases to run (all when empty)
 };

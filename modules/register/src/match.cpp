@@ -74,8 +74,7 @@ bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector
       map_coordinates(Direction::kSupineToProne, x.s, x.theta, s2, t2);
       CandidateMatch m;
       m.supine_id = a.id, m.prone_id = b.id;
-      m.along_mm = std::abs(y.s - s2);  // on the length map; laid out as pieces, also on the common s (below)
-      if (piecewise_) m.along_mm = std::min(m.along_mm, std::abs(y.s - x.s));
+      m.along_mm = std::abs(y.s - s2);  // on the length map only: the common s does not see the wall slide
       m.around_deg = angle_difference(y.theta, t2) * 180 / kPi;
       m.size_ratio = a.size_mm > 0 && b.size_mm > 0 ? std::max(a.size_mm, b.size_mm) / std::min(a.size_mm, b.size_mm) : 1.0;
       m.distance_3d_mm = (a.lps - b.lps - b_to_a_).norm();

@@ -75,6 +75,17 @@ std::unique_ptr<ColonRegistration> registered(const SyntheticPair& pair) {
   return reg;
 }
 
+// The wall vertex of a scan nearest to material (sigma, phi) (mm along, angle; radius_mm turns the angle into mm).
+size_t vertex_at_material(const std::vector<double>& sigma, const std::vector<double>& phi, double s, double f,
+                          double radius_mm) {
+  size_t best = 0;
+  double best_d = INFINITY;
+  for (size_t v = 0; v < sigma.size(); ++v)
+    if (const double d = std::pow(sigma[v] - s, 2) + std::pow(radius_mm * std::remainder(phi[v] - f, 2 * M_PI), 2); d < best_d)
+      best = v, best_d = d;
+  return best;
+}
+
 // Runs the registration and checks the targets on the polyps seen in both scans.
 void expect_targets(const SyntheticPairOptions& o, int expected_prone_pieces) {
   const SyntheticPair pair = make_synthetic_pair(o);
@@ -326,6 +337,37 @@ TEST(RegisterPieces, DroppedStretchIsUnsupportedAndNeverPaired) {
   const nlohmann::json j = reg.summary();
   EXPECT_FALSE(j["support"]["unsupported_supine_mm"].empty());
   EXPECT_EQ(j["pieces"]["prone"].size(), 2u);
+}
+
+// Two findings 42 mm apart along the colon's wall (supine at material 600 mm, which the prone does not show;
+// prone at 642 mm, which the supine does not show) that the prone wall's 20 mm slide back along the colon
+// brings within match_along_mm on the common axis (the wall slides 1-2 cm between the positions) are not
+// paired: the length map, which follows the wall's folds, puts them 42 mm apart. Session 16's rule (the
+// smaller of the length map's and the common s's distance) paired them. The same supine finding is paired
+// with a prone finding at its own material place.
+TEST(RegisterPieces, FindingsApartOnTheWallAreNotPairedWhereTheWallSlid) {
+  SyntheticPairOptions o = long_pair(1);
+  o.slide_mm = 20;  // prone material sigma lies at sigma + 20 sin(2 pi sigma / 800): 20 mm back at 600 mm
+  const SyntheticPair pair = make_synthetic_pair(o);
+  const auto run = registered(pair);
+  const ColonRegistration& reg = *run;
+  auto at = [&](bool supine, double sigma, int id) {
+    const size_t v = supine ? vertex_at_material(pair.supine_sigma, pair.supine_phi, sigma, 1.0, o.radius_mm)
+                            : vertex_at_material(pair.prone_sigma, pair.prone_phi, sigma, 1.0, o.radius_mm);
+    return ScanCandidate{id, supine ? pair.supine.lps[v] : pair.prone.lps[v], 8, 0.7};
+  };
+  const ScanCandidate a = at(true, 600, 300), b = at(false, 642, 301), c = at(false, 600, 302);
+  const double sa = reg.locate(a.lps, Direction::kSupineToProne).first, sb = reg.locate(b.lps, Direction::kProneToSupine).first;
+  double mapped, theta;
+  reg.map_coordinates(Direction::kSupineToProne, sa, 1.0, mapped, theta);
+  const double limit = reg.options().match_along_mm;
+  ASSERT_LT(std::abs(sb - sa), limit) << "the slide must bring them within the limit on the common axis";
+  ASSERT_GT(std::abs(sb - mapped), limit) << "the length map must follow the wall";
+  EXPECT_TRUE(reg.match({a}, {b}).pairs.empty()) << "common s " << std::abs(sb - sa) << " mm, length map "
+                                                  << std::abs(sb - mapped) << " mm";
+  const CandidateMatching same = reg.match({a}, {c});
+  ASSERT_EQ(same.pairs.size(), 1u);
+  EXPECT_EQ(same.pairs[0].prone_id, 302);
 }
 
 // The pieces of a split prone colon are placed in the right order and direction on the supine

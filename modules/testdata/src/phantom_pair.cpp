@@ -78,6 +78,15 @@ std::vector<CutCase> segmentation_cut_cases(double L) {
           {"both: sup 20+100, pro 25 %", {{0.2 * L, 0.2 * L + 20}, {0.8 * L, 0.8 * L + 100}}, {{0, 50}, {0.35 * L, 0.6 * L}}, false}};
 }
 
+std::vector<CutCase> held_out_cut_cases(double L) {
+  return {{"held: sup collapse 15 mm at 30 %", {{0.30 * L, 0.30 * L + 15}}, {}},
+          {"held: sup split +3 (10/25/12 mm)", {{0.18 * L, 0.18 * L + 10}, {0.42 * L, 0.42 * L + 25}, {0.66 * L, 0.66 * L + 12}}, {}},
+          {"held: pro 20 % dropped at 15 %", {}, {{0.15 * L, 0.35 * L}}},
+          {"held: pro cecal 25 % dropped", {}, {{0.75 * L, L + 1}}},
+          {"held: pro rectum 90 + collapse 60 %", {}, {{0, 90}, {0.60 * L, 0.60 * L + 20}}},
+          {"held: sup 20 % at 50 %, pro split +2", {{0.50 * L, 0.70 * L}}, {{0.22 * L, 0.22 * L + 15}, {0.85 * L, 0.85 * L + 15}}, false}};
+}
+
 PairFigures score_truth_pair(const ColonRegistration& reg, const std::vector<ScanCandidate>& supine,
                              const std::vector<ScanCandidate>& prone, const PhantomTruth& prone_truth) {
   PairFigures f;

@@ -54,6 +54,10 @@ struct CutCase {
   bool within_targets = true;  // one scan lacks up to 25 % or is split into up to 3 more pieces
 };
 std::vector<CutCase> segmentation_cut_cases(double length_mm);
+// Held-out kinds (session 17; the rules were not developed on them): other positions and lengths, a
+// collapse and a split in the supine scan, the cecal end dropped, the rectum cut with a collapse, both
+// scans differing (beyond the targets: the supine lacks 20 %, the prone is split into 2 more pieces).
+std::vector<CutCase> held_out_cut_cases(double length_mm);
 
 // The figures of one registered pair.
 struct PairFigures {
