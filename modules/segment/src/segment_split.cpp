@@ -142,11 +142,12 @@ RunLabels ColonSegmenter::candidate_bodies(const Bytes& candidate) const {
   };
   std::sort(pairs.begin(), pairs.end(), [](const PiecePair& a, const PiecePair& b) { return a.key < b.key; });
   UnionFind uf(units.size());
+  const bool debug = std::getenv("COLONFLAT_SEGMENT_DEBUG") != nullptr;
   for (std::size_t g0 = 0, g1; g0 < pairs.size(); g0 = g1) {  // one group per (component, piece, piece)
     std::size_t all = 0, fluid = 0;
     for (g1 = g0; g1 < pairs.size() && pairs[g1].key == pairs[g0].key; ++g1) all += pairs[g1].pairs, fluid += pairs[g1].fluid;
     const auto& [l, p0, p1] = pairs[g0].key;
-    if (std::getenv("COLONFLAT_SEGMENT_DEBUG") && p0)
+    if (debug && p0)
       std::fprintf(stderr, "pieces %u and %u: %zu boundary pairs, %zu fluid in both voxels\n", p0, p1, all, fluid);
     if (p0 == 0 || double(fluid) >= kMinFluidPairShare * double(all)) uf.unite(unit_of(l, p0), unit_of(l, p1));
   }
