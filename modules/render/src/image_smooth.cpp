@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
@@ -75,11 +76,14 @@ ImagePtr upsample(vtkImageData* coarse, int f, int w, int h) {
   ImagePtr out = new_image(w, h, nc);
   const auto* c = static_cast<const double*>(coarse->GetScalarPointer());
   auto* o = static_cast<double*>(out->GetScalarPointer());
+  std::vector<CoarseAxis> columns;  // the same for every row
+  columns.reserve(std::size_t(w));
+  for (int i = 0; i < w; ++i) columns.emplace_back(i, f, w, cw);
   parallel_for(std::size_t(h), [&](std::size_t j0, std::size_t j1) {
     for (int j = int(j0); j < int(j1); ++j) {
       const CoarseAxis y(j, f, h, ch);
       for (int i = 0; i < w; ++i) {
-        const CoarseAxis x(i, f, w, cw);
+        const CoarseAxis& x = columns[std::size_t(i)];
         for (int k = 0; k < nc; ++k) {
           auto at = [&](int r, int q) { return c[(std::size_t(r) * cw + q) * nc + k]; };
           const double lo = (1 - x.t) * at(y.lo, x.lo) + x.t * at(y.lo, x.hi);
