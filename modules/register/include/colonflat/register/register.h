@@ -54,7 +54,7 @@ enum class Direction { kSupineToProne, kProneToSupine };
 
 struct CandidateMatch {
   int supine_id = 0, prone_id = 0;
-  double along_mm = 0;      // |s_prone - map(s_supine)|; laid out as pieces, at most |s_prone - s_supine| (common s)
+  double along_mm = 0;      // |s_prone - map(s_supine)| on the length map (never the common s: it misses the wall slide)
   double around_deg = 0;    // |theta difference| after registration
   double size_ratio = 1;    // larger / smaller (1 when a size is unknown)
   double score = 0;         // raised: 1 - (1 - score_supine)(1 - score_prone)
