@@ -62,13 +62,19 @@ Eigen::Vector3d ColonRegistration::map_place(const CandidateMatching& m, int id,
 Eigen::Vector3d ColonRegistration::map_candidate(int id, Direction d) const { return map_place(matching_, id, d); }
 
 // Supine candidate `a` (at one of its places `pa`) and prone `b` (`pb`): the combination of places
-// within the match limits with the lowest cost (along^2 + around^2 + log-size^2, each over its
-// limit) in `best` and `cost`; false when none is within them or a place has no support.
+// within the match limits that uses the fewest places other than a candidate's nearest (places()[0]),
+// then the lowest cost (along^2 + around^2 + log-size^2, each over its limit), in `best` and `cost`;
+// false when none is within them or a place has no support. A finding stands on its own wall, the
+// nearest to it; another loop touching it is a second pass of the course, used only when the nearest
+// places cannot pair (session 18: on the real mask the cheaper other pass mapped a right pair 225 mm off).
 bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector<Place>& pa, const ScanCandidate& b,
                                        const std::vector<Place>& pb, CandidateMatch& best, double& cost) const {
   bool found = false;
-  for (const Place& x : pa)
-    for (const Place& y : pb) {
+  int best_rank = 0;  // places used other than a candidate's nearest
+  for (size_t i = 0; i < pa.size(); ++i)
+    for (size_t j = 0; j < pb.size(); ++j) {
+      const Place &x = pa[i], &y = pb[j];
+      const int rank = int(i > 0) + int(j > 0);
       if (x.gap > opts_.max_unsupported_mm || y.gap > opts_.max_unsupported_mm) continue;  // never paired
       double s2, t2;
       map_coordinates(Direction::kSupineToProne, x.s, x.theta, s2, t2);
@@ -84,12 +90,12 @@ bool ColonRegistration::pair_at_places(const ScanCandidate& a, const std::vector
       const double size_term = std::log(m.size_ratio) / std::log(std::max(1.0001, opts_.match_size_ratio));
       const double c = std::pow(m.along_mm / opts_.match_along_mm, 2) + std::pow(m.around_deg / opts_.match_around_deg, 2) +
                        size_term * size_term;
-      if (found && c >= cost) continue;
+      if (found && (rank > best_rank || (rank == best_rank && c >= cost))) continue;
       m.supine_gap_mm = x.gap, m.prone_gap_mm = y.gap;
       m.supine_s_mm = x.s, m.supine_theta = x.theta, m.prone_s_mm = y.s, m.prone_theta = y.theta;
       m.anchor_mm = support_.supine_anchor_mm.empty() ? 0.0 : support_.supine_anchor_mm[size_t(sup_.profile.bin_of(x.s))];
       m.score = 1 - (1 - std::clamp(a.score, 0.0, 1.0)) * (1 - std::clamp(b.score, 0.0, 1.0));
-      found = true, cost = c, best = m;
+      found = true, cost = c, best = m, best_rank = rank;
     }
   return found;
 }

@@ -570,5 +570,76 @@ TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
     if (ts[k].id == q.id) EXPECT_LT(f.along_mm[k], 5.0);
 }
 
+// Moves the 30 mm stretch of material [from, from + 30) of one scan rigidly so that its wall vertex at material
+// (from + 15, 0) lies `gap_mm` from the point p along that vertex's outward normal (the centre of its cross-section
+// to it): the wall of another loop touching the finding at p, its nearest stretch vertex that one.
+void press_stretch_against(ColonScan& scan, const std::vector<double>& sigma, const std::vector<double>& phi,
+                           double from, const Eigen::Vector3d& p, double gap_mm) {
+  const size_t touch = vertex_at_material(sigma, phi, from + 15, 0, 20);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (size_t v = 0; v < sigma.size(); ++v)
+    if (std::abs(sigma[v] - sigma[touch]) < 1) centre += scan.lps[v], ++n;
+  const Eigen::Vector3d normal = (scan.lps[touch] - centre / std::max(1, n)).normalized();
+  const Eigen::Vector3d move = p - gap_mm * normal - scan.lps[touch];
+  for (size_t v = 0; v < sigma.size(); ++v)
+    if (sigma[v] >= from && sigma[v] < from + 30) scan.lps[v] += move;
+}
+
+// Two loops touch at a polyp in both scans: in each, a 30 mm stretch of the colon 200 mm or more further on
+// lies against the polyp, its wall 1.5 mm farther from the polyp's point than the polyp's own wall (within the
+// places' reach: two places on the course in both scans), and the prone finding's point lies 10 mm further
+// along its colon than the supine's (the wall slides 1-2 cm between the positions), so the other pass pairs
+// cheaper along. The pair is made on the polyp's own wall (the nearest place in both scans) and mapped there;
+// without the preference for the nearest places it was made at the other pass (real mask: mapped 225 mm off).
+TEST(RegisterPieces, PolypWhereTwoLoopsTouchInBothScansIsPairedOnItsOwnWall) {
+  SyntheticPair pair = make_synthetic_pair(long_pair(1));
+  SyntheticPolyp& q = pair.polyps[2];
+  std::vector<double> at;  // polyps 200 mm or more further on
+  for (const auto& o : pair.polyps)
+    if (o.sigma_mm > q.sigma_mm + 200) at.push_back(o.sigma_mm);
+  std::sort(at.begin(), at.end());
+  ASSERT_GE(at.size(), 2u);
+  size_t widest = 1;  // a 30 mm stretch in the middle of the widest gap between two of them
+  for (size_t k = 2; k < at.size(); ++k)
+    if (at[k] - at[k - 1] > at[widest] - at[widest - 1]) widest = k;
+  const double from = (at[widest] + at[widest - 1]) / 2 - 15;
+  for (const auto& o : pair.polyps) ASSERT_TRUE(o.sigma_mm < from - 10 || o.sigma_mm > from + 40);
+  const size_t a = vertex_at_material(pair.prone_sigma, pair.prone_phi, q.sigma_mm, q.phi_rad, 20);
+  const size_t b = vertex_at_material(pair.prone_sigma, pair.prone_phi, q.sigma_mm + 10, q.phi_rad, 20);
+  q.prone_lps += pair.prone.lps[b] - pair.prone.lps[a];
+  for (auto& c : pair.prone.candidates)
+    if (c.id == q.id) c.lps = q.prone_lps;
+  for (const bool supine : {true, false}) {
+    ColonScan& scan = supine ? pair.supine : pair.prone;
+    const Eigen::Vector3d& p = supine ? q.supine_lps : q.prone_lps;
+    double own = INFINITY;  // the polyp point's distance to its own wall
+    for (const auto& v : scan.lps) own = std::min(own, (v - p).norm());
+    press_stretch_against(scan, supine ? pair.supine_sigma : pair.prone_sigma, supine ? pair.supine_phi : pair.prone_phi,
+                          from, p, own + 1.5);
+  }
+  const auto run = registered(pair);
+  const ColonRegistration& reg = *run;
+  const double own_s = reg.locate(q.prone_lps, Direction::kProneToSupine).first;
+  for (const auto& [p, d] : {std::pair{q.supine_lps, Direction::kSupineToProne}, std::pair{q.prone_lps, Direction::kProneToSupine}}) {
+    const auto places = reg.locations(p, d, 3);
+    ASSERT_GE(places.size(), 2u);  // its own wall first, the touching stretch second
+    EXPECT_LT(places[0].first, from - 100);
+    EXPECT_GT(places[1].first, from - 40);
+  }
+  const CandidateMatch* m = nullptr;
+  for (const auto& x : reg.matching().pairs)
+    if (x.supine_id == q.id) m = &x;
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(m->prone_id, q.id);
+  EXPECT_LT(std::abs(m->supine_s_mm - reg.locate(q.supine_lps, Direction::kSupineToProne).first), 1.0);
+  EXPECT_LT(std::abs(m->prone_s_mm - own_s), 1.0);
+  double s2, t2;  // mapped onto the prone's own wall: 10 mm (the finding's offset) from its place, not 250
+  reg.map_coordinates(Direction::kSupineToProne, m->supine_s_mm, m->supine_theta, s2, t2);
+  EXPECT_LT(std::abs(s2 - own_s), 20.0);
+  EXPECT_LT((reg.map_candidate(q.id, Direction::kSupineToProne) - q.prone_lps).norm(), 25.0);
+  expect_every_polyp_paired(score(pair, reg));
+}
+
 }  // namespace
 }  // namespace cf
