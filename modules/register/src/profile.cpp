@@ -246,6 +246,18 @@ double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3
   return a < 0 ? a + kTwoPi : a;
 }
 
+double angle_about_axis(const Eigen::Vector3d& centre, const Eigen::Vector3d& tangent, const Eigen::Vector3d& reference,
+                        const Eigen::Vector3d& x, double* radial) {
+  Eigen::Vector3d e1 = reference - reference.dot(tangent) * tangent;
+  if (e1.norm() < 1e-9) return std::numeric_limits<double>::quiet_NaN();
+  e1.normalize();
+  Eigen::Vector3d d = x - centre;
+  d -= d.dot(tangent) * tangent;
+  if (radial) *radial = d.norm();
+  const double a = std::atan2(d.dot(tangent.cross(e1)), d.dot(e1));
+  return a < 0 ? a + kTwoPi : a;
+}
+
 void fill_profile(const ColonScan& scan, const ProfileOptions& o, int bins, ScanCoordinates& c) {
   LengthProfile& p = c.profile;
   p.bin_mm = o.bin_mm;

@@ -9,11 +9,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <thread>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
 #include "along_slabs.h"
+#include "piece_split.h"
 
 namespace cf {
 namespace {
@@ -231,14 +233,51 @@ int ColonRegistration::vertex_at(bool supine_scan, double s, double theta) const
 }
 
 namespace {
+struct Axis {
+  Eigen::Vector3d centre, direction;  // LPS mm; unit, towards increasing common s
+};
+
+// The axis of the piece wall vertex w lies on, at its own centreline mm: the mean of the piece's centre
+// points within +-half_mm and their direction towards increasing common s. At a neck the common
+// profile's centre is the centroid of every wall laid at that s (the band's and the branches' inserted
+// or held there, smoothed), which differs between the scans; the piece's own centre line is the lumen
+// the point stands in, in both. False when w lies on no piece (a short side branch, no pieces).
+bool piece_axis(const ColonScan& scan, const std::vector<ColonPiece>& pieces, size_t w, double half_mm, Axis& axis) {
+  if (w >= scan.centreline_mm.size() || !std::isfinite(scan.centreline_mm[w])) return false;
+  std::multimap<int, const ColonPiece*> by_segment;
+  for (const auto& q : pieces)
+    if (q.registered) by_segment.insert({q.segment, &q});
+  const ColonPiece* p = piece_at(by_segment, scan.segment[w], scan.centreline_mm[w]);
+  if (!p || p->centre.size() < 2) return false;
+  const int n = int(p->centre.size()), h = std::max(1, int(std::lround(half_mm / p->bin_mm)));
+  const int k = std::clamp(int((scan.centreline_mm[w] - p->from_mm) / p->bin_mm), 0, n - 1);
+  const int lo = std::max(0, k - h), hi = std::min(n - 1, k + h);
+  const Eigen::Vector3d d = p->centre[size_t(hi)] - p->centre[size_t(lo)];
+  if (d.norm() < 1e-9) return false;
+  axis.centre.setZero();
+  for (int j = lo; j <= hi; ++j) axis.centre += p->centre[size_t(j)];
+  axis.centre /= double(hi - lo + 1);
+  axis.direction = (p->flipped ? -d : d).normalized();
+  return true;
+}
+
 // (s, theta) of the point p at its wall vertex w: s of w and the angle of p itself about the centre line
 // there: a point off the wall (the head of a pedunculated polyp, up to 15 mm across and reaching the
 // colon's axis) is surrounded by its own surface at about the same distance, so its nearest vertex may
-// lie on any side of it. NaN when w is not registered.
-std::pair<double, double> place_at(const ScanCoordinates& c, size_t w, const Eigen::Vector3d& p) {
+// lie on any side of it. About `axis` (with the profile's reference direction) where the profile's
+// centre lies more than `off_mm` across from it: the common centre has left the point's own lumen.
+// NaN when w is not registered.
+std::pair<double, double> place_at(const ScanCoordinates& c, size_t w, const Eigen::Vector3d& p,
+                                   const Axis* axis = nullptr, double off_mm = 0) {
   if (std::isnan(c.s[w])) return {kNaN, kNaN};
-  double radial = 0;
-  const double theta = angle_about_centre(c.profile, c.s[w], p, &radial);
+  double radial = 0, theta = kNaN;
+  const size_t k = size_t(c.profile.bin_of(c.s[w]));
+  if (axis) {
+    Eigen::Vector3d off = axis->centre - c.profile.centre[k];
+    off -= off.dot(axis->direction) * axis->direction;
+    if (off.norm() > off_mm) theta = angle_about_axis(axis->centre, axis->direction, c.profile.reference[k], p, &radial);
+  }
+  if (std::isnan(theta)) theta = angle_about_centre(c.profile, c.s[w], p, &radial);
   return {c.s[w], radial > 0 ? theta : c.theta[w]};
 }
 }  // namespace
@@ -255,8 +294,15 @@ std::vector<std::pair<double, double>> ColonRegistration::locations(const Eigen:
   const Index& idx = sup ? *sup_index_ : *pro_index_;
   const ScanCoordinates& c = sup ? sup_ : pro_;
   const std::vector<Eigen::Vector3d>& wall = (sup ? supine_ : prone_).lps;
+  const std::vector<ColonPiece>& pieces = sup ? layout_.supine : layout_.prone;
+  auto place = [&](size_t w) {  // a candidate's angle about its own piece's centre line where the common one left it
+    Axis axis;
+    return piece_axis(sup ? supine_ : prone_, pieces, w, opts_.profile.smooth_mm, axis)
+               ? place_at(c, w, p, &axis, opts_.own_axis_off_radii * c.mean_radius_mm)
+               : place_at(c, w, p);
+  };
   const vtkIdType v = idx.lps->FindClosestPoint(p.data());  // locate()'s place first
-  std::vector<std::pair<double, double>> out{v < 0 ? std::pair{kNaN, kNaN} : place_at(c, size_t(v), p)};
+  std::vector<std::pair<double, double>> out{v < 0 ? std::pair{kNaN, kNaN} : place(size_t(v))};
   if (v < 0 || std::isnan(out[0].first)) return out;
   vtkNew<vtkIdList> near;
   idx.lps->FindPointsWithinRadius((wall[size_t(v)] - p).norm() + reach_mm, p.data(), near);
@@ -267,7 +313,7 @@ std::vector<std::pair<double, double>> ColonRegistration::locations(const Eigen:
   for (const auto& [d2, w] : by_distance) {
     bool known = false;
     for (const auto& place : out) known |= std::abs(c.s[w] - place.first) <= opts_.match_along_mm;
-    if (!known) out.push_back(place_at(c, w, p));
+    if (!known) out.push_back(place(w));
   }
   return out;
 }

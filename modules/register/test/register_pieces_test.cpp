@@ -641,5 +641,37 @@ TEST(RegisterPieces, PolypWhereTwoLoopsTouchInBothScansIsPairedOnItsOwnWall) {
   expect_every_polyp_paired(score(pair, reg));
 }
 
+// The supine keeps the 50 mm of material from 1 mm after a polyp as a short side branch (shorter than a
+// colon piece: all its wall laid at its neck's s) bent 200 mm away on the polyp's side, so the common
+// profile's centre at the polyp leaves its lumen towards it; the prone keeps that stretch in its band.
+// The polyp's angle is measured about its own piece's centre line: within 20 deg of the prone's after
+// the map, and it is paired with itself (checked: about the common centre 182 deg apart, unpaired).
+TEST(RegisterPieces, PolypWhereTheCommonCentreLeavesItsLumenIsMeasuredAboutItsOwnPiece) {
+  SyntheticPair pair = make_synthetic_pair(long_pair(3));
+  const SyntheticPolyp& q = pair.polyps[7];
+  const double from = q.sigma_mm + 1, to = from + 50;
+  for (const auto& o : pair.polyps) ASSERT_TRUE(o.id == q.id || o.sigma_mm < from - 40 || o.sigma_mm > to + 40);
+  const size_t w = vertex_at_material(pair.supine_sigma, pair.supine_phi, q.sigma_mm, q.phi_rad, 20);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the polyp's cross-section
+  int n = 0;
+  for (size_t v = 0; v < pair.supine_sigma.size(); ++v)
+    if (std::abs(pair.supine_sigma[v] - pair.supine_sigma[w]) < 1) centre += pair.supine.lps[v], ++n;
+  const Eigen::Vector3d away = 200 * (pair.supine.lps[w] - centre / n).normalized();
+  for (size_t v = 0; v < pair.supine_sigma.size(); ++v)
+    if (pair.supine_sigma[v] >= from && pair.supine_sigma[v] < to) pair.supine.lps[v] += away;
+  make_side_branch(pair.supine, pair.supine_sigma, from, to);
+  const auto run = registered(pair);
+  const ColonRegistration& reg = *run;
+  const auto [s, t] = reg.locations(q.supine_lps, Direction::kSupineToProne, 3).front();
+  const double pt = reg.locations(q.prone_lps, Direction::kProneToSupine, 3).front().second;
+  double s2, t2;
+  reg.map_coordinates(Direction::kSupineToProne, s, t, s2, t2);
+  EXPECT_LT(std::abs(std::remainder(t2 - pt, 2 * M_PI)) * 180 / M_PI, 20.0);
+  bool paired = false;
+  for (const auto& m : reg.matching().pairs) paired |= m.supine_id == q.id && m.prone_id == q.id;
+  EXPECT_TRUE(paired);
+  EXPECT_EQ(score(pair, reg).wrong, 0);
+}
+
 }  // namespace
 }  // namespace cf

@@ -215,5 +215,19 @@ TEST(RegisterProfile, SideBranchVerticesSitAtTheirNeck) {
   EXPECT_NEAR(c.s[16 * 100], 100.0, 1e-9);  // a colon vertex keeps its centreline mm
 }
 
+// angle_about_axis keeps the profile's convention about any axis: 0 = the reference projected on the
+// cross-section, a quarter turn at tangent x reference, the distance from the axis in radial; NaN when
+// the reference runs along the axis.
+TEST(RegisterProfile, AngleAboutAnAxisUsesTheProjectedReference) {
+  const Eigen::Vector3d c(10, 20, 30), t(0, 0, 1), ref(0, -1, 0.5);  // reference not across the axis
+  double radial = 0;
+  EXPECT_NEAR(angle_about_axis(c, t, ref, c + Eigen::Vector3d(0, -5, 3), &radial), 0.0, 1e-12);
+  EXPECT_NEAR(radial, 5.0, 1e-12);
+  EXPECT_NEAR(angle_about_axis(c, t, ref, c + Eigen::Vector3d(2, 0, -7), &radial), M_PI / 2, 1e-12);  // t x (0,-1,0) = +x
+  EXPECT_NEAR(radial, 2.0, 1e-12);
+  EXPECT_NEAR(angle_about_axis(c, t, ref, c + Eigen::Vector3d(0, 4, 0)), M_PI, 1e-12);
+  EXPECT_TRUE(std::isnan(angle_about_axis(c, t, Eigen::Vector3d(0, 0, 2), c + Eigen::Vector3d(1, 0, 0))));
+}
+
 }  // namespace
 }  // namespace cf

@@ -66,6 +66,12 @@ void fill_profile(const ColonScan& scan, const ProfileOptions& opts, int bins, S
 // direction, the patient's anterior); its distance from the centre line in `radial` when given.
 double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3d& x, double* radial = nullptr);
 
+// Angle (rad in [0, 2 pi)) of `x` about the axis through `centre` along the unit `tangent`, 0 = `reference`
+// projected on the cross-section (the profile's convention with another axis); NaN when `reference` is
+// parallel to `tangent`. Its distance from the axis in `radial` when given.
+double angle_about_axis(const Eigen::Vector3d& centre, const Eigen::Vector3d& tangent, const Eigen::Vector3d& reference,
+                        const Eigen::Vector3d& x, double* radial = nullptr);
+
 // Gaussian smoothing of a sampled signal (sigma in samples), edges by renormalisation.
 std::vector<double> gaussian_smooth(const std::vector<double>& v, double sigma_samples);
 

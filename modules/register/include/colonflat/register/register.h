@@ -40,6 +40,10 @@ struct RegisterOptions {
                                      //   polyp stands on reaches its radius around it (3 mm: half the smallest
                                      //   polyp reported, 6 mm)
   PieceOptions pieces;               // colons with centreline_mm: laid out piece by piece (pieces.h)
+  double own_axis_off_radii = 0.5;   // colon radii; where the common profile's centre lies this far across
+                                     //   from a candidate's own piece's centre line (walls of other
+                                     //   stretches laid at that s: a neck), its angle is taken about its own
+                                     //   piece's (a centre line within half a radius is inside the lumen)
   LandmarkOptions landmarks;
   double support_radius_mm = 100;    // mm; centre points farther apart after the shift do not support the map
   double max_unsupported_mm = 10;    // mm; a candidate farther along from a supported bin is never paired
@@ -134,7 +138,9 @@ class ColonRegistration {
   // it more than once (a neck with a long branch inserted into the course before it, walls of two loops
   // touching) the wall within `reach_mm` beyond the nearest vertex's distance belongs to several
   // stretches; each is represented by its vertex nearest to p that lies more than match_along_mm along
-  // from the places already found (nearest first). Post: size >= 1; entries NaN when not registered.
+  // from the places already found (nearest first). Each angle is about the point's own piece's centre
+  // line where the profile's centre lies own_axis_off_radii or more across from it (a neck; else as
+  // locate()). Post: size >= 1; entries NaN when not registered.
   std::vector<std::pair<double, double>> locations(const Eigen::Vector3d& p, Direction from, double reach_mm) const;
 
   const ScanCoordinates& supine_coordinates() const { return sup_; }
