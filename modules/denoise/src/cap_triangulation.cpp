@@ -8,16 +8,9 @@
 #include <string>
 
 #include "colonflat/core/error.h"
-#include "colonflat/core/threads.h"
 #include "denoise_debug.h"
 
 namespace cf {
-
-namespace {
-// Rings from this many vertices split the restricted triangulation's subproblems over the threads:
-// below, a length's subproblems take less time than handing them to threads.
-constexpr int kParallelRing = 48;
-}  // namespace
 
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
                                                         const std::function<bool(int, int, int)>& allowed,
@@ -52,17 +45,14 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
     W[std::size_t(i) * n + j] = best;
     arg[std::size_t(i) * n + j] = best_m;
   };
-  // The subproblems of one length are independent (they read shorter ones only): with `allowed`
-  // on a long ring they are split over the threads (the result does not depend on the split).
-  const bool split = allowed && n >= kParallelRing;
+  // One thread: splitting each length's subproblems over threads (one start and join per length,
+  // n - 2 per triangulation) cost more wall time than it saved (issue 26, session 18: real CT
+  // surface at 2 threads and load 4-6, surgery 11.7-17.0 s wall with the split, 6.1-6.3 s without,
+  // 5.3-5.6 s at 1 thread; same output).
+  std::vector<std::pair<double, int>> order;
   for (int len = 2; len < n; ++len) {
-    auto range = [&](std::size_t begin, std::size_t end) {
-      std::vector<std::pair<double, int>> order;
-      for (std::size_t i = begin; i < end; ++i) solve(int(i), int(i) + len, order);
-    };
-    if (split) parallel_for(std::size_t(n - len), range);
-    else range(0, std::size_t(n - len));
-    if (give_up && give_up()) return {};  // between lengths: the same for any thread count
+    for (int i = 0; i + len < n; ++i) solve(i, i + len, order);
+    if (give_up && give_up()) return {};  // between lengths
   }
   std::vector<std::pair<int, int>> stack{{0, n - 1}};
   while (!stack.empty()) {

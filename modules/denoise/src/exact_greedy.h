@@ -71,6 +71,7 @@ class ExactGreedy {
  private:
   // exact_sources.cpp
   void build_homology();
+  void carry_bounds(const std::vector<std::pair<int, SourceBound>>& old);
   void deactivate_all_slots();
   void maybe_rebuild(int cuts, int total_genus);
   void enter_crossing_mode();
@@ -202,7 +203,18 @@ class ExactGreedy {
   // ... and per cut since the last build at least this many times the vertex count (a quarter
   // of a build's cost: below it the searches are local and a fresh cut graph does not help).
   static constexpr double kRebuildWorkPerCut = 0.25;
+  // A late rebuild once the genus left is at most the genus at the last build over this: the cut
+  // graph then has at least 4 times the loops the surface still needs (2g each), spread over the
+  // whole surface, each of whose sources must be certified against every long loop to come; a
+  // build costs about 1.3 vertex counts of settling. Real CT (genus 91, 1.07 M vertices): builds
+  // at genus 91, 22, 5, 2 (the last by the work rule); 19.2 M settled vertices, 28.4 M without.
+  static constexpr double kLateRebuildRatio = 4.0;
   double largest_limit_ = 0;
+  double last_cut_value_ = 0;  // mm: the last loop cut (its certified value)
+  long long bounds_carried_ = 0;
+  // Levels of carry_bounds(): the last loop's length times kCarryStep^k, k < kCarryLevels.
+  static constexpr int kCarryLevels = 4;
+  static constexpr double kCarryStep = 1.5;
   Stopwatch debug_clock_;  // COLONFLAT_DENOISE_DEBUG: since the last cut
   double debug_search_ = 0, fallback_s_ = 0, debug_cpu_ = 0;
   long long debug_searches_ = 0, debug_settled_ = 0, fallback_settled_ = 0;

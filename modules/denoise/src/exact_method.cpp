@@ -178,6 +178,7 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
 
 void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   set_bound(slot, SourceBound{0, false, -1, 0});  // searched again after the surgery
+  last_cut_value_ = c.value;
   const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
   std::vector<std::uint64_t> cls = search_->cycle_class(loop);
   std::vector<std::uint64_t> reduced = cls;
@@ -227,6 +228,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["parallel_search_pairs"] = parallel_pairs_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
+  stats["bounds_carried_at_rebuild"] = bounds_carried_;
   stats["crossing_family_switches"] = crossing_modes_;
   stats["loops_replaced_for_clean_caps"] = alternatives_ + crossing_alternatives_;
   stats["loops_replaced_by_crossing_loop"] = crossing_alternatives_;

@@ -4,6 +4,11 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStaticPointLocator.h>
+
 #include "colonflat/core/geodesic_ball.h"
 #include "colonflat/core/run_stats.h"
 #include "exact_greedy.h"
@@ -15,9 +20,9 @@ namespace cf::detail {
 // quantity whatever the annotations.
 void ExactGreedy::build_homology() {
   Stopwatch sw;
-  std::unordered_map<int, SourceBound> kept;  // vertex -> bound, the span family's active sources
+  std::vector<std::pair<int, SourceBound>> old;  // (vertex, bound) of the span family's active sources
   for (int s : active_)
-    if (slots_[s].active && slots_[s].family == 0) kept[slots_[s].vertex] = slots_[s].bound;
+    if (slots_[s].active && slots_[s].family == 0) old.push_back({slots_[s].vertex, slots_[s].bound});
   if (st_.initial_homology) {  // built by prepare_input() while the input was analysed
     homology_ = std::move(*st_.initial_homology);
     st_.initial_homology.reset();
@@ -36,13 +41,54 @@ void ExactGreedy::build_homology() {
   far_anchor_ = -1;
   families_.resize(1);
   for (int v : homology_.pruned_cut_graph_vertices()) add_source(0, v);
+  const std::unordered_map<int, SourceBound> kept(old.begin(), old.end());  // vertex -> bound
   for (int s : active_) {
     const auto it = kept.find(slots_[s].vertex);
     set_bound(s, it == kept.end() ? SourceBound{} : it->second);
   }
+  carry_bounds(old);
   st_.t.homology += sw.seconds();
   settled_at_build_ = settled_;
   ++builds_;
+}
+
+// Bounds of the new cut graph's sources from the old source set's (issue 26): every cycle of the
+// span family meets the old sources, so a cycle through t of length F(t) < B passes through an
+// old source s with bound(s) <= F(s) <= F(t) < B, at most F(t)/2 from t along the surface, so
+// at least that far in space. Hence, for any B, F(t) >= min(B, 2 |t - {old s: bound(s) < B}|).
+// Taken at the levels B = L r^k, k < kCarryLevels (L: the last loop cut; bounds below it spare
+// no search, as the next loops are about as long), the largest kept. Without it every new source
+// starts at 0 and needs its own searches up to the next loop's length, wherever it lies.
+void ExactGreedy::carry_bounds(const std::vector<std::pair<int, SourceBound>>& old) {
+  if (old.empty() || !(last_cut_value_ > 0)) return;
+  std::vector<double> carried(active_.size(), 0.0);  // per active_ entry: the largest level value
+  for (int k = 0; k < kCarryLevels; ++k) {
+    const double level = last_cut_value_ * std::pow(kCarryStep, k);
+    vtkNew<vtkPoints> below;  // old sources whose bound may be under the level
+    below->SetDataTypeToDouble();
+    for (const auto& [v, b] : old)
+      if (b.value < level) below->InsertNextPoint(st_.mesh.point(Mesh::VertexHandle(v)).data());
+    if (below->GetNumberOfPoints() == 0) {
+      std::fill(carried.begin(), carried.end(), level);
+      continue;
+    }
+    vtkNew<vtkPolyData> cloud;
+    cloud->SetPoints(below);
+    vtkNew<vtkStaticPointLocator> locator;
+    locator->SetDataSet(cloud);
+    locator->BuildLocator();
+    for (std::size_t i = 0; i < active_.size(); ++i) {
+      const Vec3& p = st_.mesh.point(Mesh::VertexHandle(slots_[active_[i]].vertex));
+      double q[3];
+      below->GetPoint(locator->FindClosestPoint(p.data()), q);
+      carried[i] = std::max(carried[i], std::min(level, 2.0 * (p - Vec3(q[0], q[1], q[2])).norm()));
+    }
+  }
+  for (std::size_t i = 0; i < active_.size(); ++i)
+    if (carried[i] > slots_[active_[i]].bound.value) {
+      set_bound(active_[i], SourceBound{carried[i], false, -1, 0});
+      ++bounds_carried_;
+    }
 }
 
 // Every slot leaves the source set; those not added again lose their bound (it would no
@@ -63,13 +109,20 @@ void ExactGreedy::deactivate_all_slots() {
 // each cut more than kRebuildWorkPerCut. Where each cut needs only local searches (many short
 // handles), the fresh sources do not shorten them: the 300-handle sphere settled 7.48 M
 // vertices with its rebuild (0.06 vertex counts per cut), 7.00 M without; colon-like surfaces
-// (1.7 per cut, long loops) settle far fewer with it.
+// (1.7 per cut, long loops) settle far fewer with it. Also rebuilt late, once the genus left is
+// at most 1/kLateRebuildRatio of the genus at the last build, whatever the work so far (issue 26):
+// the last handles of a colon are the long ones, and the old cut graph (2g loops over the whole
+// surface) plus every ring must all be certified against each of them; the new cut graph's
+// sources start from the old bounds (carry_bounds()), not from 0.
 void ExactGreedy::maybe_rebuild(int cuts, int total_genus) {
   // Not for the last handle: the crossing families start from the span family's bounds, which a
   // rebuild would drop (colon-like 60 mm contact: 29.9 M settled vertices with, 16.7 M without).
-  if (total_genus < 2 || cuts - cuts_at_build_ < std::max(1, genus_at_build_ / 2)) return;
+  if (total_genus < 2) return;
+  const bool late = kLateRebuildRatio * total_genus <= genus_at_build_;
   const double work = double(settled_ - settled_at_build_) / double(st_.mesh.n_vertices());  // in vertex counts
-  if (work < kRebuildWork || work < kRebuildWorkPerCut * (cuts - cuts_at_build_)) return;
+  const bool costly = cuts - cuts_at_build_ >= std::max(1, genus_at_build_ / 2) && work >= kRebuildWork &&
+                      work >= kRebuildWorkPerCut * (cuts - cuts_at_build_);
+  if (!late && !costly) return;
   build_homology();
   cuts_at_build_ = cuts;
   genus_at_build_ = total_genus;

@@ -75,6 +75,29 @@ TEST(DenoiseLoopSearch, EveryLoopMatchesBruteForceOnItsMesh) {
   }
 }
 
+// A late rebuild (genus left <= a quarter of the genus at the last build) happens on a surface
+// too small for the work rule, and the loops after it, searched from the new cut graph with the
+// bounds carried from the old sources, are still the shortest non-separating cycles of their
+// meshes: a chain of 8 tori beside a large sphere (rebuilt at genus 2; loops 7 and 8 against
+// brute force).
+TEST(DenoiseLoopSearch, LateRebuildCarriesBoundsAndKeepsLoopsExact) {
+  // The sphere (genus 0: no sources) holds most vertices, so the searches' work stays far below
+  // the work rule's 2.5 vertex counts: only the late rule rebuilds.
+  const Mesh m = to_mesh(disjoint_union(torus_chain(8, 3, 1, 14, 8, 9), translated(sphere(40, 80, 48), 0, 100, 0)));
+  ASSERT_EQ(*analyze_topology(m).genus, 8);
+  const DenoiseResult full = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(full.loops.size(), 8u);
+  EXPECT_GE(full.report["search"]["homology_builds"].get<int>(), 2);
+  for (int i = 6; i < 8; ++i) {
+    DenoiseOptions o;
+    o.target_genus = 8 - i;  // the first i surgeries of the same greedy run
+    const Mesh before = denoise(m, o).mesh;
+    const double mine = full.loops[i].length;
+    const double ref = testing::brute_force_shortest_nonseparating(before, mine * (1 + 1e-9) + 1e-12);
+    EXPECT_NEAR(mine, ref, 1e-9 * (1 + ref)) << "loop " << i;
+  }
+}
+
 // On a torus (outward normals) a meridian bounds a disk inside the solid: handle; the inner
 // equator bounds a disk across the hole, outside: tunnel.
 TEST(DenoiseLoopSearch, HandleAndTunnelOnTorus) {
