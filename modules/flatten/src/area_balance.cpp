@@ -197,10 +197,8 @@ constexpr double kMinOutOfBoundsGain = 0.01, kMinAngleGain = 0.001;
 // Minimises the symmetric Dirichlet energy on one region (proxy_descent.h: the cotangent
 // Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps), until
 // the energy converges or a step no longer lowers measure_region() (kMinOutOfBoundsGain, kMinAngleGain).
-int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3,
-                    double lo, double hi, const std::vector<int>* vertex_order) {
-  RegionSystem sys;
-  if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces), vertex_order)) return 0;
+int minimise_region(const Surface& s, Embedding& emb, const Region& r, const RegionSystem& sys, int iterations,
+                    const std::vector<double>& area3, double lo, double hi) {
   std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
   for (int f : r.faces)
     if (emb.area2(s, f) > 0) unfolded.push_back(f);
@@ -279,12 +277,25 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
   std::vector<double> area3(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
   std::vector<char> moved(s.p.size(), 0);
+  Region built;  // the region whose system `sys` is
+  RegionSystem sys;
+  bool usable = false;
   for (int pass = 0; pass < 2; ++pass) {
-    const Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
+    Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
     if (r.faces.empty()) break;
-    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high, vertex_order));
-    res.faces = std::max(res.faces, r.faces.size());
-    for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || r.free_vertex[v];
+    // The system depends only on the region (its faces, free vertices, the 3D weights and the
+    // order): the second pass's region is often the first's (the real CT colon band: 740 905 faces
+    // both times), and then its factorisation is the same bits.
+    if (pass == 0 || r.faces != built.faces || r.free_vertex != built.free_vertex) {
+      usable = sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces), vertex_order);
+      built = std::move(r);
+      ++res.systems_built;
+    }
+    const Region& region = built;
+    if (usable)
+      res.iterations += std::size_t(minimise_region(s, emb, region, sys, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high));
+    res.faces = std::max(res.faces, region.faces.size());
+    for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || region.free_vertex[v];
   }
   res.vertices = std::size_t(std::count(moved.begin(), moved.end(), 1));
   return res;

@@ -239,6 +239,7 @@ void label_ends(std::vector<FlatSegment>& segs, double midline_x, std::vector<ch
 // Laplacian-preconditioned descent with a flip-preventing, Armijo line search.
 struct BalanceResult {
   std::size_t vertices = 0, faces = 0, iterations = 0;
+  std::size_t systems_built = 0;  // regions' systems factorised (a pass whose region is the last one's reuses it)
 };
 // `vertex_order` (optional): a fill-reducing order of the band's vertices for the regions' systems.
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,

@@ -37,5 +37,20 @@ TEST(AreaBalance, GridWithinBoundsTakesNoStep) {
   EXPECT_EQ(balance_area(g.s, g.vf, g.emb, g.fixed, g.degenerate, o).iterations, 0u);
 }
 
+// A pass whose region is the previous pass's (no step taken in between: balance_iterations 0)
+// reuses that region's factorised system: both passes select the squeezed region, one system is
+// factorised, and the map does not move.
+TEST(AreaBalance, SecondPassOnTheSameRegionReusesItsSystem) {
+  FlattenOptions o;
+  o.balance_iterations = 0;
+  Grid g(0.2);
+  const std::vector<V2> before = g.emb.pos;
+  const BalanceResult r = balance_area(g.s, g.vf, g.emb, g.fixed, g.degenerate, o);
+  EXPECT_GT(r.faces, 0u);
+  EXPECT_EQ(r.iterations, 0u);
+  EXPECT_EQ(r.systems_built, 1u);
+  EXPECT_EQ(g.emb.pos, before);
+}
+
 }  // namespace
 }  // namespace cf::flat_detail
