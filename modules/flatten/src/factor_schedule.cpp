@@ -25,6 +25,22 @@ std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind) {
   return parent;
 }
 
+std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent) {
+  std::vector<double> work(std::size_t(n), 0.0);
+  std::vector<int> mark(std::size_t(n), -1), held(std::size_t(n), 0);  // held: entries of column j so far
+  for (int k = 0; k < n; ++k) {
+    mark[std::size_t(k)] = k;
+    double w = 1.0;  // the diagonal
+    for (int p = colptr[k]; p < colptr[k + 1]; ++p)
+      for (int i = rowind[p]; i >= 0 && i < k && mark[std::size_t(i)] != k; i = parent[std::size_t(i)]) {
+        mark[std::size_t(i)] = k;  // L(k, i) != 0: an update with column i's entries so far, then one more
+        w += 1.0 + double(held[std::size_t(i)]++);
+      }
+    work[std::size_t(k)] = w;
+  }
+  return work;
+}
+
 namespace {
 
 // The elimination tree with child lists (ascending) and the work of every subtree.

@@ -201,15 +201,15 @@ bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_fa
   return ok;
 }
 
-// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))), each
-// column's work estimated as its squared column count.
-RowSchedule factor_schedule(cholmod_sparse* upper, const cholmod_factor* L, int parts) {
-  const std::vector<int> parent = elimination_tree(int(upper->ncol), static_cast<const int*>(upper->p),
-                                                   static_cast<const int*>(upper->i));
-  const int* count = static_cast<const int*>(L->ColCount);
-  std::vector<double> work(L->n);
-  for (std::size_t j = 0; j < L->n; ++j) work[j] = double(count[j]) * double(count[j]);
-  return schedule_rows(parent, work, parts);
+// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))), each row's
+// work estimated as the up-looking kernel's cost of it (row_work): counted at the row that does it,
+// so the rows above the parts (few, but each updating with long columns) weigh what they cost.
+RowSchedule factor_schedule(cholmod_sparse* upper, int parts) {
+  const int n = int(upper->ncol);
+  const int* colptr = static_cast<const int*>(upper->p);
+  const int* rowind = static_cast<const int*>(upper->i);
+  const std::vector<int> parent = elimination_tree(n, colptr, rowind);
+  return schedule_rows(parent, row_work(n, colptr, rowind, parent), parts);
 }
 
 // cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
@@ -226,7 +226,7 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   cholmod_sparse* upper =
       cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
   if (!upper) return -1;
-  RowSchedule schedule = factor_schedule(upper, L, parts);
+  RowSchedule schedule = factor_schedule(upper, parts);
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
   if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
