@@ -41,4 +41,13 @@ std::vector<double> row_work(int n, const int* colptr, const int* rowind, const 
 // row k (the caller: row_work). Deterministic (ties by row index).
 RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<double>& work, int parts);
 
+// schedule_rows, then its rest split again the same way (the rest is closed under ancestors: its
+// rows form a forest whose subtrees only read finished parts and their own rows), while a split
+// saves more than kPhaseMinGain of the rest's estimated work; at most kMaxPhases phases. Phase i's
+// parts run side by side after phase i - 1; only the last phase's rest is left (the others' rest
+// is empty). Rows are global, ascending in every part and rest.
+std::vector<RowSchedule> schedule_phases(const std::vector<int>& parent, const std::vector<double>& work, int parts);
+constexpr double kPhaseMinGain = 0.05;
+constexpr int kMaxPhases = 8;
+
 }  // namespace cf::flat_detail
