@@ -197,10 +197,8 @@ constexpr double kMinOutOfBoundsGain = 0.01, kMinAngleGain = 0.001;
 // Minimises the symmetric Dirichlet energy on one region (proxy_descent.h: the cotangent
 // Laplacian of the 3D triangles as the energy's quadratic proxy, fold-free Armijo steps), until
 // the energy converges or a step no longer lowers measure_region() (kMinOutOfBoundsGain, kMinAngleGain).
-int minimise_region(const Surface& s, Embedding& emb, const Region& r, int iterations, const std::vector<double>& area3,
-                    double lo, double hi, const std::vector<int>* vertex_order) {
-  RegionSystem sys;
-  if (!sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces), vertex_order)) return 0;
+int minimise_region(const Surface& s, Embedding& emb, const Region& r, const RegionSystem& sys, int iterations,
+                    const std::vector<double>& area3, double lo, double hi) {
   std::vector<int> unfolded;  // folded faces (left by untangle) are not judged
   for (int f : r.faces)
     if (emb.area2(s, f) > 0) unfolded.push_back(f);
@@ -219,25 +217,26 @@ int minimise_region(const Surface& s, Embedding& emb, const Region& r, int itera
 
 std::vector<std::array<double, 3>> corner_weights(const Surface& s, const std::vector<int>& faces) {
   std::vector<std::array<double, 3>> w(faces.size());
-  for (std::size_t i = 0; i < faces.size(); ++i) {
-    const Tri& t = s.t[faces[i]];
-    for (int k = 0; k < 3; ++k) {
-      const V3 e1 = s.p[t[(k + 1) % 3]] - s.p[t[k]], e2 = s.p[t[(k + 2) % 3]] - s.p[t[k]];
-      w[i][k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-12), 0.01, 100.0);
+  for_each_block(faces.size(), [&](std::size_t begin, std::size_t end) {  // each face its own weights
+    for (std::size_t i = begin; i < end; ++i) {
+      const Tri& t = s.t[faces[i]];
+      for (int k = 0; k < 3; ++k) {
+        const V3 e1 = s.p[t[(k + 1) % 3]] - s.p[t[k]], e2 = s.p[t[(k + 2) % 3]] - s.p[t[k]];
+        w[i][k] = std::clamp(0.5 * e1.dot(e2) / std::max(e1.cross(e2).norm(), 1e-12), 0.01, 100.0);
+      }
     }
-  }
+  });
   return w;
 }
 
-double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep) {
-  auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
-  const auto c = emb.corners(s, f);
-  const Tri& t = s.t[f];
-  const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
-  const V2 g1 = (next[t[1]] - emb.pos[t[1]]) - (next[t[0]] - emb.pos[t[0]]);
-  const V2 g2 = (next[t[2]] - emb.pos[t[2]]) - (next[t[0]] - emb.pos[t[0]]);
-  const double A = cross(e1, e2), B = cross(e1, g2) + cross(g1, e2), C = cross(g1, g2);
-  if (A <= 0) return 1e300;  // degenerate or already folded: not judged
+namespace {
+
+double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// face_step_limit() of a face with edges e1, e2 (corner 0 to corners 1 and 2), A = cross2(e1, e2) > 0
+// and moves g1, g2 of corners 1 and 2 relative to corner 0.
+double step_limit(const V2& e1, const V2& e2, double A, const V2& g1, const V2& g2, double keep) {
+  const double B = cross2(e1, g2) + cross2(g1, e2), C = cross2(g1, g2);
   // smallest t > 0 with C t^2 + B t + (1 - keep) A = 0 (twice the areas)
   const double a0 = (1 - std::clamp(keep, 0.0, 1.0)) * A;
   double root = 1e300;
@@ -254,18 +253,39 @@ double face_step_limit(const Surface& s, const Embedding& emb, const std::vector
   return root;
 }
 
+// The moves of corners 1 and 2 of face t relative to corner 0.
+std::array<V2, 2> relative_moves(const Tri& t, const Embedding& emb, const std::vector<V2>& next) {
+  const V2 m0 = next[t[0]] - emb.pos[t[0]];
+  return {V2((next[t[1]] - emb.pos[t[1]]) - m0), V2((next[t[2]] - emb.pos[t[2]]) - m0)};
+}
+
+}  // namespace
+
+double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep) {
+  const auto c = emb.corners(s, f);
+  const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
+  const double A = cross2(e1, e2);
+  if (A <= 0) return 1e300;  // degenerate or already folded: not judged
+  const auto g = relative_moves(s.t[f], emb, next);
+  return step_limit(e1, e2, A, g[0], g[1], keep);
+}
+
 // Largest t in (0, 1] such that along pos + t (next - pos) every face keeps at least
 // min(half its current area, `floor_ratio` x its 3D area): no face can collapse (a barrier in
-// place of the one ARAP lacks), and none that is readable now can become unreadable.
+// place of the one ARAP lacks), and none that is readable now can become unreadable. Each face's
+// corners are read once (its 2D area, 0.5 A, is emb.area2()'s value to the bit).
 double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
                      const std::vector<double>& area3, double floor_ratio) {
   const double tmax = block_min(faces.size(), 1.0, [&](std::size_t begin, std::size_t end) {
     double t = 1.0;
     for (std::size_t i = begin; i < end; ++i) {
       const int f = faces[i];
-      const double a = emb.area2(s, f);
+      const auto c = emb.corners(s, f);
+      const V2 e1 = c[1] - c[0], e2 = c[2] - c[0];
+      const double A = cross2(e1, e2), a = 0.5 * A;
       if (a <= 0) continue;
-      t = std::min(t, face_step_limit(s, emb, next, f, std::min(0.5, floor_ratio * area3[f] / a)));
+      const auto g = relative_moves(s.t[f], emb, next);
+      t = std::min(t, step_limit(e1, e2, A, g[0], g[1], std::min(0.5, floor_ratio * area3[f] / a)));
     }
     return t;
   });
@@ -279,12 +299,25 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
   std::vector<double> area3(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) area3[f] = face_area_3d(s, int(f));
   std::vector<char> moved(s.p.size(), 0);
+  Region built;  // the region whose system `sys` is
+  RegionSystem sys;
+  bool usable = false;
   for (int pass = 0; pass < 2; ++pass) {
-    const Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
+    Region r = select_region(s, vf, emb, area3, fixed, degenerate, o.area_ratio_low, o.area_ratio_high);
     if (r.faces.empty()) break;
-    res.iterations += std::size_t(minimise_region(s, emb, r, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high, vertex_order));
-    res.faces = std::max(res.faces, r.faces.size());
-    for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || r.free_vertex[v];
+    // The system depends only on the region (its faces, free vertices, the 3D weights and the
+    // order): the second pass's region is often the first's (the real CT colon band: 740 905 faces
+    // both times), and then its factorisation is the same bits.
+    if (pass == 0 || r.faces != built.faces || r.free_vertex != built.free_vertex) {
+      usable = sys.build(s, r.free_vertex, r.faces, corner_weights(s, r.faces), vertex_order);
+      built = std::move(r);
+      ++res.systems_built;
+    }
+    const Region& region = built;
+    if (usable)
+      res.iterations += std::size_t(minimise_region(s, emb, region, sys, o.balance_iterations, area3, o.area_ratio_low, o.area_ratio_high));
+    res.faces = std::max(res.faces, region.faces.size());
+    for (std::size_t v = 0; v < s.p.size(); ++v) moved[v] = moved[v] || region.free_vertex[v];
   }
   res.vertices = std::size_t(std::count(moved.begin(), moved.end(), 1));
   return res;

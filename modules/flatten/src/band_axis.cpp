@@ -295,8 +295,8 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug balance: %zu faces, %zu iterations, %.2f s\n", bal.faces, bal.iterations,
-                 sw.seconds());
+    std::fprintf(stderr, "flatten debug balance: %zu faces, %zu iterations, %zu systems factorised, %.2f s\n", bal.faces,
+                 bal.iterations, bal.systems_built, sw.seconds());
 }
 
 }  // namespace cf::flat_detail

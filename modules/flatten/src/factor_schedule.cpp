@@ -25,6 +25,22 @@ std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind) {
   return parent;
 }
 
+std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent) {
+  std::vector<double> work(std::size_t(n), 0.0);
+  std::vector<int> mark(std::size_t(n), -1), held(std::size_t(n), 0);  // held: entries of column j so far
+  for (int k = 0; k < n; ++k) {
+    mark[std::size_t(k)] = k;
+    double w = 1.0;  // the diagonal
+    for (int p = colptr[k]; p < colptr[k + 1]; ++p)
+      for (int i = rowind[p]; i >= 0 && i < k && mark[std::size_t(i)] != k; i = parent[std::size_t(i)]) {
+        mark[std::size_t(i)] = k;  // L(k, i) != 0: an update with column i's entries so far, then one more
+        w += 1.0 + double(held[std::size_t(i)]++);
+      }
+    work[std::size_t(k)] = w;
+  }
+  return work;
+}
+
 namespace {
 
 // The elimination tree with child lists (ascending) and the work of every subtree.
@@ -160,6 +176,38 @@ RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<doub
   out.rest_work = s.rest_work;
   out.largest_part = *std::max_element(part_work.begin(), part_work.end());
   return out;
+}
+
+namespace {
+
+// The rows of `rows` (ascending, closed under ancestors) as a tree of their own: each row's parent
+// by its index in `rows`, -1 for a root.
+std::vector<int> restricted_tree(const std::vector<int>& parent, const std::vector<int>& rows) {
+  std::vector<int> sub(rows.size(), -1);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int p = parent[std::size_t(rows[i])];
+    if (p >= 0) sub[i] = int(std::lower_bound(rows.begin(), rows.end(), p) - rows.begin());
+  }
+  return sub;
+}
+
+}  // namespace
+
+std::vector<RowSchedule> schedule_phases(const std::vector<int>& parent, const std::vector<double>& work, int parts) {
+  std::vector<RowSchedule> phases{schedule_rows(parent, work, parts)};
+  while (int(phases.size()) < kMaxPhases && !phases.back().rest.empty()) {
+    const std::vector<int> rows = phases.back().rest;
+    std::vector<double> sub_work(rows.size());
+    for (std::size_t i = 0; i < rows.size(); ++i) sub_work[i] = work[std::size_t(rows[i])];
+    RowSchedule next = schedule_rows(restricted_tree(parent, rows), sub_work, parts);
+    if (next.largest_part + next.rest_work > (1.0 - kPhaseMinGain) * next.total_work) break;
+    for (std::vector<int>& part : next.parts)
+      for (int& k : part) k = rows[std::size_t(k)];  // local -> global: ascending stays ascending
+    for (int& k : next.rest) k = rows[std::size_t(k)];
+    phases.back().rest.clear();
+    phases.push_back(std::move(next));
+  }
+  return phases;
 }
 
 }  // namespace cf::flat_detail

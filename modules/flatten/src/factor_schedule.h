@@ -24,12 +24,30 @@ struct RowSchedule {
 // with path compression).
 std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind);
 
+// The cost of computing each row of L by the up-looking kernel (cholmod_rowfac), for the upper
+// triangle given as above and its elimination tree `parent`: row k's pattern is the union of the
+// tree paths from the rows i < k of column k up to k; for each column j on it the kernel updates
+// with the entries column j holds so far (rows j < i < k) and appends L(k, j). work[k] = 1 + the sum
+// over j of (1 + those entries): multiply-adds plus one per entry written. Summed over all rows it is
+// sum_j c_j (c_j + 1) / 2 + n (c_j: entries below the diagonal of column j), but each column's work is
+// counted at the later rows that do it, not at the column's own row. O(entries of L) time, O(n) memory.
+std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent);
+
 // Splits the rows of the elimination tree `parent` into `parts` unions of whole subtrees and the
 // rest above them, so that the largest part plus the rest (the time with `parts` threads) is as
 // small as this search finds: starting from the roots, the heaviest subtree is repeatedly replaced
 // by its children (its own row goes to the rest), the subtrees dealt to the parts largest first,
 // each to the lightest part; the best split seen is kept. `work[k]` >= 0: the estimated cost of
-// row k's column (the caller: its squared column count). Deterministic (ties by row index).
+// row k (the caller: row_work). Deterministic (ties by row index).
 RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<double>& work, int parts);
+
+// schedule_rows, then its rest split again the same way (the rest is closed under ancestors: its
+// rows form a forest whose subtrees only read finished parts and their own rows), while a split
+// saves more than kPhaseMinGain of the rest's estimated work; at most kMaxPhases phases. Phase i's
+// parts run side by side after phase i - 1; only the last phase's rest is left (the others' rest
+// is empty). Rows are global, ascending in every part and rest.
+std::vector<RowSchedule> schedule_phases(const std::vector<int>& parent, const std::vector<double>& work, int parts);
+constexpr double kPhaseMinGain = 0.05;
+constexpr int kMaxPhases = 8;
 
 }  // namespace cf::flat_detail

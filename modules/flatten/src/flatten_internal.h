@@ -239,6 +239,7 @@ void label_ends(std::vector<FlatSegment>& segs, double midline_x, std::vector<ch
 // Laplacian-preconditioned descent with a flip-preventing, Armijo line search.
 struct BalanceResult {
   std::size_t vertices = 0, faces = 0, iterations = 0;
+  std::size_t systems_built = 0;  // regions' systems factorised (a pass whose region is the last one's reuses it)
 };
 // `vertex_order` (optional): a fill-reducing order of the band's vertices for the regions' systems.
 BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
@@ -299,6 +300,14 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
                             const std::vector<char>& fixed, const std::vector<char>& degenerate, bool local,
                             const FlattenOptions& o, bool grow = false, const std::function<bool()>& enough = {},
                             const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr);
+
+// The local pass's bound on a piece's work (faces x steps) with `iterations` =
+// area_correction_iterations: faces x iterations when that is over 1e7, faces x 60 iterations when
+// that is under it, else 1e7 (the step budget 1e7 / faces, not rounded to whole steps).
+double piece_work_bound(std::size_t faces, int iterations);
+// The order the local pieces (faces of each) start in: the largest work bound first, then more
+// faces (a permutation of 0 .. pieces.size() - 1). Pre: iterations >= 1.
+std::vector<std::size_t> most_work_first(const std::vector<std::vector<int>>& pieces, int iterations);
 
 struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with

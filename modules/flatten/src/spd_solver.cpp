@@ -201,24 +201,54 @@ bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_fa
   return ok;
 }
 
-// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))), each
-// column's work estimated as its squared column count.
-RowSchedule factor_schedule(cholmod_sparse* upper, const cholmod_factor* L, int parts) {
-  const std::vector<int> parent = elimination_tree(int(upper->ncol), static_cast<const int*>(upper->p),
-                                                   static_cast<const int*>(upper->i));
-  const int* count = static_cast<const int*>(L->ColCount);
-  std::vector<double> work(L->n);
-  for (std::size_t j = 0; j < L->n; ++j) work[j] = double(count[j]) * double(count[j]);
-  return schedule_rows(parent, work, parts);
+// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))) in phases,
+// each row's work estimated as the up-looking kernel's cost of it (row_work): counted at the row
+// that does it, so the rows above the parts (few, but each updating with long columns) weigh what
+// they cost.
+std::vector<RowSchedule> factor_schedule(cholmod_sparse* upper, int parts) {
+  const int n = int(upper->ncol);
+  const int* colptr = static_cast<const int*>(upper->p);
+  const int* rowind = static_cast<const int*>(upper->i);
+  const std::vector<int> parent = elimination_tree(n, colptr, rowind);
+  return schedule_phases(parent, row_work(n, colptr, rowind, parent), parts);
+}
+
+// One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds.
+bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu) {
+  std::vector<char> ok(phase.parts.size(), 0);
+  std::vector<double> seconds(phase.parts.size(), 0.0);
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t p = 0; p < phase.parts.size(); ++p)
+    tasks.push_back([&, p] {
+      ThreadCommon tc;
+      ok[p] = rowfac_rows(upper, phase.parts[p], L, tc.c, &seconds[p]);
+    });
+  parallel_tasks(tasks);
+  cpu.resize(std::max(cpu.size(), seconds.size()), 0.0);
+  for (std::size_t p = 0; p < seconds.size(); ++p) cpu[p] += seconds[p];
+  cpu.push_back(seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));  // the phase's longest
+  return std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size());
+}
+
+// COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured.
+void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
+                        double rest_cpu, double seconds) {
+  double largest = 0, longest = 0;
+  for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
+  for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
+  std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases, largest parts %.3f, rest %.3f "
+               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s\n", parts, n,
+               phases.size(), largest, phases.back().rest_work / phases.front().total_work, cpu.size() > 0 ? cpu[0] : 0.0,
+               cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds);
 }
 
 // cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
 // cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over all
-// rows), with the rows split over the worker threads (factor_schedule.h): parts of whole subtrees
-// side by side, each with its own cholmod_common, then the rows above them. Row k reads only the
-// columns of its subtree and each column gets its entries in increasing row order, so the factor is
-// bit for bit cholmod_factorize's for any thread count. Returns -1 (nothing done) when this does
-// not apply, 0 when the factorisation failed, 1 when it succeeded.
+// rows), with the rows split over the worker threads (factor_schedule.h): in each phase, parts of
+// whole subtrees side by side, then the rows above the last phase's. Row k reads only the columns
+// of its subtree and each column gets its entries in increasing row order, so the factor is bit
+// for bit cholmod_factorize's for any thread count. Returns -1 (nothing done) when this does not
+// apply, 0 when the factorisation failed, 1 when it succeeded.
 int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common) {
   const int parts = thread_count();
   if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
@@ -226,35 +256,24 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   cholmod_sparse* upper =
       cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
   if (!upper) return -1;
-  RowSchedule schedule = factor_schedule(upper, L, parts);
+  std::vector<RowSchedule> phases = factor_schedule(upper, parts);
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
   if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
-  const bool numeric = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
+  bool ok = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
   common.grow2 = grow2;
-  if (numeric && !columns_have_room(L)) {  // (not expected) every row here, in order
-    schedule.parts.clear();
-    schedule.rest.resize(L->n);
-    for (std::size_t k = 0; k < L->n; ++k) schedule.rest[k] = int(k);
+  if (ok && !columns_have_room(L)) {  // (not expected) every row here, in order
+    phases.assign(1, RowSchedule{});
+    phases[0].rest.resize(L->n);
+    for (std::size_t k = 0; k < L->n; ++k) phases[0].rest[k] = int(k);
   }
-  std::vector<char> ok(schedule.parts.size(), 0);
-  std::vector<double> cpu(schedule.parts.size() + 1, 0.0);  // per part, then the rest
-  std::vector<std::function<void()>> tasks;
-  for (std::size_t p = 0; p < schedule.parts.size() && numeric; ++p)
-    tasks.push_back([&, p] {
-      ThreadCommon tc;
-      ok[p] = rowfac_rows(upper, schedule.parts[p], L, tc.c, &cpu[p]);
-    });
-  parallel_tasks(tasks);
-  const bool done = numeric && std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size()) &&
-                    rowfac_rows(upper, schedule.rest, L, common, &cpu.back()) && L->minor == L->n;
+  std::vector<double> cpu(std::size_t(parts), 0.0);  // per part (summed over phases), then each phase's longest
+  for (const RowSchedule& phase : phases) ok = ok && factor_parts(upper, phase, L, cpu);
+  double rest_cpu = 0;
+  ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
   cholmod_free_sparse(&upper, &common);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, largest part %.3f, rest %.3f of the "
-                 "estimated work; CPU s: parts %.2f / %.2f, rest %.2f; %.2f s\n", parts, L->n,
-                 schedule.largest_part / schedule.total_work, schedule.rest_work / schedule.total_work, cpu[0],
-                 cpu.size() > 2 ? cpu[1] : 0.0, cpu.back(), sw.seconds());
-  return done ? 1 : 0;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds());
+  return ok ? 1 : 0;
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 // distortion.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "squeezed_grid.h"
 
 namespace cf::flat_detail {
@@ -35,6 +37,42 @@ TEST(AreaBalance, GridWithinBoundsTakesNoStep) {
   FlattenOptions o;
   Grid g(0.6);
   EXPECT_EQ(balance_area(g.s, g.vf, g.emb, g.fixed, g.degenerate, o).iterations, 0u);
+}
+
+// A pass whose region is the previous pass's (no step taken in between: balance_iterations 0)
+// reuses that region's factorised system: both passes select the squeezed region, one system is
+// factorised, and the map does not move.
+TEST(AreaBalance, SecondPassOnTheSameRegionReusesItsSystem) {
+  FlattenOptions o;
+  o.balance_iterations = 0;
+  Grid g(0.2);
+  const std::vector<V2> before = g.emb.pos;
+  const BalanceResult r = balance_area(g.s, g.vf, g.emb, g.fixed, g.degenerate, o);
+  EXPECT_GT(r.faces, 0u);
+  EXPECT_EQ(r.iterations, 0u);
+  EXPECT_EQ(r.systems_built, 1u);
+  EXPECT_EQ(g.emb.pos, before);
+}
+
+// The largest fold-free step reads each face's corners once: it is, to the bit, the smallest of
+// face_step_limit() over the faces with a positive area, each with keep = min(0.5, floor x its 3D
+// area / its 2D area), for moves that crush some faces and fold others (floor 0 and 0.3).
+TEST(AreaBalance, LargestStepIsTheSmallestFaceLimitToTheBit) {
+  Grid g(0.2);
+  std::vector<V2> next = g.emb.pos;
+  for (std::size_t v = 0; v < next.size(); ++v)
+    next[v] += V2(0.9 * std::sin(1.7 * double(v)), 0.7 * std::cos(2.3 * double(v)));
+  std::vector<int> faces(g.s.t.size());
+  std::vector<double> area3(g.s.t.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) faces[f] = int(f), area3[f] = face_area_3d(g.s, int(f));
+  for (double floor_ratio : {0.0, 0.3}) {
+    double smallest = 1.0;
+    for (int f : faces)
+      if (const double a = g.emb.area2(g.s, f); a > 0)
+        smallest = std::min(smallest, face_step_limit(g.s, g.emb, next, f, std::min(0.5, floor_ratio * area3[f] / a)));
+    EXPECT_LT(smallest, 1.0);
+    EXPECT_EQ(max_area_step(g.s, g.emb, next, faces, area3, floor_ratio), std::max(0.0, smallest));
+  }
 }
 
 }  // namespace

@@ -115,5 +115,25 @@ TEST(AreaCorrection, WholeBandPassEndsWhenItsCallerSaysTheBoundsAreMet) {
     for (std::size_t f = 0; f < g->s.t.size(); ++f) EXPECT_GT(g->emb.area2(g->s, int(f)), 0.0) << f;
 }
 
+// The local pieces start in the order of their work bound (faces x steps allowed), the largest
+// first and, among the pieces the 1e7 work bound caps, the one with most faces first: a 76 347-face
+// piece (131 steps allowed) before pieces of 3 001 and 7 411 faces (3 332 and 1 349 steps), which
+// a bound rounded to whole steps ranked first (9 999 332 and 9 997 439 against 9 925 110 faces x
+// steps); uncapped pieces (60 x 60 steps) after them, the larger first; 200 000 faces (over
+// 1e7 at 60 steps) before all.
+TEST(AreaCorrection, LocalPiecesStartWithTheMostWorkThenTheMostFaces) {
+  auto pieces_of = [](std::initializer_list<std::size_t> sizes) {
+    std::vector<std::vector<int>> pieces;
+    for (std::size_t n : sizes) pieces.emplace_back(n, 0);
+    return pieces;
+  };
+  const auto order = flat_detail::most_work_first(pieces_of({3001, 1000, 76347, 200000, 7411, 2000}), 60);
+  EXPECT_EQ(order, (std::vector<std::size_t>{3, 2, 4, 0, 5, 1}));
+  EXPECT_EQ(flat_detail::piece_work_bound(76347, 60), 1e7);
+  EXPECT_EQ(flat_detail::piece_work_bound(3001, 60), 1e7);
+  EXPECT_EQ(flat_detail::piece_work_bound(1000, 60), 3.6e6);
+  EXPECT_EQ(flat_detail::piece_work_bound(200000, 60), 1.2e7);
+}
+
 }  // namespace
 }  // namespace cf
