@@ -63,6 +63,35 @@ struct Quality {
   double interface_kept = 1;  // fraction of true-lumen voxels within 1 mm of a fluid level segmented as lumen
 };
 
+// A polyp stays wall: at least 90 % of its head's true wall voxels (and the centre voxel) are not lumen.
+bool polyp_stays_wall(const cf::MaskImage* seg, const cf::MaskImage* gt, const cf::PhantomPolyp& pol) {
+  const auto sp = gt->GetSpacing();
+  const double rad = 0.5 * pol.diameter_mm;
+  cf::MaskImage::PointType c;
+  for (int d = 0; d < 3; ++d) c[d] = pol.center_lps_mm[d];
+  cf::MaskImage::IndexType ci;
+  seg->TransformPhysicalPointToIndex(c, ci);
+  const int rr[3] = {int(std::ceil(rad / sp[0])), int(std::ceil(rad / sp[1])), int(std::ceil(rad / sp[2]))};
+  std::size_t tissue = 0, kept = 0;
+  bool centre_ok = true;
+  for (int dk = -rr[2]; dk <= rr[2]; ++dk)
+    for (int dj = -rr[1]; dj <= rr[1]; ++dj)
+      for (int di = -rr[0]; di <= rr[0]; ++di) {
+        cf::MaskImage::IndexType t = ci;
+        t[0] += di;
+        t[1] += dj;
+        t[2] += dk;
+        if (!seg->GetLargestPossibleRegion().IsInside(t)) continue;
+        cf::MaskImage::PointType pt;
+        seg->TransformIndexToPhysicalPoint(t, pt);
+        if (pt.EuclideanDistanceTo(c) > rad || gt->GetPixel(t)) continue;
+        ++tissue;
+        kept += seg->GetPixel(t) == 0;
+        if (di == 0 && dj == 0 && dk == 0 && seg->GetPixel(t)) centre_ok = false;
+      }
+  return centre_ok && tissue > 0 && kept >= 0.9 * double(tissue);
+}
+
 Quality evaluate(const cf::MaskImage* seg, const cf::Phantom& p) {
   Quality q;
   const cf::MaskImage* gt = p.lumen.GetPointer();
@@ -97,34 +126,7 @@ Quality evaluate(const cf::MaskImage* seg, const cf::Phantom& p) {
             }
         q.leak += !near;
       }
-  // Polyps: at least 90 % of the head's true wall voxels (and the centre voxel) stay wall.
-  for (const auto& pol : p.polyps) {
-    ++q.polyps;
-    const double rad = 0.5 * pol.diameter_mm;
-    cf::MaskImage::PointType c;
-    for (int d = 0; d < 3; ++d) c[d] = pol.center_lps_mm[d];
-    cf::MaskImage::IndexType ci;
-    seg->TransformPhysicalPointToIndex(c, ci);
-    const int rr[3] = {int(std::ceil(rad / sp[0])), int(std::ceil(rad / sp[1])), int(std::ceil(rad / sp[2]))};
-    std::size_t tissue = 0, kept = 0;
-    bool centre_ok = true;
-    for (int dk = -rr[2]; dk <= rr[2]; ++dk)
-      for (int dj = -rr[1]; dj <= rr[1]; ++dj)
-        for (int di = -rr[0]; di <= rr[0]; ++di) {
-          cf::MaskImage::IndexType t = ci;
-          t[0] += di;
-          t[1] += dj;
-          t[2] += dk;
-          if (!seg->GetLargestPossibleRegion().IsInside(t)) continue;
-          cf::MaskImage::PointType pt;
-          seg->TransformIndexToPhysicalPoint(t, pt);
-          if (pt.EuclideanDistanceTo(c) > rad || gt->GetPixel(t)) continue;
-          ++tissue;
-          kept += seg->GetPixel(t) == 0;
-          if (di == 0 && dj == 0 && dk == 0 && seg->GetPixel(t)) centre_ok = false;
-        }
-    q.polyps_wall += centre_ok && tissue > 0 && kept >= 0.9 * double(tissue);
-  }
+  for (const auto& pol : p.polyps) ++q.polyps, q.polyps_wall += polyp_stays_wall(seg, gt, pol);
   // Air/fluid interfaces.
   std::size_t tot = 0, kept = 0;
   const auto org = gt->GetOrigin();

@@ -95,11 +95,18 @@ void compute_frames(Path& P) {
   for (std::size_t i = 1; i < q; ++i) P.arc[i] = P.arc[i - 1] + (P.p[i] - P.p[i - 1]).norm();
 }
 
+// Radius at path index i (+ fraction t) before any collapse.
+double open_radius_at(const Model& m, std::size_t i, double t) {
+  const Path& P = m.path;
+  const std::size_t j = std::min(i + 1, P.r.size() - 1);
+  return P.r[i] * (1 - t) + P.r[j] * t;
+}
+
 // Nominal radius at path index i (+ fraction t), narrowed to zero in collapsed stretches.
 double radius_at(const Model& m, std::size_t i, double t) {
   const Path& P = m.path;
   const std::size_t j = std::min(i + 1, P.r.size() - 1);
-  double r = P.r[i] * (1 - t) + P.r[j] * t;
+  double r = open_radius_at(m, i, t);
   const double s = P.s[i] * (1 - t) + P.s[j] * t;
   for (const Collapse& c : m.collapses) {
     const double u = std::abs(s - c.s) / (0.5 * c.len);

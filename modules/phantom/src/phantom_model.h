@@ -147,6 +147,7 @@ struct Model {
 
 double seg_point_dist2(const V3& p, const V3& a, const V3& b, double* tout = nullptr);
 void parallel_for(int n, const std::function<void(int, int)>& body);
+double open_radius_at(const Model& m, std::size_t i, double t);
 double radius_at(const Model& m, std::size_t i, double t);
 double lumen_radius(const Model& m, double s, double r, double theta, const V3& u);
 void paint_body(const Grid& g, std::vector<unsigned char>& mat);
@@ -216,6 +217,7 @@ class PhantomPainter {
   void paint_rectal_tube();
   struct Local {
     double s, d, R, Reff, theta;
+    double outer;  // outer wall radius (mm): the open colon's wall area kept where the lumen collapses
     std::size_t i;
     V3 u;
   };

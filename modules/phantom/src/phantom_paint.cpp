@@ -145,6 +145,12 @@ bool PhantomPainter::local_at(int ii, int j, int k, Local& L) const {
   L.theta = std::atan2(v.dot(B), v.dot(N));
   L.R = radius_at(md_, L.i, t);
   L.Reff = lumen_radius(md_, L.s, L.R, L.theta, L.u);
+  // A collapsing colon's wall does not vanish: its cross-section area pi (2 ro w + w^2) (open radius
+  // ro, wall w) stays around the narrowed lumen R, so a fully collapsed neck is a soft-tissue cord of
+  // radius sqrt(2 ro w + w^2) (walls apposed), not a w-thin cord in fat. Where R = ro: R + w, as before.
+  const double ro = open_radius_at(md_, L.i, t), w = md_.wall;
+  L.outer = std::max(L.Reff, L.R) + w;
+  if (L.R < ro) L.outer = std::max(L.outer, std::sqrt(L.R * L.R + 2 * ro * w + w * w));
   return true;
 }
 
@@ -159,7 +165,7 @@ void PhantomPainter::paint_colon() {
           unsigned char& m = mat_[g.index(ii, j, k)];
           if (m == kOutsideAir || m == kSubcutFat) continue;
           if (L.d < L.Reff) m = kColonGas;
-          else if (L.d < std::max(L.Reff, L.R) + md_.wall) m = kColonWall;
+          else if (L.d < L.outer) m = kColonWall;
         }
   });
 }

@@ -5,6 +5,9 @@
 
 #include <itkConnectedComponentImageFilter.h>
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <cstring>
 
@@ -44,6 +47,28 @@ double mean_y(const Phantom& p, unsigned char label) {
     for (std::size_t j = 0; j < sz[1]; ++j)
       for (std::size_t i = 0; i < sz[0]; ++i, ++q)
         if (p.labels->GetBufferPointer()[q] == label) sum += p.labels->GetOrigin()[1] + double(j) * p.labels->GetSpacing()[1], ++n;
+  return n ? sum / double(n) : NAN;
+}
+
+// Mean CT value (HU) on rings of radius 4, 5 and 6 mm (8 directions each) perpendicular to the
+// centreline at every point where the lumen is fully collapsed (radius 0); NaN if there is none.
+double collapsed_neck_ring_hu(const Phantom& p) {
+  const auto& c = p.centerline;
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 2; i + 2 < c.size(); ++i) {
+    if (c[i].radius_mm > 0) continue;
+    const Eigen::Vector3d x(c[i].p_lps_mm.data()), T = (Eigen::Vector3d(c[i + 2].p_lps_mm.data()) - Eigen::Vector3d(c[i - 2].p_lps_mm.data())).normalized();
+    const Eigen::Vector3d U = T.unitOrthogonal(), V = T.cross(U);
+    for (double r : {4.0, 5.0, 6.0})
+      for (int a = 0; a < 8; ++a) {
+        const Eigen::Vector3d q = x + r * (std::cos(a * M_PI / 4) * U + std::sin(a * M_PI / 4) * V);
+        CtImage::PointType pt;
+        for (int d = 0; d < 3; ++d) pt[d] = q[d];
+        CtImage::IndexType id;
+        if (p.ct->TransformPhysicalPointToIndex(pt, id)) sum += p.ct->GetPixel(id), ++n;
+      }
+  }
   return n ? sum / double(n) : NAN;
 }
 
@@ -93,6 +118,17 @@ TEST(PhantomPosition, FullyTaggedStretches) {
     ASSERT_EQ(st.size(), 2u);
     for (const auto& s : st) EXPECT_GT(s["volume_ml"].get<double>(), 10);
     EXPECT_EQ(lumen_components(p.lumen), 5u);
+  }
+}
+
+// A collapsed neck keeps the open colon's wall tissue (walls apposed, no fat between them): the
+// rings 4-6 mm around its axis are soft tissue (mean > -30 HU, fat is -90), supine and prone.
+TEST(PhantomPosition, CollapsedNecksAreWallNotFat) {
+  for (const char* position : {"supine", "prone"}) {
+    SCOPED_TRACE(position);
+    const double hu = collapsed_neck_ring_hu(make(position, 2));
+    ASSERT_FALSE(std::isnan(hu));
+    EXPECT_GT(hu, -30);
   }
 }
 

@@ -33,6 +33,11 @@ constexpr double kMinFluidSampleMl = 0.5;  // fluid near a contact measured from
 // the two bodies are separate bowels with pericolic or mesenteric fat between them.
 constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
 constexpr double kContactSeparationMm = 20;
+// A body across a gap from a colon end continues the colon only at the colon's calibre: the small
+// bowel is at most about 3 cm wide (wider is obstruction), the distended colon at CT colonography at
+// least about 4 cm, so a body whose diameter is under 3/4 of the other's is a small-bowel loop lying
+// end-on against the colon, not the colon beyond a collapsed neck (docs/segment.md step 6).
+constexpr double kMinDiameterRatio = 0.75;
 // How far a body narrows toward a contact: its nearest front's cross-section (cells) over its widest
 // front's within the shape radius (1: full calibre up to the contact). At a collapsed neck the colon
 // narrows into the neck from both sides (one tube, its wall folded in), so both bodies narrow alike.
@@ -40,6 +45,16 @@ double narrowing(const LocalShape& s) {
   std::size_t widest = 0;
   for (const Front& f : s.fronts) widest = std::max(widest, f.cells);
   return widest ? double(s.fronts.front().cells) / double(widest) : 1.0;
+}
+// Ratio of the two bodies' equivalent diameters near a contact (<= 1): each body's widest front
+// within the shape radius is its cross-section times the front's width (a cap of the front's
+// radius where the body is wider), so the square root of the cell counts' ratio is the diameters'.
+double diameter_ratio(const LocalShape& a, const LocalShape& b) {
+  std::size_t wa = 0, wb = 0;
+  for (const Front& f : a.fronts) wa = std::max(wa, f.cells);
+  for (const Front& f : b.fronts) wb = std::max(wb, f.cells);
+  if (wa == 0 || wb == 0) return 0;
+  return std::sqrt(double(std::min(wa, wb)) / double(std::max(wa, wb)));
 }
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
@@ -273,6 +288,7 @@ bool ColonSegmenter::judge_link(const Contact& c, const LocalShape& sg, const Lo
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
   const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
   if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
+  if (diameter_ratio(sg, sf) < kMinDiameterRatio) return why = "narrower than the colon end across the gap (a small-bowel loop, not the colon)", false;
   const double ng = narrowing(sg), nf = narrowing(sf);
   if (std::min(ng, nf) < kMinCalibreRatio * std::max(ng, nf)) return why = "a blunt end beside a tapering colon end (not a collapsed neck)", false;
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
@@ -387,6 +403,7 @@ void ColonSegmenter::log_link(const Contact& c, const LocalShape& sg, const Loca
   if (!sg.fronts.empty() && !sf.fronts.empty()) {
     const Eigen::Vector3d ug = -sg.fronts[0].centroid.normalized(), uf = sf.fronts[0].centroid.normalized();
     j["dir"] = ug.dot(uf);
+    j["diameter_ratio"] = diameter_ratio(sg, sf);
     if ((b - a).norm() > 0) j["seg_axis_link"] = ug.dot((b - a).normalized()), j["cand_axis_link"] = uf.dot((b - a).normalized());
   }
   const auto [facing_seg, facing_cand] = facing_cells(c, sg, sf);

@@ -179,6 +179,26 @@ TEST(SegmentRules, TubeAcrossFatFromColonEndRejected) {
   }
 }
 
+// A contrast tube across a 7 mm soft-tissue neck in line with a 9 mm colon end is kept at 8 mm
+// radius (the colon continuing) and rejected at 6 mm (2/3 of the colon's diameter: a small-bowel
+// loop lying end-on against it), though its cross-section (0.44) passes the 0.3 calibre rule.
+TEST(SegmentRules, NarrowerTubeAcrossGapFromColonEndRejected) {
+  for (double radius : {6.0, 8.0}) {
+    SCOPED_TRACE(radius);
+    auto ct = make_volume(100, [&](double x, double y, double z) {
+      const double d = tube_dist(y, z, 50, 50);
+      if (x >= 8 && x <= 40 && d < 9) return -1000.0;
+      if (x >= 47 && x <= 80 && d < radius) return 500.0;
+      return kKeep;
+    }, 0.6, 10);
+    auto [m, st] = segment_small(ct, tagged_options(1));
+    const bool kept = radius > 7;
+    EXPECT_EQ(st.tagged_stretches, kept ? 1 : 0) << st.to_json()["decisions"].dump(1);
+    EXPECT_EQ(at(m, 70, 50, 50), kept);
+    if (!kept) EXPECT_TRUE(has_decision(st, "rejected", "narrower than the colon end")) << st.to_json()["decisions"].dump(1);
+  }
+}
+
 // The link log (COLONFLAT_SEGMENT_LINKS) gives the median tagged-fluid HU near the contact on each
 // side: a 500 HU tube across a 6 mm neck from a dry gas end reads about 500 HU, the gas end none.
 TEST(SegmentRules, LinkLogReportsFluidHuNearContact) {
