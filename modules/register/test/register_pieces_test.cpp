@@ -517,6 +517,24 @@ PhantomTruth prone_truth(const SyntheticPair& pair) {
   return t;
 }
 
+// The start (material mm) of a 30 mm stretch 200 mm or more beyond material `after`, in the middle of
+// the widest gap between two polyps there, so that no polyp lies within 10 mm of it; NaN when fewer
+// than two polyps lie that far on or the gap is too narrow.
+double free_stretch_beyond(const SyntheticPair& pair, double after) {
+  std::vector<double> at;
+  for (const auto& o : pair.polyps)
+    if (o.sigma_mm > after + 200) at.push_back(o.sigma_mm);
+  std::sort(at.begin(), at.end());
+  if (at.size() < 2) return NAN;
+  size_t widest = 1;
+  for (size_t k = 2; k < at.size(); ++k)
+    if (at[k] - at[k - 1] > at[widest] - at[widest - 1]) widest = k;
+  const double from = (at[widest] + at[widest - 1]) / 2 - 15;
+  for (const auto& o : pair.polyps)
+    if (o.sigma_mm >= from - 10 && o.sigma_mm <= from + 40) return NAN;
+  return from;
+}
+
 // The colon passes one polyp twice (walls of two loops touching): in the supine a 30 mm stretch of
 // the colon 200 mm or more further on lies against the polyp, its wall half as far from the polyp's point as
 // the polyp's own (so locate() puts the polyp on that stretch, which the prone has elsewhere: no
@@ -527,16 +545,8 @@ PhantomTruth prone_truth(const SyntheticPair& pair) {
 TEST(RegisterPieces, PolypWhereTheColonPassesTwiceIsPairedAtItsOtherPlace) {
   SyntheticPair pair = make_synthetic_pair(long_pair(1));
   const SyntheticPolyp& q = pair.polyps[2];
-  std::vector<double> at;  // polyps 200 mm or more further on
-  for (const auto& o : pair.polyps)
-    if (o.sigma_mm > q.sigma_mm + 200) at.push_back(o.sigma_mm);
-  std::sort(at.begin(), at.end());
-  ASSERT_GE(at.size(), 2u);
-  size_t widest = 1;  // a 30 mm stretch in the middle of the widest gap between two of them
-  for (size_t k = 2; k < at.size(); ++k)
-    if (at[k] - at[k - 1] > at[widest] - at[widest - 1]) widest = k;
-  const double from = (at[widest] + at[widest - 1]) / 2 - 15;
-  for (const auto& o : pair.polyps) ASSERT_TRUE(o.sigma_mm < from - 10 || o.sigma_mm > from + 40);
+  const double from = free_stretch_beyond(pair, q.sigma_mm);
+  ASSERT_TRUE(std::isfinite(from));
   double own = INFINITY;  // the polyp point's distance to its own wall
   size_t touch = 0;       // the stretch's vertex nearest to it
   for (size_t v = 0; v < pair.supine.lps.size(); ++v) {
@@ -595,16 +605,8 @@ void press_stretch_against(ColonScan& scan, const std::vector<double>& sigma, co
 TEST(RegisterPieces, PolypWhereTwoLoopsTouchInBothScansIsPairedOnItsOwnWall) {
   SyntheticPair pair = make_synthetic_pair(long_pair(1));
   SyntheticPolyp& q = pair.polyps[2];
-  std::vector<double> at;  // polyps 200 mm or more further on
-  for (const auto& o : pair.polyps)
-    if (o.sigma_mm > q.sigma_mm + 200) at.push_back(o.sigma_mm);
-  std::sort(at.begin(), at.end());
-  ASSERT_GE(at.size(), 2u);
-  size_t widest = 1;  // a 30 mm stretch in the middle of the widest gap between two of them
-  for (size_t k = 2; k < at.size(); ++k)
-    if (at[k] - at[k - 1] > at[widest] - at[widest - 1]) widest = k;
-  const double from = (at[widest] + at[widest - 1]) / 2 - 15;
-  for (const auto& o : pair.polyps) ASSERT_TRUE(o.sigma_mm < from - 10 || o.sigma_mm > from + 40);
+  const double from = free_stretch_beyond(pair, q.sigma_mm);
+  ASSERT_TRUE(std::isfinite(from));
   const size_t a = vertex_at_material(pair.prone_sigma, pair.prone_phi, q.sigma_mm, q.phi_rad, 20);
   const size_t b = vertex_at_material(pair.prone_sigma, pair.prone_phi, q.sigma_mm + 10, q.phi_rad, 20);
   q.prone_lps += pair.prone.lps[b] - pair.prone.lps[a];

@@ -139,18 +139,24 @@ TEST(SegmentRules, RectalTubeTrimmedRectumKept) {
   EXPECT_TRUE(at(kept, 40, 40, 5));
 }
 
+// A 9 mm gas colon end (x 8-40) and, across a 7 mm soft-tissue neck in line with it, a 500 HU
+// contrast tube of `radius` mm (x 47-80).
+auto colon_end_then_tube(double radius) {
+  return make_volume(100, [&](double x, double y, double z) {
+    const double d = tube_dist(y, z, 50, 50);
+    if (x >= 8 && x <= 40 && d < 9) return -1000.0;
+    if (x >= 47 && x <= 80 && d < radius) return 500.0;
+    return kKeep;
+  }, 0.6, 10);
+}
+
 // A contrast-filled tube 4 mm in radius continues a 9 mm colon end across a 7 mm neck, in line
 // with it: a tube of a third of the colon's calibre is not the colon continuing (small bowel at the
 // caecum); the same tube at the colon's calibre is kept.
 TEST(SegmentRules, ThinTubeAtColonEndRejectedByCalibre) {
   for (double radius : {4.0, 8.0}) {
     SCOPED_TRACE(radius);
-    auto ct = make_volume(100, [&](double x, double y, double z) {
-      const double d = tube_dist(y, z, 50, 50);
-      if (x >= 8 && x <= 40 && d < 9) return -1000.0;
-      if (x >= 47 && x <= 80 && d < radius) return 500.0;
-      return kKeep;
-    }, 0.6, 10);
+    auto ct = colon_end_then_tube(radius);
     auto [m, st] = segment_small(ct, tagged_options(1));
     EXPECT_EQ(st.tagged_stretches, radius > 5 ? 1 : 0) << st.to_json()["decisions"].dump(1);
     EXPECT_EQ(at(m, 70, 50, 50), radius > 5);
@@ -185,12 +191,7 @@ TEST(SegmentRules, TubeAcrossFatFromColonEndRejected) {
 TEST(SegmentRules, NarrowerTubeAcrossGapFromColonEndRejected) {
   for (double radius : {6.0, 8.0}) {
     SCOPED_TRACE(radius);
-    auto ct = make_volume(100, [&](double x, double y, double z) {
-      const double d = tube_dist(y, z, 50, 50);
-      if (x >= 8 && x <= 40 && d < 9) return -1000.0;
-      if (x >= 47 && x <= 80 && d < radius) return 500.0;
-      return kKeep;
-    }, 0.6, 10);
+    auto ct = colon_end_then_tube(radius);
     auto [m, st] = segment_small(ct, tagged_options(1));
     const bool kept = radius > 7;
     EXPECT_EQ(st.tagged_stretches, kept ? 1 : 0) << st.to_json()["decisions"].dump(1);
