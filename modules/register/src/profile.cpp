@@ -235,27 +235,29 @@ ScanCoordinates colon_coordinates_from_s(const ColonScan& scan, std::vector<doub
   return c;
 }
 
-double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3d& x, double* radial) {
-  const int k = p.bin_of(s);
-  const Eigen::Vector3d& t = p.tangent[size_t(k)];
-  const Eigen::Vector3d& e1 = p.reference[size_t(k)];
-  Eigen::Vector3d d = x - p.centre[size_t(k)];
+namespace {
+// Angle in [0, 2 pi) of x about the axis (centre, unit t), 0 = the unit e1 (perpendicular to t);
+// x's distance from the axis in `radial` when given.
+double angle_in_frame(const Eigen::Vector3d& centre, const Eigen::Vector3d& t, const Eigen::Vector3d& e1,
+                      const Eigen::Vector3d& x, double* radial) {
+  Eigen::Vector3d d = x - centre;
   d -= d.dot(t) * t;
   if (radial) *radial = d.norm();
   const double a = std::atan2(d.dot(t.cross(e1)), d.dot(e1));
   return a < 0 ? a + kTwoPi : a;
+}
+}  // namespace
+
+double angle_about_centre(const LengthProfile& p, double s, const Eigen::Vector3d& x, double* radial) {
+  const size_t k = size_t(p.bin_of(s));
+  return angle_in_frame(p.centre[k], p.tangent[k], p.reference[k], x, radial);
 }
 
 double angle_about_axis(const Eigen::Vector3d& centre, const Eigen::Vector3d& tangent, const Eigen::Vector3d& reference,
                         const Eigen::Vector3d& x, double* radial) {
   Eigen::Vector3d e1 = reference - reference.dot(tangent) * tangent;
   if (e1.norm() < 1e-9) return std::numeric_limits<double>::quiet_NaN();
-  e1.normalize();
-  Eigen::Vector3d d = x - centre;
-  d -= d.dot(tangent) * tangent;
-  if (radial) *radial = d.norm();
-  const double a = std::atan2(d.dot(tangent.cross(e1)), d.dot(e1));
-  return a < 0 ? a + kTwoPi : a;
+  return angle_in_frame(centre, tangent, e1.normalized(), x, radial);
 }
 
 void fill_profile(const ColonScan& scan, const ProfileOptions& o, int bins, ScanCoordinates& c) {

@@ -41,18 +41,21 @@ constexpr double kMinDiameterRatio = 0.75;
 // How far a body narrows toward a contact: its nearest front's cross-section (cells) over its widest
 // front's within the shape radius (1: full calibre up to the contact). At a collapsed neck the colon
 // narrows into the neck from both sides (one tube, its wall folded in), so both bodies narrow alike.
-double narrowing(const LocalShape& s) {
+// Cells of a body's widest front within the shape radius (0 without fronts).
+std::size_t widest_front(const LocalShape& s) {
   std::size_t widest = 0;
   for (const Front& f : s.fronts) widest = std::max(widest, f.cells);
+  return widest;
+}
+double narrowing(const LocalShape& s) {
+  const std::size_t widest = widest_front(s);
   return widest ? double(s.fronts.front().cells) / double(widest) : 1.0;
 }
 // Ratio of the two bodies' equivalent diameters near a contact (<= 1): each body's widest front
 // within the shape radius is its cross-section times the front's width (a cap of the front's
 // radius where the body is wider), so the square root of the cell counts' ratio is the diameters'.
 double diameter_ratio(const LocalShape& a, const LocalShape& b) {
-  std::size_t wa = 0, wb = 0;
-  for (const Front& f : a.fronts) wa = std::max(wa, f.cells);
-  for (const Front& f : b.fronts) wb = std::max(wb, f.cells);
+  const std::size_t wa = widest_front(a), wb = widest_front(b);
   if (wa == 0 || wb == 0) return 0;
   return std::sqrt(double(std::min(wa, wb)) / double(std::max(wa, wb)));
 }
