@@ -37,7 +37,7 @@ const ArtifactType& mesh_artifact() {
 }
 
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
-                                 const std::string& stage) {
+                                 const std::string& stage, TopologyReport* topology) {
   // In place: the bag's value is not const (ArtifactBag::take does the same), and a copy of a
   // 1.4 M-face mesh costs more than the check.
   Mesh& mesh = const_cast<Mesh&>(bag.get<Mesh>(port));
@@ -47,7 +47,7 @@ nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, cons
     r = OrientationReport::from_json(nlohmann::json::parse(mesh.property(h)));
     mesh.remove_property(h);
   }
-  r.append(orient_outward(mesh));
+  r.append(orient_outward(mesh, topology));
   for (const std::string& note : r.notes()) ctx.progress(stage + ": " + port + ": " + note);
   return r.to_json();
 }

@@ -301,11 +301,12 @@ OrientationReport orient_outward(TriangleList& t, const TopologyReport& topo) {
   return r;
 }
 
-OrientationReport orient_outward(Mesh& mesh) {
+OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology) {
   TriangleList t = to_triangle_list(mesh);
-  const TopologyReport topo = analyze_topology(t);
+  TopologyReport topo = analyze_topology(t);
   OrientationReport r = orient_outward(t, topo);
   if (!r.empty()) mesh = build_mesh(t);
+  if (topology) *topology = std::move(topo);
   return r;
 }
 

@@ -196,6 +196,30 @@ TEST(CoreOrientation, StageInputReportsWhatWasTurnedAndReversed) {
   EXPECT_FALSE(bag.get<Mesh>("surface").get_property_handle(h, kReadOrientationProperty));
 }
 
+// The topology a stage gets back from orienting its input (render's snapshot caption uses its
+// genus) is the reversed mesh's own: an inward torus beside an outward sphere gives genus 1 in
+// two components, as analyze_topology of the bag's mesh says afterwards.
+TEST(CoreOrientation, StageInputHandsBackTheMeshTopology) {
+  const TriangleList t = synthetic::disjoint_union(reversed(synthetic::torus(30, 10, 40, 16)),
+                                                   synthetic::translated(synthetic::sphere(10, 24, 12), 100, 0, 0));
+  ArtifactBag bag;
+  bag.put("surface", synthetic::to_mesh(t));
+  RunContext ctx;
+  TopologyReport topo;
+  const nlohmann::json j = orient_mesh_input(bag, "surface", ctx, "render", &topo);
+  EXPECT_EQ(j["reversed_components"], 1);
+  const TopologyReport after = analyze_topology(bag.get<Mesh>("surface"));
+  ASSERT_TRUE(topo.genus.has_value());
+  EXPECT_EQ(*topo.genus, 1);
+  EXPECT_EQ(topo.genus, after.genus);
+  ASSERT_EQ(topo.components.size(), 2u);
+  ASSERT_EQ(after.components.size(), 2u);
+  for (std::size_t c = 0; c < 2; ++c) {
+    EXPECT_EQ(topo.components[c].faces, after.components[c].faces);
+    EXPECT_EQ(topo.components[c].euler, after.components[c].euler);
+  }
+}
+
 // Reading a non-orientable file fails with one line naming the file and the reason.
 TEST(CoreOrientation, NonOrientableFileIsRefused) {
   testing::TempDir tmp;

@@ -4,6 +4,11 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStaticCellLocator.h>
 
 #include <algorithm>
 #include <cmath>
@@ -135,7 +140,7 @@ namespace {
 class PolypDetector {
  public:
   PolypDetector(const TriangleList& s, const std::vector<std::array<double, 3>>& normals, const PolypOptions& o)
-      : s_(s), o_(o), g_(vertex_graph(s)), c_(curvature_on_graph(s, g_, normals, o.fit_radius)), area_(vertex_areas(s)),
+      : s_(s), normals_(normals), o_(o), g_(vertex_graph(s)), c_(curvature_on_graph(s, g_, normals, o.fit_radius)), area_(vertex_areas(s)),
         region_(s.points.size(), -1), footprint_stamp_(s.points.size(), -1) {}
   std::vector<PolypCandidate> run(Curvature* curvature_out);
 
@@ -150,8 +155,10 @@ class PolypDetector {
   double elongation(const std::vector<int>& cap, const V3& centre, double cap_area) const;
   void size_and_score(PolypCandidate& pc) const;
   bool passes(const PolypCandidate& pc) const;
+  bool solid(const std::vector<int>& cap, const PolypCandidate& pc) const;
 
   const TriangleList& s_;
+  const std::vector<std::array<double, 3>>& normals_;  // out of the lumen
   const PolypOptions& o_;
   const VertexGraph g_;
   Curvature c_;  // after g_: computed on it
@@ -172,7 +179,7 @@ std::vector<PolypCandidate> PolypDetector::run(Curvature* curvature_out) {
     grow_footprint(cap, pc);
     pc.elongation = elongation(cap, centre, pc.cap_area_mm2);
     size_and_score(pc);
-    if (passes(pc)) out.push_back(std::move(pc));
+    if (passes(pc) && solid(cap, pc)) out.push_back(std::move(pc));
   }
   if (curvature_out) *curvature_out = std::move(c_);
   return out;
@@ -255,6 +262,57 @@ void PolypDetector::size_and_score(PolypCandidate& pc) const {
 bool PolypDetector::passes(const PolypCandidate& pc) const {
   return !(pc.cap_area_mm2 < o_.min_cap_area || pc.size_mm < o_.min_size || pc.size_mm > o_.max_size ||
            pc.score < o_.min_score);
+}
+
+// The surface's triangles with a corner within `radius` of `centre`, in a cell locator (ray casts).
+vtkSmartPointer<vtkStaticCellLocator> local_locator(const TriangleList& s, const V3& centre, double radius) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> cells;
+  std::vector<vtkIdType> local(s.points.size(), -1);
+  const double r2 = radius * radius;
+  for (const auto& t : s.triangles) {
+    if ((P(s, t[0]) - centre).squaredNorm() > r2 && (P(s, t[1]) - centre).squaredNorm() > r2 &&
+        (P(s, t[2]) - centre).squaredNorm() > r2)
+      continue;
+    vtkIdType ids[3];
+    for (int k = 0; k < 3; ++k) {
+      if (local[t[k]] < 0) local[t[k]] = points->InsertNextPoint(s.points[t[k]].data());
+      ids[k] = local[t[k]];
+    }
+    cells->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  pd->SetPolys(cells);
+  auto locator = vtkSmartPointer<vtkStaticCellLocator>::New();
+  locator->SetDataSet(pd);
+  locator->BuildLocator();
+  return locator;
+}
+
+// Whether the cap is the top of a solid body: the tissue behind it (median over its vertices, at
+// most 64 of them evenly spread, of the distance along the outward normal to the next crossing of
+// the surface) is at least min_thickness_ratio x its size. A polyp head of diameter d is tissue
+// for about d behind its apex and at least d/2 behind most of its cap, then the wall; the partial-
+// volume layer of a gas/tagged-fluid level left out of the lumen is a sheet about one voxel thick
+// with lumen (the fluid) right behind it, and its rim is as curved as a polyp head.
+bool PolypDetector::solid(const std::vector<int>& cap, const PolypCandidate& pc) const {
+  const double reach = pc.size_mm, start = 1e-3 * reach;
+  double extent = 0;
+  for (int v : cap) extent = std::max(extent, (P(s_, v) - P(s_, pc.vertex)).norm());
+  const auto locator = local_locator(s_, P(s_, pc.vertex), extent + reach);
+  std::vector<double> thickness;
+  const std::size_t step = std::max<std::size_t>(1, cap.size() / 64);
+  for (std::size_t k = 0; k < cap.size(); k += step) {
+    const V3 p = P(s_, cap[k]), n = V3(normals_[cap[k]][0], normals_[cap[k]][1], normals_[cap[k]][2]).normalized();
+    V3 a = p + start * n, b = p + reach * n, hit;
+    double t = 0, pcoords[3];
+    int sub = 0;
+    thickness.push_back(locator->IntersectWithLine(a.data(), b.data(), 0.0, t, hit.data(), pcoords, sub) ? (hit - p).norm()
+                                                                                                     : reach);
+  }
+  std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
+  return thickness[thickness.size() / 2] >= o_.min_thickness_ratio * pc.size_mm;
 }
 
 // Merge candidates whose apexes are closer than the larger radius (one polyp, several caps);

@@ -1,6 +1,7 @@
 #include "colonflat/render/render_stage.h"
 
 #include <future>
+#include <optional>
 
 #include <vtkImageData.h>
 #include <vtkPolyData.h>
@@ -44,10 +45,10 @@ const ParamTable<RenderOptions>& render_param_table() {
 
 namespace {
 
-// The snapshot of the surface before denoising, its caption giving the genus and the loop count.
-ImagePtr snapshot_before(const Mesh& m, vtkPolyData* loops, SnapshotOptions so) {
-  const auto topo = analyze_topology(m);
-  so.caption = "before denoising: genus " + (topo.genus ? std::to_string(*topo.genus) : std::string("?")) +
+// The snapshot of the surface before denoising, its caption giving the genus (of the surface's
+// topology, found when it was oriented) and the loop count.
+ImagePtr snapshot_before(const Mesh& m, std::optional<int> genus, vtkPolyData* loops, SnapshotOptions so) {
+  so.caption = "before denoising: genus " + (genus ? std::to_string(*genus) : std::string("?")) +
                (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
   return render_snapshot(to_triangle_list(m), loops, so);
 }
@@ -62,8 +63,11 @@ ImagePtr snapshot_before(const Mesh& m, vtkPolyData* loops, SnapshotOptions so) 
 // display can be had, `error` says why.
 RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const {
   Snapshots s;
+  TopologyReport surface_topology;
   for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
-    if (bag.has(port)) ctx.report["orientation"][port] = orient_mesh_input(bag, port, ctx, "render");
+    if (bag.has(port))
+      ctx.report["orientation"][port] =
+          orient_mesh_input(bag, port, ctx, "render", std::string(port) == "surface" ? &surface_topology : nullptr);
   if (bag.has("loops")) s.loops = loops_to_polydata(bag.get<LoopSet>("loops"));
   s.options.width = s.options.height = opts_.snapshot_size;
   try {
@@ -74,9 +78,10 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   }
   const Mesh* surface = bag.has("surface") ? &bag.get<Mesh>("surface") : nullptr;
   const Mesh* denoised = bag.has("denoised") ? &bag.get<Mesh>("denoised") : nullptr;
-  s.images = std::async(std::launch::async, [surface, denoised, &flat, loops = s.loops.Get(), so = s.options] {
+  s.images = std::async(std::launch::async, [surface, denoised, &flat, genus = surface_topology.genus,
+                                               loops = s.loops.Get(), so = s.options] {
     SnapshotImages im;
-    if (surface) im.before = snapshot_before(*surface, loops, so);
+    if (surface) im.before = snapshot_before(*surface, genus, loops, so);
     im.after = render_snapshot(denoised ? to_triangle_list(*denoised) : flat_to_surface(flat), loops, so);
     return im;
   });

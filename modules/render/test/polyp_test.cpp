@@ -1,7 +1,15 @@
 // Polyp candidates: curvature signs on analytic shapes, detection of known bumps on a synthetic
 // colon with haustral folds (folds not flagged), size estimates, known-polyp JSON and scoring.
 #include <gtest/gtest.h>
+#include <vtkIdList.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkWindowedSincPolyDataFilter.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -22,6 +30,68 @@ synthetic::ColonOptions polyp_colon() {
 std::vector<KnownPolyp> truth(const synthetic::Colon& c) {
   std::vector<KnownPolyp> t;
   for (const auto& p : c.polyps) t.push_back({p.id, p.center, p.diameter, "sessile"});
+  return t;
+}
+
+// A CT-like lumen mask of a horizontal tube (radius 11 mm, axis z, 0.7 mm voxels) with a tagged-fluid
+// level at y = 4 mm (supine: +y down; gas above, fluid below, both lumen) whose one-voxel partial-
+// volume layer is left out of the lumen over part of the level (a disc of radius 5 mm reaching the
+// wall: what a segmentation missing part of the gas/fluid interface leaves), and two 9 mm
+// hemispherical polyps on the wall: one far from the level (top wall, z = 75) and one standing
+// in the fluid and through the level (-x wall at y = 4, z = 40). Meshed with flying edges,
+// smoothed (windowed sinc) like reconstruct; outward normals.
+struct MeniscusTube {
+  TriangleList surface;
+  std::vector<std::array<double, 3>> normals;
+  std::vector<KnownPolyp> polyps;
+};
+
+MeniscusTube meniscus_tube() {
+  const double h = 0.7, r = 11, level = 4;
+  const int nx = 40, ny = 40, nz = 150;
+  MeniscusTube t;
+  t.polyps = {{1, {0, -r, 75}, 9, "sessile"}, {2, {-std::sqrt(r * r - level * level), level, 40}, 9, "sessile"}};
+  auto img = vtkSmartPointer<vtkImageData>::New();
+  img->SetDimensions(nx, ny, nz);
+  img->SetSpacing(h, h, h);
+  img->SetOrigin(-h * (nx - 1) / 2, -h * (ny - 1) / 2, -h * 5);
+  img->AllocateScalars(VTK_FLOAT, 1);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const double x = img->GetOrigin()[0] + i * h, y = img->GetOrigin()[1] + j * h, z = img->GetOrigin()[2] + k * h;
+        const double zc = std::clamp(z, 15.0, 95.0);
+        bool lumen = std::hypot(x, y, z - zc) < r;
+        if (std::abs(y - level) < 0.5 * h && std::hypot(x - 6, z - 40) < 5) lumen = false;  // membrane
+        for (const auto& p : t.polyps)
+          if (std::hypot(x - p.center_lps_mm[0], y - p.center_lps_mm[1], z - p.center_lps_mm[2]) < 4.5) lumen = false;
+        img->SetScalarComponentFromFloat(i, j, k, 0, lumen ? 1.0f : 0.0f);
+      }
+  auto fe = vtkSmartPointer<vtkFlyingEdges3D>::New();
+  fe->SetInputData(img);
+  fe->SetValue(0, 0.5);
+  auto smooth = vtkSmartPointer<vtkWindowedSincPolyDataFilter>::New();
+  smooth->SetInputConnection(fe->GetOutputPort());
+  smooth->SetNumberOfIterations(20);
+  smooth->SetPassBand(0.1);
+  auto nf = vtkSmartPointer<vtkPolyDataNormals>::New();
+  nf->SetInputConnection(smooth->GetOutputPort());
+  nf->SplittingOff();
+  nf->AutoOrientNormalsOn();  // closed surface: normals out of the lumen
+  nf->Update();
+  vtkPolyData* pd = nf->GetOutput();
+  for (vtkIdType v = 0; v < pd->GetNumberOfPoints(); ++v) {
+    double p[3], n[3];
+    pd->GetPoint(v, p);
+    pd->GetPointData()->GetNormals()->GetTuple(v, n);
+    t.surface.points.push_back({p[0], p[1], p[2]});
+    t.normals.push_back({n[0], n[1], n[2]});
+  }
+  auto ids = vtkSmartPointer<vtkIdList>::New();
+  for (vtkIdType c = 0; c < pd->GetNumberOfCells(); ++c) {
+    pd->GetCellPoints(c, ids);
+    t.surface.triangles.push_back({int(ids->GetId(0)), int(ids->GetId(1)), int(ids->GetId(2))});
+  }
   return t;
 }
 
@@ -83,6 +153,17 @@ TEST(PolypDetect, FoldsAloneGiveNoCandidates) {
   std::vector<std::array<double, 3>> n(s.points.size());
   for (std::size_t i = 0; i < map.size(); ++i) n[map[i]] = f.normal[i];
   EXPECT_TRUE(detect_polyps(s, n, PolypOptions{}).empty());
+}
+
+// A fluid level's partial-volume membrane (one voxel between gas and tagged fluid, lumen on both
+// sides) is not a polyp: both 9 mm polyps (one far from the level, one through it) are found, no
+// candidate lies on the membrane.
+TEST(PolypDetect, FluidLevelMembraneIsNotAPolyp) {
+  const MeniscusTube t = meniscus_tube();
+  const auto cands = detect_polyps(t.surface, t.normals, PolypOptions{});
+  const auto sc = score_detections(cands, t.polyps, 6.0, 3.0);
+  EXPECT_EQ(sc.polyps_detected, 2);
+  EXPECT_EQ(sc.false_positives, 0);
 }
 
 // Known polyp lists: phantom-style objects and bare [x,y,z] lists; bad entries name the file.

@@ -24,9 +24,10 @@ inline constexpr const char* kReadOrientationProperty = "colonflat:read_orientat
 // reports what the reader turned or reversed, reverses every closed component whose normals still
 // point into the lumen (orient_outward, orientation.h: a mesh not read from a file) in the bag, prints one progress line per changed
 // component ("<stage>: <port>: component 0 (...): normals pointed into the lumen; reversed")
-// and returns the report entry (OrientationReport::to_json()).
+// and returns the report entry (OrientationReport::to_json()). `topology` (optional) receives
+// the mesh's analyze_topology, computed on the way (orient_outward).
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
-                                 const std::string& stage);
+                                 const std::string& stage, TopologyReport* topology = nullptr);
 
 nlohmann::json topology_to_json(const TopologyReport& t);
 nlohmann::json diagnosis_to_json(const MeshDiagnosis& d);

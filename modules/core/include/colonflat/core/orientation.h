@@ -79,8 +79,9 @@ OrientationReport make_consistent(TriangleList& t, const TopologyReport& topo);
 // Precondition: topo = analyze_topology(t), consistently oriented.
 OrientationReport orient_outward(TriangleList& t, const TopologyReport& topo);
 // The same on a mesh (no deleted elements); rebuilt, same vertex and face order, when a
-// component is reversed.
-OrientationReport orient_outward(Mesh& mesh);
+// component is reversed. `topology` (optional) receives analyze_topology of the mesh, which
+// reversing whole components does not change (components, counts, Euler characteristic, genus).
+OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology = nullptr);
 
 // Builds an OpenMesh mesh from a manifold, consistently oriented triangle list (same order).
 // Throws PreconditionError when a face cannot be added.

@@ -6,7 +6,9 @@
 // CV in range, grown through SI >= grow_si into a cap region; the size estimate is the diameter of
 // the sphere with the cap's mean curvedness (2 / CV); the score combines mean SI, cap coverage of
 // that sphere and roundness (fold tips are elongated caps). Folds are ridges (SI ~0.5) and are not
-// flagged. The footprint (SI >= footprint_si within max_radius) is kept for outlines.
+// flagged. The footprint (SI >= footprint_si within max_radius) is kept for outlines. A cap with
+// lumen right behind it (median tissue thickness along the normal < min_thickness_ratio x size:
+// the partial-volume sheet of a gas/tagged-fluid level left out of the lumen) is not a polyp.
 #include <array>
 #include <filesystem>
 #include <string>
@@ -30,6 +32,8 @@ struct PolypOptions {
   double max_radius = 15.0;     // mm, footprint growth limit from the candidate centre
   double min_cap_area = 3.0;    // mm^2, smallest cap region (smaller caps are surface noise)
   double min_score = 0.65;      // candidates below this score are dropped
+  double min_thickness_ratio = 0.5;  // tissue behind the cap along its normal (median), x size: a polyp
+                                     // head is solid; a fluid level's partial-volume sheet is ~1 voxel
 };
 
 struct Curvature {
