@@ -208,6 +208,13 @@ class ColonSegmenter {
   void find_fluid_bodies();
   void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
   void grow_pieces(const Bytes& bright, std::vector<std::size_t>& queue);
+  std::vector<std::size_t> seed_cores(const RunLabels& cl);
+  std::vector<float> core_levels(const RunLabels& cl) const;
+  float mean3_at(std::size_t q) const;
+  std::vector<std::vector<std::size_t>> other_level_cores(const Bytes& bright, const Bytes& core, const RunLabels& cl) const;
+  std::vector<std::vector<std::size_t>> plateaus_beyond_bridge(const std::vector<std::size_t>& region, std::uint32_t p, double own,
+                                                              const Bytes& core, Bytes& seen) const;
+  void debug_other_level(const std::vector<std::size_t>& region, std::size_t plateau, float level) const;
   RunLabels candidate_bodies(const Bytes& candidate) const;
   std::vector<PiecePair> piece_pairs(const RunLabels& cl, const Bytes& candidate, std::vector<std::uint64_t>& units) const;
   void scan_contacts(int axis, Bytes* contact, bool layer);

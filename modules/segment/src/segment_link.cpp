@@ -35,9 +35,12 @@ constexpr double kFatLowHu = -190, kFatHighHu = -30, kFatRunMm = 3;
 constexpr double kContactSeparationMm = 20;
 // A body across a gap from a colon end continues the colon only at the colon's calibre: the small
 // bowel is at most about 3 cm wide (wider is obstruction), the distended colon at CT colonography at
-// least about 4 cm, so a body whose diameter is under 3/4 of the other's is a small-bowel loop lying
-// end-on against the colon, not the colon beyond a collapsed neck (docs/segment.md step 6).
+// least about 4 cm, so a candidate whose diameter is under 3/4 of the colon end's is a small-bowel
+// loop lying end-on against the colon, not the colon beyond a collapsed neck - unless it is itself of
+// colon calibre (>= kColonMinDiameterMm: a poorly distended stretch beside a wide one). One-sided: a
+// candidate wider than the colon end is never refused by it (docs/segment.md step 6).
 constexpr double kMinDiameterRatio = 0.75;
+constexpr double kColonMinDiameterMm = 40;
 // How far a body narrows toward a contact: its nearest front's cross-section (cells) over its widest
 // front's within the shape radius (1: full calibre up to the contact). At a collapsed neck the colon
 // narrows into the neck from both sides (one tube, its wall folded in), so both bodies narrow alike.
@@ -51,13 +54,14 @@ double narrowing(const LocalShape& s) {
   const std::size_t widest = widest_front(s);
   return widest ? double(s.fronts.front().cells) / double(widest) : 1.0;
 }
-// Ratio of the two bodies' equivalent diameters near a contact (<= 1): each body's widest front
-// within the shape radius is its cross-section times the front's width (a cap of the front's
-// radius where the body is wider), so the square root of the cell counts' ratio is the diameters'.
-double diameter_ratio(const LocalShape& a, const LocalShape& b) {
-  const std::size_t wa = widest_front(a), wb = widest_front(b);
-  if (wa == 0 || wb == 0) return 0;
-  return std::sqrt(double(std::min(wa, wb)) / double(std::max(wa, wb)));
+// Ratio of the candidate's equivalent diameter to the colon end's near a contact (> 1: the candidate
+// is wider): each body's widest front within the shape radius is its cross-section times the front's
+// width (a cap of the front's radius where the body is wider), so the square root of the cell
+// counts' ratio is the diameters'.
+double diameter_ratio(const LocalShape& colon, const LocalShape& cand) {
+  const std::size_t wg = widest_front(colon), wf = widest_front(cand);
+  if (wg == 0 || wf == 0) return 0;
+  return std::sqrt(double(wf) / double(wg));
 }
 bool colon_kind(unsigned char v) { return v == kGas || v == kPool || v == kLayer; }
 std::string fixed1(double v) {
@@ -291,7 +295,8 @@ bool ColonSegmenter::judge_link(const Contact& c, const LocalShape& sg, const Lo
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
   const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
   if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
-  if (diameter_ratio(sg, sf) < kMinDiameterRatio) return why = "narrower than the colon end across the gap (a small-bowel loop, not the colon)", false;
+  if (diameter_ratio(sg, sf) < kMinDiameterRatio && grid_->front_diameter_mm(widest_front(sf)) < kColonMinDiameterMm)
+    return why = "narrower than the colon end across the gap (a small-bowel loop, not the colon)", false;
   const double ng = narrowing(sg), nf = narrowing(sf);
   if (std::min(ng, nf) < kMinCalibreRatio * std::max(ng, nf)) return why = "a blunt end beside a tapering colon end (not a collapsed neck)", false;
   const Eigen::Vector3d ug = -fg.centroid.normalized(), uf = ff.centroid.normalized();  // out of the colon; into the candidate
@@ -407,6 +412,8 @@ void ColonSegmenter::log_link(const Contact& c, const LocalShape& sg, const Loca
     const Eigen::Vector3d ug = -sg.fronts[0].centroid.normalized(), uf = sf.fronts[0].centroid.normalized();
     j["dir"] = ug.dot(uf);
     j["diameter_ratio"] = diameter_ratio(sg, sf);
+    j["seg_diameter_mm"] = grid_->front_diameter_mm(widest_front(sg));
+    j["cand_diameter_mm"] = grid_->front_diameter_mm(widest_front(sf));
     if ((b - a).norm() > 0) j["seg_axis_link"] = ug.dot((b - a).normalized()), j["cand_axis_link"] = uf.dot((b - a).normalized());
   }
   const auto [facing_seg, facing_cand] = facing_cells(c, sg, sf);

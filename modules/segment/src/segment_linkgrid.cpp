@@ -195,7 +195,7 @@ LocalShape LinkGrid::shape(const std::vector<std::uint32_t>& labels, std::uint32
     out.region.push_back(entry);
   }
   std::sort(out.region.begin(), out.region.end());
-  const double width = 2.0 * std::max({d_.sp[0], d_.sp[1], d_.sp[2]});
+  const double width = front_width_mm();
   for (int t = 1; t <= 3; ++t) {
     const double r = radius_mm * t / 3.0;
     if (out.reach_mm < r - 0.5 * width) break;

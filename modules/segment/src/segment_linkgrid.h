@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -79,6 +80,14 @@ class LinkGrid {
   // A kept candidate becomes part of colon segment `segment` (colon for later contacts).
   void absorb(std::uint32_t candidate, std::uint32_t segment);
   Eigen::Vector3d mm(std::size_t cell) const;
+  // Width of a geodesic front (two cells along the coarsest axis, mm).
+  double front_width_mm() const { return 2.0 * std::max({d_.sp[0], d_.sp[1], d_.sp[2]}); }
+  // Equivalent diameter (mm) of a front of `cells` cells: the disc whose area times the front's width
+  // holds the cells' volume (a tube's cross-section; where the body is wider than the front's radius
+  // the front is a cap and this over-reads).
+  double front_diameter_mm(std::size_t cells) const {
+    return 2.0 * std::sqrt(double(cells) * d_.sp[0] * d_.sp[1] * d_.sp[2] / (front_width_mm() * 3.14159265358979));
+  }
   // The fine voxels of `cell`: [lo, hi) along each axis of `fine`.
   void fine_box(std::size_t cell, const Dims& fine, std::size_t lo[3], std::size_t hi[3]) const {
     std::size_t c[3];

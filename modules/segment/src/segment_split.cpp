@@ -23,6 +23,9 @@ namespace {
 constexpr double kCoreRadiusMm = 3.0;
 constexpr double kMinCoreVoxels = 1.5;  // the ball must span this many voxels along every axis
 constexpr double kMinFluidPairShare = 0.5;  // two pieces are one lumen when this share of their boundary is fluid
+// A plateau of another level holds at least this much (50 mm^3: a lumen 4 mm across over 4 mm beyond its rim);
+// smaller components above a region's median are noise blobs of the 3 x 3 x 3 mean (a few voxels).
+constexpr double kMinOtherLevelMl = 0.05;
 }
 
 // Erosion of `m` (0/1) by the ball of radius r_mm (an ellipsoid in voxels): voxels outside the
@@ -93,10 +96,11 @@ void ColonSegmenter::grow_pieces(const Bytes& bright, std::vector<std::size_t>& 
 }
 
 // fluid_label_: the pieces of the bright mask (cores grown along paths inside the mask, then the
-// coreless components); fluid_count_ their number.
+// coreless components); fluid_count_ their number. Where a piece holds fluid of another level behind
+// a darker bridge (other_level_cores), that fluid is a core of its own and the pieces are grown again.
 void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   fluid_label_.assign(d_.total, 0);
-  std::vector<std::size_t> queue;
+  fluid_count_ = 0;
   // Voxels coarser than the ball can resolve (radius < 1.5 voxels: the 3 x 3 x 3 mean alone spreads
   // a voxel): no cores, every bright component is one piece.
   const bool resolved = kCoreRadiusMm >= kMinCoreVoxels * std::max({d_.sp[0], d_.sp[1], d_.sp[2]});
@@ -104,23 +108,160 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
     Bytes core = erode_ball(bright, d_, kCoreRadiusMm);
     for (std::size_t q = 0; q < d_.total; ++q) core[q] = core[q] && hu_[q] >= opts_.fluid_threshold;  // a wall voxel is no core
     const RunLabels cl = component_runs(core.data(), d_);
-    fluid_count_ = cl.count();
-    for (std::uint32_t l = 1; l <= fluid_count_; ++l)
-      for (const Run* r = cl.begin(l); r != cl.end(l); ++r) {
-        std::fill_n(fluid_label_.data() + r->start, r->length, l);
-        for (std::size_t q = r->start; q < r->start + r->length; ++q) queue.push_back(q);
-      }
-  } else {
-    fluid_count_ = 0;
+    std::vector<std::size_t> queue = seed_cores(cl);
+    grow_pieces(bright, queue);
+    const std::vector<std::vector<std::size_t>> other = other_level_cores(bright, core, cl);
+    Bytes().swap(core);
+    if (!other.empty()) {  // each a core of its own (its voxels leave the old cores); all grown again
+      fluid_label_.assign(d_.total, 0);
+      queue = seed_cores(cl);
+      for (std::size_t t = 0; t < other.size(); ++t)
+        for (std::size_t q : other[t]) fluid_label_[q] = cl.count() + std::uint32_t(t) + 1, queue.push_back(q);
+      fluid_count_ += std::uint32_t(other.size());
+      grow_pieces(bright, queue);
+    }
   }
-  grow_pieces(bright, queue);
-  std::vector<std::size_t>().swap(queue);
   Bytes rest(d_.total);
   for (std::size_t q = 0; q < d_.total; ++q) rest[q] = bright[q] && !fluid_label_[q];
   const RunLabels thin = component_runs(rest.data(), d_);
   for (std::uint32_t l = 1; l <= thin.count(); ++l)
     for (const Run* r = thin.begin(l); r != thin.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, fluid_count_ + l);
   fluid_count_ += thin.count();
+}
+
+// Labels the cores 1.. into fluid_label_ and returns their voxels in label order (the breadth-first
+// queue of grow_pieces); fluid_count_ = the cores' number.
+std::vector<std::size_t> ColonSegmenter::seed_cores(const RunLabels& cl) {
+  std::vector<std::size_t> queue;
+  for (std::uint32_t l = 1; l <= cl.count(); ++l)
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r) {
+      std::fill_n(fluid_label_.data() + r->start, r->length, l);
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) queue.push_back(q);
+    }
+  fluid_count_ = cl.count();
+  return queue;
+}
+
+// Per core label of `cl`: the level of its fluid, the median own HU of its core voxels (>= fluid-threshold).
+std::vector<float> ColonSegmenter::core_levels(const RunLabels& cl) const {
+  std::vector<float> level(cl.count() + 1, 0), v;
+  for (std::uint32_t l = 1; l <= cl.count(); ++l) {
+    v.clear();
+    for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
+      v.insert(v.end(), hu_.begin() + std::ptrdiff_t(r->start), hu_.begin() + std::ptrdiff_t(r->start + r->length));
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    level[l] = v[v.size() / 2];
+  }
+  return level;
+}
+
+// 3 x 3 x 3 mean of the CT at voxel q (edges clamped, as box_mean3_slices).
+float ColonSegmenter::mean3_at(std::size_t q) const {
+  std::size_t c[3];
+  d_.coords(q, c[0], c[1], c[2]);
+  double sum = 0;
+  for (int dk = -1; dk <= 1; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const long x = std::clamp(long(c[0]) + di, 0L, long(d_.n[0]) - 1), y = std::clamp(long(c[1]) + dj, 0L, long(d_.n[1]) - 1);
+        const long z = std::clamp(long(c[2]) + dk, 0L, long(d_.n[2]) - 1);
+        sum += hu_[d_.idx(std::size_t(x), std::size_t(y), std::size_t(z))];
+      }
+  return float(sum / 27.0);
+}
+
+// Fluid of another level behind a darker bridge (docs/segment.md step 4, session 19). One lumen holds
+// one mixture of tagged fluid: its HU departs from the level only by noise and, toward the wall, by
+// partial volume, and where two mixtures meet in one lumen the fluid between them is fluid. So the
+// voxels of a piece whose 3 x 3 x 3 mean is below the midpoint between its cores' level and
+// fluid-threshold, without the partial-volume rim (eroded by one voxel) and fluid in their own
+// value, in regions of >= kMinOtherLevelMl, are another lumen's fluid when they reach the piece's own
+// level only through voxels darker than themselves (plateau_beyond_bridge): oral contrast in a
+// small-bowel loop joined to a colon pool through the walls' partial volume. Returns each such
+// plateau (its voxels), a core of its own.
+std::vector<std::vector<std::size_t>> ColonSegmenter::other_level_cores(const Bytes& bright, const Bytes& core, const RunLabels& cl) const {
+  const std::vector<float> level = core_levels(cl);
+  Bytes low(d_.total, 0);
+  parallel_for(d_.total, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) {
+      const std::uint32_t l = fluid_label_[q];
+      if (bright[q] && l >= 1 && l <= cl.count()) low[q] = mean3_at(q) < 0.5 * (level[l] + opts_.fluid_threshold);
+    }
+  });
+  const int one[3] = {1, 1, 1};
+  erode_box(low, d_, one);
+  for (std::size_t q = 0; q < d_.total; ++q) low[q] = low[q] && hu_[q] >= opts_.fluid_threshold;
+  const RunLabels found = component_runs(low.data(), d_);
+  Bytes().swap(low);
+  std::vector<std::vector<std::size_t>> out;
+  Bytes seen(d_.total, 0);
+  for (std::uint32_t f = 1; f <= found.count(); ++f) {
+    std::vector<std::size_t> region;
+    for (const Run* r = found.begin(f); r != found.end(f); ++r)
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) region.push_back(q);
+    if (double(region.size()) * voxel_ml_ < kMinOtherLevelMl) continue;
+    const std::uint32_t p = fluid_label_[region.front()];
+    auto found_here = plateaus_beyond_bridge(region, p, 0.5 * (level[p] + opts_.fluid_threshold), core, seen);
+    std::size_t n = 0;
+    for (auto& v : found_here) n += v.size(), out.push_back(std::move(v));
+    if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_other_level(region, n, level[p]);
+  }
+  return out;
+}
+
+// The plateaus of `region` (of piece p) behind a darker bridge: from each of its voxels whose 3 x 3 x 3
+// mean is at least the region's median (its own fluid, not the bridge or rim it may hold), breadth-
+// first through the piece's voxels at least as bright; a component that never reaches the piece's
+// own level (mean >= `own`: one lumen, whose mixtures meet through fluid) and holds >= kMinOtherLevelMl
+// is a plateau, with the piece's core voxels below `own` connected to it (the core may pass the
+// bridge). seen: 1 for a component joined to the piece's level (a later flood meeting it is joined).
+std::vector<std::vector<std::size_t>> ColonSegmenter::plateaus_beyond_bridge(const std::vector<std::size_t>& region, std::uint32_t p,
+                                                                            double own, const Bytes& core, Bytes& seen) const {
+  std::vector<float> m;
+  for (std::size_t q : region) m.push_back(mean3_at(q));
+  std::nth_element(m.begin(), m.begin() + std::ptrdiff_t(m.size() / 2), m.end());
+  const float floor = m[m.size() / 2];
+  std::vector<std::vector<std::size_t>> out;
+  std::vector<std::size_t> marked;
+  for (std::size_t q : region) {
+    if (seen[q] || mean3_at(q) < floor) continue;
+    std::vector<std::size_t> comp{q};
+    seen[q] = 2;
+    bool joined = false;
+    auto flood = [&](auto&& admit) {
+      for (std::size_t head = 0; head < comp.size() && !joined; ++head)
+        for_face_neighbours(d_, comp[head], [&](std::size_t r) {
+          if (seen[r] == 1) joined = true;
+          if (seen[r] || fluid_label_[r] != p || joined || !admit(r, mean3_at(r))) return;
+          seen[r] = 2;
+          comp.push_back(r);
+        });
+    };
+    flood([&](std::size_t, float v) { return v >= own ? (joined = true, false) : v >= floor; });
+    if (!joined && double(comp.size()) * voxel_ml_ >= kMinOtherLevelMl) flood([&](std::size_t r, float v) { return core[r] && v < own; });
+    for (std::size_t c : comp) seen[c] = 1, marked.push_back(c);  // joined or small: no later flood passes it
+    if (!joined && double(comp.size()) * voxel_ml_ >= kMinOtherLevelMl) out.push_back(std::move(comp));
+  }
+  for (std::size_t c : marked) seen[c] = 0;
+  return out;
+}
+
+// A region of another level (COLONFLAT_SEGMENT_DEBUG): volume, centroid (LPS), median own HU, the
+// level of its piece, and the plateau's volume when it lies behind a darker bridge (0: joined).
+void ColonSegmenter::debug_other_level(const std::vector<std::size_t>& region, std::size_t plateau, float level) const {
+  std::vector<float> v;
+  double sum[3] = {0, 0, 0};
+  for (std::size_t q : region) {
+    std::size_t c[3];
+    d_.coords(q, c[0], c[1], c[2]);
+    for (int a = 0; a < 3; ++a) sum[a] += double(c[a]);
+    v.push_back(hu_[q]);
+  }
+  const double n = double(v.size()), c[3] = {sum[0] / n, sum[1] / n, sum[2] / n};
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+  const auto p = lps_of(c);
+  std::fprintf(stderr, "other level %.2f mL at LPS (%.0f %.0f %.0f) crop (%.0f %.0f %.0f) HU %.0f, piece level %.0f: %s %.2f mL\n", n * voxel_ml_,
+               p[0], p[1], p[2], c[0], c[1], c[2], v[v.size() / 2], level, plateau ? "behind a bridge, core" : "joined", double(plateau) * voxel_ml_);
 }
 
 // Candidate bodies (docs/segment.md step 6): face-connected candidate voxels, where two fluid pieces

@@ -144,6 +144,28 @@ TEST(SegmentFluid, DependentFilmOneVoxelThickKept) {
   EXPECT_EQ(wall.second, 0u);
 }
 
+// A supine pool (750 HU) and, under it across 2 mm of wall, a loop of oral contrast (380 HU, radius
+// 4 mm) joined to it by a broad 280 HU bridge (session 19, the real prone CT's 395 HU structure): the
+// core ball passes through the bridge, so the loop's core was part of the pool's and the loop was
+// kept with it. The loop's fluid is under the midpoint between the pool's level and fluid-threshold
+// and reaches the pool only through the darker bridge: it is another lumen and is not kept, while
+// the pool stays whole. Fails without the other-level rule (the loop kept with the pool).
+TEST(SegmentFluid, LoopOfAnotherLevelBridgedToPoolNotKept) {
+  auto ct = make_volume(96, [&](double x, double y, double z) {
+    if (x >= 10 && x <= 85 && radial(y, z, 34, 48) < 10) return y < 34 ? -1000.0 : 750.0;  // colon: gas over a pool
+    if (x >= 15 && x <= 80 && radial(y, z, 50, 48) < 4) return 380.0;                      // small-bowel loop
+    if (x >= 40 && x <= 56 && y >= 40 && y <= 50 && std::abs(z - 48) <= 4) return 280.0;   // bridge
+    return kKeep;
+  }, 0.6, 10);
+  SegmentStats st;
+  auto m = segment_supine(ct, &st);
+  const auto pool = kept_in(m, 14, 81, 36, 43, 40, 56, [](int, int y, int z) { return radial(y, z, 34, 48) < 8.5; });
+  EXPECT_EQ(pool.second, pool.first) << st.to_json()["decisions"].dump(1);
+  const auto loop = kept_in(m, 18, 77, 47, 53, 45, 51, [](int x, int y, int z) { return (x < 36 || x > 60) && radial(y, z, 50, 48) < 2.5; });
+  EXPECT_GT(loop.first, 500u);
+  EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
 // A dense bright blob (900 HU, like a vertebral body) 3 mm beside the colon's gas: it has no level
 // under gas and does not continue the colon; it is not kept.
 TEST(SegmentFluid, BoneLikeBlobsRejected) {

@@ -200,6 +200,41 @@ TEST(SegmentRules, NarrowerTubeAcrossGapFromColonEndRejected) {
   }
 }
 
+// Session 19, both ways of the diameter rule at CT-colonography size (2 mm voxels, 280 mm): a fully
+// tagged stretch between two gas segments across 8 mm necks (rounded ends), 42 mm wide beside 64 mm wide gas ends
+// (a poorly distended stretch: under 3/4 of the colon end's diameter, but of colon calibre, >= 40 mm),
+// and 64 mm wide beside 42 mm gas ends (wider than the colon end: the rule is one-sided). Both are
+// kept; the link log shows the linking contact's diameter ratio beyond 3/4 either way. Both fail with
+// session 18's symmetric rule ("narrower than the colon end across the gap").
+TEST(SegmentRules, StretchOfColonCalibreAcrossGapKeptNarrowerOrWider) {
+  for (bool wider : {false, true}) {
+    SCOPED_TRACE(wider);
+    const double gas_r = wider ? 10.5 : 16, stretch_r = wider ? 16 : 10.5;  // voxels of 2 mm
+    auto ct = make_volume(140, [&](double x, double y, double z) {  // rounded ends: the necks on the axis
+      const double d = tube_dist(y, z, 70, 70), bg = 6 * (d / gas_r) * (d / gas_r), bs = 6 * (d / stretch_r) * (d / stretch_r);
+      if (d < gas_r && ((x >= 5 && x <= 44 - bg) || (x >= 97 + bg && x <= 134))) return -1000.0;
+      if (d < stretch_r && x >= 49 + bs && x <= 92 - bs) return 500.0;
+      return kKeep;
+    }, 0.6, 10);
+    const double sp[3] = {2, 2, 2};
+    ct->SetSpacing(sp);
+    ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
+    auto [m, st] = segment_small(ct, tagged_options(1));
+    ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+    EXPECT_EQ(st.tagged_stretches, 1) << st.to_json()["decisions"].dump(1);
+    EXPECT_TRUE(at(m, 70, 70, 70));
+    bool linked = false;
+    for (const auto& j : st.links)
+      if (j["ok"].get<bool>()) {
+        linked = true;
+        const double ratio = j["diameter_ratio"].get<double>();
+        EXPECT_TRUE(wider ? ratio > 1 / 0.75 : ratio < 0.75) << j.dump();
+        if (!wider) EXPECT_GE(j["cand_diameter_mm"].get<double>(), 40.0) << j.dump();
+      }
+    EXPECT_TRUE(linked) << st.links.dump(1);
+  }
+}
+
 // The link log (COLONFLAT_SEGMENT_LINKS) gives the median tagged-fluid HU near the contact on each
 // side: a 500 HU tube across a 6 mm neck from a dry gas end reads about 500 HU, the gas end none.
 TEST(SegmentRules, LinkLogReportsFluidHuNearContact) {
