@@ -252,6 +252,31 @@ TEST(FlattenSolver, NestedDissectionOrderSolvesWithFewerOperationsThanAmd) {
   if (amd.factor_flops() > 0) EXPECT_LT(nd.factor_flops(), 0.9 * amd.factor_flops());
 }
 
+// A segment with kNestedDissectionMinVertices vertices flattened area-balanced gets nested
+// dissection's order already for its first conformal solve (fewer factorisation operations than
+// AMD's, which it got before); one vertex fewer, or the conformal map alone, keeps AMD's.
+TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
+  const int nx = 448, nv = nx * nx;  // 200 704 vertices
+  const auto big = std::size_t(nv);
+  ASSERT_GE(big, cf::flat_detail::kNestedDissectionMinVertices);
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 19));
+  const std::size_t limit = cf::flat_detail::kNestedDissectionMinVertices;
+  EXPECT_TRUE(cf::flat_detail::uses_dissection(limit, "area-balanced"));
+  EXPECT_FALSE(cf::flat_detail::uses_dissection(limit - 1, "area-balanced"));
+  EXPECT_FALSE(cf::flat_detail::uses_dissection(big, "conformal"));
+  const std::vector<int> order =
+      cf::flat_detail::segment_vertex_order(E, nv, cf::flat_detail::uses_dissection(big, "area-balanced"));
+  EXPECT_EQ(order, cf::flat_detail::nested_dissection_vertex_order(E, nv));
+  EXPECT_EQ(cf::flat_detail::segment_vertex_order(E, nv, false), cf::flat_detail::fill_reducing_vertex_order(E, nv));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  SpdSolver first, amd;
+  first.analyze(A, &order);
+  amd.analyze(A);
+  if (amd.factor_flops() > 0) EXPECT_LT(first.factor_flops(), 0.9 * amd.factor_flops());
+}
+
 namespace {
 
 // The system of a 150 x 150 grid (22 500 unknowns: above the threaded factorisation's threshold)
