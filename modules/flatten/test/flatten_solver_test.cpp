@@ -6,6 +6,7 @@
 #include <map>
 #include <cmath>
 #include <random>
+#include <thread>
 #include <cstring>
 #include <utility>
 
@@ -275,6 +276,29 @@ TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
   first.analyze(A, &order);
   amd.analyze(A);
   if (amd.factor_flops() > 0) EXPECT_LT(first.factor_flops(), 0.9 * amd.factor_flops());
+}
+
+// Two nested dissection orders computed at the same time (two large colon segments flattened side
+// by side) are each the order computed alone: METIS draws from the C library's one rand() state, so
+// its calls must not overlap (they did before: the orders then depended on the timing).
+TEST(FlattenSolver, NestedDissectionOrdersAtTheSameTimeAreEachTheOrderAlone) {
+  std::vector<SpdSolver::SpMat> systems;
+  for (int nx : {200, 210}) {
+    const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 23));
+    std::vector<int> all(nx * nx);
+    for (int v = 0; v < nx * nx; ++v) all[v] = v;
+    systems.push_back(grid_system(E, nx, all, nx * nx));
+  }
+  const std::vector<int> alone0 = SpdSolver::nested_dissection_order(systems[0]);
+  const std::vector<int> alone1 = SpdSolver::nested_dissection_order(systems[1]);
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int> at_once0, at_once1;
+    std::thread other([&] { at_once1 = SpdSolver::nested_dissection_order(systems[1]); });
+    at_once0 = SpdSolver::nested_dissection_order(systems[0]);
+    other.join();
+    EXPECT_EQ(at_once0, alone0) << "round " << round;
+    EXPECT_EQ(at_once1, alone1) << "round " << round;
+  }
 }
 
 namespace {
