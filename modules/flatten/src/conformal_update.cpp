@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/union_find.h"
 #include "conformal_factor.h"
 
@@ -108,11 +109,15 @@ bool restrict_factor(ConformalFactor& f, const Edges& E, const std::vector<doubl
   const SpdSolver::SpMat up = grow.matrix(n), down = shrink.matrix(n);
   const double budget = kUpdateShareOfFactorisation * f.solver.factor_flops();
   const double cost = f.solver.modify_flops({&up, &down}, budget);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+  const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
+  if (debug)
     std::fprintf(stderr, "flatten debug factor update: %d rank-one terms, about %.3g flops against %.3g for a new factorisation\n",
                  grow.columns + shrink.columns, cost, f.solver.factor_flops());
   if (cost > budget) return false;
-  return f.solver.modify(up, true) && f.solver.modify(down, false);
+  const Stopwatch sw;
+  const bool ok = f.solver.modify(up, true) && f.solver.modify(down, false);
+  if (debug) std::fprintf(stderr, "flatten debug factor update done: %.2f s\n", sw.seconds());
+  return ok;
 }
 
 }  // namespace cf::flat_detail

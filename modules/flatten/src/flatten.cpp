@@ -49,24 +49,24 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The fill-reducing
-// order of the conformal solve (w.prior) is computed on a second thread meanwhile, on the closed
-// surface, and restricted to the annulus; on a large segment the nested dissection order of the
-// systems after the first map (w.dissection) is computed on a second thread next, beside the first
-// conformal map (whose order, AMD's, is ready first: ~5 x faster).
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The elimination
+// order of the conformal solve (w.prior; segment_vertex_order: nested dissection on a large segment,
+// kept in w.dissection for the systems after the first map, else AMD) is computed on a second
+// thread meanwhile, on the closed surface, and restricted to the annulus.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     auto E0 = std::make_shared<const Edges>(build_edges(s.t));
     const int nv = int(s.p.size());
-    auto order = std::async(side_launch(), [&] { return fill_reducing_vertex_order(*E0, nv); });
+    const bool dissect = uses_dissection(s.p.size(), o.map);
+    auto order = std::async(side_launch(), [E0, nv, dissect] { return segment_vertex_order(*E0, nv, dissect); }).share();
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
     for (int v : order.get())
       if (op.new_of_old[v] >= 0) w.prior.vertex_order.push_back(op.new_of_old[v]);
-    if (s.p.size() >= kNestedDissectionMinVertices && o.map == "area-balanced") {
-      w.dissection = std::async(side_launch(), [E0, nv] { return nested_dissection_vertex_order(*E0, nv); }).share();
+    if (dissect) {
+      w.dissection = order;
       w.dissection_to_annulus = std::move(op.new_of_old);
     }
   }

@@ -126,12 +126,19 @@ std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
 // Nested dissection's (METIS) order of the same graph (E.ev read): about half the factorisation's
 // operations of AMD's on a colon band, for about 5 x its ordering time (SpdSolver).
 std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv);
-// A colon segment from this many vertices on has its nested dissection order computed beside its
-// first conformal map, for the systems solved after it on the whole band (the re-solve after
-// cutting side branches, the whole-band area correction, the balancing). Below it the ordering
+// A colon segment from this many vertices on has its systems on the whole band (the first conformal
+// map, the re-solve after cutting side branches, the whole-band area correction, the balancing)
+// solved in nested dissection order, computed beside the opening of its ends. Below it the ordering
 // (~5 x AMD's time) costs about what it saves: on a 94 k-vertex side branch 4e8 flops saved (~0.3
 // s) for ~0.8 s of ordering (session 12).
 constexpr std::size_t kNestedDissectionMinVertices = 200000;
+// Whether a segment of `vertices` vertices (closed surface) flattened with `map` gets the nested
+// dissection order: from kNestedDissectionMinVertices on, for the area-balanced map (the conformal
+// map alone solves one large system: the ordering would cost about what it saves there).
+bool uses_dissection(std::size_t vertices, const std::string& map);
+// The elimination order of a segment's closed surface (E, nv vertices) for its conformal solve:
+// nested_dissection_vertex_order when `dissect`, else fill_reducing_vertex_order (AMD).
+std::vector<int> segment_vertex_order(const Edges& E, int nv, bool dissect);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.

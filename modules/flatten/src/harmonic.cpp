@@ -322,12 +322,36 @@ SpMat unit_laplacian(const Edges& E, int nv) {
 
 }  // namespace
 
+namespace {
+
+// COLONFLAT_FLATTEN_DEBUG: what an order of the vertex graph cost.
+void print_order_debug(const char* kind, int nv, const Stopwatch& sw) {
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug %s order: %d vertices, %.2f s\n", kind, nv, sw.seconds());
+}
+
+}  // namespace
+
 std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
-  return SpdSolver::fill_reducing_order(unit_laplacian(E, nv));
+  const Stopwatch sw;
+  std::vector<int> order = SpdSolver::fill_reducing_order(unit_laplacian(E, nv));
+  print_order_debug("AMD", nv, sw);
+  return order;
 }
 
 std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv) {
-  return SpdSolver::nested_dissection_order(unit_laplacian(E, nv));
+  const Stopwatch sw;
+  std::vector<int> order = SpdSolver::nested_dissection_order(unit_laplacian(E, nv));
+  print_order_debug("nested dissection", nv, sw);
+  return order;
+}
+
+bool uses_dissection(std::size_t vertices, const std::string& map) {
+  return vertices >= kNestedDissectionMinVertices && map == "area-balanced";
+}
+
+std::vector<int> segment_vertex_order(const Edges& E, int nv, bool dissect) {
+  return dissect ? nested_dissection_vertex_order(E, nv) : fill_reducing_vertex_order(E, nv);
 }
 
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {

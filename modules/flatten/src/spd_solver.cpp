@@ -136,6 +136,15 @@ Eigen::MatrixXd take_dense(cholmod_dense*& x, cholmod_common& common) {
   return out;
 }
 
+// METIS (libmetis 5.1 as packaged) draws its random numbers from the C library's rand(): one state
+// for the process, re-seeded at each call. Two calls at once interleave their draws, and each order
+// then depends on the timing (two large colon segments flattened side by side); one at a time, each
+// is the order it is alone.
+std::mutex& metis_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 // CHOLMOD's AMD (`nested` false) or METIS nested dissection order of A; empty when it fails.
 std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
   use_huge_pages_for_cholmod();
@@ -144,6 +153,8 @@ std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
   common.print = 0;
   cholmod_sparse view = view_lower(A);
   std::vector<int> order(std::size_t(A.rows()));
+  std::unique_lock<std::mutex> one_metis_at_a_time(metis_mutex(), std::defer_lock);
+  if (nested) one_metis_at_a_time.lock();
   const bool ok = nested ? cholmod_metis(&view, nullptr, 0, 1, order.data(), &common)
                          : cholmod_amd(&view, nullptr, 0, order.data(), &common);
   cholmod_finish(&common);

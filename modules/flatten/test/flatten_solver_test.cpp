@@ -6,6 +6,7 @@
 #include <map>
 #include <cmath>
 #include <random>
+#include <thread>
 #include <cstring>
 #include <utility>
 
@@ -250,6 +251,54 @@ TEST(FlattenSolver, NestedDissectionOrderSolvesWithFewerOperationsThanAmd) {
   const double amd_residual = (full * amd.solve(b) - b).norm();
   EXPECT_LT((full * nd.solve(b) - b).norm(), std::max(10 * amd_residual, 1e-12 * b.norm()));
   if (amd.factor_flops() > 0) EXPECT_LT(nd.factor_flops(), 0.9 * amd.factor_flops());
+}
+
+// A segment with kNestedDissectionMinVertices vertices flattened area-balanced gets nested
+// dissection's order already for its first conformal solve (fewer factorisation operations than
+// AMD's, which it got before); one vertex fewer, or the conformal map alone, keeps AMD's.
+TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
+  const int nx = 448, nv = nx * nx;  // 200 704 vertices
+  const auto big = std::size_t(nv);
+  ASSERT_GE(big, cf::flat_detail::kNestedDissectionMinVertices);
+  const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 19));
+  const std::size_t limit = cf::flat_detail::kNestedDissectionMinVertices;
+  EXPECT_TRUE(cf::flat_detail::uses_dissection(limit, "area-balanced"));
+  EXPECT_FALSE(cf::flat_detail::uses_dissection(limit - 1, "area-balanced"));
+  EXPECT_FALSE(cf::flat_detail::uses_dissection(big, "conformal"));
+  const std::vector<int> order =
+      cf::flat_detail::segment_vertex_order(E, nv, cf::flat_detail::uses_dissection(big, "area-balanced"));
+  EXPECT_EQ(order, cf::flat_detail::nested_dissection_vertex_order(E, nv));
+  EXPECT_EQ(cf::flat_detail::segment_vertex_order(E, nv, false), cf::flat_detail::fill_reducing_vertex_order(E, nv));
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  SpdSolver first, amd;
+  first.analyze(A, &order);
+  amd.analyze(A);
+  if (amd.factor_flops() > 0) EXPECT_LT(first.factor_flops(), 0.9 * amd.factor_flops());
+}
+
+// Two nested dissection orders computed at the same time (two large colon segments flattened side
+// by side) are each the order computed alone: METIS draws from the C library's one rand() state, so
+// its calls must not overlap (they did before: the orders then depended on the timing).
+TEST(FlattenSolver, NestedDissectionOrdersAtTheSameTimeAreEachTheOrderAlone) {
+  std::vector<SpdSolver::SpMat> systems;
+  for (int nx : {200, 210}) {
+    const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 23));
+    std::vector<int> all(nx * nx);
+    for (int v = 0; v < nx * nx; ++v) all[v] = v;
+    systems.push_back(grid_system(E, nx, all, nx * nx));
+  }
+  const std::vector<int> alone0 = SpdSolver::nested_dissection_order(systems[0]);
+  const std::vector<int> alone1 = SpdSolver::nested_dissection_order(systems[1]);
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int> at_once0, at_once1;
+    std::thread other([&] { at_once1 = SpdSolver::nested_dissection_order(systems[1]); });
+    at_once0 = SpdSolver::nested_dissection_order(systems[0]);
+    other.join();
+    EXPECT_EQ(at_once0, alone0) << "round " << round;
+    EXPECT_EQ(at_once1, alone1) << "round " << round;
+  }
 }
 
 namespace {
