@@ -43,6 +43,7 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.weights = j.value("weights", "");
   s.untangled_vertices = j.value("untangled_vertices", std::size_t(0));
   s.crowded_faces = j.value("crowded_faces_left_out", std::size_t(0));
+  s.inverted_faces = j.value("inverted_faces_left_out", std::size_t(0));
   s.dirichlet_period_ratio = j.value("period_consistency", 1.0);
   if (j.contains("distortion")) {
     const auto& d = j["distortion"];

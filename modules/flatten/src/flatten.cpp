@@ -144,8 +144,10 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   kept.reserve(fd.size());
   double a2 = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) w.in_map[f] = 0, ++w.seg.crowded_faces;
-    else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
+    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) {
+      w.in_map[f] = 0, ++w.seg.crowded_faces;
+      w.seg.inverted_faces += fd[f].area2 < 0;
+    } else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
   }
   w.seg.stats = stats_of(kept);
   const double scale = a2 > 0 ? w.seg.area_3d / a2 : 1.0;
@@ -364,6 +366,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   // reads the collapse, which untangling cannot lift).
   w.folds_pending = may_cut && !w.branch;
   conformal(w, loops, p, o);
+  if (depth == 0) debug_stats("first conformal", w, p.degenerate);
   phase("conformal map");
   std::future<FlattenedBranches> cut;
   if (may_cut) cut = cut_branches(w, loops, p, o, depth);

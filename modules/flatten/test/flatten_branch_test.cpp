@@ -66,6 +66,45 @@ TEST(FlattenBranches, WithoutBranchesThePouchIsNotShownAndLocated) {
   EXPECT_GT(f.coverage.not_shown[0].centroid_lps_mm[1], 30.0);
 }
 
+// A 40 mm strand stump (tissue, 1 mm radius) is crushed by the conformal map below what the map
+// resolves: it is cut at its base and shown as a band of its own, and the colon band keeps every
+// face in its map (none left out, none folded), its whole wall shown.
+TEST(FlattenBranches, CrushedTissueStrandIsABandOfItsOwn) {
+  const FlatMap f = flatten_colon(test_shapes::tube_and_strand(40.0));
+  const FlatSegment& colon = f.segments[0];
+  EXPECT_EQ(colon.crowded_faces, 0u);
+  EXPECT_EQ(colon.inverted_faces, 0u);
+  EXPECT_EQ(colon.stats.flipped, 0u);
+  EXPECT_GE(colon.coverage.fraction, 0.995);
+  EXPECT_LE(colon.stats.qc_mean, 1.5);
+  ASSERT_EQ(f.segments.size(), 2u);
+  const FlatSegment& b = f.segments[1];
+  EXPECT_EQ(b.kind, "branch");
+  EXPECT_NEAR(b.attach_lps[0], 104.0, 6.0);  // its neck is at the strand's base on the wall (z = -12)
+  EXPECT_LT(b.attach_lps[2], -8.0);
+  EXPECT_GT(b.area_3d, 0.8 * 2 * M_PI * 1.0 * 30.0);
+  EXPECT_GE(b.coverage.fraction, 0.9);
+  EXPECT_GE(f.coverage.fraction, 0.995);
+}
+
+// The same strand kept on the colon band (--branch-min-area 0): its faces are left out of the map,
+// and the stage's segment line says how many and how many of them fold over ("flipped" counts only
+// faces in the map), as the flat file's segment fields do.
+TEST(FlattenBranches, StrandLeftOnTheBandIsCountedLeftOut) {
+  testing::TempDir tmp;
+  write_mesh(synthetic::to_mesh(test_shapes::tube_and_strand(40.0)), tmp / "in.vtp");
+  const auto r = testing::run_stage_command(
+      make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "0"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const FlatMap g = read_flat(tmp / "flat.vtp");
+  ASSERT_EQ(g.segments.size(), 1u);
+  EXPECT_GT(g.segments[0].crowded_faces, 20u);
+  EXPECT_LT(g.coverage.fraction, 0.995);
+  const std::string said = "left out of the map " + std::to_string(g.segments[0].crowded_faces) + " faces (" +
+                           std::to_string(g.segments[0].inverted_faces) + " folded over)";
+  EXPECT_NE((r.out + r.err).find(said), std::string::npos) << r.out << r.err;
+}
+
 // A polyp on a thin stalk is collapsed like a pouch but is tissue, not lumen: it stays on the
 // colon band (no side branch), where the image and the polyp detection look for it.
 TEST(FlattenBranches, PolypOnAStalkStaysOnTheColonBand) {

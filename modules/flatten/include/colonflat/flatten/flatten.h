@@ -79,6 +79,7 @@ struct FlatSegment {
   std::string weights;      // weights used ("cotan" or "clamped")
   std::size_t untangled_vertices = 0;    // vertices re-embedded (Tutte) to undo fold-overs
   std::size_t crowded_faces = 0;         // faces left out: area factor < 1e-7 or folded (thin protrusions)
+  std::size_t inverted_faces = 0;        // of those: folded over (negative 2D area), however small
   DistortionStats stats;
   // area-balanced map (empty / 0 for older files and the conformal map)
   std::string map;                                   // "area-balanced" or "conformal"
