@@ -244,7 +244,9 @@ class BranchFinder {
     const double r = neck_radius(c, d, b.neck_mm);
     const std::vector<char> in = r > 0 ? inside(c, d, r) : std::vector<char>();
     debug_cluster(c, b, r, in);
-    if (in.empty() || !is_disk(in) || !(holds_lumen(in) || crushed(c))) return false;
+    if (in.empty() || !is_disk(in)) return false;
+    b.tissue = !holds_lumen(in);
+    if (b.tissue && !crushed(c)) return false;
     for (std::size_t f = 0; f < s_.t.size(); ++f)
       if (in[f]) b.faces.push_back(int(f)), b.area_mm2 += area3_[f];
     return !b.faces.empty();

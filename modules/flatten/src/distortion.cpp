@@ -257,6 +257,7 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
     j["attach_mm"] = s.attach_mm;
     j["attach_lps_mm"] = s.attach_lps;
     j["neck_mm"] = s.neck_mm;
+    j["holds"] = s.holds;
   }
   return j;
 }

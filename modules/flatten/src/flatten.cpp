@@ -217,6 +217,7 @@ struct BranchPiece {
   Surface surface;
   std::vector<int> neck;
   double neck_mm = 0;
+  bool tissue = false;  // holds tissue (a strand stump), not lumen
 };
 
 // Flattens the cut-off branches (each as a band of its own, recursively); returns their works and
@@ -233,6 +234,7 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
       sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
       sub[0].cap_area = 0;
       sub[0].seg.neck_mm = piece.neck_mm;
+      sub[0].seg.holds = piece.tissue ? "tissue" : "lumen";
       sub[0].neck = piece.neck;
       placed += surface_area(piece.surface);
       append_branch(sub, out);
@@ -276,6 +278,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     BranchPiece piece;
     piece.surface = sub_surface(w.ann, in);
     piece.neck_mm = cut.neck_mm;
+    piece.tissue = cut.tissue;
     for (std::size_t f = 0; f < nf; ++f)
       if (in[f])
         for (int v : w.ann.t[f])

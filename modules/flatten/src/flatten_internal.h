@@ -167,6 +167,7 @@ struct BranchCut {
   double area_mm2 = 0;  // 3D area of the branch
   double neck_mm = 0;   // 3D length of the neck
   V2 centre;            // flat position of the collapse in the conformal embedding (mm)
+  bool tissue = false;  // the region closed over the neck holds tissue (a crushed strand stump), not lumen
 };
 // Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; largest first,
 // disjoint; pouches of the lumen (face normals x `lumen_sign` point out of the lumen), not tissue

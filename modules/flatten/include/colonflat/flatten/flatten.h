@@ -99,6 +99,9 @@ struct FlatSegment {
   double attach_mm = 0;                              // branch: centreline mm of its neck on the parent band
   std::array<double, 3> attach_lps{0, 0, 0};         // branch: centre of the neck, LPS mm
   double neck_mm = 0;                                // branch: 3D length of the neck (mm)
+  std::string holds = "lumen";                       // branch: what the region closed over its neck holds:
+                                                     // "lumen" (a pouch: diverticulum, blind loop) or "tissue"
+                                                     // (a crushed strand stump: a tissue bridge cut by denoise)
 };
 
 // The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices
