@@ -224,16 +224,32 @@ class BranchFinder {
     return std::any_of(c.faces.begin(), c.faces.end(), [&](int f) { return emb_.area2(s_, f) < 0; });
   }
 
+  // A face's smallest height in the map (2 |area| / longest side), in units of the spacing of the
+  // doubles at its corners' largest coordinate: how finely the map's numbers resolve its shape.
+  double height_in_ulps(int f) const {
+    const auto c = emb_.corners(s_, f);
+    double side = 0, coord = 0;
+    for (int k = 0; k < 3; ++k) {
+      side = std::max(side, (c[(k + 1) % 3] - c[k]).norm());
+      coord = std::max({coord, std::abs(c[k].x()), std::abs(c[k].y())});
+    }
+    const double ulp = std::nextafter(coord, 2 * coord + 1) - coord;
+    return side > 0 ? 2 * std::abs(emb_.area2(s_, f)) / side / ulp : 0;
+  }
+
   // COLONFLAT_FLATTEN_DEBUG=1: each candidate cluster, its neck and why it is kept or not.
   void debug_cluster(const Cluster& c, const BranchCut& b, double r, const std::vector<char>& in) const {
     if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
     V3 m = V3::Zero();
-    double lowest = 1e300;
-    for (int f : c.faces) m += s_.p[s_.t[f][0]], lowest = std::min(lowest, emb_.area2(s_, f) / area3_[f]);
+    double lowest = 1e300, finest = 1e300;
+    for (int f : c.faces) {
+      m += s_.p[s_.t[f][0]], lowest = std::min(lowest, emb_.area2(s_, f) / area3_[f]);
+      finest = std::min(finest, height_in_ulps(f));
+    }
     m /= double(c.faces.size());
     const bool found = !in.empty();
-    std::fprintf(stderr, "flatten debug cluster %zu faces %.1f mm2 min ratio %.2g LPS %.1f %.1f %.1f centre x %.2f: "
-                 "neck radius %.3g, %.1f mm, disk %d, lumen %d, crushed %d\n", c.faces.size(), c.area, lowest, m.x(), m.y(),
+    std::fprintf(stderr, "flatten debug cluster %zu faces %.1f mm2 min ratio %.2g height %.3g ulp LPS %.1f %.1f %.1f centre x %.2f: "
+                 "neck radius %.3g, %.1f mm, disk %d, lumen %d, crushed %d\n", c.faces.size(), c.area, lowest, finest, m.x(), m.y(),
                  m.z(), b.centre.x(), r, b.neck_mm, found ? int(is_disk(in)) : -1, found ? int(holds_lumen(in)) : -1,
                  int(crushed(c)));
   }
