@@ -223,9 +223,10 @@ void stress_row(const std::string& name, const cf::Mesh& mesh, int threads, cons
     phases += " " + ph["phase"].get<std::string>() + " " + std::to_string(ph["time_s"].get<double>()).substr(0, 5) + ";";
   std::printf("    phases:%s\n", phases.c_str());
   for (const auto& sg : flat.segments)
-    std::printf("    segment %d (%s, %zu faces): area p05 %.3f p95 %.3f, qc %.3f, shown %.2f %%, correction steps %d\n",
+    std::printf("    segment %d (%s, %zu faces): area p05 %.3f p95 %.3f, qc %.3f, shown %.2f %%, correction steps %d, "
+                "left out %zu (%zu inverted)\n",
                 sg.id, sg.kind.c_str(), sg.faces, sg.stats.area_p05, sg.stats.area_p95, sg.stats.qc_mean,
-                100 * sg.coverage.fraction, sg.corrected_iterations);
+                100 * sg.coverage.fraction, sg.corrected_iterations, sg.crowded_faces, sg.inverted_faces);
   std::fflush(stdout);
   if (!out.empty() && same == "-") {
     std::filesystem::create_directories(out);

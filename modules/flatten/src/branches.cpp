@@ -11,11 +11,15 @@
 //  3. the neck: the radius r >= the cluster's extent whose rim is shortest in 3D (inside the pouch
 //     the rim runs around its body, beyond the neck it grows with the tube wall);
 //  4. the branch: faces with d < r connected to the cluster, with any enclosed island added; kept
-//     when it is a disk holding lumen (a polyp on a stalk, tissue, stays on the colon band).
+//     when it is a disk holding lumen (a polyp on a stalk, tissue, stays on the colon band), or
+//     when the cluster is crushed below what the map resolves (a fold in it: a long strand stump,
+//     tissue, that the colon band could only leave out of its map).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <cstdio>
+#include <cstdlib>
 
 #include "flatten_internal.h"
 
@@ -212,13 +216,53 @@ class BranchFinder {
     return vol * lumen_sign_ > 0;
   }
 
+  // A collapsed cluster holding a fold (negative 2D area) is crushed below what the map's doubles
+  // resolve: its corners' flat positions differ by a few units in the last place and their rounding
+  // decides the sign. Untangling cannot lift it (its ring is as crushed) and the area correction
+  // only moves a map with positive areas, so it is cut off, lumen or tissue (a long strand stump).
+  bool crushed(const Cluster& c) const {
+    return std::any_of(c.faces.begin(), c.faces.end(), [&](int f) { return emb_.area2(s_, f) < 0; });
+  }
+
+  // A face's smallest height in the map (2 |area| / longest side), in units of the spacing of the
+  // doubles at its corners' largest coordinate: how finely the map's numbers resolve its shape.
+  double height_in_ulps(int f) const {
+    const auto c = emb_.corners(s_, f);
+    double side = 0, coord = 0;
+    for (int k = 0; k < 3; ++k) {
+      side = std::max(side, (c[(k + 1) % 3] - c[k]).norm());
+      coord = std::max({coord, std::abs(c[k].x()), std::abs(c[k].y())});
+    }
+    const double ulp = std::nextafter(coord, 2 * coord + 1) - coord;
+    return side > 0 ? 2 * std::abs(emb_.area2(s_, f)) / side / ulp : 0;
+  }
+
+  // COLONFLAT_FLATTEN_DEBUG=1: each candidate cluster, its neck and why it is kept or not.
+  void debug_cluster(const Cluster& c, const BranchCut& b, double r, const std::vector<char>& in) const {
+    if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+    V3 m = V3::Zero();
+    double lowest = 1e300, finest = 1e300;
+    for (int f : c.faces) {
+      m += s_.p[s_.t[f][0]], lowest = std::min(lowest, emb_.area2(s_, f) / area3_[f]);
+      finest = std::min(finest, height_in_ulps(f));
+    }
+    m /= double(c.faces.size());
+    const bool found = !in.empty();
+    std::fprintf(stderr, "flatten debug cluster %zu faces %.1f mm2 min ratio %.2g height %.3g ulp LPS %.1f %.1f %.1f centre x %.2f: "
+                 "neck radius %.3g, %.1f mm, disk %d, lumen %d, crushed %d\n", c.faces.size(), c.area, lowest, finest, m.x(), m.y(),
+                 m.z(), b.centre.x(), r, b.neck_mm, found ? int(is_disk(in)) : -1, found ? int(holds_lumen(in)) : -1,
+                 int(crushed(c)));
+  }
+
   bool cut_branch(const Cluster& c, BranchCut& b) const {
     b.centre = centre_of(c);
     const std::vector<double> d = flat_distance(b.centre);
     const double r = neck_radius(c, d, b.neck_mm);
-    if (!(r > 0)) return false;
-    const std::vector<char> in = inside(c, d, r);
-    if (!is_disk(in) || !holds_lumen(in)) return false;
+    const std::vector<char> in = r > 0 ? inside(c, d, r) : std::vector<char>();
+    debug_cluster(c, b, r, in);
+    if (in.empty() || !is_disk(in)) return false;
+    b.tissue = !holds_lumen(in);
+    if (b.tissue && !crushed(c)) return false;
     for (std::size_t f = 0; f < s_.t.size(); ++f)
       if (in[f]) b.faces.push_back(int(f)), b.area_mm2 += area3_[f];
     return !b.faces.empty();

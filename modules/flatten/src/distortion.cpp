@@ -235,6 +235,7 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
                       {"weights", s.weights},
                       {"untangled_vertices", s.untangled_vertices},
                       {"crowded_faces_left_out", s.crowded_faces},
+                      {"inverted_faces_left_out", s.inverted_faces},
                       {"period_consistency", s.dirichlet_period_ratio},
                       {"distortion", distortion_to_json(s.stats)}};
   if (s.map.empty()) return j;
@@ -256,6 +257,7 @@ nlohmann::json segment_to_json(const FlatSegment& s) {
     j["attach_mm"] = s.attach_mm;
     j["attach_lps_mm"] = s.attach_lps;
     j["neck_mm"] = s.neck_mm;
+    j["holds"] = s.holds;
   }
   return j;
 }

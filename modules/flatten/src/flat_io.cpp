@@ -43,6 +43,7 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.weights = j.value("weights", "");
   s.untangled_vertices = j.value("untangled_vertices", std::size_t(0));
   s.crowded_faces = j.value("crowded_faces_left_out", std::size_t(0));
+  s.inverted_faces = j.value("inverted_faces_left_out", std::size_t(0));
   s.dirichlet_period_ratio = j.value("period_consistency", 1.0);
   if (j.contains("distortion")) {
     const auto& d = j["distortion"];
@@ -74,6 +75,7 @@ FlatSegment segment_from_json(const nlohmann::json& j) {
   s.attach_mm = j.value("attach_mm", 0.0);
   if (j.contains("attach_lps_mm")) s.attach_lps = j["attach_lps_mm"].get<std::array<double, 3>>();
   s.neck_mm = j.value("neck_mm", 0.0);
+  s.holds = j.value("holds", "lumen");  // (files before session 19: every branch was a pouch of lumen)
   return s;
 }
 

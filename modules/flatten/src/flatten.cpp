@@ -144,8 +144,10 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   kept.reserve(fd.size());
   double a2 = 0;
   for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) w.in_map[f] = 0, ++w.seg.crowded_faces;
-    else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
+    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) {
+      w.in_map[f] = 0, ++w.seg.crowded_faces;
+      w.seg.inverted_faces += fd[f].area2 < 0;
+    } else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
   }
   w.seg.stats = stats_of(kept);
   const double scale = a2 > 0 ? w.seg.area_3d / a2 : 1.0;
@@ -215,6 +217,7 @@ struct BranchPiece {
   Surface surface;
   std::vector<int> neck;
   double neck_mm = 0;
+  bool tissue = false;  // holds tissue (a strand stump), not lumen
 };
 
 // Flattens the cut-off branches (each as a band of its own, recursively); returns their works and
@@ -231,6 +234,7 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
       sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
       sub[0].cap_area = 0;
       sub[0].seg.neck_mm = piece.neck_mm;
+      sub[0].seg.holds = piece.tissue ? "tissue" : "lumen";
       sub[0].neck = piece.neck;
       placed += surface_area(piece.surface);
       append_branch(sub, out);
@@ -274,6 +278,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     BranchPiece piece;
     piece.surface = sub_surface(w.ann, in);
     piece.neck_mm = cut.neck_mm;
+    piece.tissue = cut.tissue;
     for (std::size_t f = 0; f < nf; ++f)
       if (in[f])
         for (int v : w.ann.t[f])
@@ -364,6 +369,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   // reads the collapse, which untangling cannot lift).
   w.folds_pending = may_cut && !w.branch;
   conformal(w, loops, p, o);
+  if (depth == 0) debug_stats("first conformal", w, p.degenerate);
   phase("conformal map");
   std::future<FlattenedBranches> cut;
   if (may_cut) cut = cut_branches(w, loops, p, o, depth);

@@ -174,11 +174,13 @@ struct BranchCut {
   double area_mm2 = 0;  // 3D area of the branch
   double neck_mm = 0;   // 3D length of the neck
   V2 centre;            // flat position of the collapse in the conformal embedding (mm)
+  bool tissue = false;  // the region closed over the neck holds tissue (a crushed strand stump), not lumen
 };
 // Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; largest first,
-// disjoint; pouches of the lumen only (face normals x `lumen_sign` point out of the lumen), not
-// tissue protrusions (a polyp on a stalk). `emb`: conformal embedding at the area-preserving
-// scale, band [0, length] in x.
+// disjoint; pouches of the lumen (face normals x `lumen_sign` point out of the lumen), not tissue
+// protrusions (a polyp on a stalk) unless their cluster holds a fold (negative 2D area: crushed
+// below what the map's doubles resolve, e.g. a long strand stump). `emb`: conformal embedding at
+// the area-preserving scale (not untangled), band [0, length] in x.
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
                                      double lumen_sign, double min_area_mm2);
 

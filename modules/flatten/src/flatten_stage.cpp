@@ -27,6 +27,16 @@ const ParamTable<FlattenOptions>& flatten_param_table() {
   return table;
 }
 
+namespace {
+// ", left out of the map N faces (M folded over)" when a segment has faces too small for its map
+// ("flipped" counts the faces in the map only).
+std::string left_out(const FlatSegment& s) {
+  if (s.crowded_faces == 0) return "";
+  return ", left out of the map " + std::to_string(s.crowded_faces) + " faces (" + std::to_string(s.inverted_faces) +
+         " folded over)";
+}
+}  // namespace
+
 void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
   const nlohmann::json orientation = orient_mesh_input(bag, "denoised", ctx, "flatten");
   const Mesh& mesh = bag.get<Mesh>("denoised");
@@ -40,6 +50,7 @@ void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
     std::ostringstream line;
     line << std::fixed << std::setprecision(1) << "flatten: segment " << s.id << " (" << s.input_kind << ", "
          << s.faces << " faces): " << s.length << " x " << s.period << " mm, flipped " << s.stats.flipped
+         << left_out(s)
          << ", quasi-conformal mean " << std::setprecision(3) << s.stats.qc_mean << " p95 " << s.stats.qc_p95
          << " max " << s.stats.qc_max << ", area p05 " << s.stats.area_p05 << " p95 " << s.stats.area_p95
          << ", shown " << std::setprecision(2) << 100 * s.coverage.fraction << " % of the wall, ends "
@@ -49,6 +60,10 @@ void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
   }
   if (flat.stats.flipped > 0)
     ctx.progress("flatten: warning: " + std::to_string(flat.stats.flipped) + " flipped triangles");
+  std::size_t inverted = 0;
+  for (const auto& s : flat.segments) inverted += s.inverted_faces;
+  if (inverted > 0)
+    ctx.progress("flatten: warning: " + std::to_string(inverted) + " triangles folded over, left out of the map");
   bag.put("flat", std::move(flat));
 }
 

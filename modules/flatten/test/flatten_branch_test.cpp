@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include "colonflat/core/error.h"
@@ -28,8 +29,8 @@ double wall_area(const TriangleList& t) {
   return a;
 }
 
-// A pouch (22 mm sphere) behind a 3 mm neck: a second band, hanging from the colon band at the
-// neck (LPS ~ (120, 12..32, 0), neck length ~ 2 pi 3 mm), and the whole wall shown.
+// A pouch (22 mm sphere) behind a 3 mm neck: a second band holding lumen, hanging from the colon
+// band at the neck (LPS ~ (120, 12..32, 0), neck length ~ 2 pi 3 mm), and the whole wall shown.
 TEST(FlattenBranches, PouchBehindNarrowNeckIsABandOfItsOwn) {
   const TriangleList mesh = test_shapes::pouch_behind_neck(3.0);
   const FlatMap f = flatten_colon(mesh);
@@ -40,6 +41,7 @@ TEST(FlattenBranches, PouchBehindNarrowNeckIsABandOfItsOwn) {
   EXPECT_EQ(b.kind, "branch");
   EXPECT_EQ(b.parent, colon.id);
   EXPECT_EQ(b.x0_end, "neck");
+  EXPECT_EQ(b.holds, "lumen");
   EXPECT_NEAR(b.attach_lps[0], 120.0, 6.0);
   EXPECT_GT(b.attach_lps[1], 8.0);
   EXPECT_LT(b.attach_lps[1], 40.0);
@@ -64,6 +66,46 @@ TEST(FlattenBranches, WithoutBranchesThePouchIsNotShownAndLocated) {
   ASSERT_FALSE(f.coverage.not_shown.empty());
   EXPECT_NEAR(f.coverage.not_shown[0].centroid_lps_mm[0], 120.0, 10.0);
   EXPECT_GT(f.coverage.not_shown[0].centroid_lps_mm[1], 30.0);
+}
+
+// A 40 mm strand stump (tissue, 1 mm radius) is crushed by the conformal map below what the map
+// resolves: it is cut at its base and shown as a band of its own that says it holds tissue, and
+// the colon band keeps every face in its map (none left out, none folded), its whole wall shown.
+TEST(FlattenBranches, CrushedTissueStrandIsABandOfItsOwn) {
+  const FlatMap f = flatten_colon(test_shapes::tube_and_strand(40.0));
+  const FlatSegment& colon = f.segments[0];
+  EXPECT_EQ(colon.crowded_faces, 0u);
+  EXPECT_EQ(colon.inverted_faces, 0u);
+  EXPECT_EQ(colon.stats.flipped, 0u);
+  EXPECT_GE(colon.coverage.fraction, 0.995);
+  EXPECT_LE(colon.stats.qc_mean, 1.5);
+  ASSERT_EQ(f.segments.size(), 2u);
+  const FlatSegment& b = f.segments[1];
+  EXPECT_EQ(b.kind, "branch");
+  EXPECT_EQ(b.holds, "tissue");
+  EXPECT_NEAR(b.attach_lps[0], 104.0, 6.0);  // its neck is at the strand's base on the wall (z = -12)
+  EXPECT_LT(b.attach_lps[2], -8.0);
+  EXPECT_GT(b.area_3d, 0.8 * 2 * M_PI * 1.0 * 30.0);
+  EXPECT_GE(b.coverage.fraction, 0.9);
+  EXPECT_GE(f.coverage.fraction, 0.995);
+}
+
+// The same strand kept on the colon band (--branch-min-area 0): its faces are left out of the map,
+// and the stage's segment line says how many and how many of them fold over ("flipped" counts only
+// faces in the map), as the flat file's segment fields do.
+TEST(FlattenBranches, StrandLeftOnTheBandIsCountedLeftOut) {
+  testing::TempDir tmp;
+  write_mesh(synthetic::to_mesh(test_shapes::tube_and_strand(40.0)), tmp / "in.vtp");
+  const auto r = testing::run_stage_command(
+      make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "0"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const FlatMap g = read_flat(tmp / "flat.vtp");
+  ASSERT_EQ(g.segments.size(), 1u);
+  EXPECT_GT(g.segments[0].crowded_faces, 20u);
+  EXPECT_LT(g.coverage.fraction, 0.995);
+  const std::string said = "left out of the map " + std::to_string(g.segments[0].crowded_faces) + " faces (" +
+                           std::to_string(g.segments[0].inverted_faces) + " folded over)";
+  EXPECT_NE((r.out + r.err).find(said), std::string::npos) << r.out << r.err;
 }
 
 // A polyp on a thin stalk is collapsed like a pouch but is tissue, not lumen: it stays on the
@@ -91,7 +133,7 @@ TEST(FlattenBranches, PlainFoldedTubeHasNoBranch) {
   EXPECT_GE(f.coverage.fraction, 0.995);
 }
 
-// The branch fields (kind, parent, attachment, neck) survive the flat .vtp round trip.
+// The branch fields (kind, parent, attachment, neck, what it holds) survive the flat .vtp round trip.
 TEST(FlattenBranches, BranchFieldsSurviveTheFlatFile) {
   testing::TempDir tmp;
   const FlatMap f = flatten_colon(test_shapes::pouch_behind_neck(3.0));
@@ -104,7 +146,27 @@ TEST(FlattenBranches, BranchFieldsSurviveTheFlatFile) {
   EXPECT_DOUBLE_EQ(g.segments[1].attach_mm, f.segments[1].attach_mm);
   EXPECT_EQ(g.segments[1].attach_lps, f.segments[1].attach_lps);
   EXPECT_DOUBLE_EQ(g.segments[1].neck_mm, f.segments[1].neck_mm);
+  EXPECT_EQ(g.segments[1].holds, "lumen");
   EXPECT_EQ(g.segments[0].kind, "colon");
+}
+
+// A strand stump's band says "tissue" in the flat file's FlatSegments and in the stage's report
+// (segments[1].holds), which render reads to caption it.
+TEST(FlattenBranches, TissueBandSaysSoInTheFlatFileAndReport) {
+  testing::TempDir tmp;
+  write_mesh(synthetic::to_mesh(test_shapes::tube_and_strand(40.0)), tmp / "in.vtp");
+  const auto r = testing::run_stage_command(make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"),
+                                                                 "--report", tmp.str("report.json")});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const FlatMap g = read_flat(tmp / "flat.vtp");
+  ASSERT_EQ(g.segments.size(), 2u);
+  EXPECT_EQ(g.segments[1].holds, "tissue");
+  std::ifstream in(tmp / "report.json");
+  const nlohmann::json segs = nlohmann::json::parse(in)["result"]["segments"];
+  ASSERT_EQ(segs.size(), 2u);
+  EXPECT_EQ(segs[1].value("kind", ""), "branch");
+  EXPECT_EQ(segs[1].value("holds", ""), "tissue");
+  EXPECT_FALSE(segs[0].contains("holds"));  // the colon band is no branch
 }
 
 // A negative --branch-min-area is refused by `colonflat flatten` (usage error, one line, no output).

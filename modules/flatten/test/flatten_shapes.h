@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 
 #include "colonflat/core/soup.h"
@@ -111,6 +112,22 @@ inline TriangleList pouch_and_stump() {
         return std::max(tube, -stump);  // lumen = tube and pouch minus the stump's tissue
       },
       {-15, -22, -31}, {215, 38, 31}, 0.8);
+}
+
+// Closed tube along x (radius 12 mm, 0..200 mm) with a long strand stump: a finger of tissue of
+// radius 1 mm leaving the wall at x ~ 100, z = -12 and rising into the lumen at 30 degrees to the
+// tube's axis, `length` mm from its buried end (about length - 4 mm of it in the lumen), at 0.8 mm:
+// what denoise leaves of a cut tissue bridge. The conformal map shrinks a finger of radius r by
+// about exp(-depth / r) in length; at 35 mm that is far below what double precision resolves.
+inline TriangleList tube_and_strand(double length) {
+  return surface_of(
+      [length](const Eigen::Vector3d& p) {
+        const double tube = capsule(p, {0, 0, 0}, {200, 0, 0}, 12);
+        const Eigen::Vector3d base(100, 0, -14), dir(std::cos(M_PI / 6), 0, std::sin(M_PI / 6));
+        const double strand = capsule(p, base, base + length * dir, 1.0);
+        return std::max(tube, -strand);  // lumen = tube minus the strand's tissue
+      },
+      {-15, -15, -15}, {215, 15, 15}, 0.8);
 }
 
 }  // namespace cf::test_shapes

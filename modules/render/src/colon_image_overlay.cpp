@@ -243,14 +243,9 @@ void ColonImagePainter::write_band_captions() {
   for (const Band& b : bands_) {
     const FlatSegment& s = flat_.segments[b.seg];
     const bool along = !s.map.empty() && s.map != "conformal";
-    std::string t = "segment " + std::to_string(s.id + 1) + ": ";
-    if (s.kind == "branch")
-      t += "side branch (pouch) of segment " + std::to_string(s.parent + 1) + " at " + fmt0(s.attach_mm / 10) +
-           " cm, neck " + fmt0(s.neck_mm) + " mm around; ";
-    t += fmt0(s.length) + " mm long x " + fmt0(s.period) + " mm around; " + s.x0_end + " (left) to " + s.x1_end +
-         " (right); " +
-         (along ? "x axis: cm along the centreline from the " + s.x0_end
-                : "x axis: cm of the conformal map (not centreline length)");
+    const std::string t = band_caption(s) +
+                          (along ? "x axis: cm along the centreline from the " + s.x0_end
+                                 : "x axis: cm of the conformal map (not centreline length)");
     draw_text(image_, t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
     const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
     draw_text(image_, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
@@ -280,3 +275,18 @@ std::string ColonImagePainter::automatic_title() const {
 }
 
 }  // namespace cf::detail
+
+namespace cf {
+
+std::string band_caption(const FlatSegment& s) {
+  using detail::fmt0;
+  std::string t = "segment " + std::to_string(s.id + 1) + ": ";
+  if (s.kind == "branch")
+    t += std::string(s.holds == "tissue" ? "tissue strand (cut bridge) off" : "side branch (pouch) of") + " segment " +
+         std::to_string(s.parent + 1) + " at " + fmt0(s.attach_mm / 10) + " cm, neck " + fmt0(s.neck_mm) +
+         " mm around; ";
+  return t + fmt0(s.length) + " mm long x " + fmt0(s.period) + " mm around; " + s.x0_end + " (left) to " + s.x1_end +
+         " (right); ";
+}
+
+}  // namespace cf

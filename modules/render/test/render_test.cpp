@@ -27,6 +27,7 @@
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
 #include "colonflat/render/artifacts.h"
+#include "colonflat/render/colon_image.h"
 #include "colonflat/render/render_stage.h"
 #include "colonflat/render/snapshot.h"
 #include "colonflat/testing/stage_command.h"
@@ -113,6 +114,29 @@ TEST(RenderImage, MissingWallIsHatched) {
   const ColonImage holed = render_colon_image(f, {}, none, o);
   const double px_area = holed.pixel_size * holed.pixel_size;
   EXPECT_NEAR(double(holed.missing_pixels) * px_area, removed, 0.15 * removed);
+}
+
+// A band's caption says what it shows: a side branch holding tissue (flatten's "holds", a crushed
+// strand stump: FlattenBranches.CrushedTissueStrandIsABandOfItsOwn) is a "tissue strand (cut
+// bridge)", never a pouch; one holding lumen stays "side branch (pouch)"; the colon band is neither.
+TEST(RenderImage, BandCaptionSaysPouchOrTissueStrand) {
+  FlatSegment colon, branch;
+  colon.id = 0, colon.length = 200, colon.period = 75;
+  branch.id = 1, branch.kind = "branch", branch.parent = 0, branch.attach_mm = 104, branch.neck_mm = 7;
+  branch.length = 36, branch.period = 6, branch.x0_end = "neck", branch.x1_end = "tip";
+  branch.holds = "lumen";
+  const std::string pouch = band_caption(branch);
+  EXPECT_EQ(pouch.rfind("segment 2: side branch (pouch) of segment 1 at 10 cm, neck 7 mm around; 36 mm long", 0), 0u)
+      << pouch;
+  branch.holds = "tissue";
+  const std::string strand = band_caption(branch);
+  EXPECT_EQ(strand.rfind("segment 2: tissue strand (cut bridge) off segment 1 at 10 cm, neck 7 mm around; ", 0), 0u)
+      << strand;
+  EXPECT_EQ(strand.find("pouch"), std::string::npos) << strand;
+  const std::string band = band_caption(colon);
+  EXPECT_EQ(band.rfind("segment 1: 200 mm long x 75 mm around; end A (left) to end B (right); ", 0), 0u) << band;
+  EXPECT_EQ(band.find("pouch"), std::string::npos);
+  EXPECT_EQ(band.find("tissue"), std::string::npos);
 }
 
 // The colon image is the same, pixel for pixel and in its counts, for 1 and 2 threads (a hole

@@ -79,6 +79,7 @@ struct FlatSegment {
   std::string weights;      // weights used ("cotan" or "clamped")
   std::size_t untangled_vertices = 0;    // vertices re-embedded (Tutte) to undo fold-overs
   std::size_t crowded_faces = 0;         // faces left out: area factor < 1e-7 or folded (thin protrusions)
+  std::size_t inverted_faces = 0;        // of those: folded over (negative 2D area), however small
   DistortionStats stats;
   // area-balanced map (empty / 0 for older files and the conformal map)
   std::string map;                                   // "area-balanced" or "conformal"
@@ -98,6 +99,9 @@ struct FlatSegment {
   double attach_mm = 0;                              // branch: centreline mm of its neck on the parent band
   std::array<double, 3> attach_lps{0, 0, 0};         // branch: centre of the neck, LPS mm
   double neck_mm = 0;                                // branch: 3D length of the neck (mm)
+  std::string holds = "lumen";                       // branch: what the region closed over its neck holds:
+                                                     // "lumen" (a pouch: diverticulum, blind loop) or "tissue"
+                                                     // (a crushed strand stump: a tissue bridge cut by denoise)
 };
 
 // The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices

@@ -64,6 +64,12 @@ struct ColonImageGeometry {
 };
 ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, int max_width);
 
+// The caption above a segment's band, up to its x-axis note: "segment N: " (1-based), for a side
+// branch what it is, "side branch (pouch) of segment P" (holds lumen) or "tissue strand (cut
+// bridge) off segment P" (holds tissue: a crushed strand stump), its neck's place (cm) and length
+// (mm), then the band's size (mm) and its left / right ends, ending in "; ".
+std::string band_caption(const FlatSegment& s);
+
 // `shape_index`: per flat vertex (for color = "curvature"); may be empty.
 ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& shape_index,
                               std::vector<ImageMarker>& markers, const ColonImageOptions& opts);
