@@ -53,6 +53,13 @@ bool is_branch(const ColonScan& scan, int id) {
   return e && e->value("kind", std::string("colon")) == "branch";
 }
 
+// A band flatten cut off around tissue (a strand stump left where denoise cut a tissue bridge),
+// not a pouch of lumen: never a stretch of the colon's course, whatever its length.
+bool holds_tissue(const ColonScan& scan, int id) {
+  const auto* e = segment_entry(scan, id);
+  return e && e->value("holds", std::string("lumen")) == "tissue";
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return kNaN;
   const size_t m = v.size() / 2;
@@ -407,7 +414,7 @@ std::vector<ColonPiece> colon_pieces(const ColonScan& scan, const PieceOptions& 
   std::vector<ColonPiece> out;
   for (auto& [k, p] : keyed) out.push_back(std::move(p));
   for (const auto& [seg, neck] : branch_necks(scan))
-    if (const auto it = length.find(seg); it != length.end() && it->second >= o.min_branch_piece_mm)
+    if (const auto it = length.find(seg); it != length.end() && it->second >= o.min_branch_piece_mm && !holds_tissue(scan, seg))
       out.push_back(branch_piece(scan, seg, it->second, neck, out, o.bin_mm));
   order_branches_at_necks(out, o.same_neck_mm);
   return out;

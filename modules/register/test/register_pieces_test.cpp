@@ -225,6 +225,19 @@ TEST(RegisterPieces, StretchKeptAsSideBranchInOneScanIsLaidOutAlongTheColon) {
   }
 }
 
+// A band of colon length that flatten cut off around tissue (a strand stump, FlatSegments "holds":
+// "tissue") is not inserted into the colon's course as a branch piece; the same band holding lumen is.
+TEST(RegisterPieces, TissueBandOfColonLengthIsNoPieceOfTheCourse) {
+  for (const char* holds : {"lumen", "tissue"}) {
+    SyntheticPair pair = make_synthetic_pair(long_pair(3));
+    make_side_branch(pair.supine, pair.supine_sigma, 220, 370, false);
+    pair.supine.segments.back()["holds"] = holds;
+    const std::vector<ColonPiece> pieces = colon_pieces(pair.supine, PieceOptions());
+    const auto branches = std::count_if(pieces.begin(), pieces.end(), [](const ColonPiece& p) { return p.branch; });
+    EXPECT_EQ(branches, std::string(holds) == "lumen" ? 1 : 0) << holds;
+  }
+}
+
 // Both scans keep the same 150 mm stretch as a side branch (the real mask's uncut pair): the prone
 // branch is placed on the supine one, branch to branch, and the band across the neck keeps both
 // sides of the jump: every polyp seen in both paired right, the polyps on the branch included,

@@ -24,7 +24,8 @@
 // reference it is inserted into the colon's course at its neck (the colon runs out along the branch
 // from the neck, then on along its band: the band's s after the neck moves by the branch's length);
 // in the other scan it is placed by its projections like any piece. Shorter branches (pouches,
-// diverticula, a polyp on a stalk) stay at their neck.
+// diverticula, a polyp on a stalk) stay at their neck, and so does a band that holds tissue
+// (FlatSegments "holds": a strand stump cut off because its map was crushed), whatever its length.
 #include <algorithm>
 #include <string>
 #include <utility>
