@@ -150,22 +150,6 @@ class ExactGreedy {
   // exact_method.cpp
   double search_limit(int slot);
   CycleCandidate search_from(int slot, double limit);
-  // exact_probes.cpp: while no loop is known, the source at the top of the queue is searched
-  // together with the next pending one far enough away that neither search can reach the
-  // other's source (a pair formed for any thread count; two threads run it at once).
-  struct ProbeRun {
-    int slot = -1;
-    double limit = 0;
-    CycleCandidate result;
-    std::size_t settled = 0;
-    std::vector<int> ball;  // settled vertices, at ball_distance from the source
-    std::vector<double> ball_distance;
-  };
-  void probe(int first);
-  int probe_partner(int first, double limit);
-  void run_probe(ProbeRun& p, FundamentalCycleSearch& search) const;
-  void finish_probe(const ProbeRun& p);
-  static constexpr std::size_t kMaxPartnerScan = 64;  // queue entries looked at for a partner, at most
   bool stop_before(const QueueEntry& top, std::string* reason) const;
   void cut(int slot, const CycleCandidate& c, int iteration);
   int total_genus_left() const;
@@ -206,7 +190,7 @@ class ExactGreedy {
   double far_popped_distance_ = 0;                  // key of the entry farthest_pending() returned last
   std::vector<double> from_anchor_;                // per vertex: scratch for farthest_pending(), +inf between calls
   long long far_searches_ = 0;
-  long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0, probe_pairs_ = 0;
+  long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
   std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;           // loops replaced by another of the same class (caps)

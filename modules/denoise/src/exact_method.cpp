@@ -160,7 +160,6 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
       const int far = want_type_ ? -1 : farthest_pending(best);
       const int s = far >= 0 ? far : top.slot;
       if (!want_type_ && std::isfinite(best)) search_group(s, best);
-      else if (!want_type_ && !(crossing_ && families_.size() == 2)) probe(s);
       else search_from(s, search_limit(s));
       continue;
     }
@@ -233,7 +232,6 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["group_exact_bounds"] = group_exact_;
   stats["parallel_search_pairs"] = parallel_pairs_;
   stats["settled_vertices_alone"] = settled_alone_;
-  stats["probe_pairs"] = probe_pairs_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["bounds_carried_at_rebuild"] = bounds_carried_;

@@ -131,19 +131,6 @@ TEST(DenoiseThreads, OneAndTwoThreadsGiveTheSameLoopsAndMeshOnManyHandles) {
   expect_same_result(a, b);
 }
 
-// While no loop is known, the source at the top of the queue is searched beside a far pending
-// one (probe pairs): the same pairs form with 1 and 2 threads, and the loops and the output mesh
-// are identical.
-TEST(DenoiseThreads, ProbePairsFormTheSameForAnyThreadCount) {
-  const Mesh m = bench::sphere_with_handles(30, 24, 0.6);
-  const DenoiseResult a = denoise_with_threads(m, 1), b = denoise_with_threads(m, 2);
-  const long long pairs = a.report["search"]["probe_pairs"].get<long long>();
-  EXPECT_GT(pairs, 0);
-  EXPECT_EQ(b.report["search"]["probe_pairs"].get<long long>(), pairs);
-  EXPECT_EQ(b.report["genus_after"], 0);
-  expect_same_result(a, b);
-}
-
 // The colon-like surface (long contact handle, surgery on top of surgery, crossing families for
 // the last loop): identical loops and mesh with 1, 2 and 3 threads.
 TEST(DenoiseThreads, ColonLikeSurfaceIsTheSameForAnyThreadCount) {
