@@ -1,66 +1,157 @@
 #include "colonflat/denoise/cap_triangulation.h"
 
 #include <algorithm>
-#include <atomic>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/threads.h"
 #include "denoise_debug.h"
 
 namespace cf {
 
-std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
-                                                        const std::function<bool(int, int, int)>& allowed,
-                                                        const std::function<bool()>& give_up) {
-  const int n = static_cast<int>(ring.size());
-  std::vector<std::array<int, 3>> tris;
-  if (n < 3) return tris;
-  auto area = [&](int i, int m, int j) { return 0.5 * OpenMesh::cross(ring[m] - ring[i], ring[j] - ring[i]).norm(); };
-  std::vector<double> W(static_cast<std::size_t>(n) * n, 0.0);
-  std::vector<int> arg(static_cast<std::size_t>(n) * n, -1);
-  constexpr double kNone = std::numeric_limits<double>::infinity();
-  // Subproblem (i, j): the lightest triangle (i, m, j) over triangulated sides. With `allowed`
-  // (a grid query per triangle), the candidates are tried lightest first until one passes: in
-  // the order of m it ran for every m that improved on the lightest allowed one so far, which on
-  // a twisted loop whose triangles mostly cross the surface is nearly every m.
-  auto solve = [&](int i, int j, std::vector<std::pair<double, int>>& order) {
-    double best = kNone;
-    int best_m = -1;
-    order.clear();
+namespace {
+
+constexpr double kNone = std::numeric_limits<double>::infinity();
+
+// The minimum-area dynamic programme with `allowed` asked lazily (issue 26, session 19): solve
+// with the triangles and sides known to be refused left out, ask `allowed` (and `side_ok`) only for
+// the n - 2 triangles of that solution, leave out those refused, and solve again. Every value of a
+// round is at most the restricted one (fewer triangles are left out), so a solution whose triangles
+// all pass is the restricted optimum, with the same tie-break (smallest apex m among the lightest
+// at each subproblem) and the same floating-point sums: the result is the eager programme's,
+// which asked `allowed` for the candidates of every subproblem lightest first (k^2 / 2 queries at
+// least) and sorted them. A refused side (a, b) leaves out every triangle on it: subproblem (a, b)
+// gets no triangulation.
+class LazyMinArea {
+ public:
+  LazyMinArea(const std::vector<Vec3>& ring, const std::function<bool(int, int, int)>& allowed,
+              const std::function<bool(int, int)>& side_ok, const std::function<bool()>& give_up)
+      : p_(ring), n_(static_cast<int>(ring.size())), allowed_(allowed), side_ok_(side_ok), give_up_(give_up),
+        W_(std::size_t(n_) * n_, 0.0), arg_(std::size_t(n_) * n_, -1), dead_(side_ok ? std::size_t(n_) * n_ : 0, 0),
+        marked_(allowed && !side_ok ? std::size_t(n_) * n_ : 0, -1), changed_(marked_.size(), -1),
+        lightest_first_(static_cast<bool>(side_ok)) {}
+  std::vector<std::array<int, 3>> run();
+
+ private:
+  std::size_t at(int i, int j) const { return std::size_t(i) * n_ + j; }
+  double area(int i, int m, int j) const { return 0.5 * OpenMesh::cross(p_[m] - p_[i], p_[j] - p_[i]).norm(); }
+  void solve(int i, int j);
+  void solve_lightest_first(int i, int j);
+  void solve_around(int i_hi, int j_lo);
+  std::vector<std::array<int, 3>> extract() const;
+  bool refuse_failing(const std::vector<std::array<int, 3>>& tris, int* i_hi, int* j_lo);
+  bool side_refused(int a, int b);
+
+  const std::vector<Vec3>& p_;
+  const int n_;
+  const std::function<bool(int, int, int)>& allowed_;
+  const std::function<bool(int, int)>& side_ok_;
+  const std::function<bool()>& give_up_;
+  std::vector<double> W_;  // W_[at(i, j)]: lightest triangulation of the sub-polygon i..j
+  std::vector<int> arg_;   // its apex m over side (i, j), -1: none
+  std::vector<signed char> dead_;                               // side (i, j): 0 not asked, 1 passes, 2 refused
+  int round_ = 0;                                               // rounds solved so far
+  std::vector<int> marked_, changed_;  // at(i, j) -> last round it had a new refusal / a new value
+  std::unordered_map<std::size_t, std::vector<int>> refused_;   // at(i, j) -> refused apexes m, sorted
+  std::unordered_set<std::uint64_t> passed_;                    // triangles `allowed` accepted
+  const bool lightest_first_;                                   // with side_ok: one eager pass
+  bool gave_up_ = false;
+  std::vector<std::pair<double, int>> order_;                   // a subproblem's candidates (w, m)
+};
+
+// Subproblem (i, j): the lightest triangle (i, m, j) over triangulated sides, smallest m on ties.
+void LazyMinArea::solve(int i, int j) {
+  if (lightest_first_) return solve_lightest_first(i, j);
+  double best = kNone;
+  int best_m = -1;
+  if (dead_.empty() || dead_[at(i, j)] != 2) {
+    const auto it = refused_.find(at(i, j));
+    const int* skip = it == refused_.end() ? nullptr : it->second.data();
+    const int* skip_end = skip ? skip + it->second.size() : nullptr;
     for (int m = i + 1; m < j; ++m) {
-      const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] + area(i, m, j);
-      if (!(w < kNone)) continue;  // a side has no triangulation
-      if (allowed) order.push_back({w, m});
-      else if (w < best) best = w, best_m = m;
+      if (skip != skip_end && *skip == m) {
+        ++skip;
+        continue;
+      }
+      const double sides = W_[at(i, m)] + W_[at(m, j)];
+      if (!(sides < best)) continue;  // area >= 0: w = sides + area cannot be lighter
+      const double w = sides + area(i, m, j);
+      if (w < best) best = w, best_m = m;
     }
-    std::sort(order.begin(), order.end());
-    for (const auto& [w, m] : order)
-      if (allowed(i, m, j)) {
+  }
+  W_[at(i, j)] = best;
+  arg_[at(i, j)] = best_m;
+}
+
+// With side_ok (restricted caps, whose queries are grid queries and refuse most candidates on a
+// ring that runs along a wall): the candidates (w, m) over sides with a triangulation are taken
+// from a min-heap, lightest first (smallest m on ties), until `allowed` passes one; none is asked
+// when side (i, j) is refused (then so would be every triangle on it). Lazy rounds cost more here
+// (real CT surface, issue 26 session 19: 100-940 rounds per ring of 87-173 vertices, 2.6 s of CPU
+// for its 16 restricted triangulations against 1.5 s lightest first).
+void LazyMinArea::solve_lightest_first(int i, int j) {
+  order_.clear();
+  for (int m = i + 1; m < j; ++m) {
+    const double w = W_[at(i, m)] + W_[at(m, j)] + area(i, m, j);
+    if (w < kNone) order_.push_back({w, m});
+  }
+  double best = kNone;
+  int best_m = -1;
+  if (!order_.empty() && !side_refused(i, j)) {
+    const auto later = std::greater<std::pair<double, int>>();
+    std::make_heap(order_.begin(), order_.end(), later);
+    for (auto end = order_.end(); end != order_.begin(); --end) {
+      std::pop_heap(order_.begin(), end, later);
+      const auto [w, m] = *(end - 1);
+      if (allowed_(i, m, j)) {
         best = w, best_m = m;
         break;
       }
-    W[std::size_t(i) * n + j] = best;
-    arg[std::size_t(i) * n + j] = best_m;
-  };
-  // One thread: splitting each length's subproblems over threads (one start and join per length,
-  // n - 2 per triangulation) cost more wall time than it saved (issue 26, session 18: real CT
-  // surface at 2 threads and load 4-6, surgery 11.7-17.0 s wall with the split, 6.1-6.3 s without,
-  // 5.3-5.6 s at 1 thread; same output).
-  std::vector<std::pair<double, int>> order;
-  for (int len = 2; len < n; ++len) {
-    for (int i = 0; i + len < n; ++i) solve(i, i + len, order);
-    if (give_up && give_up()) return {};  // between lengths
+    }
   }
-  std::vector<std::pair<int, int>> stack{{0, n - 1}};
+  W_[at(i, j)] = best;
+  arg_[at(i, j)] = best_m;
+}
+
+// Solves again the subproblems (i, j) with i <= i_hi and j >= j_lo (those that contain a refusal),
+// shortest first, but only those marked this round or whose chosen apex has a side whose value
+// changed this round: refusals only accumulate, so values only grow, and a subproblem whose
+// chosen triangle and sides kept their values keeps its value and its apex (every other
+// candidate only grew). Round 0 solves everything.
+void LazyMinArea::solve_around(int i_hi, int j_lo) {
+  for (int len = 2; len < n_; ++len) {
+    for (int i = std::max(0, j_lo - len); i <= i_hi && i + len < n_; ++i) {
+      const int j = i + len, m = arg_[at(i, j)];
+      const bool stale = round_ == 0 || marked_[at(i, j)] == round_ ||
+                         (m >= 0 && (changed_[at(i, m)] == round_ || changed_[at(m, j)] == round_));
+      if (!stale) continue;
+      const double before = W_[at(i, j)];
+      solve(i, j);
+      if (!changed_.empty() && W_[at(i, j)] != before) changed_[at(i, j)] = round_;
+    }
+    if (lightest_first_ && give_up_ && give_up_()) {  // after each length
+      gave_up_ = true;
+      return;
+    }
+  }
+}
+
+std::vector<std::array<int, 3>> LazyMinArea::extract() const {
+  std::vector<std::array<int, 3>> tris;
+  std::vector<std::pair<int, int>> stack{{0, n_ - 1}};
   while (!stack.empty()) {
     auto [i, j] = stack.back();
     stack.pop_back();
     if (j - i < 2) continue;
-    const int m = arg[std::size_t(i) * n + j];
-    if (m < 0) return {};  // every triangulation uses a forbidden triangle
+    const int m = arg_[at(i, j)];
+    if (m < 0) return {};  // every triangulation uses a refused triangle
     tris.push_back({i, m, j});
     stack.push_back({i, m});
     stack.push_back({m, j});
@@ -69,45 +160,96 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
   return tris;
 }
 
+bool LazyMinArea::side_refused(int a, int b) {
+  if (dead_.empty() || b - a == 1 || (a == 0 && b == n_ - 1)) return false;  // a ring edge
+  signed char& s = dead_[at(a, b)];
+  if (s == 0) s = side_ok_(a, b) ? 1 : 2;
+  return s == 2;
+}
+
+// Asks about the solution's triangles; records the refused ones (and refused sides) and widens
+// [0, i_hi] x [j_lo, n) to every subproblem that contains one. True when all passed.
+bool LazyMinArea::refuse_failing(const std::vector<std::array<int, 3>>& tris, int* i_hi, int* j_lo) {
+  bool all = true;
+  auto mark = [&](int i, int j) {
+    *i_hi = std::max(*i_hi, i), *j_lo = std::min(*j_lo, j), all = false;
+    marked_[at(i, j)] = round_ + 1;
+  };
+  for (const auto& [i, m, j] : tris) {
+    bool side_bad = false;
+    for (const auto& [a, b] : {std::pair{i, m}, std::pair{m, j}, std::pair{i, j}})
+      if (side_refused(a, b)) side_bad = true, mark(a, b);
+    if (side_bad) continue;
+    const std::uint64_t key = (std::uint64_t(i) * n_ + m) * n_ + j;
+    if (passed_.count(key)) continue;
+    if (!allowed_ || allowed_(i, m, j)) {
+      passed_.insert(key);
+      continue;
+    }
+    auto& r = refused_[at(i, j)];
+    r.insert(std::lower_bound(r.begin(), r.end(), m), m);
+    mark(i, j);
+  }
+  return all;
+}
+
+std::vector<std::array<int, 3>> LazyMinArea::run() {
+  if (n_ < 3) return {};
+  solve_around(n_ - 1, 0);
+  if (gave_up_) return {};
+  if (!allowed_ || lightest_first_) return extract();
+  for (;;) {
+    std::vector<std::array<int, 3>> tris = extract();
+    if (tris.empty()) return {};
+    int i_hi = -1, j_lo = n_;
+    if (refuse_failing(tris, &i_hi, &j_lo)) return tris;
+    if (give_up_ && give_up_()) return {};  // between rounds
+    ++round_;
+    solve_around(i_hi, j_lo);
+  }
+}
+
+}  // namespace
+
+std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
+                                                        const std::function<bool(int, int, int)>& allowed,
+                                                        const std::function<bool()>& give_up,
+                                                        const std::function<bool(int, int)>& side_ok) {
+  return LazyMinArea(ring, allowed, side_ok, give_up).run();
+}
+
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid,
     const std::vector<std::array<int, 3>>& others, long long* budget) {
   const int n = static_cast<int>(ring.size());
-  std::atomic<long long> queries{0};
+  long long queries = 0;
   std::vector<Vec3> pts;
   for (auto v : ring) pts.push_back(mesh.point(v));
   auto diagonal_ok = [&](int a, int b) {
     if (std::abs(a - b) == 1 || std::abs(a - b) == n - 1) return true;  // a ring edge
     return !blocked(ring[a], ring[b]);
   };
-  // Per diagonal: 0 not asked yet, 1 clear, 2 pierces the surface (then so does every triangle on
-  // it: k^2 / 2 segment queries spare most of the k^3 / 6 triangle queries on rings whose
-  // triangles mostly cross the surface). Threads may ask the same diagonal: same answer.
-  std::vector<std::atomic<signed char>> chord(grid ? std::size_t(n) * n : 0);
-  auto pierces = [&](int a, int b) {
-    if (std::abs(a - b) == 1 || std::abs(a - b) == n - 1) return false;  // a ring edge
-    auto& c = chord[std::size_t(a) * n + b];
-    if (c.load(std::memory_order_relaxed) == 0)
-      c.store(grid->segment_hits(mesh, ring[a].idx(), ring[b].idx()) ? 2 : 1, std::memory_order_relaxed);
-    return c.load(std::memory_order_relaxed) == 2;
-  };
+  // A diagonal that pierces the surface fails every triangle on it (one segment query for all).
+  std::function<bool(int, int)> side_ok;
+  if (grid)
+    side_ok = [&](int a, int b) { return diagonal_ok(a, b) && !grid->segment_hits(mesh, ring[a].idx(), ring[b].idx()); };
   auto allowed = [&](int i, int m, int j) {
     const Vec3 &a = pts[i], &b = pts[m], &c = pts[j];
     const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
     if (OpenMesh::cross(b - a, c - a).norm() < 1e-4 * longest) return false;
     if (!grid) return true;  // diagonals are checked on the result: cheaper than here
-    if (!diagonal_ok(i, m) || !diagonal_ok(m, j) || !diagonal_ok(i, j)) return false;
-    if (pierces(i, m) || pierces(m, j) || pierces(i, j)) return false;
     ++queries;
     return !grid->hits(mesh, {ring[i].idx(), ring[m].idx(), ring[j].idx()}, others);
   };
-  auto give_up = [&] { return budget && queries.load() > *budget; };
-  std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed, give_up);
+  auto give_up = [&] { return budget && queries > *budget; };
+  const double cpu0 = grid && detail::denoise_debug() ? process_cpu_seconds() : 0.0;
+  std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed, give_up, side_ok);
   if (grid && detail::denoise_debug() && n >= 48)
-    std::fprintf(stderr, "denoise debug: restricted triangulation of %d vertices: %lld grid queries, %s\n", n,
-                 queries.load(), t.empty() ? "none" : "found");
-  if (budget) *budget -= queries.load();
+    std::fprintf(stderr, "denoise debug: restricted triangulation of %d vertices: %lld grid queries, %s, CPU %.3f s\n",
+                 n, queries,
+                 t.empty() ? "none" : "found", process_cpu_seconds() - cpu0);
+  if (budget) *budget -= queries;
   for (auto& tri : t) {
     for (int e = 0; e < 3; ++e)
       if (!diagonal_ok(tri[e], tri[(e + 1) % 3])) return {};

@@ -218,6 +218,11 @@ class ExactGreedy {
   Stopwatch debug_clock_;  // COLONFLAT_DENOISE_DEBUG: since the last cut
   double debug_search_ = 0, fallback_s_ = 0, debug_cpu_ = 0;
   long long debug_searches_ = 0, debug_settled_ = 0, fallback_settled_ = 0;
+  // Settled vertices of searches that ran with no other beside them (search_from(), batches of
+  // one group): the work a second thread cannot share today.
+  long long settled_alone_ = 0, debug_alone_ = 0;
+  // Per batch searched on more than one thread: the settled vertices of its busiest lane.
+  long long settled_longest_lane_ = 0, debug_longest_lane_ = 0;
 };
 
 }  // namespace cf::detail

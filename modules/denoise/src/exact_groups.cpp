@@ -8,6 +8,7 @@
 // it (F(t) >= F(c) - 2 d(c, t) < U); a search from the whole stretch of sources, its tree edges
 // counted as length 0, gives each of them F >= U at the cost of about two single searches.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "colonflat/core/run_stats.h"
@@ -159,18 +160,31 @@ void ExactGreedy::run_group(GroupRun& g, FundamentalCycleSearch& search) const {
 }
 
 // Run 0 on this thread's search object (extract() of its result stays possible); with T
-// threads, thread t searches runs t, t + T, ... with its own search object. A run's result does
-// not depend on the search object or thread that computes it.
+// threads, each thread takes the next run not yet taken (run 0 first on this thread) with its
+// own search object, so that a lane that drew a small group goes on with the next one instead
+// of idling beside a large one. A run's result does not depend on the search object or thread
+// that computes it, so the batch's results are the same for any thread count.
 void ExactGreedy::run_groups(std::vector<GroupRun>& runs) {
   const int lanes = search_lanes(runs.size());
+  if (runs.size() == 1) {  // alone on this thread whatever the thread count
+    run_group(runs[0], *search_);
+    settled_alone_ += static_cast<long long>(runs[0].settled);
+    return;
+  }
   if (lanes == 1) {
     for (GroupRun& g : runs) run_group(g, *search_);
     return;
   }
   parallel_pairs_ += static_cast<long long>(runs.size() / 2);
+  std::atomic<std::size_t> next{1};
+  std::vector<long long> lane_settled(lanes, 0);
   worker_->run(lanes, [&](int t) {
-    for (std::size_t i = t; i < runs.size(); i += lanes) run_group(runs[i], lane_search(t));
+    for (std::size_t i = t == 0 ? 0 : next++; i < runs.size(); i = next++) {
+      run_group(runs[i], lane_search(t));
+      lane_settled[t] += static_cast<long long>(runs[i].settled);
+    }
   });
+  settled_longest_lane_ += *std::max_element(lane_settled.begin(), lane_settled.end());
 }
 
 int ExactGreedy::search_lanes(std::size_t tasks) {

@@ -111,6 +111,7 @@ CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   const CycleCandidate c = search_->run(Mesh::VertexHandle(v), limit, want_type_ ? &accept_ : nullptr);
   ++searches_;
   settled_ += static_cast<long long>(search_->last_settled());
+  settled_alone_ += static_cast<long long>(search_->last_settled());
   largest_limit_ = std::max(largest_limit_, limit);
   slots_[slot].own_limit = limit;
   const double own = c.found ? c.value : c.truncated ? limit : kInf;
@@ -201,12 +202,14 @@ void ExactGreedy::debug_cut(int iteration, double surgery_s) {
   const LoopRecord& L = st_.loops.back();
   std::fprintf(stderr,
                "denoise debug: cut %d: %.1f mm, %zu vertices, %zu cap pairs%s; since the last cut: %.2f s (CPU %.2f s) "
-               "(search %.2f s, %lld searches, %lld settled; fallback searches %.2f s, %lld settled), surgery %.2f s; "
+               "(search %.2f s, %lld searches, %lld settled, %lld of them alone, busiest lanes of batches %lld; "
+               "fallback searches %.2f s, %lld settled), surgery %.2f s; "
                "%zu sources, %d homology builds in all\n",
                iteration, L.length, L.vertex_ids.size(), L.cap_intersections,
                L.replaced_length > 0 ? " (replaced a loop)" : "", debug_clock_.seconds(), process_cpu_seconds() - debug_cpu_,
                st_.t.search - debug_search_,
-               searches_ - debug_searches_, settled_ - debug_settled_, fallback_s_, fallback_settled_, surgery_s,
+               searches_ - debug_searches_, settled_ - debug_settled_, settled_alone_ - debug_alone_,
+               settled_longest_lane_ - debug_longest_lane_, fallback_s_, fallback_settled_, surgery_s,
                active_.size(), builds_);
   fallback_s_ = 0;
   fallback_settled_ = 0;
@@ -215,6 +218,8 @@ void ExactGreedy::debug_cut(int iteration, double surgery_s) {
   debug_search_ = st_.t.search;
   debug_searches_ = searches_;
   debug_settled_ = settled_;
+  debug_alone_ = settled_alone_;
+  debug_longest_lane_ = settled_longest_lane_;
 }
 
 void ExactGreedy::write_stats(nlohmann::json& stats) const {
@@ -226,6 +231,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["group_members"] = group_members_;
   stats["group_exact_bounds"] = group_exact_;
   stats["parallel_search_pairs"] = parallel_pairs_;
+  stats["settled_vertices_alone"] = settled_alone_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["bounds_carried_at_rebuild"] = bounds_carried_;

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 
 #include "colonflat/denoise/cap_triangulation.h"
 
@@ -70,6 +72,97 @@ TEST(DenoiseCapTriangulation, MinAreaTriangulationRespectsAllowed) {
   EXPECT_NE(std::find(tris.begin(), tris.end(), std::array<int, 3>{0, 1, 5}), tris.end());
   EXPECT_NEAR(triangulation_area(hexagon, tris), 1.5 * std::sqrt(3.0), 1e-12);
   EXPECT_TRUE(min_area_triangulation(hexagon, [](int, int, int) { return false; }).empty());
+}
+
+// A bumpy 3D ring of n corners (the shape of a cut loop on a wrinkled wall).
+std::vector<Vec3> bumpy_ring(int n) {
+  std::vector<Vec3> ring;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    ring.push_back(Vec3(3 * std::cos(a), std::sin(a), 0.4 * std::sin(5 * a) + 0.1 * std::cos(11 * a)));
+  }
+  return ring;
+}
+
+// The old programme, written out as the reference: every subproblem's candidates sorted by
+// (weight, apex) and `allowed` asked lightest first until one passes.
+std::vector<std::array<int, 3>> lightest_first_reference(const std::vector<Vec3>& p,
+                                                         const std::function<bool(int, int, int)>& allowed) {
+  const int n = static_cast<int>(p.size());
+  const double none = std::numeric_limits<double>::infinity();
+  std::vector<double> W(std::size_t(n) * n, 0.0);
+  std::vector<int> arg(std::size_t(n) * n, -1);
+  for (int len = 2; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      std::vector<std::pair<double, int>> order;
+      for (int m = i + 1; m < j; ++m) {
+        const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] +
+                         0.5 * OpenMesh::cross(p[m] - p[i], p[j] - p[i]).norm();
+        if (w < none) order.push_back({w, m});
+      }
+      std::sort(order.begin(), order.end());
+      W[std::size_t(i) * n + j] = none;
+      for (const auto& [w, m] : order)
+        if (allowed(i, m, j)) {
+          W[std::size_t(i) * n + j] = w, arg[std::size_t(i) * n + j] = m;
+          break;
+        }
+    }
+  std::vector<std::array<int, 3>> tris;
+  std::vector<std::pair<int, int>> stack{{0, n - 1}};
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    if (j - i < 2) continue;
+    const int m = arg[std::size_t(i) * n + j];
+    if (m < 0) return {};
+    tris.push_back({i, m, j});
+    stack.push_back({i, m});
+    stack.push_back({m, j});
+  }
+  std::reverse(tris.begin(), tris.end());
+  return tris;
+}
+
+// A pure pseudo-random refusal of about `percent` % of the triangles (or sides: j = -1).
+bool refused(int i, int m, int j, int percent) {
+  const unsigned h = static_cast<unsigned>(i * 73856093 ^ m * 19349663 ^ (j + 7) * 83492791);
+  return (h >> 7) % 100 < static_cast<unsigned>(percent);
+}
+
+// Without refusals the lazy programme asks `allowed` only for the n - 2 triangles of its solution
+// (the lightest-first one asked once per subproblem, about n^2 / 2 times): 58 asks on a 60-vertex
+// ring, and the same triangles as the reference.
+TEST(DenoiseCapTriangulation, LazyProgrammeAsksOnlyTheSolutionsTriangles) {
+  const std::vector<Vec3> ring = bumpy_ring(60);
+  int asked = 0;
+  auto yes = [&](int, int, int) { return ++asked, true; };
+  const auto tris = min_area_triangulation(ring, yes);
+  EXPECT_EQ(asked, 58);
+  EXPECT_EQ(tris, lightest_first_reference(ring, [](int, int, int) { return true; }));
+}
+
+// Refusals of a quarter of the triangles (lazy rounds), or of a fifth of the sides and a tenth of
+// the triangles (lightest first, with side_ok): the same triangles, in the same order, as the
+// reference, which asks every subproblem's candidates lightest first.
+TEST(DenoiseCapTriangulation, RestrictedProgrammesGiveTheLightestAllowedTriangulation) {
+  const std::vector<Vec3> ring = bumpy_ring(48);
+  const int n = static_cast<int>(ring.size());
+  auto quarter = [](int i, int m, int j) { return !refused(i, m, j, 25); };
+  const auto lazy = min_area_triangulation(ring, quarter);
+  ASSERT_EQ(lazy.size(), ring.size() - 2);
+  EXPECT_EQ(lazy, lightest_first_reference(ring, quarter));
+  auto side_ok = [](int a, int b) { return !refused(a, b, -1, 20); };
+  auto tenth = [](int i, int m, int j) { return !refused(i, m, j, 10); };
+  auto both = [&](int i, int m, int j) {
+    auto ok = [&](int a, int b) { return b - a == 1 || (a == 0 && b == n - 1) || side_ok(a, b); };
+    return ok(i, m) && ok(m, j) && ok(i, j) && tenth(i, m, j);
+  };
+  const auto eager = min_area_triangulation(ring, tenth, {}, side_ok);
+  ASSERT_EQ(eager.size(), ring.size() - 2);
+  EXPECT_EQ(eager, lightest_first_reference(ring, both));
+  EXPECT_EQ(min_area_triangulation(ring, both), eager);  // the lazy rounds, sides asked with the triangle
 }
 
 // A planar ring of 40 vertices (radius 10) with a wall (two triangles, 6 x 10) standing across

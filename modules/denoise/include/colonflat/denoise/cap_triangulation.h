@@ -11,13 +11,18 @@ namespace cf {
 
 // Minimum-area triangulation of a closed polygon (dynamic programming, O(n^3)); triangles
 // (i, m, j) with i < m < j index `ring` and are oriented like the polygon, listed as ears: each
-// triangle has two edges on the polygon left by removing the ones before it. With `allowed`, only
-// triangles it accepts are used (called for the candidates of each subproblem in order of weight until one passes);
-// empty result when no triangulation consists of allowed triangles, or when give_up() (asked after
-// each subproblem length) says so.
+// triangle has two edges on the polygon left by removing the ones before it. Ties: the smallest
+// apex m at each sub-polygon (i, j). With `allowed` (and `side_ok`, asked for sides (a, b), a < b,
+// that are not ring edges), the lightest triangulation of triangles it accepts on sides it
+// accepts, found lazily: the programme is solved with the refusals known so far, only the
+// solution's triangles (and their sides) are asked, refused ones are left out and the programme
+// solved again (same result as asking every candidate; each triangle and side asked at most
+// once). Empty result when no such triangulation exists, or when give_up() (asked after each
+// round) says so. Pre: `allowed` and `side_ok` are pure (the same answer for the same triangle).
 std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& ring,
                                                         const std::function<bool(int, int, int)>& allowed = {},
-                                                        const std::function<bool()>& give_up = {});
+                                                        const std::function<bool()>& give_up = {},
+                                                        const std::function<bool(int, int)>& side_ok = {});
 
 // A cap for the closed ring `ring` (mesh vertices in boundary order; the triangles are oriented
 // like it): its minimum-area triangulation without near-collinear triangles (height below 1e-4
