@@ -42,24 +42,6 @@ void ColonPiece::move_by(double mm) {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const nlohmann::json* segment_entry(const ColonScan& scan, int id) {
-  for (const auto& seg : scan.segments)
-    if (seg.value("id", -1) == id) return &seg;
-  return nullptr;
-}
-
-bool is_branch(const ColonScan& scan, int id) {
-  const auto* e = segment_entry(scan, id);
-  return e && e->value("kind", std::string("colon")) == "branch";
-}
-
-// A band flatten cut off around tissue (a strand stump left where denoise cut a tissue bridge),
-// not a pouch of lumen: never a stretch of the colon's course, whatever its length.
-bool holds_tissue(const ColonScan& scan, int id) {
-  const auto* e = segment_entry(scan, id);
-  return e && e->value("holds", std::string("lumen")) == "tissue";
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return kNaN;
   const size_t m = v.size() / 2;

@@ -108,4 +108,20 @@ ColonScan read_run_dir(const fs::path& dir) {
   return s;
 }
 
+const nlohmann::json* segment_entry(const ColonScan& scan, int id) {
+  for (const auto& seg : scan.segments)
+    if (seg.value("id", -1) == id) return &seg;
+  return nullptr;
+}
+
+bool is_branch(const ColonScan& scan, int id) {
+  const auto* e = segment_entry(scan, id);
+  return e && e->value("kind", std::string("colon")) == "branch";
+}
+
+bool holds_tissue(const ColonScan& scan, int id) {
+  const auto* e = segment_entry(scan, id);
+  return e && e->value("holds", std::string("lumen")) == "tissue";
+}
+
 }  // namespace cf

@@ -38,6 +38,14 @@ struct ColonScan {
   nlohmann::json run_report = nlohmann::json::object();  // run_report.json, {} when absent
 };
 
+// The FlatSegments entry of band `id` (nullptr when the scan has none).
+const nlohmann::json* segment_entry(const ColonScan& scan, int id);
+// Band `id` is a side branch (FlatSegments kind "branch").
+bool is_branch(const ColonScan& scan, int id);
+// Band `id` was cut off around tissue (FlatSegments holds "tissue": a strand stump left where denoise
+// cut a tissue bridge, not a pouch of lumen): never a stretch of the colon's course.
+bool holds_tissue(const ColonScan& scan, int id);
+
 // Reads DIR/flat.vtp (required), DIR/candidates.json or DIR/polyps.json (optional) and
 // DIR/run_report.json (optional). Throws InputError naming the offending file.
 ColonScan read_run_dir(const std::filesystem::path& dir);
