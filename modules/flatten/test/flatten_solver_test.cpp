@@ -331,16 +331,31 @@ SpdSolver::SpMat permuted_upper(const NestedGrid& g) {
   return upper;
 }
 
+// The grid's factor as the row schedule reads it: triu(P A P^T), its elimination tree and each row's work.
+struct GridRows {
+  int n = 0;
+  SpdSolver::SpMat upper;
+  std::vector<int> parent;
+  std::vector<double> work;
+};
+GridRows grid_rows(const NestedGrid& g) {
+  GridRows r;
+  r.n = int(g.A.rows());
+  r.upper = permuted_upper(g);
+  r.parent = cf::flat_detail::elimination_tree(r.n, r.upper.outerIndexPtr(), r.upper.innerIndexPtr());
+  r.work = cf::flat_detail::row_work(r.n, r.upper.outerIndexPtr(), r.upper.innerIndexPtr(), r.parent);
+  return r;
+}
+
 }  // namespace
 
 // The rows of a nested dissection factor split into two parts of whole elimination subtrees (each
 // row's parent in its own part or above both, every row once) that are about even, with little
 // left above them: the split the threaded factorisation computes side by side.
 TEST(FlattenSolver, RowScheduleSplitsTheEliminationTreeIntoIndependentEvenParts) {
-  const NestedGrid g = nested_grid();
-  const int n = int(g.A.rows());
-  const SpdSolver::SpMat upper = permuted_upper(g);
-  const std::vector<int> parent = cf::flat_detail::elimination_tree(n, upper.outerIndexPtr(), upper.innerIndexPtr());
+  const GridRows r = grid_rows(nested_grid());
+  const int n = r.n;
+  const std::vector<int>& parent = r.parent;
   const cf::flat_detail::RowSchedule s = cf::flat_detail::schedule_rows(parent, std::vector<double>(n, 1.0), 2);
   ASSERT_EQ(s.parts.size(), 2u);
   std::vector<int> where(n, -2);  // part of each row, -1: the rest
@@ -367,12 +382,11 @@ TEST(FlattenSolver, RowScheduleSplitsTheEliminationTreeIntoIndependentEvenParts)
 // with the old estimate (a column's squared count at its own row) the rest came out several times
 // too small.
 TEST(FlattenSolver, RowWorkIsTheUpLookingKernelsCostOfEachRow) {
-  const NestedGrid g = nested_grid();
-  const int n = int(g.A.rows());
-  const SpdSolver::SpMat upper = permuted_upper(g);
-  const std::vector<int> parent = cf::flat_detail::elimination_tree(n, upper.outerIndexPtr(), upper.innerIndexPtr());
-  const std::vector<double> work = cf::flat_detail::row_work(n, upper.outerIndexPtr(), upper.innerIndexPtr(), parent);
-  const SpdSolver::SpMat lower = upper.transpose();
+  const GridRows r = grid_rows(nested_grid());
+  const int n = r.n;
+  const std::vector<int>& parent = r.parent;
+  const std::vector<double>& work = r.work;
+  const SpdSolver::SpMat lower = r.upper.transpose();
   Eigen::SimplicialLDLT<SpdSolver::SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(lower);
   ASSERT_EQ(ldlt.info(), Eigen::Success);
   const SpdSolver::SpMat L = ldlt.matrixL();
@@ -398,11 +412,10 @@ TEST(FlattenSolver, RowWorkIsTheUpLookingKernelsCostOfEachRow) {
 // read finished rows and their own), and the estimated time with four threads (each phase's largest
 // part, then the last rest) below the one-phase split's.
 TEST(FlattenSolver, RowPhasesSplitTheRestAgainIntoIndependentParts) {
-  const NestedGrid g = nested_grid();
-  const int n = int(g.A.rows());
-  const SpdSolver::SpMat upper = permuted_upper(g);
-  const std::vector<int> parent = cf::flat_detail::elimination_tree(n, upper.outerIndexPtr(), upper.innerIndexPtr());
-  const std::vector<double> work = cf::flat_detail::row_work(n, upper.outerIndexPtr(), upper.innerIndexPtr(), parent);
+  const GridRows r = grid_rows(nested_grid());
+  const int n = r.n;
+  const std::vector<int>& parent = r.parent;
+  const std::vector<double>& work = r.work;
   const auto phases = cf::flat_detail::schedule_phases(parent, work, 4);
   const int last = int(phases.size());
   std::vector<std::pair<int, int>> where(std::size_t(n), {-1, -1});  // (phase, part); (last, -1): the rest
