@@ -131,7 +131,7 @@ struct Projection {
 std::map<int, std::pair<int, double>> branch_necks(const ColonScan& scan, const std::set<int>& pieces = {}) {
   std::map<int, std::pair<int, double>> neck;
   for (const auto& seg : scan.segments) {
-    if (seg.value("kind", std::string("colon")) != "branch") continue;
+    if (!is_branch_entry(seg)) continue;
     int parent = seg.value("parent", -1);
     double attach = seg.value("attach_mm", 0.0);
     for (int guard = 0; guard < 16 && is_branch(scan, parent) && !pieces.count(parent); ++guard) {

@@ -112,7 +112,7 @@ std::vector<double> axial_from_flat_x(const ColonScan& scan, const ProfileOption
 void place_branches_at_their_neck(const ColonScan& scan, std::vector<double>& s) {
   std::map<int, std::pair<int, double>> branch;  // id -> (parent, attach_mm)
   for (const auto& seg : scan.segments)
-    if (seg.value("kind", std::string("colon")) == "branch")
+    if (is_branch_entry(seg))
       branch[seg.value("id", -1)] = {seg.value("parent", -1), seg.value("attach_mm", 0.0)};
   if (branch.empty()) return;
   std::map<int, double> at;  // branch id -> centreline mm of its chain's neck on the colon band

@@ -114,9 +114,11 @@ const nlohmann::json* segment_entry(const ColonScan& scan, int id) {
   return nullptr;
 }
 
+bool is_branch_entry(const nlohmann::json& seg) { return seg.value("kind", std::string("colon")) == "branch"; }
+
 bool is_branch(const ColonScan& scan, int id) {
   const auto* e = segment_entry(scan, id);
-  return e && e->value("kind", std::string("colon")) == "branch";
+  return e && is_branch_entry(*e);
 }
 
 bool holds_tissue(const ColonScan& scan, int id) {

@@ -40,6 +40,8 @@ struct ColonScan {
 
 // The FlatSegments entry of band `id` (nullptr when the scan has none).
 const nlohmann::json* segment_entry(const ColonScan& scan, int id);
+// A FlatSegments entry of a side branch (kind "branch").
+bool is_branch_entry(const nlohmann::json& seg);
 // Band `id` is a side branch (FlatSegments kind "branch").
 bool is_branch(const ColonScan& scan, int id);
 // Band `id` was cut off around tissue (FlatSegments holds "tissue": a strand stump left where denoise
