@@ -209,18 +209,46 @@
   }
 
   // ---- segmentation QC ----------------------------------------------------------------------------
-  // Montages per plane (labels R<n> on the rejected bodies where they show), then the tables.
-  function segSlice(plane, im, byId) {
+  // Montages per plane with a numbered tag per rejected body where it shows (its box placed by the
+  // report in image pixels, so the tag scales with the image; the reason's colour), the reason key
+  // above them, the legend (number, reason, volume, slices where seen) and the kept bodies below.
+  const pct = (v, of) => (100 * v / of).toFixed(3) + "%";
+  function segTag(t, im, b, r) {
+    const cq = (px) => (100 * px / im.w).toFixed(3) + "cqw";  // image pixels in the figure's width
+    const tag = el("span", { class: "seg-tag", "data-body": String(t.id), text: String(t.id),
+      title: t.id + ": " + fix(b.volume_ml, 0) + " mL, " + (b.reason || "") });
+    Object.assign(tag.style, { left: pct(t.x, im.w), top: pct(t.y, im.h), width: pct(t.w, im.w), height: pct(t.h, im.h),
+      fontSize: cq(0.8 * t.h), lineHeight: cq(t.h), background: r.colour || "rgb(255,50,30)", color: r.ink || "#fff" });
+    return tag;
+  }
+  function segSlice(plane, n, im, byId, reasons) {
     const box = el("div", { class: "seg-img" }, [el("img", { src: im.file, alt: plane + " " + im.axis + " " + im.position_mm + " mm" })]);
-    for (const l of im.labels) {
-      const b = byId[l.id] || {};
-      const tag = el("span", { class: "seg-label", "data-body": "R" + l.id, title: (b.what || "") + ": " + (b.reason || ""),
-        text: "R" + l.id + " " + fix(b.volume_ml, 0) + " mL: " + (b.reason || "") });
-      tag.style.left = (100 * (l.col + 0.5) / im.w).toFixed(2) + "%";
-      tag.style.top = (100 * (l.row + 0.5) / im.h).toFixed(2) + "%";
-      box.appendChild(tag);
-    }
-    return el("figure", { class: "seg-slice", "data-plane": plane }, [box, el("figcaption", { text: plane + " · " + im.axis + " " + fix(im.position_mm, 1) + " mm" })]);
+    for (const t of im.tags || []) if (t.placed) box.appendChild(segTag(t, im, byId[t.id] || {}, reasons[(byId[t.id] || {}).reason_index] || {}));
+    return el("figure", { class: "seg-slice", "data-plane": plane }, [box,
+      el("figcaption", { text: plane + " " + n + " · " + im.axis + " " + fix(im.position_mm, 1) + " mm" })]);
+  }
+  const swatch = (b, r) => el("span", { class: "seg-swatch", style: "background:" + (r.colour || "") + ";color:" + (r.ink || "#fff"), text: String(b.id) });
+  function seenText(b) {
+    const by = {};
+    for (const s of b.seen || []) (by[s.plane] = by[s.plane] || []).push(s.slice);
+    const t = Object.entries(by).map(([p, v]) => p + " " + v.join(", ")).join("; ");
+    return t || "on no slice shown";
+  }
+  function segReasonKey(bodies, reasons) {
+    return el("ul", { class: "seg-key" }, reasons.map((r, i) => {
+      const mine = bodies.filter((b) => b.reason_index === i);
+      return el("li", { class: "seg-reason" }, [el("span", { class: "seg-swatch", style: "background:" + r.colour }), " " + r.reason + " (" +
+        mine.length + ", " + fix(mine.reduce((a, b) => a + b.volume_ml, 0), 0) + " mL): " + mine.map((b) => b.id).join(", ")]);
+    }));
+  }
+  function segLegend(bodies, reasons) {
+    const rows = bodies.map((b) => el("tr", { class: "seg-rejected", "data-body": String(b.id) }, [el("td", {}, [swatch(b, reasons[b.reason_index] || {})])].concat(
+      [b.reason, fix(b.volume_ml, 1) + " mL", b.what + " (" + b.kind + ")", seenText(b),
+        b.outlined ? fix(b.measured_ml, 1) + " mL" + (b.truncated ? " (grown to 3x, stopped)" : "") :
+        b.too_large ? "not drawn: over twice the lumen's volume (outside air)" : "not found near its position",
+        lpsText(b.position_lps_mm)].map((v) => el("td", { text: v })))));
+    return el("table", { class: "seg-table seg-legend" }, [el("tr", {}, ["#", "reason", "volume (segment)", "what", "seen on slices",
+      "outlined here", "LPS mm"].map((h) => el("th", { text: h })))].concat(rows));
   }
   function buildSegmentation() {
     const S = R.segmentation || {}, body = $("segmentation-body");
@@ -228,23 +256,19 @@
       body.appendChild(el("p", { class: "dim", text: "No segmentation view: " + (S.missing || "no data") + "." }));
       return;
     }
-    const bodies = S.bodies || [], byId = {};
+    const bodies = S.bodies || [], reasons = S.reasons || [], byId = {};
     bodies.forEach((b) => (byId[b.id] = b));
     const small = S.small_rejected || {};
     body.appendChild(el("p", { text: "Lumen " + fix(S.lumen_ml, 0) + " mL in " + (S.segment_volumes_ml || []).length + " segment(s); " +
       bodies.length + " rejected bodies of " + fix(S.min_body_ml, 0) + " mL or more (" + fix(bodies.reduce((a, b) => a + b.volume_ml, 0), 0) + " mL)" +
       (small.count ? "; " + small.count + " smaller rejected bodies (" + fix(small.volume_ml, 1) + " mL) not drawn" : "") + "." }));
+    if (bodies.length) body.appendChild(segReasonKey(bodies, reasons));
     for (const plane of ["coronal", "axial", "sagittal"]) {
       body.appendChild(el("h3", { text: plane }));
-      body.appendChild(el("div", { class: "montage", "data-plane": plane }, (S.planes[plane] || []).map((im) => segSlice(plane, im, byId))));
+      body.appendChild(el("div", { class: "montage", "data-plane": plane }, (S.planes[plane] || []).map((im, i) => segSlice(plane, i + 1, im, byId, reasons))));
     }
-    body.appendChild(el("h3", { text: "Rejected bodies (" + fix(S.min_body_ml, 0) + " mL or more)" }));
-    const rej = bodies.map((b) => el("tr", { class: "seg-rejected", "data-body": "R" + b.id }, ["R" + b.id, b.what, b.kind, fix(b.volume_ml, 1) + " mL",
-      b.outlined ? fix(b.measured_ml, 1) + " mL" + (b.truncated ? " (grown to 3x, stopped)" : "") :
-      b.too_large ? "not drawn: over twice the lumen's volume (outside air)" : "not found near its position", b.reason,
-      lpsText(b.position_lps_mm)].map((v) => el("td", { text: v }))));
-    body.appendChild(el("table", { class: "seg-table" }, [el("tr", {}, ["id", "what", "voxels", "volume (segment)", "outlined here", "reason", "LPS mm"]
-      .map((h) => el("th", { text: h })))].concat(rej)));
+    body.appendChild(el("h3", { text: "Rejected bodies (" + fix(S.min_body_ml, 0) + " mL or more): legend of the tags" }));
+    body.appendChild(segLegend(bodies, reasons));
     body.appendChild(el("h3", { text: "Kept" }));
     body.appendChild(el("table", { class: "seg-table" }, [el("tr", {}, ["what", "volume", "reason"].map((h) => el("th", { text: h })))].concat(
       (S.kept || []).map((k) => el("tr", { class: "seg-kept" }, [k.what, fix(k.volume_ml, 1) + " mL", k.reason].map((v) => el("td", { text: v })))))));

@@ -2,14 +2,18 @@
 // find the bodies segment rejected (from each decision's position: the gas or tagged-fluid voxels
 // outside the lumen connected to the nearest such voxel), choose slices through the bodies and the
 // lumen, draw the montages (CT in the lung window, lumen outline green, rejected bodies tinted and
-// outlined red) and list the kept and rejected bodies.
+// outlined in their reason's colour, a numbered tag at each (qc_tags.h)) and list the kept and
+// rejected bodies (the legend: number, reason, volume, slices where seen).
 #include "colonflat/report/segmentation_qc.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
 
 #include "colonflat/core/threads.h"
 #include "colonflat/report/ct_views.h"
+#include "colonflat/report/qc_tags.h"
 
 namespace fs = std::filesystem;
 
@@ -17,15 +21,44 @@ namespace cf {
 namespace {
 
 constexpr unsigned char kLumenRgb[3] = {40, 230, 90};
-constexpr unsigned char kBodyRgb[3] = {255, 50, 30};
+// One colour per rejection reason, in the order reasons first appear (cycled beyond 8); none is
+// near the lumen's green, each stands out on the grey CT.
+constexpr std::array<unsigned char, 3> kReasonRgb[8] = {{255, 50, 30},  {255, 160, 0},   {230, 60, 230}, {0, 200, 255},
+                                                        {255, 235, 60}, {120, 110, 255}, {255, 130, 170}, {190, 130, 60}};
+
+std::string css_rgb(const std::array<unsigned char, 3>& c) {
+  return "rgb(" + std::to_string(c[0]) + "," + std::to_string(c[1]) + "," + std::to_string(c[2]) + ")";
+}
+
+// A montage being drawn: pixels, lumen mask, body number per pixel (0 none), outline masks.
+struct SliceCanvas {
+  int w = 0, h = 0;
+  std::vector<unsigned char> rgb, lum, lumen_edge, body_edge;
+  std::vector<int> body;
+};
 
 struct QcBody {
   int id = 0;
   nlohmann::json decision;
   std::vector<std::size_t> voxels;  // sorted
   int cls = -1;                     // 0 gas, 1 tagged fluid
+  int reason = 0;                   // index of its reason among the bodies' reasons (its colour)
   bool truncated = false, too_large = false;
 };
+
+// Each body's "seen": the slices whose montage shows it ({plane, slice (1-based), axis, position_mm}).
+void add_seen(nlohmann::json& section) {
+  for (const char* plane : {"coronal", "axial", "sagittal"}) {
+    int n = 0;
+    for (const auto& im : section["planes"][plane]) {
+      ++n;
+      for (const auto& t : im["tags"]) {
+        auto& b = section["bodies"][t["id"].get<std::size_t>() - 1];
+        b["seen"].push_back({{"plane", plane}, {"slice", n}, {"axis", im["axis"]}, {"position_mm", im["position_mm"]}});
+      }
+    }
+  }
+}
 
 class SegmentationQc {
  public:
@@ -57,7 +90,12 @@ class SegmentationQc {
     for (int d = 0; d < 3; ++d) lo_[d] = std::min(lo_[d], p[d]), hi_[d] = std::max(hi_[d], p[d]);
   }
   std::vector<double> slice_positions(Plane p) const;
+  void assign_reasons();
+  const std::array<unsigned char, 3>& colour(int body_id) const { return kReasonRgb[bodies_[std::size_t(body_id - 1)].reason % 8]; }
   nlohmann::json draw(Plane p, double fixed, int n, QcMontage& out) const;
+  SliceCanvas paint(Plane p, double fixed) const;
+  void outline(SliceCanvas& cv) const;
+  nlohmann::json tag(SliceCanvas& cv) const;
   nlohmann::json tables() const;
 
   const CtImage* ct_;
@@ -71,6 +109,7 @@ class SegmentationQc {
   std::array<double, 3> lo_{1e300, 1e300, 1e300}, hi_{-1e300, -1e300, -1e300}, hist_lo_{};
   std::array<std::vector<double>, 3> hist_;  // lumen voxels per 1 mm along each LPS axis from hist_lo_
   std::vector<QcBody> bodies_;
+  std::vector<std::string> reasons_;  // distinct reasons of the bodies, in order of first appearance
   std::vector<bool> taken_;
   std::vector<std::pair<std::size_t, int>> body_voxels_;  // (voxel, body index + 1), sorted
 };
@@ -193,12 +232,23 @@ void SegmentationQc::find_bodies() {
   std::sort(body_voxels_.begin(), body_voxels_.end());
 }
 
+// Each body's reason index (its colour): distinct reasons numbered in order of first appearance.
+void SegmentationQc::assign_reasons() {
+  for (QcBody& b : bodies_) {
+    const std::string r = b.decision.value("reason", std::string());
+    const auto it = std::find(reasons_.begin(), reasons_.end(), r);
+    b.reason = int(it - reasons_.begin());
+    if (it == reasons_.end()) reasons_.push_back(r);
+  }
+}
+
 // The montages' slices are drawn on the threads, each into its own slot: the same drawing for
 // any thread count.
 SegmentationQcDrawing SegmentationQc::run() {
   thresholds();
   scan_lumen();
   find_bodies();
+  assign_reasons();
   SegmentationQcDrawing out;
   if (lo_[0] > hi_[0]) {
     out.section = {{"missing", "the lumen mask is empty and no rejected body was found"}};
@@ -225,6 +275,7 @@ SegmentationQcDrawing SegmentationQc::run() {
   out.section = tables();
   for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) out.section["planes"][plane_name(p)] = nlohmann::json::array();
   for (std::size_t i = 0; i < slices.size(); ++i) out.section["planes"][plane_name(slices[i].plane)].push_back(entries[i]);
+  add_seen(out.section);
   return out;
 }
 
@@ -265,61 +316,102 @@ std::vector<double> SegmentationQc::slice_positions(Plane p) const {
   return pos;
 }
 
-// One montage image: the CT plane (lung window), rejected bodies tinted and outlined red, the lumen
-// outlined green; a label per body where it shows (its pixels' centre).
+// One montage image: the CT plane (lung window), rejected bodies tinted and outlined in their
+// reason's colour, the lumen outlined green, a numbered tag per body seen (placed by qc_tags.h,
+// with a leader line when moved off its body).
 nlohmann::json SegmentationQc::draw(Plane p, double fixed, int n, QcMontage& out) const {
+  SliceCanvas cv = paint(p, fixed);
+  outline(cv);
+  const nlohmann::json tags = tag(cv);
+  out.name = std::string("seg_") + plane_name(p) + "_" + std::to_string(n) + ".png";
+  out.w = cv.w, out.h = cv.h, out.rgb = std::move(cv.rgb);
+  return {{"position_mm", std::round(fixed * 10) / 10}, {"axis", std::string(1, "LPS"[plane_axes(p).fixed_axis])},
+          {"w", out.w}, {"h", out.h}, {"pixel_mm", pix_}, {"tags", tags}};
+}
+
+// The CT plane in the lung window over the lumen's and bodies' box (+ margin), the lumen mask and
+// the body number of every pixel, bodies tinted (65 % CT, 35 % their colour).
+SliceCanvas SegmentationQc::paint(Plane p, double fixed) const {
   const PlaneAxes a = plane_axes(p);
   const auto range = [&](int axis, int sign) {
     const double x = sign * lo_[axis], y = sign * hi_[axis];
     return std::array<double, 2>{std::min(x, y) - o_.margin_mm, std::max(x, y) + o_.margin_mm};
   };
   const auto ur = range(a.u_axis, a.u_sign), vr = range(a.v_axis, a.v_sign);
-  const int w = std::max(1, int(std::ceil((ur[1] - ur[0]) / pix_))), h = std::max(1, int(std::ceil((vr[1] - vr[0]) / pix_)));
-  const PlaneImage im = sample_plane(ct_, p, fixed, ur[0], vr[0], w, h, pix_);
-  std::vector<unsigned char> lum(std::size_t(w) * h, 0), rgb(std::size_t(w) * h * 3);
-  std::vector<int> body(std::size_t(w) * h, 0);
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
+  SliceCanvas cv;
+  cv.w = std::max(1, int(std::ceil((ur[1] - ur[0]) / pix_))), cv.h = std::max(1, int(std::ceil((vr[1] - vr[0]) / pix_)));
+  const PlaneImage im = sample_plane(ct_, p, fixed, ur[0], vr[0], cv.w, cv.h, pix_);
+  const std::size_t np = std::size_t(cv.w) * cv.h;
+  cv.lum.assign(np, 0), cv.rgb.assign(np * 3, 0), cv.body.assign(np, 0);
+  for (int r = 0; r < cv.h; ++r)
+    for (int c = 0; c < cv.w; ++c) {
       CtImage::PointType pt;
       pt[a.fixed_axis] = fixed;
       pt[a.u_axis] = a.u_sign * (ur[0] + c * pix_);
       pt[a.v_axis] = a.v_sign * (vr[0] + r * pix_);
       CtImage::IndexType idx;
-      const std::size_t px = std::size_t(r) * w + c;
+      const std::size_t px = std::size_t(r) * cv.w + c;
       const unsigned char g = window_grey(im.hu[px], lung_window());
-      for (int k = 0; k < 3; ++k) rgb[3 * px + k] = g;
+      for (int k = 0; k < 3; ++k) cv.rgb[3 * px + k] = g;
       if (!ct_->TransformPhysicalPointToIndex(pt, idx)) continue;
       const std::size_t q = std::size_t(idx[0]) + n_[0] * (std::size_t(idx[1]) + n_[1] * std::size_t(idx[2]));
-      lum[px] = m_[q];
+      cv.lum[px] = m_[q];
       const auto it = std::lower_bound(body_voxels_.begin(), body_voxels_.end(), std::make_pair(q, 0));
-      if (it != body_voxels_.end() && it->first == q) body[px] = it->second;
-      if (body[px])
-        for (int k = 0; k < 3; ++k) rgb[3 * px + k] = static_cast<unsigned char>(0.65 * g + 0.35 * kBodyRgb[k]);
+      if (it == body_voxels_.end() || it->first != q) continue;
+      cv.body[px] = it->second;
+      for (int k = 0; k < 3; ++k) cv.rgb[3 * px + k] = static_cast<unsigned char>(0.65 * g + 0.35 * colour(it->second)[k]);
     }
-  std::vector<std::array<double, 3>> centre(bodies_.size() + 1, {0, 0, 0});  // sum col, sum row, count
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      const std::size_t px = std::size_t(r) * w + c;
+  return cv;
+}
+
+// Outline pixels (4-neighbours outside the region): lumen green, each body in its colour.
+void SegmentationQc::outline(SliceCanvas& cv) const {
+  cv.lumen_edge.assign(cv.lum.size(), 0), cv.body_edge.assign(cv.lum.size(), 0);
+  for (int r = 0; r < cv.h; ++r)
+    for (int c = 0; c < cv.w; ++c) {
+      const std::size_t px = std::size_t(r) * cv.w + c;
       bool lum_edge = false, body_edge = false;
       for (const auto& [dr, dc] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
         const int rr = r + dr, cc = c + dc;
-        if (rr < 0 || cc < 0 || rr >= h || cc >= w) continue;
-        const std::size_t o = std::size_t(rr) * w + cc;
-        lum_edge = lum_edge || (lum[px] && !lum[o]);
-        body_edge = body_edge || (body[px] && body[o] != body[px]);
+        if (rr < 0 || cc < 0 || rr >= cv.h || cc >= cv.w) continue;
+        const std::size_t o = std::size_t(rr) * cv.w + cc;
+        lum_edge = lum_edge || (cv.lum[px] && !cv.lum[o]);
+        body_edge = body_edge || (cv.body[px] && cv.body[o] != cv.body[px]);
       }
-      if (lum_edge) std::copy_n(kLumenRgb, 3, &rgb[3 * px]);
-      if (body_edge) std::copy_n(kBodyRgb, 3, &rgb[3 * px]);
-      if (body[px]) centre[std::size_t(body[px])][0] += c, centre[std::size_t(body[px])][1] += r, centre[std::size_t(body[px])][2] += 1;
+      cv.lumen_edge[px] = lum_edge, cv.body_edge[px] = body_edge;
+      if (lum_edge) std::copy_n(kLumenRgb, 3, &cv.rgb[3 * px]);
+      if (body_edge) std::copy_n(colour(cv.body[px]).data(), 3, &cv.rgb[3 * px]);
     }
-  out.name = std::string("seg_") + plane_name(p) + "_" + std::to_string(n) + ".png";
-  out.w = w, out.h = h, out.rgb = std::move(rgb);
-  nlohmann::json labels = nlohmann::json::array();
-  for (std::size_t b = 1; b < centre.size(); ++b)
-    if (centre[b][2] > 0)
-      labels.push_back({{"id", int(b)}, {"col", centre[b][0] / centre[b][2]}, {"row", centre[b][1] / centre[b][2]}, {"pixels", centre[b][2]}});
-  return {{"position_mm", std::round(fixed * 10) / 10}, {"axis", std::string(1, "LPS"[a.fixed_axis])},
-          {"w", w}, {"h", h}, {"pixel_mm", pix_}, {"labels", labels}};
+}
+
+// Tags: each body seen points at its pixel nearest its pixels' centre; the bodies with fewest
+// pixels here are placed first (they need a near place most). Leaders are drawn into the image.
+nlohmann::json SegmentationQc::tag(SliceCanvas& cv) const {
+  const std::size_t nb = bodies_.size() + 1;
+  std::vector<std::array<double, 3>> sum(nb, {0, 0, 0});  // col, row, pixels
+  for (std::size_t px = 0; px < cv.body.size(); ++px)
+    if (const int b = cv.body[px]) sum[std::size_t(b)][0] += double(px % cv.w), sum[std::size_t(b)][1] += double(px / cv.w), sum[std::size_t(b)][2] += 1;
+  std::vector<double> best(nb, 1e300);
+  std::vector<QcTagAnchor> anchors(nb);
+  for (std::size_t px = 0; px < cv.body.size(); ++px) {
+    const std::size_t b = std::size_t(cv.body[px]);
+    if (!b) continue;
+    const double dc = double(px % cv.w) - sum[b][0] / sum[b][2], dr = double(px / cv.w) - sum[b][1] / sum[b][2];
+    if (dc * dc + dr * dr < best[b]) best[b] = dc * dc + dr * dr, anchors[b] = {int(b), int(px % cv.w), int(px / cv.w)};
+  }
+  std::vector<QcTagAnchor> seen;
+  for (std::size_t b = 1; b < nb; ++b)
+    if (sum[b][2] > 0) seen.push_back(anchors[b]);
+  std::stable_sort(seen.begin(), seen.end(), [&](const QcTagAnchor& x, const QcTagAnchor& y) { return sum[std::size_t(x.id)][2] < sum[std::size_t(y.id)][2]; });
+  const std::vector<QcTag> tags = place_qc_tags(cv.w, cv.h, cv.lumen_edge, cv.body_edge, seen, o_.tags);
+  std::vector<std::array<unsigned char, 3>> colours(nb);
+  for (std::size_t b = 1; b < nb; ++b) colours[b] = colour(int(b));
+  draw_qc_leaders(cv.w, cv.h, cv.rgb, tags, colours);
+  nlohmann::json out = nlohmann::json::array();
+  for (const QcTag& t : tags)
+    out.push_back({{"id", t.id}, {"col", t.col}, {"row", t.row}, {"pixels", sum[std::size_t(t.id)][2]}, {"placed", t.placed},
+                   {"x", t.x}, {"y", t.y}, {"w", t.w}, {"h", t.h}, {"leader", t.leader}, {"lumen_covered", t.lumen_covered}});
+  return out;
 }
 
 // The kept and rejected bodies of segment's decisions, the lumen volume and the thresholds used.
@@ -329,8 +421,14 @@ nlohmann::json SegmentationQc::tables() const {
     bodies.push_back({{"id", b.id}, {"what", b.decision.value("what", "")}, {"reason", b.decision.value("reason", "")},
                       {"volume_ml", b.decision.value("volume_ml", 0.0)}, {"position_lps_mm", b.decision["position_lps_mm"]},
                       {"outlined", !b.voxels.empty()}, {"measured_ml", b.voxels.size() * voxel_ml_}, {"truncated", b.truncated},
-                      {"too_large", b.too_large},
-                      {"kind", b.cls == 0 ? "gas" : b.cls == 1 ? "tagged fluid" : "not found"}});
+                      {"too_large", b.too_large}, {"reason_index", b.reason}, {"colour", css_rgb(kReasonRgb[b.reason % 8])},
+                      {"seen", nlohmann::json::array()}, {"kind", b.cls == 0 ? "gas" : b.cls == 1 ? "tagged fluid" : "not found"}});
+  nlohmann::json reasons = nlohmann::json::array();
+  for (std::size_t r = 0; r < reasons_.size(); ++r) {
+    const auto& c = kReasonRgb[r % 8];
+    const bool light = 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2] > 140;  // dark digits on a light tag
+    reasons.push_back({{"reason", reasons_[r]}, {"colour", css_rgb(c)}, {"ink", light ? "#000" : "#fff"}});
+  }
   double small_ml = 0;
   int small = 0;
   for (const auto& d : result_.value("decisions", nlohmann::json::array())) {
@@ -341,7 +439,7 @@ nlohmann::json SegmentationQc::tables() const {
   return {{"bodies", bodies}, {"kept", kept}, {"segment_volumes_ml", result_.value("segment_volumes_ml", nlohmann::json::array())},
           {"lumen_ml", lumen_ml_}, {"min_body_ml", o_.min_body_ml}, {"small_rejected", {{"count", small}, {"volume_ml", small_ml}}},
           {"thresholds_hu", {{"gas_below", gas_thr_}, {"fluid_above", fluid_thr_}}},
-          {"colours", {{"lumen", "rgb(40,230,90)"}, {"rejected", "rgb(255,50,30)"}}}};
+          {"reasons", reasons}, {"colours", {{"lumen", "rgb(40,230,90)"}}}};
 }
 
 }  // namespace

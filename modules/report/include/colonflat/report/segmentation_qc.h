@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/report/qc_tags.h"
 #include "colonflat/volume/volume_io.h"
 
 namespace cf {
@@ -21,6 +22,7 @@ struct SegmentationQcOptions {
   int max_pixels = 360;       // longest side of a montage image
   double margin_mm = 15;      // around the lumen and the bodies
   double search_mm = 25;      // a body's voxels are looked for this far from its decision's position
+  QcTagOptions tags;          // the numbered tags' size and placement (qc_tags.h)
 };
 
 // One montage drawn in memory: RGB pixels, 3 bytes a pixel, row 0 at the top.
@@ -51,9 +53,11 @@ nlohmann::json write_segmentation_qc(const SegmentationQcDrawing& drawing, const
                                      const std::string& rel_prefix, int* images);
 
 // Both in one call: writes the montage PNGs `<dir>/seg_<plane>_<n>.png` and returns the section's data:
-// {planes: {axial|coronal|sagittal: [{file, position_mm, axis, w, h, labels: [{id, col, row}]}]},
-//  bodies: [{id, what, reason, volume_ml, position_lps_mm, outlined, measured_ml, colour}], kept: [...],
-//  lumen_ml, thresholds_hu}. `segment_result` is the segment stage's result object (may be empty).
+// {planes: {axial|coronal|sagittal: [{file, position_mm, axis, w, h, pixel_mm, tags: [{id, col, row
+//  (anchor pixel), pixels, placed, x, y, w, h (tag box, image pixels), leader, lumen_covered}]}]},
+//  bodies: [{id, what, kind, reason, reason_index, colour, volume_ml, position_lps_mm, outlined,
+//  measured_ml, seen: [{plane, slice, axis, position_mm}]}], reasons: [{reason, colour, ink}],
+//  kept: [...], lumen_ml, thresholds_hu}. Body `id` is its index in `bodies` + 1 and its tag's number. `segment_result` is the segment stage's result object (may be empty).
 // The lumen must be on the CT's grid (else: {"missing": why}). `images` += PNGs written.
 nlohmann::json write_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
                                      const std::filesystem::path& dir, const std::string& rel_prefix, int* images,
