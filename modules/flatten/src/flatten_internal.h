@@ -107,6 +107,10 @@ struct PriorSolve {
   std::vector<int> vertex_order;            // the vertices in a fill-reducing elimination order (empty: none)
   std::shared_ptr<ConformalFactor> factor;  // the factorisation (null: none)
   std::vector<int> new_of_old;              // per vertex of the factor's surface: its id here, -1 when cut off
+  // The order while it is still being computed (a segment's first solve: beside the opening of its
+  // ends): gives vertex_order's value, waiting for it; asked only once a new factorisation needs the
+  // order, so the system is assembled meanwhile. Empty: vertex_order is final.
+  std::function<std::vector<int>()> order_when_ready;
 };
 struct Harmonic {
   Eigen::VectorXd u, v;
@@ -118,7 +122,7 @@ struct Harmonic {
   std::shared_ptr<ConformalFactor> factor;  // its factorisation, when new (null when an earlier one was updated)
 };
 // `prior` (optional): an earlier solve's vertex order (e.g. on a surface this one is a subset of;
-// AMD when there is none) and, with the same weights (`clamp`) and `new_of_old` set, its factor,
+// AMD when there is none; prior->order_when_ready is asked for it after the system is assembled) and, with the same weights (`clamp`) and `new_of_old` set, its factor,
 // updated to this surface (conformal_update.cpp) instead of a new factorisation; consumed.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
                         const std::vector<int>& loop_b, bool clamp, PriorSolve* prior = nullptr);
