@@ -33,15 +33,11 @@ class ConformalAreaEnergy {
   // `scale`: 3D / 2D area of the whole band (ratios at the area-preserving scale).
   ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
                       double lo, double hi, double lambda, double scale)
-      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), log_lo_(std::log(lo)), log_hi_(std::log(hi)),
-        lambda_(lambda), scale_(scale) {
+      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), excess_(lo, hi), lambda_(lambda), scale_(scale) {
     w_ = corner_weights(s, faces_);
   }
   const std::vector<std::array<double, 3>>& weights() const { return w_; }
   const std::vector<int>& faces() const { return faces_; }
-
-  // Excess of a log ratio outside [log lo, log hi] (signed).
-  double excess(double log_ratio) const { return log_ratio - std::clamp(log_ratio, log_lo_, log_hi_); }
 
   double energy(const std::vector<V2>& pos) const {
     const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
@@ -52,7 +48,7 @@ class ConformalAreaEnergy {
         if (a2 <= 0) return kHuge;
         for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
         const int f = faces_[i];
-        const double x = excess(std::log(scale_ * a2 / area3_[f]));
+        const double x = excess_(scale_ * a2 / area3_[f]);
         part += lambda_ * area3_[f] * x * x;
       }
       return part;
@@ -67,7 +63,7 @@ class ConformalAreaEnergy {
         const int f = faces_[i];
         const auto c = corners(pos, f);
         const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-        const double x = excess(std::log(scale_ * a2 / area3_[f]));
+        const double x = excess_(scale_ * a2 / area3_[f]);
         const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
         std::array<V2, 3>& grad = out[i];
         grad = {V2::Zero(), V2::Zero(), V2::Zero()};
@@ -91,7 +87,8 @@ class ConformalAreaEnergy {
   const Embedding& emb_;
   std::vector<int> faces_;
   const std::vector<double>& area3_;
-  double log_lo_, log_hi_, lambda_, scale_ = 1;
+  LogRatioExcess excess_;
+  double lambda_, scale_ = 1;
   std::vector<std::array<double, 3>> w_;
 };
 

@@ -50,9 +50,10 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
 // smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The elimination
-// order of the conformal solve (w.prior; segment_vertex_order: nested dissection on a large segment,
-// kept in w.dissection for the systems after the first map, else AMD) is computed on a second
-// thread meanwhile, on the closed surface, and restricted to the annulus.
+// order of the conformal solve (segment_vertex_order: nested dissection on a large segment, kept in
+// w.dissection for the systems after the first map, else AMD) is computed on a second thread, on
+// the closed surface, meanwhile and until the first solve has assembled its system: it is
+// w.prior.order_when_ready, the order restricted to the annulus.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
@@ -63,11 +64,16 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     w.seg.removed_faces = op.removed;
-    for (int v : order.get())
-      if (op.new_of_old[v] >= 0) w.prior.vertex_order.push_back(op.new_of_old[v]);
+    auto to_annulus = std::make_shared<const std::vector<int>>(std::move(op.new_of_old));
+    w.prior.order_when_ready = [order, to_annulus] {
+      std::vector<int> restricted;
+      for (int v : order.get())
+        if ((*to_annulus)[std::size_t(v)] >= 0) restricted.push_back((*to_annulus)[std::size_t(v)]);
+      return restricted;
+    };
     if (dissect) {
       w.dissection = order;
-      w.dissection_to_annulus = std::move(op.new_of_old);
+      w.dissection_to_annulus = *to_annulus;
     }
   }
   E = build_edges(w.ann.t);
@@ -110,7 +116,7 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
     Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, &w.prior);
-    w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}};
+    w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}, {}};
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
     for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));

@@ -6,7 +6,9 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <future>
@@ -105,6 +107,10 @@ struct PriorSolve {
   std::vector<int> vertex_order;            // the vertices in a fill-reducing elimination order (empty: none)
   std::shared_ptr<ConformalFactor> factor;  // the factorisation (null: none)
   std::vector<int> new_of_old;              // per vertex of the factor's surface: its id here, -1 when cut off
+  // The order while it is still being computed (a segment's first solve: beside the opening of its
+  // ends): gives vertex_order's value, waiting for it; asked only once a new factorisation needs the
+  // order, so the system is assembled meanwhile. Empty: vertex_order is final.
+  std::function<std::vector<int>()> order_when_ready;
 };
 struct Harmonic {
   Eigen::VectorXd u, v;
@@ -116,7 +122,7 @@ struct Harmonic {
   std::shared_ptr<ConformalFactor> factor;  // its factorisation, when new (null when an earlier one was updated)
 };
 // `prior` (optional): an earlier solve's vertex order (e.g. on a surface this one is a subset of;
-// AMD when there is none) and, with the same weights (`clamp`) and `new_of_old` set, its factor,
+// AMD when there is none; prior->order_when_ready is asked for it after the system is assembled) and, with the same weights (`clamp`) and `new_of_old` set, its factor,
 // updated to this surface (conformal_update.cpp) instead of a new factorisation; consumed.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
                         const std::vector<int>& loop_b, bool clamp, PriorSolve* prior = nullptr);
@@ -274,6 +280,28 @@ struct StepTimes {
   double gradient = 0, solve = 0, step_limit = 0, line_search = 0, check = 0;
   int energy_evals = 0;
 };
+// The area correction's penalty term of a face with area ratio r: log r minus log r clamped to
+// [log lo, log hi] (signed; 0 inside). A ratio inside [lo, hi] by the relative margin
+// kInsideMargin has its logarithm inside [log lo, log hi] whatever the last bits of the three
+// logarithms (each within an ulp, ~1e-16, of the true value; the margin moves log r by 1e-9), so
+// its excess is 0 without calling log: bit for bit the full formula, which most faces of a
+// correction region skip (docs/flatten.md, session 20). Pre: 0 < lo <= hi.
+class LogRatioExcess {
+ public:
+  static constexpr double kInsideMargin = 1e-9;
+  LogRatioExcess(double lo, double hi)
+      : log_lo_(std::log(lo)), log_hi_(std::log(hi)), inside_lo_(lo * (1 + kInsideMargin)),
+        inside_hi_(hi * (1 - kInsideMargin)) {}
+  double operator()(double ratio) const {
+    if (ratio > 0 && ratio >= inside_lo_ && ratio <= inside_hi_) return 0.0;
+    const double l = std::log(ratio);
+    return l - std::clamp(l, log_lo_, log_hi_);
+  }
+
+ private:
+  double log_lo_, log_hi_, inside_lo_, inside_hi_;
+};
+
 // What correct_area() did: steps, faces, energies, why it stopped.
 struct AreaCorrection {
   int iterations = 0;

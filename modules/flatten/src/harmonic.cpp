@@ -229,10 +229,20 @@ void solve_with(const ConformalFactor& f, const Edges& E, const std::vector<doub
   }
 }
 
+// The vertex order `prior` gives for a new factorisation (empty: none), waiting for it when it is
+// still being computed.
+std::vector<int> given_vertex_order(PriorSolve* prior) {
+  if (!prior) return {};
+  if (prior->vertex_order.empty() && prior->order_when_ready) prior->vertex_order = prior->order_when_ready();
+  prior->order_when_ready = nullptr;
+  return prior->vertex_order;
+}
+
 // A new factorisation of v's system (pinned at `pinned`), one fill-reducing order for u and v
-// (the given vertex order, else AMD on v's system), loops last.
+// (the vertex order `prior` gives, asked for once the system is assembled, else AMD on v's
+// system), loops last.
 UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::vector<signed char>& eta,
-                       const std::vector<char>& mark, int pinned, bool clamp, const std::vector<int>* vertex_order) {
+                       const std::vector<char>& mark, int pinned, bool clamp, PriorSolve* prior) {
   const LinearSystem vs = v_system(E, w, eta, int(mark.size()), pinned);
   auto f = std::make_shared<ConformalFactor>();
   f->unknown_of = vs.unknown_of;
@@ -240,8 +250,8 @@ UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::
   f->clamp = clamp;
   f->edges = E.ev;
   f->weights = w;
-  const std::vector<int> by_vertex =
-      vertex_order ? *vertex_order : vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
+  std::vector<int> by_vertex = given_vertex_order(prior);
+  if (by_vertex.empty()) by_vertex = vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
   const std::vector<int> order = loops_last(by_vertex, vs.unknown_of, mark, f->leading);
   const Stopwatch sw;
   f->solver.analyze(vs.A, &order);
@@ -290,10 +300,7 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   UvSolution sol;
   const bool updated = prior && prior->factor && solve_updated(*prior, E, w, h.eta, mark, clamp, sol);
   if (prior) prior->factor.reset();  // consumed (or of no use here): its memory back before a new one
-  if (!updated) {
-    const bool ordered = prior && !prior->vertex_order.empty();
-    sol = solve_fresh(E, w, h.eta, mark, loop_a.front(), clamp, ordered ? &prior->vertex_order : nullptr);
-  }
+  if (!updated) sol = solve_fresh(E, w, h.eta, mark, loop_a.front(), clamp, prior);
   h.u = std::move(sol.u);
   h.v = std::move(sol.v);
   h.vertex_order = std::move(sol.vertex_order);

@@ -4,7 +4,15 @@
 // refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <limits>
+#include <random>
+#include <utility>
+#include <vector>
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
@@ -133,6 +141,37 @@ TEST(AreaCorrection, LocalPiecesStartWithTheMostWorkThenTheMostFaces) {
   EXPECT_EQ(flat_detail::piece_work_bound(3001, 60), 1e7);
   EXPECT_EQ(flat_detail::piece_work_bound(1000, 60), 3.6e6);
   EXPECT_EQ(flat_detail::piece_work_bound(200000, 60), 1.2e7);
+}
+
+
+// The penalty's log-ratio excess skips the logarithm inside the bounds without changing a bit:
+// for five bound pairs (the defaults 0.4 / 3, wide, narrow, one-sided, lo = hi) and ratios spread
+// over 1e-12 .. 1e6, the ulps around lo, hi and the skip's margins, 0, negative, inf and NaN, it
+// is log r - clamp(log r, log lo, log hi) to the bit.
+TEST(AreaCorrection, LogRatioExcessIsTheFullFormulaToTheBit) {
+  auto bits = [](double x) {
+    std::uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  };
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> exponent(-12.0, 6.0);
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0.4, 3.0}, {0.1, 10.0}, {0.999, 1.001}, {1e-3, 1.0}, {1.0, 1.0}}) {
+    const flat_detail::LogRatioExcess excess(lo, hi);
+    std::vector<double> ratios{0.0, -1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()};
+    for (double edge : {lo, hi, lo * (1 + flat_detail::LogRatioExcess::kInsideMargin), hi * (1 - flat_detail::LogRatioExcess::kInsideMargin)}) {
+      double r = edge;
+      for (int k = 0; k < 64; ++k) r = std::nextafter(r, 0.0);
+      for (int k = 0; k < 128; ++k, r = std::nextafter(r, 2 * edge)) ratios.push_back(r);
+    }
+    for (int k = 0; k < 200000; ++k) ratios.push_back(std::pow(10.0, exponent(rng)));
+    std::size_t differ = 0;
+    for (double r : ratios) {
+      const double l = std::log(r);
+      differ += bits(excess(r)) != bits(l - std::clamp(l, std::log(lo), std::log(hi)));
+    }
+    EXPECT_EQ(differ, 0u) << "bounds " << lo << " " << hi;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // built from, and the SPD solver with a reused elimination order.
 #include <gtest/gtest.h>
 
+#include <future>
+
 #include <algorithm>
 #include <map>
 #include <cmath>
@@ -227,6 +229,39 @@ TEST(FlattenSolver, UpdatedFactorisationSolvesTheSurfaceThatRemains) {
   for (std::size_t v = 0; v < whole.p.size(); ++v)
     if (new_of_old[v] >= 0) moved = std::max(moved, std::abs(first.v[Eigen::Index(v)] - fresh.v[new_of_old[v]]));
   EXPECT_GT(moved, 1e-3);
+}
+
+// A first solve whose elimination order is still being computed on another thread (as beside the
+// opening of a colon's ends) asks for it once, when its system is assembled, and gives the map of
+// that order given up front to the bit (nested dissection's order, not AMD's).
+TEST(FlattenSolver, OrderStillBeingComputedGivesTheMapOfTheOrderGivenUpFront) {
+  using namespace cf::flat_detail;
+  const Surface tube = bumpy_tube(24, 400);
+  const Edges E = build_edges(tube.t);
+  auto loops = boundary_loops(tube, E);
+  ASSERT_EQ(loops.size(), 2u);
+  if (loops[0][0] != 0) std::swap(loops[0], loops[1]);
+  const int nv = int(tube.p.size());
+  auto computing = std::async(std::launch::async, [&E, nv] { return nested_dissection_vertex_order(E, nv); }).share();
+  int asked = 0;
+  PriorSolve pending;
+  pending.order_when_ready = [&] {
+    ++asked;
+    return computing.get();
+  };
+  const Harmonic late = solve_harmonic(tube, E, loops[0], loops[1], false, &pending);
+  PriorSolve given;
+  given.vertex_order = computing.get();
+  const Harmonic early = solve_harmonic(tube, E, loops[0], loops[1], false, &given);
+  const Harmonic amd = solve_harmonic(tube, E, loops[0], loops[1], false);
+  EXPECT_EQ(asked, 1);
+  EXPECT_FALSE(pending.order_when_ready);
+  EXPECT_EQ(late.vertex_order, early.vertex_order);
+  EXPECT_NE(late.vertex_order, amd.vertex_order);
+  int differ = 0;
+  for (Eigen::Index v = 0; v < Eigen::Index(nv); ++v) differ += late.u[v] != early.u[v] || late.v[v] != early.v[v];
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(late.period, early.period);
 }
 
 // The nested dissection order (METIS) of a large grid is a permutation of its unknowns whose
