@@ -81,6 +81,7 @@ class ExactGreedy {
   void add_source(int family, int v);
   void set_bound(int slot, const SourceBound& b);
   double best_exact_value();
+  double best_known(int* anchor = nullptr);
   int farthest_pending(double best);
   void spread_bounds(int centre_slot, double bound, const std::vector<int>& ball, const std::vector<double>& distance);
   void add_surgery_sources(const SurgeryResult& sr);
@@ -181,8 +182,10 @@ class ExactGreedy {
   std::priority_queue<QueueEntry, std::vector<QueueEntry>, std::greater<QueueEntry>> exact_queue_;
   long long searches_ = 0, settled_ = 0, bounds_spread_ = 0, bounds_reset_ = 0;
   int builds_ = 0, crossing_modes_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
+  // Searches from entering the crossing families to finding Z (the largest over the switches).
+  long long searches_at_crossing_ = 0, crossing_searches_to_z_ = 0;
   // Sources to certify against the best known loop, farthest from its source first.
-  int far_anchor_ = -1;
+  int far_anchor_ = -1;  // vertex the far-first order was measured from (-1: none)
   double far_value_ = 0;
   std::vector<std::pair<double, int>> far_order_;  // (distance from the anchor, slot), a max-heap
   std::vector<double> distances_;  // scratch: distances of the last single search's settled vertices
@@ -191,6 +194,7 @@ class ExactGreedy {
   std::vector<double> from_anchor_;                // per vertex: scratch for farthest_pending(), +inf between calls
   long long far_searches_ = 0;
   long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
+  long long mixed_batches_ = 0;  // batches holding groups of two crossing families
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
   std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;           // loops replaced by another of the same class (caps)

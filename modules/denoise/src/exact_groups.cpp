@@ -84,6 +84,8 @@ void ExactGreedy::search_group(int seed, double best) {
   }
   far_skipped_.clear();
   run_groups(runs);
+  mixed_batches_ += std::any_of(runs.begin(), runs.end(),
+                                [&](const GroupRun& g) { return slots_[g.seed].family != slots_[seed].family; });
   std::size_t settled = 0;
   for (const GroupRun& g : runs) {
     settled += g.settled;
@@ -106,7 +108,10 @@ std::size_t ExactGreedy::batch_size() const {
 // Whether a group search from `seed` may settle a vertex that the search of g settles (their
 // balls, within limit/2 of the group's roots, can meet: Euclidean test, which bounds the graph
 // distance from below). Groups of a batch are kept apart so that none certifies another.
+// Searches of different families never do (each raises only its own family's bounds): A's and
+// Z's groups of the crossing families pair whatever their distance.
 bool ExactGreedy::near_group(int seed, const GroupRun& g) const {
+  if (slots_[seed].family != slots_[g.seed].family) return false;
   const double reach = g.radius + g.limit;  // both balls: roots within the radius, searched to limit/2
   const Vec3& a = st_.mesh.point(Mesh::VertexHandle(slots_[seed].vertex));
   const Vec3& b = st_.mesh.point(Mesh::VertexHandle(slots_[g.seed].vertex));

@@ -97,7 +97,7 @@ int ExactGreedy::total_genus_left() const { return std::accumulate(st_.genus_lef
 double ExactGreedy::search_limit(int slot) {
   const double m = slots_[slot].bound.value;
   double limit = std::max({first_radius_, 2.0 * m, 2.0 * slots_[slot].own_limit});
-  const double best = best_exact_value();
+  const double best = best_known();
   if (std::isfinite(best) && best > m) limit = kBestFactor * best;
   limit = std::max(limit, 1.05 * m);
   return std::min(limit, opts_.max_loop_length);
@@ -152,11 +152,11 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
     if (stop_before(top, &reason)) return reason;
     if (!top.exact) {
       queue_.push(top);  // still pending; the order below does not change what is cut
-      const double best = best_exact_value();
-      if (crossing_wanted_ && !crossing_ && std::isfinite(best)) {
+      if (crossing_wanted_ && !crossing_ && std::isfinite(best_exact_value())) {
         enter_crossing_mode();
         continue;
       }
+      const double best = best_known();
       const int far = want_type_ ? -1 : farthest_pending(best);
       const int s = far >= 0 ? far : top.slot;
       if (!want_type_ && std::isfinite(best)) search_group(s, best);
@@ -231,11 +231,13 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["group_members"] = group_members_;
   stats["group_exact_bounds"] = group_exact_;
   stats["parallel_search_pairs"] = parallel_pairs_;
+  stats["batches_of_two_families"] = mixed_batches_;
   stats["settled_vertices_alone"] = settled_alone_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
   stats["bounds_carried_at_rebuild"] = bounds_carried_;
   stats["crossing_family_switches"] = crossing_modes_;
+  stats["crossing_searches_to_z"] = crossing_searches_to_z_;
   stats["loops_replaced_for_clean_caps"] = alternatives_ + crossing_alternatives_;
   stats["loops_replaced_by_crossing_loop"] = crossing_alternatives_;
   stats["first_search_radius_mm"] = first_radius_;

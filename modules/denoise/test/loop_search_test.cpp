@@ -192,5 +192,19 @@ TEST(DenoiseLoopSearch, CrossingFamiliesKeepTheLoopExact) {
   }
 }
 
+// Proves that the crossing families take loop A's length U as the known bound: on a thin torus
+// (meridian A 4.37 mm; the cycles crossing it >= the inner longitude, 33.3 mm = 7.6 U) Z is found
+// within 4 searches of A's family (limits 2U, then doubled: 4U, 8U >= 7.6 U); without A's length
+// A's sources are searched one by one with limits doubling from 10 mean edges (11 searches).
+TEST(DenoiseLoopSearch, CrossingFamiliesSearchToTwiceLoopA) {
+  const Mesh m = to_mesh(torus(6, 0.7, 90, 12));
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 1u);
+  ASSERT_GE(r.report["search"]["crossing_family_switches"].get<int>(), 1);
+  EXPECT_LE(r.report["search"]["crossing_searches_to_z"].get<long long>(), 4);
+  const double ref = testing::brute_force_shortest_nonseparating(m, r.loops[0].length * (1 + 1e-9) + 1e-12);
+  EXPECT_NEAR(r.loops[0].length, ref, 1e-9 * (1 + ref));
+}
+
 }  // namespace
 }  // namespace cf
