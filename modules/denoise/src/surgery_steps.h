@@ -66,6 +66,7 @@ class Surgery {
   void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
                        const std::vector<Mesh::VertexHandle>& inner);
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
+  bool left_first(std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
   std::unordered_map<int, std::vector<std::uint64_t>> ring_potentials(const std::vector<Mesh::VertexHandle>& ring) const;
   // A left-side ring as its hole runs: x_0, x_(k-1), ..., x_1 (the left ring itself, or its collar).
