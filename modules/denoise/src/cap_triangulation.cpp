@@ -221,7 +221,7 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid,
-    const std::vector<std::array<int, 3>>& others, long long* budget) {
+    const std::vector<std::array<int, 3>>& others, long long* budget, RingQueryCache* cache) {
   const int n = static_cast<int>(ring.size());
   long long queries = 0;
   std::vector<Vec3> pts;
@@ -232,15 +232,26 @@ std::vector<std::array<int, 3>> triangulate_ring(
   };
   // A diagonal that pierces the surface fails every triangle on it (one segment query for all).
   std::function<bool(int, int)> side_ok;
-  if (grid)
-    side_ok = [&](int a, int b) { return diagonal_ok(a, b) && !grid->segment_hits(mesh, ring[a].idx(), ring[b].idx()); };
+  auto pierces = [&](int a, int b) {
+    if (!cache) return grid->segment_hits(mesh, ring[a].idx(), ring[b].idx());
+    const auto [it, added] = cache->sides_ok.try_emplace(static_cast<long long>(a) * n + b, false);
+    if (added) it->second = !grid->segment_hits(mesh, ring[a].idx(), ring[b].idx());
+    return !it->second;
+  };
+  if (grid) side_ok = [&](int a, int b) { return diagonal_ok(a, b) && !pierces(a, b); };
   auto allowed = [&](int i, int m, int j) {
     const Vec3 &a = pts[i], &b = pts[m], &c = pts[j];
     const double longest = std::max({(b - a).sqrnorm(), (c - b).sqrnorm(), (a - c).sqrnorm()});
     if (OpenMesh::cross(b - a, c - a).norm() < 1e-4 * longest) return false;
     if (!grid) return true;  // diagonals are checked on the result: cheaper than here
     ++queries;
-    return !grid->hits(mesh, {ring[i].idx(), ring[m].idx(), ring[j].idx()}, others);
+    const long long key = (static_cast<long long>(i) * n + m) * n + j;
+    if (cache && cache->hits.count(key)) return false;
+    if (cache && others.empty() && cache->clean.count(key)) return true;
+    const bool hit = grid->hits(mesh, {ring[i].idx(), ring[m].idx(), ring[j].idx()}, others);
+    if (cache && !hit) cache->clean.insert(key);
+    if (cache && hit && others.empty()) cache->hits.insert(key);
+    return !hit;
   };
   auto give_up = [&] { return budget && queries > *budget; };
   const double cpu0 = grid && detail::denoise_debug() ? process_cpu_seconds() : 0.0;

@@ -6,6 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "colonflat/denoise/cap_triangulation.h"
 #include "colonflat/denoise/homology.h"
 #include "colonflat/denoise/surgery.h"
 
@@ -66,6 +67,7 @@ class Surgery {
   void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
                        const std::vector<Mesh::VertexHandle>& inner);
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
+  bool left_first(std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
   std::unordered_map<int, std::vector<std::uint64_t>> ring_potentials(const std::vector<Mesh::VertexHandle>& ring) const;
   // A left-side ring as its hole runs: x_0, x_(k-1), ..., x_1 (the left ring itself, or its collar).
@@ -137,6 +139,7 @@ class Surgery {
   std::vector<Vec3> normal_left_, normal_right_;             // unit normals of the placed rings' own sides
   ConcentricCap cap_left_, cap_right_;
   SurgeryResult result_;
+  RingQueryCache right_cache_, left_cache_;  // grid answers of each ring's restricted triangulations, this placement
   bool gave_up_ = false;                // no more restricted triangulations (budget spent, or the right ring has none)
   long long query_budget_ = 0;          // grid queries left for them (kMaxGridQueries per surgery)
   const char* cap_kind_ = "concentric";  // which step made the caps (COLONFLAT_DENOISE_DEBUG)

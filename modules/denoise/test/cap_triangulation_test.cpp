@@ -209,5 +209,41 @@ TEST(DenoiseCapTriangulation, RestrictedTriangulationStopsAtItsBudget) {
   EXPECT_EQ(triangulate_ring(free_ring, ring2, never, &far_grid, {}, &enough).size(), 38u);
 }
 
+// A shared RingQueryCache gives the same triangulations and spends the same budget as fresh
+// queries, in either order of a call that avoids `others` (a triangle piercing the ring's plane
+// near its centre) and one that avoids the grid only: refusals caused by `others` are not
+// reused as the grid's, and triangles clean of the grid are not accepted where `others` refuse them.
+TEST(DenoiseCapTriangulation, QueryCacheGivesTheSameTriangulations) {
+  constexpr double kPi = 3.14159265358979323846;
+  Mesh m;
+  std::vector<Mesh::VertexHandle> ring;
+  for (int i = 0; i < 12; ++i) ring.push_back(m.add_vertex(Vec3(std::cos(2 * kPi * i / 12), std::sin(2 * kPi * i / 12), 0)));
+  const auto f = m.add_vertex(Vec3(50, 50, 50));  // the grid's one face, far away
+  m.add_face(f, m.add_vertex(Vec3(51, 50, 50)), m.add_vertex(Vec3(50, 51, 50)));
+  const std::vector<std::array<int, 3>> blocker = {
+      {m.add_vertex(Vec3(0.2, 0, -1)).idx(), m.add_vertex(Vec3(0.25, 0, 1)).idx(), m.add_vertex(Vec3(0.15, 0, 1)).idx()}};
+  const FaceGrid grid(m, 1.0);
+  auto never = [](Mesh::VertexHandle, Mesh::VertexHandle) { return false; };
+  auto run = [&](const std::vector<std::array<int, 3>>& others, RingQueryCache* cache, long long* spent) {
+    long long budget = 1000000;
+    auto t = triangulate_ring(m, ring, never, &grid, others, &budget, cache);
+    *spent = 1000000 - budget;
+    return t;
+  };
+  long long spent_free = 0, spent_blocked = 0, spent = 0;
+  const auto free_cap = run({}, nullptr, &spent_free), blocked_cap = run(blocker, nullptr, &spent_blocked);
+  ASSERT_EQ(free_cap.size(), 10u);
+  ASSERT_EQ(blocked_cap.size(), 10u);
+  ASSERT_NE(free_cap, blocked_cap);  // the blocker refuses the free cap's triangles
+  RingQueryCache blocked_first, free_first;
+  EXPECT_EQ(run(blocker, &blocked_first, &spent), blocked_cap);
+  EXPECT_EQ(spent, spent_blocked);
+  EXPECT_EQ(run({}, &blocked_first, &spent), free_cap);
+  EXPECT_EQ(spent, spent_free);
+  EXPECT_EQ(run({}, &free_first, &spent), free_cap);
+  EXPECT_EQ(run(blocker, &free_first, &spent), blocked_cap);
+  EXPECT_EQ(spent, spent_blocked);
+}
+
 }  // namespace
 }  // namespace cf

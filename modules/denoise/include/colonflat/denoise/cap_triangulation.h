@@ -2,6 +2,8 @@
 // Minimum-area triangulation of a closed 3D polygon (the caps of surgery).
 #include <array>
 #include <functional>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
@@ -32,10 +34,20 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
 // Returns mesh vertex ids in ear order (ready for add_face one by one), or nothing if no such
 // triangulation exists or (with `grid` and `budget`) it took more grid queries (triangles
 // tested) than *budget; *budget is lowered by the queries made.
+// With `cache` (and `grid`): the grid's answers for this ring at its present position, by ring
+// indices, are taken from it and added to it: triangles found clean (of the grid's faces: reused
+// only when `others` is empty), triangles that hit the grid's faces (reused always) and sides that
+// pierce it or not. A cached answer is the one the query would give, so the result is the same
+// as without the cache, and it counts against *budget as the query it replaces. Pre: the same
+// ring, mesh positions and grid faces in every call that shares a cache.
+struct RingQueryCache {
+  std::unordered_set<long long> clean, hits;      // triangles (i, m, j): key (i n + m) n + j
+  std::unordered_map<long long, bool> sides_ok;  // sides (a, b), a < b: key a n + b
+};
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid = nullptr,
-    const std::vector<std::array<int, 3>>& others = {}, long long* budget = nullptr);
+    const std::vector<std::array<int, 3>>& others = {}, long long* budget = nullptr, RingQueryCache* cache = nullptr);
 
 // Adds the triangles of triangulate_ring (in its ear order) to the mesh, and to `grid` when given.
 // Throws cf::Error naming `what` if OpenMesh refuses one (the ring was not a hole's boundary).
