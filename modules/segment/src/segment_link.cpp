@@ -38,7 +38,8 @@ constexpr double kContactSeparationMm = 20;
 // least about 4 cm, so a candidate whose diameter is under 3/4 of the colon end's is a small-bowel
 // loop lying end-on against the colon, not the colon beyond a collapsed neck - unless it is itself of
 // colon calibre (>= kColonMinDiameterMm: a poorly distended stretch beside a wide one). One-sided: a
-// candidate wider than the colon end is never refused by it (docs/segment.md step 6).
+// candidate wider than the colon end is never refused by it (docs/segment.md step 6). Both bodies'
+// calibres are read beyond the cap (calibre_front).
 constexpr double kMinDiameterRatio = 0.75;
 constexpr double kColonMinDiameterMm = 40;
 // How far a body narrows toward a contact: its nearest front's cross-section (cells) over its widest
@@ -54,12 +55,23 @@ double narrowing(const LocalShape& s) {
   const std::size_t widest = widest_front(s);
   return widest ? double(s.fronts.front().cells) / double(widest) : 1.0;
 }
+// Cells of a body's calibre front near a contact: the wider of its fronts beyond the nearest (at 2/3
+// and 3/3 of the shape radius, 50 and 75 mm), or its only front. The nearest front (25 mm) lies
+// within a wide body's own radius of the contact, so it is a cap around the contact that reads the
+// width there (a small-bowel loop's bulb pressed on a colon end, 45 mm, read as colon calibre);
+// beyond the cap a front is the body's cross-section. The wider of the two, because the farther may
+// be the body's tip (a stretch ending 75 mm from the contact).
+std::size_t calibre_front(const LocalShape& s) {
+  if (s.fronts.size() < 2) return widest_front(s);
+  std::size_t widest = 0;
+  for (std::size_t t = 1; t < s.fronts.size(); ++t) widest = std::max(widest, s.fronts[t].cells);
+  return widest;
+}
 // Ratio of the candidate's equivalent diameter to the colon end's near a contact (> 1: the candidate
-// is wider): each body's widest front within the shape radius is its cross-section times the front's
-// width (a cap of the front's radius where the body is wider), so the square root of the cell
-// counts' ratio is the diameters'.
+// is wider): each body's calibre front is its cross-section times the front's width, so the square
+// root of the cell counts' ratio is the diameters'.
 double diameter_ratio(const LocalShape& colon, const LocalShape& cand) {
-  const std::size_t wg = widest_front(colon), wf = widest_front(cand);
+  const std::size_t wg = calibre_front(colon), wf = calibre_front(cand);
   if (wg == 0 || wf == 0) return 0;
   return std::sqrt(double(wf) / double(wg));
 }
@@ -295,7 +307,7 @@ bool ColonSegmenter::judge_link(const Contact& c, const LocalShape& sg, const Lo
   if (c.gap_mm <= 0) return true;  // touching in one cell: one lumen, which may turn at any angle there
   const double diagonal = std::sqrt(d_.sp[0] * d_.sp[0] + d_.sp[1] * d_.sp[1] + d_.sp[2] * d_.sp[2]);
   if (gap_fat_mm(c) >= std::max(kFatRunMm, diagonal)) return why = "separated from the colon by fat (not a collapsed neck)", false;
-  if (diameter_ratio(sg, sf) < kMinDiameterRatio && grid_->front_diameter_mm(widest_front(sf)) < kColonMinDiameterMm)
+  if (diameter_ratio(sg, sf) < kMinDiameterRatio && grid_->front_diameter_mm(calibre_front(sf)) < kColonMinDiameterMm)
     return why = "narrower than the colon end across the gap (a small-bowel loop, not the colon)", false;
   const double ng = narrowing(sg), nf = narrowing(sf);
   if (std::min(ng, nf) < kMinCalibreRatio * std::max(ng, nf)) return why = "a blunt end beside a tapering colon end (not a collapsed neck)", false;
@@ -412,8 +424,8 @@ void ColonSegmenter::log_link(const Contact& c, const LocalShape& sg, const Loca
     const Eigen::Vector3d ug = -sg.fronts[0].centroid.normalized(), uf = sf.fronts[0].centroid.normalized();
     j["dir"] = ug.dot(uf);
     j["diameter_ratio"] = diameter_ratio(sg, sf);
-    j["seg_diameter_mm"] = grid_->front_diameter_mm(widest_front(sg));
-    j["cand_diameter_mm"] = grid_->front_diameter_mm(widest_front(sf));
+    j["seg_diameter_mm"] = grid_->front_diameter_mm(calibre_front(sg));
+    j["cand_diameter_mm"] = grid_->front_diameter_mm(calibre_front(sf));
     if ((b - a).norm() > 0) j["seg_axis_link"] = ug.dot((b - a).normalized()), j["cand_axis_link"] = uf.dot((b - a).normalized());
   }
   const auto [facing_seg, facing_cand] = facing_cells(c, sg, sf);

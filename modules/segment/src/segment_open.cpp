@@ -18,11 +18,6 @@ constexpr unsigned char kGas = 1, kCandidate = 4;
 // A direct gas/fluid interface crosses the tissue range (kTissueLowHu..kTissueHighHu) in about 0.6
 // blur sigma (the blurred step from -1000 to 500-900 HU).
 constexpr int kSubSamples = 8;  // samples per voxel of the linear profile between voxel centres
-// A column is walled when the profile stays in the tissue range for >= kWallMm: two lumens pressed
-// together are separated by two bowel walls (each 1-3 mm), >= 2 mm; a direct gas/fluid interface
-// stays in the range for 0.6 blur sigma, plus up to about one voxel where a partial-volume voxel
-// lies near 0 HU (measured on the painted cases at 1.64 mm pixels: 0.5-1.5 mm).
-constexpr double kWallMm = 1.5;
 // Columns whose gas and fluid lie within kWindowMm are looked at: wide enough that a wall of two
 // bowel walls (2-6 mm) between them is seen (interface-width, 3 mm, is the layer taken as lumen).
 constexpr double kWindowMm = 6;
@@ -75,7 +70,7 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, InterfaceTally> ColonSegmenter
               InterfaceTally& t = local[{fl, owner}];
               ++t.bins[std::min(5, int(run / 0.5))];
               t.columns[axis] += 1;
-              t.open[axis] += run < kWallMm;
+              t.open[axis] += run < kOpenWallMm;
             }
           }
           last_kind = k;

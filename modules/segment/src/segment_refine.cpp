@@ -104,10 +104,51 @@ void ColonSegmenter::add_dependent_films() {
   });
 }
 
+// Gas/fluid interfaces of any slope (docs/segment.md step 10): along gravity, the voxels between a
+// lumen voxel of gas (< air-threshold) above and a lumen voxel of fluid (>= fluid-threshold) below at
+// most interface-width apart are lumen when the profile between them is open (no run of kOpenWallMm in
+// the tissue range: one lumen, no fold or wall between). Step 4's layer is marked only under pools;
+// where the level slopes or curves, or the fluid was kept later (an open interface, a link), the
+// partial-volume voxels (-600..+200 HU) read as gas/tissue or tissue/fluid edges in the graph cut and
+// stayed out as a membrane. Gas rests on fluid: gas below fluid is another lumen, however thin the wall
+// between (two loops stacked along gravity). The anchors are the lumen before this step, so the
+// result does not depend on the order of the lines (any thread count gives the same mask).
+void ColonSegmenter::add_gas_fluid_interfaces() {
+  const Bytes lumen = state_;
+  const int wvox = int(std::ceil(opts_.interface_width / d_.sp[grav_axis_]));
+  const std::size_t stride = d_.stride[grav_axis_], len = d_.n[grav_axis_];
+  parallel_for(d_.total / len, [&](std::size_t l0, std::size_t l1) {
+    for (std::size_t l = l0; l < l1; ++l) fill_interface_line(lumen, line_base(d_, grav_axis_, l), stride, len, wvox, d_.sp[grav_axis_]);
+  });
+}
+
+// One line along gravity of add_gas_fluid_interfaces: the anchors are lumen voxels of gas or fluid;
+// every voxel between a gas anchor and the fluid anchor below it is filled (fluid voxels the graph cut
+// left out too: 200-320 HU read as tissue/fluid edges); a rectal tube voxel breaks the line.
+void ColonSegmenter::fill_interface_line(const Bytes& lumen, std::size_t base, std::size_t stride, std::size_t len, int wvox, double h) {
+  const int upper = grav_sign_ > 0 ? 1 : 2;  // the kind met first along increasing index: gas when gravity points there
+  int last_kind = 0, last_pos = -1;
+  for (int p = 0; p < int(len); ++p) {
+    const std::size_t q = base + std::size_t(p) * stride;
+    const int kind = hu_[q] < opts_.air_threshold ? 1 : (hu_[q] >= opts_.fluid_threshold ? 2 : 0);
+    if (lab_[q] == kExcluded) {
+      last_kind = 0;
+      continue;
+    }
+    if (!kind || !lumen[q]) continue;
+    if (last_kind == upper && kind != upper && p - last_pos > 1 && p - last_pos - 1 <= wvox &&
+        tissue_run_mm(base, stride, last_pos, p, h) < kOpenWallMm)
+      for (int r = last_pos + 1; r < p; ++r) state_[base + std::size_t(r) * stride] = 1;
+    last_kind = kind;
+    last_pos = p;
+  }
+}
+
 // Components of the refined lumen that hold initial lumen and at least min(1 mL, half the
 // smallest body the options allow) stay; they are the final segments.
 void ColonSegmenter::final_segments() {
   add_dependent_films();
+  add_gas_fluid_interfaces();
   const RunLabels cl = component_runs(state_.data(), d_);
   const std::uint32_t n = cl.count();
   std::vector<std::size_t> count(n + 1, 0), core(n + 1, 0);

@@ -166,6 +166,56 @@ TEST(SegmentFluid, LoopOfAnotherLevelBridgedToPoolNotKept) {
   EXPECT_EQ(loop.second, 0u) << st.to_json()["decisions"].dump(1);
 }
 
+// Session 20, a sloping level: a gas tube whose 600 HU fluid meets the gas along a plane tilted 25
+// degrees from the image axes, blurred (sigma 1 mm: a partial-volume layer of -600..+200 HU). Every voxel
+// within 1.5 mm of the level and inside the lumen (1.5 mm from the wall) is lumen, and no wall voxel (1.5 mm
+// beyond the tube's radius) is. Without the interface layer the layer stays out (a membrane).
+TEST(SegmentFluid, TiltedLevelLayerKeptWallUntouched) {
+  const double tilt = std::tan(25.0 * 3.14159265358979 / 180.0), cosine = std::cos(25.0 * 3.14159265358979 / 180.0);
+  auto level = [&](double y, double z) { return (y - 42 - tilt * (z - 40)) * cosine; };  // signed distance (mm), fluid > 0
+  auto ct = make_volume(80, [&](double x, double y, double z) {
+    if (x < 8 || x > 72 || radial(y, z, 40, 40) >= 14) return kKeep;
+    return level(y, z) > 0 ? 600.0 : -1000.0;
+  }, 1.0, 10);
+  SegmentStats st;
+  auto m = segment_supine(ct, &st);
+  const auto layer = kept_in(m, 14, 66, 20, 60, 20, 60, [&](int, int y, int z) {
+    return std::abs(level(y, z)) <= 1.5 && radial(y, z, 40, 40) < 12.5;
+  });
+  EXPECT_GT(layer.first, 1000u);
+  EXPECT_EQ(layer.second, layer.first) << layer.first - layer.second << " layer voxels left out";
+  const auto wall = kept_in(m, 14, 66, 20, 60, 20, 60, [](int, int y, int z) { return radial(y, z, 40, 40) >= 15.5; });
+  EXPECT_EQ(wall.second, 0u);
+  EXPECT_EQ(components(m), 1u);
+}
+
+// Session 20, gas rests on fluid: two gas tubes stacked along gravity (supine, +y down) with one voxel
+// of wall between them, the upper one's dependent fluid (600 HU, its surface tilted 25 degrees: no level
+// pool, so step 4 marks no layer; kept as one lumen with its gas) lying on that wall. Along gravity the
+// lower tube's gas lies below that fluid across the wall with an open-looking profile (the blur mixes
+// the 1 mm wall away); the wall stays out and the two lumens stay apart. With the interface layer
+// filled in either order along gravity, the wall is taken and the lumens join (one component).
+TEST(SegmentFluid, WallUnderFluidAboveAnotherLoopsGasKept) {
+  const double tilt = std::tan(25.0 * 3.14159265358979 / 180.0);
+  auto ct = make_volume(80, [&](double x, double y, double z) {
+    if (x < 10 || x > 70) return kKeep;
+    if (radial(y, z, 30, 40) < 9.5) return y > 33 + tilt * (z - 40) ? 600.0 : -1000.0;  // upper tube: gas over fluid
+    if (radial(y, z, 52, 40) < 10.5) return -1000.0;                      // lower tube: gas, top at y 41.5
+    return kKeep;
+  }, 0.6, 10);
+  const double sp[3] = {0.75, 0.75, 0.75};  // the wall: 2 voxels, 1.5 mm
+  ct->SetSpacing(sp);
+  SegmentStats st;
+  auto m = segment_supine(ct, &st);
+  const auto wall = kept_in(m, 14, 66, 39, 42, 36, 44, [](int, int y, int z) {
+    return radial(y, z, 30, 40) >= 9.5 && radial(y, z, 52, 40) >= 10.5;
+  });
+  EXPECT_GT(wall.first, 50u);
+  EXPECT_EQ(wall.second, 0u);
+  EXPECT_TRUE(at(m, 40, 37, 40) && at(m, 40, 45, 40));  // both lumens kept
+  EXPECT_EQ(components(m), 2u);
+}
+
 // A dense bright blob (900 HU, like a vertebral body) 3 mm beside the colon's gas: it has no level
 // under gas and does not continue the colon; it is not kept.
 TEST(SegmentFluid, BoneLikeBlobsRejected) {

@@ -235,6 +235,33 @@ TEST(SegmentRules, StretchOfColonCalibreAcrossGapKeptNarrowerOrWider) {
   }
 }
 
+// Session 20, the calibre beyond the cap (2 mm voxels): a contrast body across an 8 mm neck in line
+// with a 44 mm gas colon end, 44 mm wide for its first 20 mm (a small-bowel loop's bulb pressed on the
+// colon end) and 28 mm wide (small-bowel calibre) beyond, is refused as narrower than the colon end;
+// the same body 44 mm wide all along (a colon stretch) is kept. A gas body 50 mm aside extends the crop
+// beyond the body's far end. With session 19's widest front (the bulb's 25 mm cap) the loop is kept.
+TEST(SegmentRules, LoopWideOnlyAtContactRefusedColonStretchKept) {
+  for (bool bulb : {true, false}) {
+    SCOPED_TRACE(bulb);
+    auto ct = make_volume(140, [&](double x, double y, double z) {
+      const double d = tube_dist(y, z, 70, 70), gas_r = 11;
+      if (d < gas_r && x >= 5 && x <= 44 - 6 * (d / gas_r) * (d / gas_r)) return -1000.0;  // rounded end: neck on the axis
+      if (tube_dist(y, z, 25, 70) < 9 && x >= 80 && x <= 100) return -1000.0;
+      const double r = !bulb || x < 59 ? 11.0 : std::max(7.0, 11.0 - 4.0 * (x - 59) / 6);  // voxels
+      if (d < r && x >= 49 + 6 * (d / r) * (d / r) && x <= 92) return 500.0;
+      return kKeep;
+    }, 0.6, 10);
+    const double sp[3] = {2, 2, 2};
+    ct->SetSpacing(sp);
+    ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
+    auto [m, st] = segment_small(ct, tagged_options(1));
+    ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+    EXPECT_EQ(st.tagged_stretches, bulb ? 0 : 1) << st.to_json()["decisions"].dump(1) << st.links.dump(1);
+    EXPECT_EQ(at(m, 80, 70, 70), !bulb);
+    if (bulb) EXPECT_TRUE(has_decision(st, "rejected", "narrower than the colon end")) << st.to_json()["decisions"].dump(1) << st.links.dump(1);
+  }
+}
+
 // The link log (COLONFLAT_SEGMENT_LINKS) gives the median tagged-fluid HU near the contact on each
 // side: a 500 HU tube across a 6 mm neck from a dry gas end reads about 500 HU, the gas end none.
 TEST(SegmentRules, LinkLogReportsFluidHuNearContact) {
