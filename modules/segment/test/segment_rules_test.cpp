@@ -34,6 +34,19 @@ Segmented segment_small(const CtImage::Pointer& ct, const SegmentOptions& o = sm
   return r;
 }
 
+// segment_small with the link log on (COLONFLAT_SEGMENT_LINKS: one entry per contact judged, in stats.links),
+// at 2 mm voxels when `two_mm` (CT-colonography size in a 140-voxel test volume).
+Segmented segment_logging_links(const CtImage::Pointer& ct, const SegmentOptions& o, bool two_mm) {
+  if (two_mm) {
+    const double sp[3] = {2, 2, 2};
+    ct->SetSpacing(sp);
+  }
+  ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
+  Segmented r = segment_small(ct, o);
+  ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+  return r;
+}
+
 bool has_decision(const SegmentStats& st, const std::string& decision, const std::string& reason_part,
                   const std::string& what_part = "") {
   for (const auto& d : st.decisions)
@@ -216,11 +229,7 @@ TEST(SegmentRules, StretchOfColonCalibreAcrossGapKeptNarrowerOrWider) {
       if (d < stretch_r && x >= 49 + bs && x <= 92 - bs) return 500.0;
       return kKeep;
     }, 0.6, 10);
-    const double sp[3] = {2, 2, 2};
-    ct->SetSpacing(sp);
-    ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
-    auto [m, st] = segment_small(ct, tagged_options(1));
-    ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+    auto [m, st] = segment_logging_links(ct, tagged_options(1), true);
     EXPECT_EQ(st.tagged_stretches, 1) << st.to_json()["decisions"].dump(1);
     EXPECT_TRUE(at(m, 70, 70, 70));
     bool linked = false;
@@ -251,11 +260,7 @@ TEST(SegmentRules, LoopWideOnlyAtContactRefusedColonStretchKept) {
       if (d < r && x >= 49 + 6 * (d / r) * (d / r) && x <= 92) return 500.0;
       return kKeep;
     }, 0.6, 10);
-    const double sp[3] = {2, 2, 2};
-    ct->SetSpacing(sp);
-    ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
-    auto [m, st] = segment_small(ct, tagged_options(1));
-    ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+    auto [m, st] = segment_logging_links(ct, tagged_options(1), true);
     EXPECT_EQ(st.tagged_stretches, bulb ? 0 : 1) << st.to_json()["decisions"].dump(1) << st.links.dump(1);
     EXPECT_EQ(at(m, 80, 70, 70), !bulb);
     if (bulb) EXPECT_TRUE(has_decision(st, "rejected", "narrower than the colon end")) << st.to_json()["decisions"].dump(1) << st.links.dump(1);
@@ -271,9 +276,7 @@ TEST(SegmentRules, LinkLogReportsFluidHuNearContact) {
     if (x >= 47 && x <= 80 && d < 8) return 500.0;
     return kKeep;
   }, 0.6, 10);
-  ::setenv("COLONFLAT_SEGMENT_LINKS", "1", 1);
-  auto [m, st] = segment_small(ct, tagged_options(1));
-  ::unsetenv("COLONFLAT_SEGMENT_LINKS");
+  auto [m, st] = segment_logging_links(ct, tagged_options(1), false);
   ASSERT_FALSE(st.links.empty());
   const nlohmann::json& j = st.links.front();
   ASSERT_TRUE(j.contains("cand_fluid_hu") && j["cand_fluid_hu"].is_number()) << j.dump();
