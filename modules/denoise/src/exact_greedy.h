@@ -147,6 +147,7 @@ class ExactGreedy {
   // face a ring or two off the rim (or round a slit, beside earlier caps lying across it), and
   // its caps rise from that face. The tubes of L/8 and L/4 come after them.
   static constexpr double kNearTubeEdges[] = {2.0, 4.0};
+  static constexpr double kRerouteFactor = 2.0;  // Z's reroute searched to 2 |Z| (docs/denoise.md)
   static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
   // exact_method.cpp
   double search_limit(int slot);
@@ -184,6 +185,7 @@ class ExactGreedy {
   int builds_ = 0, crossing_modes_ = 0, cuts_at_build_ = 0, genus_at_build_ = 0;
   // Searches from entering the crossing families to finding Z (the largest over the switches).
   long long searches_at_crossing_ = 0, crossing_searches_to_z_ = 0;
+  long long reroute_settled_ = 0, reroutes_found_ = 0;  // Z's reroute searches (add_transversal_family)
   // Sources to certify against the best known loop, farthest from its source first.
   int far_anchor_ = -1;  // vertex the far-first order was measured from (-1: none)
   double far_value_ = 0;

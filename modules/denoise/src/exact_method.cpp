@@ -238,6 +238,8 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["bounds_carried_at_rebuild"] = bounds_carried_;
   stats["crossing_family_switches"] = crossing_modes_;
   stats["crossing_searches_to_z"] = crossing_searches_to_z_;
+  stats["z_reroute_settled"] = reroute_settled_;
+  stats["z_reroutes_found"] = reroutes_found_;
   stats["loops_replaced_for_clean_caps"] = alternatives_ + crossing_alternatives_;
   stats["loops_replaced_by_crossing_loop"] = crossing_alternatives_;
   stats["first_search_radius_mm"] = first_radius_;

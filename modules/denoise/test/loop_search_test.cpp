@@ -206,5 +206,21 @@ TEST(DenoiseLoopSearch, CrossingFamiliesSearchToTwiceLoopA) {
   EXPECT_NEAR(r.loops[0].length, ref, 1e-9 * (1 + ref));
 }
 
+// Proves that Z's reroute is counted as a search of its own run alone: on the thin torus the
+// inner longitude stays a tube width away from the meridian A except at its root, so the reroute
+// finds a route (1 found), and its settled vertices are part of the alone and total counts.
+TEST(DenoiseLoopSearch, ZRerouteIsCountedAlone) {
+  const Mesh m = to_mesh(torus(6, 0.7, 90, 12));
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 1u);
+  const auto& s = r.report["search"];
+  EXPECT_EQ(s.at("z_reroutes_found").get<long long>(), 1);
+  const long long reroute = s.at("z_reroute_settled").get<long long>();
+  EXPECT_GT(reroute, 0);
+  EXPECT_LE(reroute, static_cast<long long>(m.n_vertices()));
+  EXPECT_LE(reroute, s["settled_vertices_alone"].get<long long>());
+  EXPECT_LE(s["settled_vertices_alone"].get<long long>(), s["settled_vertices"].get<long long>());
+}
+
 }  // namespace
 }  // namespace cf
