@@ -17,7 +17,6 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "factor_schedule.h"
-#include "metis_order.h"
 
 namespace cf::flat_detail {
 
@@ -137,10 +136,17 @@ Eigen::MatrixXd take_dense(cholmod_dense*& x, cholmod_common& common) {
   return out;
 }
 
-// CHOLMOD's AMD (`nested` false) or METIS nested dissection order of A (METIS called directly when
-// libmetis-dev was found, else through CHOLMOD's wrapper with METIS's defaults); empty when it fails.
+// METIS (libmetis 5.1 as packaged) draws its random numbers from the C library's rand(): one state
+// for the process, re-seeded at each call. Two calls at once interleave their draws, and each order
+// then depends on the timing (two large colon segments flattened side by side); one at a time, each
+// is the order it is alone.
+std::mutex& metis_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// CHOLMOD's AMD (`nested` false) or METIS nested dissection order of A; empty when it fails.
 std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
-  if (nested && metis_direct_available()) return metis_dissection_order(A, kMetisRefinementPasses);
   use_huge_pages_for_cholmod();
   cholmod_common common;
   cholmod_start(&common);

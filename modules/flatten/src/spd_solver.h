@@ -46,11 +46,9 @@ class SpdSolver {
   // AMD's fill-reducing elimination order of A (n x n, symmetric, compressed, lower triangle
   // read): order[k] = the unknown eliminated k-th.
   static std::vector<int> fill_reducing_order(const SpMat& A);
-  // Nested dissection's (METIS) elimination order of A (as above), postordered: on a colon band
+  // Nested dissection's (METIS, through CHOLMOD) elimination order of A (as above): on a colon band
   // about half the factorisation's operations of AMD's order, for about 5 x AMD's ordering time
-  // (docs/flatten.md, "Speed", session 13). METIS_NodeND called directly with
-  // kMetisRefinementPasses (metis_order.h) when libmetis-dev was found, else through CHOLMOD with
-  // METIS's defaults; AMD's order when CHOLMOD or METIS is not there.
+  // (docs/flatten.md, "Speed", session 13). AMD's order when CHOLMOD or METIS is not there.
   static std::vector<int> nested_dissection_order(const SpMat& A);
   // Symbolic analysis of A (lower triangle read). `order` (optional): the elimination order, a
   // permutation of 0..n-1 used as given (not postordered); AMD (CHOLMOD's default) when null.

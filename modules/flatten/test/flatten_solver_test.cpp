@@ -14,7 +14,6 @@
 
 #include "../src/factor_schedule.h"
 #include "../src/flatten_internal.h"
-#include "../src/metis_order.h"
 #include "../src/spd_solver.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
@@ -289,31 +288,6 @@ TEST(FlattenSolver, NestedDissectionOrderSolvesWithFewerOperationsThanAmd) {
   if (amd.factor_flops() > 0) EXPECT_LT(nd.factor_flops(), 0.9 * amd.factor_flops());
 }
 
-// The nested dissection order is METIS_NodeND's called directly with kMetisRefinementPasses (not
-// CHOLMOD's wrapper with METIS's 10 passes, which it equals when given METIS's default): a
-// postordered permutation whose factorisation costs at most 10 % more operations than the
-// default's (the CT colon band: +2.7 %, docs/flatten.md session 20).
-TEST(FlattenSolver, NestedDissectionOrderIsMetisCalledWithFewerRefinementPasses) {
-  if (!cf::flat_detail::metis_direct_available()) GTEST_SKIP() << "built without libmetis-dev";
-  const int nx = 200, nv = nx * nx;
-  const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 29));
-  std::vector<int> all(nv);
-  for (int v = 0; v < nv; ++v) all[v] = v;
-  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
-  const std::vector<int> used = SpdSolver::nested_dissection_order(A);
-  const std::vector<int> fewer = cf::flat_detail::metis_dissection_order(A, cf::flat_detail::kMetisRefinementPasses);
-  const std::vector<int> metis_default = cf::flat_detail::metis_dissection_order(A, cf::flat_detail::kMetisDefaultPasses);
-  EXPECT_EQ(used, fewer);
-  EXPECT_NE(fewer, metis_default);
-  std::vector<int> sorted = fewer;
-  std::sort(sorted.begin(), sorted.end());
-  ASSERT_EQ(sorted, all);
-  SpdSolver with_fewer, with_default;
-  with_fewer.analyze(A, &fewer);
-  with_default.analyze(A, &metis_default);
-  if (with_default.factor_flops() > 0) EXPECT_LT(with_fewer.factor_flops(), 1.1 * with_default.factor_flops());
-}
-
 // A segment with kNestedDissectionMinVertices vertices flattened area-balanced gets nested
 // dissection's order already for its first conformal solve (fewer factorisation operations than
 // AMD's, which it got before); one vertex fewer, or the conformal map alone, keeps AMD's.
@@ -365,9 +339,7 @@ TEST(FlattenSolver, NestedDissectionOrdersAtTheSameTimeAreEachTheOrderAlone) {
 namespace {
 
 // The system of a 150 x 150 grid (22 500 unknowns: above the threaded factorisation's threshold)
-// and METIS's nested dissection order with METIS's default 10 refinement passes (the order these
-// schedule tests were written on: its top separators leave four balanced quarters; the flatten's
-// 1-pass order of this grid needs only one phase).
+// and its nested dissection order.
 struct NestedGrid {
   SpdSolver::SpMat A;
   std::vector<int> order;
@@ -378,10 +350,7 @@ NestedGrid nested_grid() {
   std::vector<int> all(nv);
   for (int v = 0; v < nv; ++v) all[v] = v;
   NestedGrid g{grid_system(E, nx, all, nv), {}};
-  if (cf::flat_detail::metis_direct_available())
-    g.order = cf::flat_detail::metis_dissection_order(g.A, cf::flat_detail::kMetisDefaultPasses);
-  else
-    g.order = SpdSolver::nested_dissection_order(g.A);  // CHOLMOD's wrapper: METIS's defaults
+  g.order = SpdSolver::nested_dissection_order(g.A);
   return g;
 }
 
