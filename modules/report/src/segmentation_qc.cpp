@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <string>
 
 #include "colonflat/core/threads.h"
@@ -20,11 +21,14 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-constexpr unsigned char kLumenRgb[3] = {40, 230, 90};
+constexpr std::array<unsigned char, 3> kLumenRgb = {40, 230, 90};
 // One colour per rejection reason, in the order reasons first appear (cycled beyond 8); none is
 // near the lumen's green, each stands out on the grey CT.
 constexpr std::array<unsigned char, 3> kReasonRgb[8] = {{255, 50, 30},  {255, 160, 0},   {230, 60, 230}, {0, 200, 255},
                                                         {255, 235, 60}, {120, 110, 255}, {255, 130, 170}, {190, 130, 60}};
+
+// The colour of the reason with index `reason` (kReasonRgb cycled).
+const std::array<unsigned char, 3>& reason_rgb(std::size_t reason) { return kReasonRgb[reason % std::size(kReasonRgb)]; }
 
 std::string css_rgb(const std::array<unsigned char, 3>& c) {
   return "rgb(" + std::to_string(c[0]) + "," + std::to_string(c[1]) + "," + std::to_string(c[2]) + ")";
@@ -91,7 +95,7 @@ class SegmentationQc {
   }
   std::vector<double> slice_positions(Plane p) const;
   void assign_reasons();
-  const std::array<unsigned char, 3>& colour(int body_id) const { return kReasonRgb[bodies_[std::size_t(body_id - 1)].reason % 8]; }
+  const std::array<unsigned char, 3>& colour(int body_id) const { return reason_rgb(std::size_t(bodies_[std::size_t(body_id - 1)].reason)); }
   nlohmann::json draw(Plane p, double fixed, int n, QcMontage& out) const;
   SliceCanvas paint(Plane p, double fixed) const;
   void outline(SliceCanvas& cv) const;
@@ -379,7 +383,7 @@ void SegmentationQc::outline(SliceCanvas& cv) const {
         body_edge = body_edge || (cv.body[px] && cv.body[o] != cv.body[px]);
       }
       cv.lumen_edge[px] = lum_edge, cv.body_edge[px] = body_edge;
-      if (lum_edge) std::copy_n(kLumenRgb, 3, &cv.rgb[3 * px]);
+      if (lum_edge) std::copy_n(kLumenRgb.data(), 3, &cv.rgb[3 * px]);
       if (body_edge) std::copy_n(colour(cv.body[px]).data(), 3, &cv.rgb[3 * px]);
     }
 }
@@ -421,11 +425,11 @@ nlohmann::json SegmentationQc::tables() const {
     bodies.push_back({{"id", b.id}, {"what", b.decision.value("what", "")}, {"reason", b.decision.value("reason", "")},
                       {"volume_ml", b.decision.value("volume_ml", 0.0)}, {"position_lps_mm", b.decision["position_lps_mm"]},
                       {"outlined", !b.voxels.empty()}, {"measured_ml", b.voxels.size() * voxel_ml_}, {"truncated", b.truncated},
-                      {"too_large", b.too_large}, {"reason_index", b.reason}, {"colour", css_rgb(kReasonRgb[b.reason % 8])},
+                      {"too_large", b.too_large}, {"reason_index", b.reason}, {"colour", css_rgb(reason_rgb(std::size_t(b.reason)))},
                       {"seen", nlohmann::json::array()}, {"kind", b.cls == 0 ? "gas" : b.cls == 1 ? "tagged fluid" : "not found"}});
   nlohmann::json reasons = nlohmann::json::array();
   for (std::size_t r = 0; r < reasons_.size(); ++r) {
-    const auto& c = kReasonRgb[r % 8];
+    const auto& c = reason_rgb(r);
     const bool light = 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2] > 140;  // dark digits on a light tag
     reasons.push_back({{"reason", reasons_[r]}, {"colour", css_rgb(c)}, {"ink", light ? "#000" : "#fff"}});
   }
@@ -439,7 +443,7 @@ nlohmann::json SegmentationQc::tables() const {
   return {{"bodies", bodies}, {"kept", kept}, {"segment_volumes_ml", result_.value("segment_volumes_ml", nlohmann::json::array())},
           {"lumen_ml", lumen_ml_}, {"min_body_ml", o_.min_body_ml}, {"small_rejected", {{"count", small}, {"volume_ml", small_ml}}},
           {"thresholds_hu", {{"gas_below", gas_thr_}, {"fluid_above", fluid_thr_}}},
-          {"reasons", reasons}, {"colours", {{"lumen", "rgb(40,230,90)"}}}};
+          {"reasons", reasons}, {"colours", {{"lumen", css_rgb(kLumenRgb)}}}};
 }
 
 }  // namespace
