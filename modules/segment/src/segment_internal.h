@@ -282,7 +282,7 @@ class ColonSegmenter {
   Buffer<float> hu_;                   // CT in the crop
   std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
   Bytes lab_;                          // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
-  Buffer<std::uint32_t> fluid_label_;  // fluid components in the crop
+  Buffer<std::uint32_t> fluid_label_;  // fluid pieces in the crop (split_fluid_bodies .. candidate_bodies; then released)
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
   RunLookup gas_lookup_;                 // crop gas components

@@ -180,6 +180,7 @@ void ColonSegmenter::link_tagged_stretches() {
   for (std::size_t q = 0; q < d_.total; ++q) candidate[q] = lab_[q] == kCandidate;
   const RunLabels cl = candidate_bodies(candidate);
   Bytes().swap(candidate);
+  Buffer<std::uint32_t>().swap(fluid_label_);  // the pieces' last use: the graph cut reuses these pages
   const std::uint32_t n = cl.count();
   const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
   mark_grid(cl.raster(std::vector<unsigned char>(n + 1, 1)), false);
