@@ -98,21 +98,24 @@ std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<u
 }
 
 namespace {
-// Dilation of v along axis 0 (contiguous rows) into out, rows [row0, row1).
+// Dilation of v along axis 0 (contiguous rows) into out, rows [row0, row1): out[i] = OR of
+// v[i - r .. i + r]. Per row, a zero-padded copy where pass s ors each byte with the one 2^s ahead
+// (then byte j covers 2^(s+1) bytes from j), until the span reaches half the window; two
+// overlapping spans give each window. log2(2r + 1) + 2 branch-free byte passes, which the compiler
+// vectorizes (the nearest-set scan before ran one voxel at a time).
 void dilate_rows(const unsigned char* v, unsigned char* out, std::size_t nx, std::size_t row0, std::size_t row1, long radius) {
+  const std::size_t r = std::size_t(radius), w = 2 * r + 1, size = nx + 2 * r;
+  std::vector<unsigned char> pad(size, 0);
+  unsigned char* __restrict buf = pad.data();
   for (std::size_t row = row0; row < row1; ++row) {
-    const unsigned char* in = v + row * nx;
-    unsigned char* o = out + row * nx;
-    long last = -1000000;
-    for (long i = 0; i < long(nx); ++i) {
-      if (in[i]) last = i;
-      o[i] = (i - last <= radius) ? 1 : 0;
-    }
-    last = 1000000;
-    for (long i = long(nx) - 1; i >= 0; --i) {
-      if (in[i]) last = i;
-      if (last - i <= radius) o[i] = 1;
-    }
+    const unsigned char* __restrict in = v + row * nx;
+    unsigned char* __restrict o = out + row * nx;
+    for (std::size_t i = 0; i < nx; ++i) buf[r + i] = in[i] != 0;
+    std::size_t span = 1;  // buf[j] = OR of the padded row's [j, j + span)
+    for (; 2 * span <= w; span *= 2)
+      for (std::size_t j = 0; j + span < size; ++j) buf[j] |= buf[j + span];
+    for (std::size_t i = 0; i < nx; ++i) o[i] = buf[i] | buf[i + w - span];
+    std::fill_n(buf, r, 0), std::fill_n(buf + r + nx, r, 0);  // the padding for the next row
   }
 }
 

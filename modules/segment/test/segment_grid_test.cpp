@@ -82,11 +82,13 @@ TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
   expect_box_matches_brute_force(d, random_mask(d, 0.03, 11), random_mask(d, 0.9, 12), r);
 }
 
-// Radii of 255 voxels and more along y and z (beyond the byte distances of the fast sweep) give the
-// brute-force box too (about one set voxel per line: partly covered lines), as does radius 254.
+// Radii of 255 voxels and more along y and z (beyond the byte distances of the fast sweep) and x
+// (many doubling passes) give the brute-force box too (about one set voxel per line: partly covered
+// lines), as does radius 254.
 TEST(SegmentGrid, BoxDilationWithRadiusOver254MatchesBruteForce) {
-  const Dims dy = dims(6, 300, 3), dz = dims(6, 3, 300);
-  const int ry[3] = {0, 260, 0}, rz[3] = {0, 0, 255}, r254[3] = {1, 254, 0};
+  const Dims dx = dims(300, 3, 6), dy = dims(6, 300, 3), dz = dims(6, 3, 300);
+  const int rx[3] = {257, 0, 0}, ry[3] = {0, 260, 0}, rz[3] = {0, 0, 255}, r254[3] = {1, 254, 0};
+  expect_box_matches_brute_force(dx, random_mask(dx, 0.002, 37), random_mask(dx, 0.998, 38), rx);
   expect_box_matches_brute_force(dy, random_mask(dy, 0.002, 31), random_mask(dy, 0.998, 32), ry);
   expect_box_matches_brute_force(dz, random_mask(dz, 0.002, 33), random_mask(dz, 0.998, 34), rz);
   expect_box_matches_brute_force(dy, random_mask(dy, 0.002, 35), random_mask(dy, 0.998, 36), r254);
