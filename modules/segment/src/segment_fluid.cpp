@@ -29,7 +29,7 @@ void ColonSegmenter::find_fluid_bodies() {
   split_fluid_bodies(bright);
   pool_.assign(fluid_count_ + 1, 0);
   Bytes gas(d_.total);
-  for (std::size_t q = 0; q < d_.total; ++q) gas[q] = lab_[q] == kGas;
+  for_each_voxel(d_.total, [&](std::size_t q) { gas[q] = lab_[q] == kGas; });
   const RunLabels gl = component_runs(gas.data(), d_);
   gas_voxels_.assign(gl.count() + 1, 0);
   for (std::uint32_t l = 1; l <= gl.count(); ++l)

@@ -64,6 +64,14 @@ Dims make_dims(const std::size_t n[3], const double sp[3]);
 using cf::process_cpu_seconds;  // core/threads.h
 // Splits [0, n) into one chunk per cf::thread_count() thread (core parallel_for).
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
+// f(q) for every q in [0, n), in chunks over the worker threads (parallel_for): for passes where each
+// voxel's result depends on nothing written by the pass, so any thread count gives the same result.
+template <class F>
+void for_each_voxel(std::size_t n, F&& f) {
+  parallel_for(n, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) f(q);
+  });
+}
 // A run of voxels along axis 0: linear index of its first voxel and its length.
 struct Run {
   std::size_t start;
@@ -282,7 +290,7 @@ class ColonSegmenter {
   Buffer<float> hu_;                   // CT in the crop
   std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
   Bytes lab_;                          // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
-  Buffer<std::uint32_t> fluid_label_;  // fluid components in the crop
+  Buffer<std::uint32_t> fluid_label_;  // fluid pieces in the crop (split_fluid_bodies .. candidate_bodies; then released)
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
   RunLookup gas_lookup_;                 // crop gas components

@@ -92,7 +92,7 @@ ColonSegmenter::~ColonSegmenter() = default;
 // on the link grid.
 void ColonSegmenter::select_segments() {
   Bytes colon(d_.total);
-  for (std::size_t q = 0; q < d_.total; ++q) colon[q] = colon_kind(lab_[q]);
+  for_each_voxel(d_.total, [&](std::size_t q) { colon[q] = colon_kind(lab_[q]); });
   const RunLabels cl = component_runs(colon.data(), d_);
   Bytes().swap(colon);
   const std::uint32_t n = cl.count();
@@ -177,9 +177,10 @@ void ColonSegmenter::mark_grid(const std::vector<std::pair<Run, std::uint32_t>>&
 // them); then every other candidate is rejected with its reason.
 void ColonSegmenter::link_tagged_stretches() {
   Bytes candidate(d_.total);
-  for (std::size_t q = 0; q < d_.total; ++q) candidate[q] = lab_[q] == kCandidate;
+  for_each_voxel(d_.total, [&](std::size_t q) { candidate[q] = lab_[q] == kCandidate; });
   const RunLabels cl = candidate_bodies(candidate);
   Bytes().swap(candidate);
+  Buffer<std::uint32_t>().swap(fluid_label_);  // the pieces' last use: the graph cut reuses these pages
   const std::uint32_t n = cl.count();
   const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
   mark_grid(cl.raster(std::vector<unsigned char>(n + 1, 1)), false);

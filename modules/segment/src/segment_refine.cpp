@@ -56,11 +56,10 @@ void ColonSegmenter::refine_boundary() {
     Bytes outer = lumen0_, inner = lumen0_;
     dilate_box(outer, d_, rb);
     erode_box(inner, d_, rb);
-    for (std::size_t q = 0; q < d_.total; ++q)
-      state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0));
+    for_each_voxel(d_.total, [&](std::size_t q) { state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0)); });
   }
   Bytes near_fluid(d_.total);
-  for (std::size_t q = 0; q < d_.total; ++q) near_fluid[q] = lab_[q] == 2;
+  for_each_voxel(d_.total, [&](std::size_t q) { near_fluid[q] = lab_[q] == 2; });
   const int rf[3] = {rb[0] + 1, rb[1] + 1, rb[2] + 1};
   dilate_box(near_fluid, d_, rf);
   st_.band_voxels = std::size_t(std::count(state_.begin(), state_.end(), 2));

@@ -99,15 +99,15 @@ void ColonSegmenter::grow_pieces(const Bytes& bright, std::vector<std::size_t>& 
 // coreless components); fluid_count_ their number. Where a piece holds fluid of another level behind
 // a darker bridge (other_level_cores), that fluid is a core of its own and the pieces are grown again.
 void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
-  fluid_label_.assign(d_.total, 0);
   fluid_count_ = 0;
   // Voxels coarser than the ball can resolve (radius < 1.5 voxels: the 3 x 3 x 3 mean alone spreads
   // a voxel): no cores, every bright component is one piece.
   const bool resolved = kCoreRadiusMm >= kMinCoreVoxels * std::max({d_.sp[0], d_.sp[1], d_.sp[2]});
   if (resolved) {
     Bytes core = erode_ball(bright, d_, kCoreRadiusMm);
-    for (std::size_t q = 0; q < d_.total; ++q) core[q] = core[q] && hu_[q] >= opts_.fluid_threshold;  // a wall voxel is no core
+    for_each_voxel(d_.total, [&](std::size_t q) { core[q] = core[q] && hu_[q] >= opts_.fluid_threshold; });  // a wall voxel is no core
     const RunLabels cl = component_runs(core.data(), d_);
+    fluid_label_.assign(d_.total, 0);  // after the ball's work buffers are freed: the labels reuse their pages
     std::vector<std::size_t> queue = seed_cores(cl);
     grow_pieces(bright, queue);
     const std::vector<std::vector<std::size_t>> other = other_level_cores(bright, core, cl);
@@ -121,8 +121,9 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
       grow_pieces(bright, queue);
     }
   }
+  if (!resolved) fluid_label_.assign(d_.total, 0);
   Bytes rest(d_.total);
-  for (std::size_t q = 0; q < d_.total; ++q) rest[q] = bright[q] && !fluid_label_[q];
+  for_each_voxel(d_.total, [&](std::size_t q) { rest[q] = bright[q] && !fluid_label_[q]; });
   const RunLabels thin = component_runs(rest.data(), d_);
   for (std::uint32_t l = 1; l <= thin.count(); ++l)
     for (const Run* r = thin.begin(l); r != thin.end(l); ++r) std::fill_n(fluid_label_.data() + r->start, r->length, fluid_count_ + l);
@@ -190,7 +191,7 @@ std::vector<std::vector<std::size_t>> ColonSegmenter::other_level_cores(const By
   });
   const int one[3] = {1, 1, 1};
   erode_box(low, d_, one);
-  for (std::size_t q = 0; q < d_.total; ++q) low[q] = low[q] && hu_[q] >= opts_.fluid_threshold;
+  for_each_voxel(d_.total, [&](std::size_t q) { low[q] = low[q] && hu_[q] >= opts_.fluid_threshold; });
   const RunLabels found = component_runs(low.data(), d_);
   Bytes().swap(low);
   std::vector<std::vector<std::size_t>> out;

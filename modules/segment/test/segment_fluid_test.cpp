@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "colonflat/core/threads.h"
 
 #include "colonflat/segment/segment.h"
 #include "segment_volumes.h"
@@ -36,6 +40,17 @@ std::pair<std::size_t, std::size_t> kept_in(const MaskImage* m, int x0, int x1, 
       for (int z = z0; z <= z1; ++z)
         if (inside(x, y, z)) ++n, kept += at(m, x, y, z);
   return {n, kept};
+}
+
+// A colon tube (gas over a 750 HU pool) and a small-bowel loop of 380 HU joined to the pool's bottom
+// by a 280 HU bridge (LoopOfAnotherLevelBridgedToPoolNotKept).
+CtImage::Pointer loop_bridged_to_pool() {
+  return make_volume(96, [&](double x, double y, double z) {
+    if (x >= 10 && x <= 85 && radial(y, z, 34, 48) < 10) return y < 34 ? -1000.0 : 750.0;  // colon: gas over a pool
+    if (x >= 15 && x <= 80 && radial(y, z, 50, 48) < 4) return 380.0;                      // small-bowel loop
+    if (x >= 40 && x <= 56 && y >= 40 && y <= 50 && std::abs(z - 48) <= 4) return 280.0;   // bridge
+    return kKeep;
+  }, 0.6, 10);
 }
 
 // A colon tube with dependent fluid along its whole side (level at its axis) and a thinner loop of
@@ -151,12 +166,7 @@ TEST(SegmentFluid, DependentFilmOneVoxelThickKept) {
 // and reaches the pool only through the darker bridge: it is another lumen and is not kept, while
 // the pool stays whole. Fails without the other-level rule (the loop kept with the pool).
 TEST(SegmentFluid, LoopOfAnotherLevelBridgedToPoolNotKept) {
-  auto ct = make_volume(96, [&](double x, double y, double z) {
-    if (x >= 10 && x <= 85 && radial(y, z, 34, 48) < 10) return y < 34 ? -1000.0 : 750.0;  // colon: gas over a pool
-    if (x >= 15 && x <= 80 && radial(y, z, 50, 48) < 4) return 380.0;                      // small-bowel loop
-    if (x >= 40 && x <= 56 && y >= 40 && y <= 50 && std::abs(z - 48) <= 4) return 280.0;   // bridge
-    return kKeep;
-  }, 0.6, 10);
+  auto ct = loop_bridged_to_pool();
   SegmentStats st;
   auto m = segment_supine(ct, &st);
   const auto pool = kept_in(m, 14, 81, 36, 43, 40, 56, [](int, int y, int z) { return radial(y, z, 34, 48) < 8.5; });
@@ -232,6 +242,25 @@ TEST(SegmentFluid, BoneLikeBlobsRejected) {
   });
   EXPECT_GT(blob.first, 1000u);
   EXPECT_EQ(blob.second, 0u) << st.to_json()["decisions"].dump(1);
+}
+
+// The tagged-fluid steps (ball erosion, pieces grown, the other level's plateau, candidate bodies)
+// and the passes split over the workers (box dilation and erosion, voxel passes, graph-cut slabs)
+// give the same mask byte for byte for 1, 2 and 3 threads, on a volume where every one of them acts.
+TEST(SegmentFluid, SameMaskForOneTwoAndThreeThreads) {
+  auto ct = loop_bridged_to_pool();
+  std::vector<MaskImage::Pointer> masks;
+  for (int t : {1, 2, 3}) {
+    set_thread_count(t);
+    SegmentStats st;
+    masks.push_back(segment_supine(ct, &st));
+  }
+  set_thread_count(0);
+  const std::size_t n = masks[0]->GetLargestPossibleRegion().GetNumberOfPixels();
+  std::size_t lumen = 0;
+  for (std::size_t q = 0; q < n; ++q) lumen += masks[0]->GetBufferPointer()[q];
+  EXPECT_GT(lumen, 10000u);  // the colon is there (pi x 10^2 x 76 mm: about 23 900 voxels)
+  for (std::size_t i = 1; i < masks.size(); ++i) EXPECT_EQ(0, std::memcmp(masks[0]->GetBufferPointer(), masks[i]->GetBufferPointer(), n)) << i + 1 << " threads";
 }
 
 }  // namespace

@@ -52,13 +52,10 @@ TEST(SegmentGrid, RunLabelsMatchItkConnectedComponents) {
   for (std::size_t q = 0; q < d.total; ++q) ASSERT_EQ(label[q], ref[q]) << "voxel " << q;
 }
 
-// Box dilation (and erosion, its dual) equals the brute-force maximum over the box.
-TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
-  const Dims d = dims(31, 26, 19);
-  const Bytes m = random_mask(d, 0.03, 11);
-  const int r[3] = {2, 1, 3};
-  Bytes dil = m, ero = random_mask(d, 0.9, 12);
-  const Bytes ero_in = ero;
+// Dilates `m` and erodes `e` by the box of half-widths r and compares each voxel with the
+// brute-force maximum / minimum over the box (clipped at the volume's faces).
+void expect_box_matches_brute_force(const Dims& d, const Bytes& m, const Bytes& e, const int r[3]) {
+  Bytes dil = m, ero = e;
   dilate_box(dil, d, r);
   erode_box(ero, d, r);
   for (std::size_t q = 0; q < d.total; ++q) {
@@ -71,11 +68,30 @@ TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
           const long i = long(c[0]) + di, j = long(c[1]) + dj, k = long(c[2]) + dk;
           if (i < 0 || j < 0 || k < 0 || i >= long(d.n[0]) || j >= long(d.n[1]) || k >= long(d.n[2])) continue;
           any = any || m[d.idx(i, j, k)];
-          all = all && ero_in[d.idx(i, j, k)];
+          all = all && e[d.idx(i, j, k)];
         }
     ASSERT_EQ(bool(dil[q]), any) << "voxel " << q;
     ASSERT_EQ(bool(ero[q]), all) << "voxel " << q;
   }
+}
+
+// Box dilation (and erosion, its dual) equals the brute-force maximum over the box.
+TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
+  const Dims d = dims(31, 26, 19);
+  const int r[3] = {2, 1, 3};
+  expect_box_matches_brute_force(d, random_mask(d, 0.03, 11), random_mask(d, 0.9, 12), r);
+}
+
+// Radii of 255 voxels and more along y and z (beyond the byte distances of the fast sweep) and x
+// (many doubling passes) give the brute-force box too (about one set voxel per line: partly covered
+// lines), as does radius 254.
+TEST(SegmentGrid, BoxDilationWithRadiusOver254MatchesBruteForce) {
+  const Dims dx = dims(300, 3, 6), dy = dims(6, 300, 3), dz = dims(6, 3, 300);
+  const int rx[3] = {257, 0, 0}, ry[3] = {0, 260, 0}, rz[3] = {0, 0, 255}, r254[3] = {1, 254, 0};
+  expect_box_matches_brute_force(dx, random_mask(dx, 0.002, 37), random_mask(dx, 0.998, 38), rx);
+  expect_box_matches_brute_force(dy, random_mask(dy, 0.002, 31), random_mask(dy, 0.998, 32), ry);
+  expect_box_matches_brute_force(dz, random_mask(dz, 0.002, 33), random_mask(dz, 0.998, 34), rz);
+  expect_box_matches_brute_force(dy, random_mask(dy, 0.002, 35), random_mask(dy, 0.998, 36), r254);
 }
 
 // Ball erosion (anisotropic voxels 0.75 x 0.75 x 1.5 mm, radius 3 mm) equals the brute-force
