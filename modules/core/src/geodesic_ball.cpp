@@ -20,9 +20,9 @@ struct BallScratch {
   std::uint32_t current = 0;
 
   void start(std::size_t vertices) {
-    if (stamp.size() < vertices) {
-      stamp.resize(vertices, 0);
-      dist.resize(vertices, 0.0);
+    if (stamp.size() < vertices) {  // with room for the vertices a few surgeries add: no regrowth per call
+      stamp.resize(vertices + vertices / 8, 0);
+      dist.resize(stamp.size(), 0.0);
     }
     if (++current == 0) {  // wrapped: no old stamp may equal a new one
       std::fill(stamp.begin(), stamp.end(), 0);

@@ -196,7 +196,7 @@ struct SideMarks {
   std::uint32_t call = 0;
 
   void start(std::size_t vertices) {
-    if (stamp.size() < vertices) stamp.resize(vertices, 0);
+    if (stamp.size() < vertices) stamp.resize(vertices + vertices / 8, 0);  // room for what surgery adds
     if (++call >= 0x7fffffffu) {  // about to wrap: no old stamp may match a new call
       std::fill(stamp.begin(), stamp.end(), 0);
       call = 1;
