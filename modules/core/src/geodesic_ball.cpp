@@ -1,35 +1,66 @@
 #include "colonflat/core/geodesic_ball.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <queue>
-#include <unordered_map>
 #include <utility>
 
 namespace cf {
 
+namespace {
+
+// Per-thread distance labels by vertex id, kept between calls: a label counts only when its stamp
+// is the current call's, so a call touches only the vertices it reaches (a hash map of them cost
+// 1.4 s of CPU in one denoise of a 2.1 M-face surface: the far-first balls and the bounds lowered
+// near each surgery, about a hundred calls of up to the whole surface).
+struct BallScratch {
+  std::vector<double> dist;
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t current = 0;
+
+  void start(std::size_t vertices) {
+    if (stamp.size() < vertices) {  // with room for the vertices a few surgeries add: no regrowth per call
+      stamp.resize(vertices + vertices / 8, 0);
+      dist.resize(stamp.size(), 0.0);
+    }
+    if (++current == 0) {  // wrapped: no old stamp may equal a new one
+      std::fill(stamp.begin(), stamp.end(), 0);
+      current = 1;
+    }
+  }
+  bool labelled(int v) const { return stamp[v] == current; }
+  void label(int v, double d) {
+    stamp[v] = current;
+    dist[v] = d;
+  }
+};
+
+}  // namespace
+
 std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
                                  std::vector<double>* distances) {
-  std::unordered_map<int, double> dist;
+  thread_local BallScratch scratch;
+  scratch.start(mesh.n_vertices());
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
   for (auto s : seeds) {
-    dist[s.idx()] = 0;
+    scratch.label(s.idx(), 0);
     queue.push({0, s.idx()});
   }
   std::vector<int> out;
   while (!queue.empty()) {
     const auto [d, v] = queue.top();
     queue.pop();
-    if (d > dist[v]) continue;
+    if (d > scratch.dist[v]) continue;
     out.push_back(v);
     if (distances) distances->push_back(d);
     const Vec3& p = mesh.point(Mesh::VertexHandle(v));
     for (auto w : mesh.vv_range(Mesh::VertexHandle(v))) {
       const double nd = d + (mesh.point(w) - p).norm();
       if (nd > radius) continue;
-      auto it = dist.find(w.idx());
-      if (it == dist.end() || nd < it->second) {
-        dist[w.idx()] = nd;
+      if (!scratch.labelled(w.idx()) || nd < scratch.dist[w.idx()]) {
+        scratch.label(w.idx(), nd);
         queue.push({nd, w.idx()});
       }
     }

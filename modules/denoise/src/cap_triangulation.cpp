@@ -221,7 +221,8 @@ std::vector<std::array<int, 3>> min_area_triangulation(const std::vector<Vec3>& 
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid,
-    const std::vector<std::array<int, 3>>& others, long long* budget, RingQueryCache* cache) {
+    const std::vector<std::array<int, 3>>& others, long long* budget, RingQueryCache* cache,
+    const std::atomic<bool>* cancel) {
   const int n = static_cast<int>(ring.size());
   long long queries = 0;
   std::vector<Vec3> pts;
@@ -253,10 +254,10 @@ std::vector<std::array<int, 3>> triangulate_ring(
     if (cache && hit && others.empty()) cache->hits.insert(key);
     return !hit;
   };
-  auto give_up = [&] { return budget && queries > *budget; };
+  auto give_up = [&] { return (budget && queries > *budget) || (cancel && *cancel); };
   const double cpu0 = grid && detail::denoise_debug() ? process_cpu_seconds() : 0.0;
   std::vector<std::array<int, 3>> t = min_area_triangulation(pts, allowed, give_up, side_ok);
-  if (grid && detail::denoise_debug() && n >= 48)
+  if (grid && detail::denoise_debug() && n >= 48 && !(cancel && *cancel))
     std::fprintf(stderr, "denoise debug: restricted triangulation of %d vertices: %lld grid queries, %s, CPU %.3f s\n",
                  n, queries,
                  t.empty() ? "none" : "found", process_cpu_seconds() - cpu0);

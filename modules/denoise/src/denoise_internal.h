@@ -44,6 +44,7 @@ struct DenoiseState {
   std::unique_ptr<FaceGrid> guard;  // built at the first surgery when caps are checked (or by prepare_input())
   double mean_edge = 0;
   std::unique_ptr<SearchWorker> worker;             // the helper threads (cf::thread_count() > 1), else null
+  long long left_caps_ahead = 0;  // SurgeryResult::left_caps_ahead summed over the surgeries (kept or undone)
   std::unique_ptr<HomologyBasis> initial_homology;  // built by prepare_input() with helper threads, taken by the exact method
 
   // Registers vertices created by a surgery: copies[i] is a copy of copies_of[i]; the others

@@ -1,7 +1,6 @@
 // Setting up a denoise run: the working copy of the input, the input's topology and, with
 // helper threads, the cap guard grid and the first homology basis built at the same time.
 #include <algorithm>
-#include <exception>
 #include <iterator>
 
 #include "colonflat/core/error.h"
@@ -93,22 +92,6 @@ void init_state(DenoiseState& st, const TopologyReport& b) {
     st.component[v.idx()] = b.face_component[st.mesh.face_handle(h).idx()];
   }
   for (const auto& c : b.components) st.genus_left.push_back(*c.genus);
-}
-
-// Runs `mine` here and `theirs` on the helper thread, returns when both are done and rethrows
-// the first exception of either (neither may leave the other running on freed state).
-void run_both(SearchWorker& worker, const std::function<void()>& mine, const std::function<void()>& theirs) {
-  std::exception_ptr mine_error, their_error;
-  auto guarded = [](const std::function<void()>& job, std::exception_ptr& error) {
-    try {
-      job();
-    } catch (...) {
-      error = std::current_exception();
-    }
-  };
-  worker.run_both([&] { guarded(mine, mine_error); }, [&] { guarded(theirs, their_error); });
-  if (mine_error) std::rethrow_exception(mine_error);
-  if (their_error) std::rethrow_exception(their_error);
 }
 
 // Mean edge length over the mesh's edges (the guard grid's cells are kGuardCellEdges of it).

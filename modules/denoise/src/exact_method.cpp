@@ -53,12 +53,17 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   so.probe_concentric = attempt == CapAttempt::kFirst;
   so.restricted = attempt != CapAttempt::kPlainTrial;
   so.front = o.front_caps;
+  if (st.worker)
+    so.run_both = [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {
+      run_both(*st.worker, mine, theirs);
+    };
   if (o.check_caps) {
     if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * st.mean_edge);
     so.guard = st.guard.get();
   }
   *out = cut_and_cap(st.mesh, loop, so, hb);
   st.loops.back().cap_intersections = out->intersections;
+  st.left_caps_ahead += out->left_caps_ahead;
   st.extend_vertices(out->right_ring, out->left_ring, comp);
   st.cap_rings.push_back(out->left_ring);
   st.cap_rings.push_back(out->right_ring);
@@ -240,6 +245,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["crossing_searches_to_z"] = crossing_searches_to_z_;
   stats["z_reroute_settled"] = reroute_settled_;
   stats["z_reroutes_found"] = reroutes_found_;
+  stats["left_caps_triangulated_ahead"] = st_.left_caps_ahead;
   stats["loops_replaced_for_clean_caps"] = alternatives_ + crossing_alternatives_;
   stats["loops_replaced_by_crossing_loop"] = crossing_alternatives_;
   stats["first_search_radius_mm"] = first_radius_;

@@ -3,6 +3,7 @@
 // (the set-up's analysis beside the copy; the group searches of one batch). No thread is started
 // per job: a batch of small searches costs less than starting threads (cf::parallel_for does).
 #include <condition_variable>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -81,5 +82,21 @@ class SearchWorker {
   bool stop_ = false;
   std::vector<std::thread> helpers_;  // last: started once the members above exist
 };
+
+// Runs `mine` here and `theirs` on the helper thread, returns when both are done and rethrows
+// the first exception of either (neither may leave the other running on freed state).
+inline void run_both(SearchWorker& worker, const std::function<void()>& mine, const std::function<void()>& theirs) {
+  std::exception_ptr mine_error, their_error;
+  auto guarded = [](const std::function<void()>& job, std::exception_ptr& error) {
+    try {
+      job();
+    } catch (...) {
+      error = std::current_exception();
+    }
+  };
+  worker.run_both([&] { guarded(mine, mine_error); }, [&] { guarded(theirs, their_error); });
+  if (mine_error) std::rethrow_exception(mine_error);
+  if (their_error) std::rethrow_exception(their_error);
+}
 
 }  // namespace cf::detail

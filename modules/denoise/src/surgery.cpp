@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstdint>
 #include <deque>
 #include <unordered_set>
 
@@ -185,27 +186,49 @@ void undo_surgery(Mesh& mesh, const SurgeryUndo& undo) {
   mesh.resize(undo.vertices, undo.edges, undo.faces);
 }
 
+namespace {
+
+// Per-thread side marks by vertex id for vertices_connected(), stamped per call so that a call
+// touches only the vertices it reaches (a hash map of them cost about 0.4 s of CPU over the 93
+// cuts of the real CT surface, issue 26).
+struct SideMarks {
+  std::vector<std::uint32_t> stamp;  // (call << 1) | side, side 0: reached from a, 1: from b
+  std::uint32_t call = 0;
+
+  void start(std::size_t vertices) {
+    if (stamp.size() < vertices) stamp.resize(vertices + vertices / 8, 0);  // room for what surgery adds
+    if (++call >= 0x7fffffffu) {  // about to wrap: no old stamp may match a new call
+      std::fill(stamp.begin(), stamp.end(), 0);
+      call = 1;
+    }
+  }
+  int side(int v) const { return stamp[v] >> 1 == call ? static_cast<int>(stamp[v] & 1u) : -1; }
+  void mark(int v, int side) { stamp[v] = call << 1 | static_cast<std::uint32_t>(side); }
+};
+
+}  // namespace
+
 bool vertices_connected(const Mesh& mesh, Mesh::VertexHandle a, Mesh::VertexHandle b) {
   if (a == b) return true;
-  // mark: 1 = reached from a, 2 = reached from b
-  std::unordered_map<int, std::uint8_t> mark;
+  thread_local SideMarks marks;
+  marks.start(mesh.n_vertices());
   std::deque<Mesh::VertexHandle> qa{a}, qb{b};
-  mark[a.idx()] = 1;
-  mark[b.idx()] = 2;
+  marks.mark(a.idx(), 0);
+  marks.mark(b.idx(), 1);
   while (!qa.empty() && !qb.empty()) {
     const bool from_a = qa.size() <= qb.size();
     auto& q = from_a ? qa : qb;
-    const std::uint8_t me = from_a ? 1 : 2;
+    const int me = from_a ? 0 : 1;
     const std::size_t layer = q.size();
     for (std::size_t i = 0; i < layer; ++i) {
       const auto v = q.front();
       q.pop_front();
       for (auto w : mesh.vv_range(v)) {
-        auto it = mark.find(w.idx());
-        if (it == mark.end()) {
-          mark[w.idx()] = me;
+        const int seen = marks.side(w.idx());
+        if (seen < 0) {
+          marks.mark(w.idx(), me);
           q.push_back(w);
-        } else if (it->second != me) {
+        } else if (seen != me) {
           return true;
         }
       }

@@ -166,54 +166,6 @@ std::vector<Mesh::FaceHandle> Surgery::faces_around_rings() const {
   return faces;
 }
 
-// Minimum-area triangulations of both rings (with `avoid`: only triangles that intersect nothing);
-// true when both exist and together intersect nothing.
-bool Surgery::triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left) {
-  const std::vector<Mesh::VertexHandle> order_left = left_cap_order(result_.left_ring);
-  // A diagonal that is already a mesh edge (a chord on that side) would make the cap non-manifold.
-  auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
-  const FaceGrid* grid = avoid ? opts_.guard : nullptr;
-  right_cache_ = {};  // the rings have moved: answers of the last placement do not hold
-  left_cache_ = {};
-  RingQueryCache* right_cache = avoid ? &right_cache_ : nullptr;
-  *right = triangulate_ring(mesh_, result_.right_ring, chord, grid, {}, &query_budget_, right_cache);
-  // Fail fast: the placements move the ring by fractions of an edge; a right ring with no clean
-  // triangulation in one placement had none in any other on the real CT surface (issue 26).
-  if (right->empty()) {
-    gave_up_ = gave_up_ || avoid;  // also when the budget ran out
-    return false;
-  }
-  if (avoid && mirror_cap(*right, left)) return true;
-  *left = triangulate_ring(mesh_, order_left, chord, grid, *right, &query_budget_, avoid ? &left_cache_ : nullptr);
-  if (avoid && left->empty()) left_first(right, left);
-  gave_up_ = gave_up_ || query_budget_ <= 0;
-  if (left->empty()) return false;
-  std::vector<std::array<int, 3>> all = *right;
-  all.insert(all.end(), left->begin(), left->end());
-  return opts_.guard->count_triangles(mesh_, all) == 0;
-}
-
-// The restricted triangulations the other way round, after the right ring's was found and the left
-// ring's (avoiding it) was not: the left ring's first, avoiding the surface only, then the right
-// ring's avoiding it. The two rings are a fraction of an edge apart, so the two caps compete for
-// the same clean passage, and the first minimum-area cap takes the side of it that leaves the
-// other none where the other order leaves room for both (issue 26, session 20: on the real CT
-// surface the 114-, 96- and 178-vertex loops, whose right-first caps fail in 5-7 placements).
-// Both reuse the grid answers of triangulate_both's calls for the same rings (RingQueryCache: the
-// same result as without it). On success *right and *left are replaced; otherwise *left stays empty.
-bool Surgery::left_first(std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left) {
-  auto chord = [&](Mesh::VertexHandle a, Mesh::VertexHandle b) { return mesh_.find_halfedge(a, b).is_valid(); };
-  std::vector<std::array<int, 3>> l = triangulate_ring(mesh_, left_cap_order(result_.left_ring), chord, opts_.guard, {},
-                                                       &query_budget_, &left_cache_);
-  if (l.empty()) return false;
-  std::vector<std::array<int, 3>> r =
-      triangulate_ring(mesh_, result_.right_ring, chord, opts_.guard, l, &query_budget_, &right_cache_);
-  if (r.empty()) return false;
-  *right = std::move(r);
-  *left = std::move(l);
-  return true;
-}
-
 // The ring placements tried, in order: pulls 0.25 (ring-pull), 0.4 and 0.15 towards the side
 // targets and along a side edge each, then 0.08 along the edge.
 std::vector<Surgery::Placement> Surgery::placements() const {
@@ -229,28 +181,6 @@ bool Surgery::place_checked(const Placement& tr) {
   place_rings(tr.pull, tr.along_edge ? edge_left_ : target_left_, tr.along_edge ? edge_right_ : target_right_);
   for (auto f : ring_faces_) opts_.guard->insert(mesh_, f);
   return opts_.guard->count_intersections(mesh_, ring_faces_, 1) == 0;
-}
-
-// The left cap as the right one's mirror: the same triangles on the left copies, reversed (the
-// rings are a fraction of an edge apart, so the two caps are nearly parallel); kept when no
-// diagonal is a mesh edge on the left side and both caps together intersect nothing. Restricting
-// the left ring's own triangulation to avoid the right cap failed where the mirror is clean.
-bool Surgery::mirror_cap(const std::vector<std::array<int, 3>>& right, std::vector<std::array<int, 3>>* left) {
-  std::unordered_map<int, std::size_t> index;
-  for (std::size_t i = 0; i < k_; ++i) index[result_.right_ring[i].idx()] = i;
-  left->clear();
-  for (const auto& t : right) {
-    std::array<std::size_t, 3> r = {index.at(t[0]), index.at(t[2]), index.at(t[1])};
-    for (int e = 0; e < 3; ++e) {
-      const std::size_t a = r[e], b = r[(e + 1) % 3];
-      const bool ring_edge = (a + 1) % k_ == b || (b + 1) % k_ == a;
-      if (!ring_edge && mesh_.find_halfedge(result_.left_ring[a], result_.left_ring[b]).is_valid()) return false;
-    }
-    left->push_back({result_.left_ring[r[0]].idx(), result_.left_ring[r[1]].idx(), result_.left_ring[r[2]].idx()});
-  }
-  std::vector<std::array<int, 3>> all = right;
-  all.insert(all.end(), left->begin(), left->end());
-  return opts_.guard->count_triangles(mesh_, all) == 0;
 }
 
 // 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area

@@ -2,6 +2,7 @@
 // Internal to the denoise module: cut_and_cap() as named steps (surgery.cpp: the cut;
 // surgery_caps.cpp: cap placement). One Surgery object per call; each method is one step.
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -66,8 +67,16 @@ class Surgery {
   void add_triangulated_caps(const std::vector<std::array<int, 3>>& right, const std::vector<std::array<int, 3>>& left);
   void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
                        const std::vector<Mesh::VertexHandle>& inner);
+  // Restricted caps (surgery_restricted.cpp).
+  struct LeftAhead {  // left_first()'s first triangulation, made on the helper thread (run_both)
+    std::vector<std::array<int, 3>> tris;
+    long long queries = -1;  // grid queries it made; -1: called off (or not run)
+    std::atomic<bool> cancel{false};
+  };
   bool triangulate_both(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
-  bool left_first(std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
+  bool right_then_left(bool avoid, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
+  void left_ahead(long long budget, LeftAhead* ahead) const;
+  bool left_first(const LeftAhead& ahead, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left);
   void set_chord_classes(const std::vector<Mesh::VertexHandle>& ring);
   std::unordered_map<int, std::vector<std::uint64_t>> ring_potentials(const std::vector<Mesh::VertexHandle>& ring) const;
   // A left-side ring as its hole runs: x_0, x_(k-1), ..., x_1 (the left ring itself, or its collar).

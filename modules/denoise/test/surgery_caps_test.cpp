@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <thread>
 
 #include "colonflat/core/topology.h"
 #include "colonflat/testdata/synthetic.h"
@@ -66,14 +68,16 @@ struct Cut {
   SurgeryResult result;
 };
 
-// The tube with the box behind its loop, cut along the loop with a guard, without front caps.
-Cut cut_loop(double behind, double ahead) {
+// The tube with the box behind its loop, cut along the loop with a guard, without front caps
+// (with `run_both`: SurgeryOptions::run_both, a helper thread).
+Cut cut_loop(double behind, double ahead, const decltype(SurgeryOptions::run_both)& run_both = {}) {
   Cut c;
   c.mesh = synthetic::to_mesh(synthetic::disjoint_union(pleated_tube(), box(behind, ahead)));
   FaceGrid grid(c.mesh, 0.5);
   SurgeryOptions o;
   o.guard = &grid;
   o.front = false;  // front caps (interior vertices) span this loop too: the restricted step is the one tested
+  o.run_both = run_both;
   const std::vector<Mesh::VertexHandle> loop = {Mesh::VertexHandle(0), Mesh::VertexHandle(1), Mesh::VertexHandle(2),
                                                 Mesh::VertexHandle(3)};
   c.result = cut_and_cap(c.mesh, loop, o);
@@ -107,6 +111,34 @@ TEST(DenoiseSurgeryCaps, LeftRingFirstWhenTheRightCapBlocksIt) {
   EXPECT_EQ(t.components.size(), 2u);  // the torus cut and capped (a sphere) and the box
   EXPECT_TRUE(t.closed && t.manifold && t.consistently_oriented);
   EXPECT_EQ(testing::count_self_intersections(c.mesh), 0u);
+}
+
+// Runs both jobs at once, the second on a thread of its own (what SurgeryOptions::run_both does).
+void on_two_threads(const std::function<void()>& mine, const std::function<void()>& theirs) {
+  std::thread helper(theirs);
+  mine();
+  helper.join();
+}
+
+// The left ring's cap that left_first() needs, triangulated on a helper thread beside the right
+// ring's, is used (counted: 1, as the caps come from the first placement's left_first()) and
+// gives the caps of one thread: the same vertices, points and faces, element by element.
+TEST(DenoiseSurgeryCaps, LeftRingTriangulatedAheadGivesTheSameCaps) {
+  const Cut one = cut_loop(-1.5, -0.78);
+  const Cut two = cut_loop(-1.5, -0.78, on_two_threads);
+  EXPECT_EQ(one.result.left_caps_ahead, 0);
+  EXPECT_EQ(two.result.left_caps_ahead, 1);
+  EXPECT_STREQ(two.result.caps, "restricted");
+  EXPECT_EQ(two.result.placement, one.result.placement);
+  ASSERT_EQ(two.mesh.n_vertices(), one.mesh.n_vertices());
+  ASSERT_EQ(two.mesh.n_faces(), one.mesh.n_faces());
+  for (auto v : one.mesh.vertices()) EXPECT_EQ(two.mesh.point(v), one.mesh.point(v)) << v.idx();
+  for (auto f : one.mesh.faces()) {
+    std::vector<int> a, b;
+    for (auto v : one.mesh.fv_range(f)) a.push_back(v.idx());
+    for (auto v : two.mesh.fv_range(f)) b.push_back(v.idx());
+    EXPECT_EQ(a, b) << f.idx();
+  }
 }
 
 }  // namespace

@@ -66,6 +66,22 @@ TEST(DenoiseSurgery, SeparatingNeckSplitsTheMesh) {
   EXPECT_EQ(t.genus, 2);  // 1 + 1: the separating cut removed no handle
 }
 
+// vertices_connected keeps per-thread marks between calls: on two disjoint tori (128 vertices
+// each) it answers false across them and true within each, call after call and after calls on a
+// larger mesh (no mark of an earlier call counts).
+TEST(DenoiseSurgery, VerticesConnectedAcrossCallsAndMeshes) {
+  const Mesh big = to_mesh(torus(3, 1, 64, 32));
+  const Mesh two = to_mesh(disjoint_union(torus(3, 1, 16, 8), torus(3, 1, 16, 8)));
+  ASSERT_EQ(two.n_vertices(), 256u);
+  for (int round = 0; round < 20; ++round) {
+    EXPECT_TRUE(vertices_connected(big, VH(0), VH(static_cast<int>(big.n_vertices()) - 1)));
+    EXPECT_FALSE(vertices_connected(two, VH(0), VH(128)));
+    EXPECT_TRUE(vertices_connected(two, VH(0), VH(127)));
+    EXPECT_TRUE(vertices_connected(two, VH(130), VH(255)));
+    EXPECT_FALSE(vertices_connected(two, VH(255), VH(5)));
+  }
+}
+
 // Two surgeries in a row on a genus-3 chain leave genus 1 and one component.
 TEST(DenoiseSurgery, RepeatedSurgery) {
   Mesh m = to_mesh(torus_chain(3, 3, 1, 16, 8, 10));

@@ -1,6 +1,7 @@
 #pragma once
 // Minimum-area triangulation of a closed 3D polygon (the caps of surgery).
 #include <array>
+#include <atomic>
 #include <functional>
 #include <unordered_map>
 #include <unordered_set>
@@ -44,10 +45,13 @@ struct RingQueryCache {
   std::unordered_set<long long> clean, hits;      // triangles (i, m, j): key (i n + m) n + j
   std::unordered_map<long long, bool> sides_ok;  // sides (a, b), a < b: key a n + b
 };
+// With `cancel` (and `grid`): once *cancel is true, it gives up after the current round (another
+// thread may set it; the caller then discards the result).
 std::vector<std::array<int, 3>> triangulate_ring(
     const Mesh& mesh, const std::vector<Mesh::VertexHandle>& ring,
     const std::function<bool(Mesh::VertexHandle, Mesh::VertexHandle)>& blocked, const FaceGrid* grid = nullptr,
-    const std::vector<std::array<int, 3>>& others = {}, long long* budget = nullptr, RingQueryCache* cache = nullptr);
+    const std::vector<std::array<int, 3>>& others = {}, long long* budget = nullptr, RingQueryCache* cache = nullptr,
+    const std::atomic<bool>* cancel = nullptr);
 
 // Adds the triangles of triangulate_ring (in its ear order) to the mesh, and to `grid` when given.
 // Throws cf::Error naming `what` if OpenMesh refuses one (the ring was not a hole's boundary).

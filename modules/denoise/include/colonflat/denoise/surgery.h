@@ -12,6 +12,7 @@
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -37,6 +38,12 @@ struct SurgeryOptions {
                                   // searched for a clean one (each count stops at its first pair);
                                   // without one the caps stay in the first placement, whose pairs
                                   // are reported (the caller undoes such a cut)
+  // With a helper thread: runs the first job on the calling thread and the second on the helper
+  // at once and returns when both are done (neither may throw); empty: one thread. The restricted
+  // caps then triangulate the left ring alone on the helper beside the right ring's triangulation,
+  // and use it only where the one-thread order computes that same triangulation within the same
+  // query budget: the caps are the same for any thread count.
+  std::function<void(const std::function<void()>&, const std::function<void()>&)> run_both;
 };
 
 // What undo_surgery() needs to put the mesh back as it was before cut_and_cap(): the element
@@ -56,6 +63,7 @@ struct SurgeryResult {
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
   const char* caps = "concentric";  // which step made the caps: plain, collar, front, restricted or concentric
   int placement = -1;  // index of the ring placement the triangulated caps were made in (0 = the first); -1: concentric
+  int left_caps_ahead = 0;  // left-ring restricted triangulations taken from the helper thread's (run_both)
   SurgeryUndo undo;
 };
 
