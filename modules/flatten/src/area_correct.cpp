@@ -330,15 +330,17 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
 // One local piece: its descent; when that left more than kFrozen of the piece's hidden wall hidden
 // (a piece that opens its pockets leaves a few % at most: on the real CT colon band, every piece but
 // the frozen one left <= 12 %) and the piece holds a crushed spot, the spot is opened on its own and
-// the piece runs again. Pieces that did their job are left as they are.
+// the piece runs again; in the last local pass only (`last_pass`: the grown regions, where a piece
+// has the most room; in the first pass a frozen piece is left to it). Pieces that did their job
+// are left as they are.
 constexpr double kFrozen = 0.5;
 SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                        const std::vector<int>& piece, const std::vector<char>& free_vertex,
-                       const std::vector<double>& area3, double scale, const FlattenOptions& o, AreaCorrection& res,
-                       std::vector<V2>* scratch, CorrectionTimes* times) {
+                       const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
+                       AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
   const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
   minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
-  if (!(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
+  if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
   Stopwatch clock;
   const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, scratch);
   if (spots.faces == 0) return spots;
@@ -435,7 +437,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   for (std::size_t k = 0; k < order.size(); ++k) place[order[k]] = k;
   for (std::size_t i : order)
     tasks.push_back([&, i] {
-      spots[i] = correct_piece(s, vf, emb, pieces[i], free_vertex, area3, scale, o, part[i], &trial,
+      spots[i] = correct_piece(s, vf, emb, pieces[i], free_vertex, area3, scale, o, grow, part[i], &trial,
                                times ? &part_times[i] : nullptr);
     });
   parallel_tasks(tasks);
