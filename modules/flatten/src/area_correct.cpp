@@ -266,6 +266,92 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
   res.stop = d.stop;
 }
 
+// Wall area (3D) of `faces` whose map area ratio at `scale` is below `ratio`.
+double area_below(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
+                  const std::vector<int>& faces, double ratio) {
+  double a = 0;
+  for (int f : faces) a += scale * emb.area2(s, f) < ratio * area3[f] ? area3[f] : 0.0;
+  return a;
+}
+
+// A crushed spot of a local piece (issue 26, docs/flatten.md session 21): its faces at area ratio
+// below kSpotRatio (at the band's scale; positive: folds are not judged), grown by kSpotRings vertex
+// rings within the piece, corrected as a piece of its own. Such faces can bound every fold-free
+// step of a whole piece (no face may lose more than half its area in a step; across a spot ~1e-4
+// of its neighbours' size the piece's direction varies by far more than the spot's size), so a
+// large piece gains < min_gain per step and stops with its pockets unopened; on the spot alone the
+// same tiny steps are cheap, move only the spot, and gain until it has opened.
+constexpr double kSpotRatio = 1e-4;
+constexpr int kSpotRings = 2;
+struct SpotWork {
+  std::size_t faces = 0;  // faces of the piece's spot regions
+  int steps = 0;          // most steps a spot region took
+};
+SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                            const std::vector<int>& piece, const std::vector<char>& free_vertex,
+                            const std::vector<double>& area3, double scale, const FlattenOptions& o,
+                            std::vector<V2>* scratch) {
+  SpotWork work;
+  std::vector<int> ring;
+  for (int f : piece)
+    if (scale * emb.area2(s, f) < kSpotRatio * area3[f]) ring.push_back(f);
+  if (ring.empty()) return work;
+  std::vector<char> mark(s.t.size(), 0);  // 1: in the piece, 2: in a spot region
+  for (int f : piece) mark[f] = 1;
+  for (int f : ring) mark[f] = 2;
+  std::vector<int> faces = ring;
+  for (int k = 0; k < kSpotRings; ++k) {
+    std::vector<int> next;
+    for (int f : ring)
+      for (int v : s.t[f])
+        for (int g : vf[v])
+          if (mark[g] == 1) mark[g] = 2, next.push_back(g);
+    faces.insert(faces.end(), next.begin(), next.end());
+    ring.swap(next);
+  }
+  std::sort(faces.begin(), faces.end());
+  std::vector<char> spot_free(s.p.size(), 0);  // the piece's free vertices inside the spot regions
+  for (int f : faces)
+    for (int v : s.t[f]) spot_free[v] = free_vertex[v];
+  for (int f : faces)
+    for (int v : s.t[f])
+      if (spot_free[v])
+        for (int g : vf[v])
+          if (mark[g] != 2) spot_free[v] = 0;
+  work.faces = faces.size();
+  for (std::vector<int>& spot : connected_pieces(s, faces)) {
+    AreaCorrection res;
+    minimise(s, emb, std::move(spot), spot_free, area3, scale, o, true, res, {}, scratch);
+    work.steps = std::max(work.steps, res.iterations);
+  }
+  return work;
+}
+
+// One local piece: its descent; when that left more than kFrozen of the piece's hidden wall hidden
+// (a piece that opens its pockets leaves a few % at most: on the real CT colon band, every piece but
+// the frozen one left <= 12 %) and the piece holds a crushed spot, the spot is opened on its own and
+// the piece runs again; in the last local pass only (`last_pass`: the grown regions, where a piece
+// has the most room; in the first pass a frozen piece is left to it). Pieces that did their job
+// are left as they are.
+constexpr double kFrozen = 0.5;
+SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
+                       const std::vector<int>& piece, const std::vector<char>& free_vertex,
+                       const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
+                       AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
+  const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
+  if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
+  Stopwatch clock;
+  const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, scratch);
+  if (spots.faces == 0) return spots;
+  AreaCorrection again;
+  CorrectionTimes again_times;
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, again, {}, scratch, nullptr, &again_times);
+  res.energy_after = again.energy_after, res.iterations += again.iterations, res.stop = again.stop;
+  if (times) times->longest_s += clock.lap(), times->longest_steps = res.iterations;
+  return spots;
+}
+
 // The local pieces' times combined (the piece that took longest, the sum); `place[i]`: piece i's
 // place in the start order.
 void combine_times(const std::vector<CorrectionTimes>& part, const std::vector<std::size_t>& place,
@@ -292,20 +378,19 @@ class PieceLog {
     for (const std::vector<int>& p : pieces_) hidden_before_.push_back(area_below(p, o_.coverage_min_ratio));
   }
   void print(const std::vector<AreaCorrection>& part, const std::vector<CorrectionTimes>& times,
-             const std::vector<std::size_t>& place) const {
+             const std::vector<std::size_t>& place, const std::vector<SpotWork>& spots) const {
     for (std::size_t i = 0; i < part.size(); ++i)
       std::fprintf(stderr, "flatten debug local piece %zu (started %zu-th): %zu faces, %d steps of %d, %s, %.3f s; "
-                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2\n", i, place[i] + 1, pieces_[i].size(),
-                   part[i].iterations, iteration_budget(pieces_[i].size(), true, o_.area_correction_iterations),
-                   part[i].stop, times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i],
-                   area_below(pieces_[i], o_.coverage_min_ratio), o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low));
+                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps\n",
+                   i, place[i] + 1, pieces_[i].size(), part[i].iterations,
+                   iteration_budget(pieces_[i].size(), true, o_.area_correction_iterations), part[i].stop,
+                   times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i], area_below(pieces_[i], o_.coverage_min_ratio),
+                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps);
   }
 
  private:
   double area_below(const std::vector<int>& faces, double ratio) const {
-    double a = 0;
-    for (int f : faces) a += scale_ * emb_.area2(s_, f) < ratio * area3_[f] ? area3_[f] : 0.0;
-    return a;
+    return flat_detail::area_below(s_, emb_, area3_, scale_, faces, ratio);
   }
   const Surface& s_;
   const Embedding& emb_;
@@ -342,6 +427,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   // their results are combined in piece order, so the map is the same for any thread count.
   std::vector<std::vector<int>> pieces = connected_pieces(s, faces);
   std::vector<AreaCorrection> part(pieces.size());
+  std::vector<SpotWork> spots(pieces.size());
   std::vector<CorrectionTimes> part_times(times ? pieces.size() : 0);
   std::unique_ptr<PieceLog> log = times ? std::make_unique<PieceLog>(s, emb, area3, scale, o, pieces) : nullptr;
   std::vector<V2> trial(emb.pos.size());  // one trial buffer for all pieces: each writes only its own vertices
@@ -351,8 +437,8 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   for (std::size_t k = 0; k < order.size(); ++k) place[order[k]] = k;
   for (std::size_t i : order)
     tasks.push_back([&, i] {
-      minimise(s, emb, std::move(pieces[i]), free_vertex, area3, scale, o, true, part[i], {}, &trial, nullptr,
-               times ? &part_times[i] : nullptr);
+      spots[i] = correct_piece(s, vf, emb, pieces[i], free_vertex, area3, scale, o, grow, part[i], &trial,
+                               times ? &part_times[i] : nullptr);
     });
   parallel_tasks(tasks);
   for (const AreaCorrection& p : part) {
@@ -360,7 +446,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
     if (p.iterations >= res.iterations) res.iterations = p.iterations, res.stop = p.stop;
   }
   if (times) combine_times(part_times, place, *times);
-  if (log) log->print(part, part_times, place);
+  if (log) log->print(part, part_times, place, spots);
   return res;
 }
 

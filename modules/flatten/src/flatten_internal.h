@@ -327,7 +327,10 @@ struct CorrectionTimes {
 // `local`: only the faces not shown (ratio below coverage_min_ratio) grown by 12 vertex rings
 // move (their rim fixed): for a band whose distortion is within bounds except for pockets; up to
 // 10 x area_correction_iterations steps there while faces x steps <= 1e7, each vertex-connected
-// piece on its own (`iterations`: the most steps any piece took).
+// piece on its own (`iterations`: the most steps any piece took); with `grow`, a piece that leaves
+// over half of its hidden wall hidden and holds faces crushed below ratio 1e-4 has them (with 2
+// rings) corrected on their own and runs again (a crushed spot bounds every step of the piece:
+// docs/flatten.md, session 21).
 // `grow` (local): a piece whose region has no room (2D area < 0.6 x 3D) grows by 12 rings more, up
 // to 3 times (the second local pass, for pockets the first one could not open).
 // `enough` (whole band only, optional): asked after each step; true ends the pass (its goal met).

@@ -90,14 +90,15 @@ TEST(FlattenBranches, CrushedTissueStrandIsABandOfItsOwn) {
   EXPECT_GE(f.coverage.fraction, 0.995);
 }
 
-// The same strand kept on the colon band (--branch-min-area 0): its faces are left out of the map,
-// and the stage's segment line says how many and how many of them fold over ("flipped" counts only
-// faces in the map), as the flat file's segment fields do.
+// The same strand kept on the colon band (--branch-min-area 0) and no area correction (which moves
+// the strand's crushed tip back into the map, area_correct_test.cpp): its faces are left out of the
+// map, and the stage's segment line says how many and how many of them fold over ("flipped" counts
+// only faces in the map), as the flat file's segment fields do.
 TEST(FlattenBranches, StrandLeftOnTheBandIsCountedLeftOut) {
   testing::TempDir tmp;
   write_mesh(synthetic::to_mesh(test_shapes::tube_and_strand(40.0)), tmp / "in.vtp");
-  const auto r = testing::run_stage_command(
-      make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area", "0"});
+  const auto r = testing::run_stage_command(make_flatten_stage, {tmp.str("in.vtp"), "-o", tmp.str("flat.vtp"), "--branch-min-area",
+                                                                 "0", "--area-correction-iterations", "0"});
   ASSERT_EQ(r.code, 0) << r.err;
   const FlatMap g = read_flat(tmp / "flat.vtp");
   ASSERT_EQ(g.segments.size(), 1u);

@@ -1,5 +1,5 @@
 #pragma once
-// A flat 24 x 12 grid (z = 0, 1 mm spacing) whose map squeezes the middle 8 columns to `squeeze` of
+// A flat 24 x 12 grid (z = 0, 1 mm spacing; or k times as many vertices each way) whose map squeezes the middle 8 (8 k) columns to `squeeze` of
 // their width, its ends and rims fixed: a tiny band for the area correction and balancing tests.
 #include <algorithm>
 
@@ -9,23 +9,26 @@ namespace cf::test_shapes {
 
 struct SqueezedGrid {
   static constexpr int kNx = 24, kNy = 12;
+  int nx = kNx, ny = kNy;  // vertices along x and y
   flat_detail::Surface s;
   flat_detail::Embedding emb;
   std::vector<char> fixed, degenerate;
   std::vector<std::vector<int>> vf;
-  explicit SqueezedGrid(double squeeze = 0.2) {
-    for (int j = 0; j < kNy; ++j)
-      for (int i = 0; i < kNx; ++i) {
+  // `size`: the grid is size x (24 x 12) vertices, its columns [8, 16) x size squeezed.
+  explicit SqueezedGrid(double squeeze = 0.2, int size = 1) : nx(kNx * size), ny(kNy * size) {
+    const int a = 8 * size, b = 16 * size;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
         s.p.push_back(flat_detail::V3(i, j, 0));
-        const double x = i < 8 ? i : i < 16 ? 8 + squeeze * (i - 8) : 8 + 8 * squeeze + (i - 16);
+        const double x = i < a ? i : i < b ? a + squeeze * (i - a) : a + (b - a) * squeeze + (i - b);
         emb.pos.push_back(flat_detail::V2(x, j));
-        fixed.push_back(i == 0 || j == 0 || i == kNx - 1 || j == kNy - 1);
+        fixed.push_back(i == 0 || j == 0 || i == nx - 1 || j == ny - 1);
       }
-    for (int j = 0; j + 1 < kNy; ++j)
-      for (int i = 0; i + 1 < kNx; ++i) {
-        const int a = j * kNx + i;
-        s.t.push_back({a, a + 1, a + kNx + 1});
-        s.t.push_back({a, a + kNx + 1, a + kNx});
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        const int v = j * nx + i;
+        s.t.push_back({v, v + 1, v + nx + 1});
+        s.t.push_back({v, v + nx + 1, v + nx});
       }
     emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
     emb.period = 1000;
