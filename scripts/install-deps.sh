@@ -11,6 +11,7 @@ BUILD_PKGS=(
   libinsighttoolkit5-dev # volume I/O (DICOM/GDCM, NRRD, NIfTI, MHA), filters
   libeigen3-dev          # sparse linear algebra (flattening)
   libsuitesparse-dev     # CHOLMOD supernodal Cholesky through Eigen (flattening; optional, faster)
+  libmetis-dev           # METIS nested dissection order called directly, cheaper options (flattening; optional)
   libopenmesh-dev        # halfedge mesh + OFF/OBJ/PLY/STL I/O
   libgtest-dev libgmock-dev
   libbenchmark-dev
@@ -32,7 +33,7 @@ BUILD_PKGS=(
 # it loads comes with these packages' dependencies). libgl1-mesa-dri: the software OpenGL driver
 # that Xvfb-based 3D snapshots use (ldd cannot see it: it is loaded at run time).
 RUNTIME_PKGS=(
-  libvtk9.1 libinsighttoolkit5.2 libopenmesh1 libcholmod3 libdcmtk17 libgl1-mesa-dri xvfb xauth
+  libvtk9.1 libinsighttoolkit5.2 libopenmesh1 libcholmod3 libmetis5 libdcmtk17 libgl1-mesa-dri xvfb xauth
 )
 
 SUDO=""

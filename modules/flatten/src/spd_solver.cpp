@@ -17,6 +17,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "factor_schedule.h"
+#include "metis_order.h"
 
 namespace cf::flat_detail {
 
@@ -294,8 +295,11 @@ std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
   return order.empty() ? Fallback::eigen_amd(A) : order;
 }
 
+std::vector<int> SpdSolver::one_call_dissection_order(const SpMat& A) { return cholmod_order(A, true); }
+
 std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) {
-  std::vector<int> order = cholmod_order(A, true);
+  std::vector<int> order = metis_split_dissection_order(A);
+  if (order.empty()) order = cholmod_order(A, true);
   return order.empty() ? fill_reducing_order(A) : order;
 }
 
@@ -445,6 +449,8 @@ std::vector<int> SpdSolver::order() const {
 std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) { return Fallback::eigen_amd(A); }
 
 std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) { return Fallback::eigen_amd(A); }
+
+std::vector<int> SpdSolver::one_call_dissection_order(const SpMat&) { return {}; }
 
 void SpdSolver::release() {}
 

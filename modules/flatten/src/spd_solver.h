@@ -48,8 +48,13 @@ class SpdSolver {
   static std::vector<int> fill_reducing_order(const SpMat& A);
   // Nested dissection's (METIS, through CHOLMOD) elimination order of A (as above): on a colon band
   // about half the factorisation's operations of AMD's order, for about 5 x AMD's ordering time
-  // (docs/flatten.md, "Speed", session 13). AMD's order when CHOLMOD or METIS is not there.
+  // (docs/flatten.md, "Speed", session 13). Split at METIS's top vertex separator, its two sides
+  // ordered on two threads (metis_order.h) when libmetis-dev is there, else cholmod_metis's one
+  // call; AMD's order when CHOLMOD or METIS is not there.
   static std::vector<int> nested_dissection_order(const SpMat& A);
+  // cholmod_metis's one-call METIS order of A (METIS's defaults, postordered; what
+  // nested_dissection_order was before the split); empty without CHOLMOD or when it fails.
+  static std::vector<int> one_call_dissection_order(const SpMat& A);
   // Symbolic analysis of A (lower triangle read). `order` (optional): the elimination order, a
   // permutation of 0..n-1 used as given (not postordered); AMD (CHOLMOD's default) when null.
   void analyze(const SpMat& A, const std::vector<int>* order = nullptr);
