@@ -4,26 +4,27 @@
 // between the centres of the lumen voxel and the background voxel it separates (< 1/2 voxel from
 // the raw staircase surface).
 #include <itkAntiAliasBinaryImageFilter.h>
-#include <itkBinaryDilateImageFilter.h>
-#include <itkFlatStructuringElement.h>
 #include <itkImage.h>
 #include <vtkNew.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
+#include "colonflat/core/box_dilation.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 #include "reconstruct_internal.h"
 
 namespace cf::reconstruct_detail {
 namespace {
 
 using FloatImage = itk::Image<float, 3>;
-using LabelImage = itk::Image<unsigned char, 3>;
 
 // Index-space dimensions of a VTK image as size_t.
 std::array<std::size_t, 3> dims_of(vtkImageData* img) {
@@ -75,23 +76,17 @@ void antialias_field(const FloatImage::Pointer& binary, const ReconstructOptions
   for (std::size_t i = 0; i < count; ++i) out[i] = 0.5f + sign * phi[i];
 }
 
-// The CT's air/tissue field over the padded crop: 0.5 at air_tissue_hu, 1 at 500 HU below it
-// (air), 0 at 500 HU above it (soft tissue); NaN marks tagged fluid (lumen voxels at or above
-// fluid_hu) and their neighbourhood (2 voxels), where the mask field is used instead.
-std::size_t ct_field(vtkImageData* binary, const CtImage* ct, const Box& box, const ReconstructOptions& o, float* out) {
-  const auto n = dims_of(binary);
+// The CT's air/tissue value of the padded crop's slices [k0, k1): 0.5 at air_tissue_hu, 1 at 500 HU
+// below it (air), 0 at 500 HU above it (soft tissue); marks in `fl` the lumen voxels at or above
+// fluid_hu (tagged fluid) and returns their count. Slices are independent (parallel_for chunks).
+std::size_t ct_slices(const unsigned char* lumen, const CtImage* ct, const Box& box, const ReconstructOptions& o,
+                      const std::array<std::size_t, 3>& n, std::size_t k0, std::size_t k1, float* out,
+                      unsigned char* fl) {
   const auto ct_size = ct->GetBufferedRegion().GetSize();
   const long lo[3] = {long(box.lo[0]) - 1, long(box.lo[1]) - 1, long(box.lo[2]) - 1};  // padded crop origin
   const float* hu = ct->GetBufferPointer();
-  const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
-  auto fluid = LabelImage::New();
-  LabelImage::RegionType region;
-  for (int a = 0; a < 3; ++a) region.SetSize(a, n[a]);
-  fluid->SetRegions(region);
-  fluid->Allocate(true);
-  unsigned char* fl = fluid->GetBufferPointer();
-  std::size_t fluid_voxels = 0, idx = 0;
-  for (std::size_t k = 0; k < n[2]; ++k)
+  std::size_t fluid_voxels = 0, idx = k0 * n[1] * n[0];
+  for (std::size_t k = k0; k < k1; ++k)
     for (std::size_t j = 0; j < n[1]; ++j)
       for (std::size_t i = 0; i < n[0]; ++i, ++idx) {
         const long g[3] = {lo[0] + long(i), lo[1] + long(j), lo[2] + long(k)};
@@ -102,20 +97,77 @@ std::size_t ct_field(vtkImageData* binary, const CtImage* ct, const Box& box, co
         out[idx] = float(0.5 + (o.air_tissue_hu - double(v)) / 1000.0);
         if (lumen[idx] && double(v) >= o.fluid_hu) fl[idx] = 1, ++fluid_voxels;
       }
-  if (!fluid_voxels) return 0;
-  using Element = itk::FlatStructuringElement<3>;
-  Element::RadiusType radius;
-  radius.Fill(2);
-  using Dilate = itk::BinaryDilateImageFilter<LabelImage, LabelImage, Element>;
-  auto dilate = Dilate::New();
-  dilate->SetInput(fluid);
-  dilate->SetKernel(Element::Box(radius));
-  dilate->SetForegroundValue(1);
-  dilate->Update();
-  const unsigned char* near_fluid = dilate->GetOutput()->GetBufferPointer();
-  for (std::size_t i = 0; i < n[0] * n[1] * n[2]; ++i)
-    if (near_fluid[i]) out[i] = std::numeric_limits<float>::quiet_NaN();
   return fluid_voxels;
+}
+
+// Calls body(begin, end) on chunks of whole slices of an n-voxel image (parallel_for over the
+// slices): every voxel is computed the same way whoever computes it; per-chunk counts are summed.
+std::size_t for_slices(const std::array<std::size_t, 3>& n,
+                       const std::function<std::size_t(std::size_t k0, std::size_t k1)>& body) {
+  std::vector<std::size_t> counts(n[2], 0);  // by a chunk's first slice: chunks never share one
+  parallel_for(n[2], [&](std::size_t k0, std::size_t k1) { counts[k0] = body(k0, k1); });
+  std::size_t total = 0;
+  for (std::size_t c : counts) total += c;
+  return total;
+}
+
+// The CT field over the padded crop (ct_slices); NaN marks tagged fluid and its neighbourhood
+// (2 voxels), where the mask field is used instead. Returns the fluid voxel count.
+std::size_t ct_field(vtkImageData* binary, const CtImage* ct, const Box& box, const ReconstructOptions& o, float* out) {
+  const auto n = dims_of(binary);
+  const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
+  std::vector<unsigned char> fluid(n[0] * n[1] * n[2], 0);
+  const std::unique_ptr<unsigned char[]> scratch(new unsigned char[fluid.size()]);  // dilate_box's, no fill
+  unsigned char* fl = fluid.data();
+  const std::size_t fluid_voxels = for_slices(
+      n, [&](std::size_t k0, std::size_t k1) { return ct_slices(lumen, ct, box, o, n, k0, k1, out, fl); });
+  if (!fluid_voxels) return 0;
+  const int radius[3] = {2, 2, 2};  // the 5 x 5 x 5 box around each fluid voxel
+  const unsigned char* near_fluid = dilate_box(fl, scratch.get(), n, radius);
+  const std::size_t slice = n[0] * n[1];
+  for_slices(n, [&](std::size_t k0, std::size_t k1) {
+    for (std::size_t i = k0 * slice; i < k1 * slice; ++i)
+      if (near_fluid[i]) out[i] = std::numeric_limits<float>::quiet_NaN();
+    return std::size_t(0);
+  });
+  return fluid_voxels;
+}
+
+// The mask's own field where the CT is not used (everywhere without a CT, at the NaN voxels with
+// one): Whitaker's, or the binary values (the staircase, smoothed on the mesh afterwards).
+void mask_field(vtkImageData* binary, const std::array<double, 3>& spacing, const ReconstructOptions& o, bool use_ct,
+                float* out) {
+  const auto n = dims_of(binary);
+  const auto* b = static_cast<const unsigned char*>(binary->GetScalarPointer());
+  std::vector<float> smoothed;
+  if (o.mask_smoothing == "antialias") {
+    smoothed.resize(n[0] * n[1] * n[2]);
+    antialias_field(to_itk_float(binary, spacing), o, smoothed.data());
+  }
+  const std::size_t slice = n[0] * n[1];
+  for_slices(n, [&](std::size_t k0, std::size_t k1) {
+    for (std::size_t i = k0 * slice; i < k1 * slice; ++i)
+      if (!use_ct || std::isnan(out[i])) out[i] = smoothed.empty() ? float(b[i]) : smoothed[i];
+    return std::size_t(0);
+  });
+}
+
+// The constraint: each voxel on its side of 0.5, at least kFieldMargin from it. Returns the lumen
+// voxels the field put outside (clamped).
+std::size_t constrain(vtkImageData* binary, float* out) {
+  const auto n = dims_of(binary);
+  const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
+  const std::size_t slice = n[0] * n[1];
+  return for_slices(n, [&](std::size_t k0, std::size_t k1) {
+    std::size_t clamped = 0;
+    for (std::size_t i = k0 * slice; i < k1 * slice; ++i) {
+      const float v = out[i];
+      const float bounded = lumen[i] ? std::max(v, 0.5f + kFieldMargin) : std::min(v, 0.5f - kFieldMargin);
+      clamped += lumen[i] && bounded != v;
+      out[i] = bounded;
+    }
+    return clamped;
+  });
 }
 
 }  // namespace
@@ -124,8 +176,6 @@ vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtImage
                                              const std::array<double, 3>& spacing, const ReconstructOptions& o,
                                              ReconstructStats& st) {
   Stopwatch watch;
-  const auto n = dims_of(binary);
-  const std::size_t count = n[0] * n[1] * n[2];
   auto field = vtkSmartPointer<vtkImageData>::New();
   field->SetDimensions(binary->GetDimensions());
   field->SetOrigin(binary->GetOrigin());
@@ -140,27 +190,10 @@ vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtImage
   if (!use_ct || st.fluid_voxels) {
     // The mask's own field where the CT is not used: Whitaker's, or the binary values (the
     // staircase, smoothed on the mesh afterwards).
-    std::vector<float> mask_values(count);
-    if (o.mask_smoothing == "antialias") {
-      antialias_field(to_itk_float(binary, spacing), o, mask_values.data());
-    } else {
-      const auto* b = static_cast<const unsigned char*>(binary->GetScalarPointer());
-      for (std::size_t i = 0; i < count; ++i) mask_values[i] = float(b[i]);
-    }
+    mask_field(binary, spacing, o, use_ct, out);
     if (!use_ct) st.field_source = "mask (" + o.mask_smoothing + ")";
-    for (std::size_t i = 0; i < count; ++i)
-      if (!use_ct || std::isnan(out[i])) out[i] = mask_values[i];
   }
-  // The constraint: each voxel on its side of 0.5, at least kFieldMargin from it.
-  const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
-  std::size_t clamped = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    const float v = out[i];
-    const float bounded = lumen[i] ? std::max(v, 0.5f + kFieldMargin) : std::min(v, 0.5f - kFieldMargin);
-    clamped += lumen[i] && bounded != v;  // lumen voxels the field put outside
-    out[i] = bounded;
-  }
-  st.field_clamped_voxels = clamped;
+  st.field_clamped_voxels = constrain(binary, out);
   st.time_field_s = watch.seconds();
   return field;
 }
