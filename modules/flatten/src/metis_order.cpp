@@ -3,6 +3,8 @@
 // (see metis_order.h).
 #include "metis_order.h"
 
+#include "spd_solver.h"
+
 #include "colonflat/core/threads.h"
 
 #include <cstdlib>
@@ -151,18 +153,7 @@ bool postorder(const MetisSpMat& A, std::vector<int>& order) {
   cholmod_common common;
   cholmod_start(&common);
   common.print = 0;
-  cholmod_sparse view{};
-  view.nrow = view.ncol = n;
-  view.nzmax = std::size_t(A.nonZeros());
-  view.p = const_cast<int*>(A.outerIndexPtr());
-  view.i = const_cast<int*>(A.innerIndexPtr());
-  view.x = const_cast<double*>(A.valuePtr());
-  view.stype = -1;  // lower triangle
-  view.itype = CHOLMOD_INT;
-  view.xtype = CHOLMOD_REAL;
-  view.dtype = CHOLMOD_DOUBLE;
-  view.sorted = 1;
-  view.packed = 1;
+  cholmod_sparse view = view_lower(A);
   std::vector<int> parent(n), post(n);
   const bool ok = cholmod_analyze_ordering(&view, CHOLMOD_GIVEN, order.data(), nullptr, 0, parent.data(), post.data(),
                                            nullptr, nullptr, nullptr, &common) &&

@@ -35,9 +35,9 @@ SplitOrder metis_split_order(const MetisSpMat& A);
 // empty when METIS or CHOLMOD is missing or fails.
 std::vector<int> metis_split_dissection_order(const MetisSpMat& A);
 
-// How many times rand() has been answered by this library's per-thread generator (all threads):
-// non-zero after a METIS call proves libmetis's rand() calls reach it and not the C library's
-// one shared state.
+// How many times rand() has been answered by this library's generator on the calling thread:
+// non-zero after a METIS call on this thread proves libmetis's rand() calls reach it and not the C
+// library's one shared state.
 std::uint64_t metis_rand_calls();
 
 }  // namespace cf::flat_detail

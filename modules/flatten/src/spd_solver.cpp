@@ -70,6 +70,22 @@ Eigen::MatrixXd SpdSolver::solve_leading(const Eigen::MatrixXd& b, int leading) 
 }
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
+cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
+  cholmod_sparse m{};
+  m.nrow = m.ncol = std::size_t(A.rows());
+  m.nzmax = std::size_t(A.nonZeros());
+  m.p = const_cast<int*>(A.outerIndexPtr());
+  m.i = const_cast<int*>(A.innerIndexPtr());
+  m.x = const_cast<double*>(A.valuePtr());
+  m.stype = -1;  // symmetric, lower triangle used
+  m.itype = CHOLMOD_INT;
+  m.xtype = CHOLMOD_REAL;
+  m.dtype = CHOLMOD_DOUBLE;
+  m.sorted = 1;
+  m.packed = 1;
+  return m;
+}
+
 namespace {
 
 // CHOLMOD's large blocks (a colon's factor: about 300 MB) on transparent huge pages where the
@@ -98,23 +114,6 @@ void use_huge_pages_for_cholmod() {
     SuiteSparse_config.realloc_func = huge_realloc;
     SuiteSparse_config.free_func = std::free;
   });
-}
-
-// A read-only CHOLMOD view of the lower triangle of a compressed Eigen matrix.
-cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
-  cholmod_sparse m{};
-  m.nrow = m.ncol = std::size_t(A.rows());
-  m.nzmax = std::size_t(A.nonZeros());
-  m.p = const_cast<int*>(A.outerIndexPtr());
-  m.i = const_cast<int*>(A.innerIndexPtr());
-  m.x = const_cast<double*>(A.valuePtr());
-  m.stype = -1;  // symmetric, lower triangle used
-  m.itype = CHOLMOD_INT;
-  m.xtype = CHOLMOD_REAL;
-  m.dtype = CHOLMOD_DOUBLE;
-  m.sorted = 1;
-  m.packed = 1;
-  return m;
 }
 
 // A CHOLMOD view of a column-major Eigen matrix.

@@ -110,4 +110,10 @@ class SpdSolver {
   std::unique_ptr<Fallback> fallback_;
 };
 
+#ifdef COLONFLAT_HAVE_CHOLMOD
+// A read-only CHOLMOD view of the lower triangle of a compressed A (stype -1, no copy: valid while
+// A lives and is not changed).
+cholmod_sparse view_lower(const SpdSolver::SpMat& A);
+#endif
+
 }  // namespace cf::flat_detail
