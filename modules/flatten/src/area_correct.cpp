@@ -113,6 +113,33 @@ void hold_crushed(const Surface& s, const Embedding& emb, const std::vector<doub
               faces.end());
 }
 
+// Grows a face set by `rings` vertex rings. `ring` holds the set's newest faces; each step adds the
+// faces that share a vertex with the previous step's and that `take(g)` accepts (take marks g as
+// in the set). On return `ring` holds the last step's faces; `added` (optional) gets every added
+// face in the order added.
+template <class Take>
+void grow_face_rings(const Surface& s, const std::vector<std::vector<int>>& vf, int rings, std::vector<int>& ring,
+                     Take&& take, std::vector<int>* added = nullptr) {
+  for (int k = 0; k < rings; ++k) {
+    std::vector<int> next;
+    for (int f : ring)
+      for (int v : s.t[f])
+        for (int g : vf[v])
+          if (take(g)) next.push_back(g);
+    if (added) added->insert(added->end(), next.begin(), next.end());
+    ring.swap(next);
+  }
+}
+
+// A region's rim stays: a free vertex with a face outside the region (`inside(g)` false) is fixed.
+template <class Inside>
+void fix_region_rim(const std::vector<std::vector<int>>& vf, Inside&& inside, std::vector<char>& free_vertex) {
+  for (std::size_t v = 0; v < free_vertex.size(); ++v)
+    if (free_vertex[v])
+      for (int g : vf[v])
+        if (!inside(g)) free_vertex[v] = 0;
+}
+
 // The local region: the pockets not shown (area ratio at `scale` below coverage_min_ratio) grown
 // by kLocalRings vertex rings; a piece of it whose 2D area is still below kLocalRoom x its 3D area
 // (a pouch left in the band, a wide stretch the conformal map shrank: the rings around it cannot
@@ -128,14 +155,11 @@ std::vector<char> local_region(const Surface& s, const std::vector<std::vector<i
   for (std::size_t f = 0; f < s.t.size(); ++f)
     if (scale * emb.area2(s, int(f)) < min_ratio * std::max(area3[f], 1e-300)) in[f] = 1, ring.push_back(int(f));
   for (int growth = 0;; ++growth) {
-    for (int k = 0; k < kLocalRings; ++k) {
-      std::vector<int> next;
-      for (int f : ring)
-        for (int v : s.t[f])
-          for (int g : vf[v])
-            if (!in[g]) in[g] = 1, next.push_back(g);
-      ring.swap(next);
-    }
+    grow_face_rings(s, vf, kLocalRings, ring, [&](int g) {
+      if (in[g]) return false;
+      in[g] = 1;
+      return true;
+    });
     if (growth == growths || ring.empty()) return in;
     UnionFind sets(s.p.size());  // pieces of the region and their 2D / 3D areas
     for (std::size_t f = 0; f < s.t.size(); ++f)
@@ -172,11 +196,7 @@ std::vector<int> correction_faces(const Surface& s, const std::vector<std::vecto
       faces.push_back(int(f));
       for (int v : s.t[f]) free_vertex[v] = !fixed[v];
     }
-  if (local)  // the region's rim stays
-    for (std::size_t v = 0; v < s.p.size(); ++v)
-      if (free_vertex[v])
-        for (int g : vf[v])
-          if (!in[g]) free_vertex[v] = 0;
+  if (local) fix_region_rim(vf, [&](int g) { return in[g] != 0; }, free_vertex);
   if (!local) hold_crushed(s, emb, area3, scale, o.coverage_min_ratio, free_vertex, faces);
   return faces;
 }
@@ -300,24 +320,17 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
   for (int f : piece) mark[f] = 1;
   for (int f : ring) mark[f] = 2;
   std::vector<int> faces = ring;
-  for (int k = 0; k < kSpotRings; ++k) {
-    std::vector<int> next;
-    for (int f : ring)
-      for (int v : s.t[f])
-        for (int g : vf[v])
-          if (mark[g] == 1) mark[g] = 2, next.push_back(g);
-    faces.insert(faces.end(), next.begin(), next.end());
-    ring.swap(next);
-  }
+  const auto take = [&](int g) {
+    if (mark[g] != 1) return false;
+    mark[g] = 2;
+    return true;
+  };
+  grow_face_rings(s, vf, kSpotRings, ring, take, &faces);
   std::sort(faces.begin(), faces.end());
   std::vector<char> spot_free(s.p.size(), 0);  // the piece's free vertices inside the spot regions
   for (int f : faces)
     for (int v : s.t[f]) spot_free[v] = free_vertex[v];
-  for (int f : faces)
-    for (int v : s.t[f])
-      if (spot_free[v])
-        for (int g : vf[v])
-          if (mark[g] != 2) spot_free[v] = 0;
+  fix_region_rim(vf, [&](int g) { return mark[g] == 2; }, spot_free);
   work.faces = faces.size();
   for (std::vector<int>& spot : connected_pieces(s, faces)) {
     AreaCorrection res;
