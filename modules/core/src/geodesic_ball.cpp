@@ -1,5 +1,7 @@
 #include "colonflat/core/geodesic_ball.h"
 
+#include "colonflat/core/vertex_stamps.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <functional>
@@ -15,23 +17,16 @@ namespace {
 // 1.4 s of CPU in one denoise of a 2.1 M-face surface: the far-first balls and the bounds lowered
 // near each surgery, about a hundred calls of up to the whole surface).
 struct BallScratch {
+  VertexStamps stamps;
   std::vector<double> dist;
-  std::vector<std::uint32_t> stamp;
-  std::uint32_t current = 0;
 
   void start(std::size_t vertices) {
-    if (stamp.size() < vertices) {  // with room for the vertices a few surgeries add: no regrowth per call
-      stamp.resize(vertices + vertices / 8, 0);
-      dist.resize(stamp.size(), 0.0);
-    }
-    if (++current == 0) {  // wrapped: no old stamp may equal a new one
-      std::fill(stamp.begin(), stamp.end(), 0);
-      current = 1;
-    }
+    stamps.start(vertices);
+    dist.resize(stamps.size(), 0.0);
   }
-  bool labelled(int v) const { return stamp[v] == current; }
+  bool labelled(int v) const { return stamps.marked(v); }
   void label(int v, double d) {
-    stamp[v] = current;
+    stamps.mark(v);
     dist[v] = d;
   }
 };

@@ -9,6 +9,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/vertex_stamps.h"
 #include "denoise_debug.h"
 #include "surgery_steps.h"
 
@@ -192,18 +193,18 @@ namespace {
 // touches only the vertices it reaches (a hash map of them cost about 0.4 s of CPU over the 93
 // cuts of the real CT surface, issue 26).
 struct SideMarks {
-  std::vector<std::uint32_t> stamp;  // (call << 1) | side, side 0: reached from a, 1: from b
-  std::uint32_t call = 0;
+  VertexStamps stamps;
+  std::vector<std::uint8_t> sides;  // 0: reached from a, 1: from b (valid where stamped)
 
   void start(std::size_t vertices) {
-    if (stamp.size() < vertices) stamp.resize(vertices + vertices / 8, 0);  // room for what surgery adds
-    if (++call >= 0x7fffffffu) {  // about to wrap: no old stamp may match a new call
-      std::fill(stamp.begin(), stamp.end(), 0);
-      call = 1;
-    }
+    stamps.start(vertices);
+    sides.resize(stamps.size(), 0);
   }
-  int side(int v) const { return stamp[v] >> 1 == call ? static_cast<int>(stamp[v] & 1u) : -1; }
-  void mark(int v, int side) { stamp[v] = call << 1 | static_cast<std::uint32_t>(side); }
+  int side(int v) const { return stamps.marked(v) ? sides[std::size_t(v)] : -1; }
+  void mark(int v, int side) {
+    stamps.mark(v);
+    sides[std::size_t(v)] = static_cast<std::uint8_t>(side);
+  }
 };
 
 }  // namespace
