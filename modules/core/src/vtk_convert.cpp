@@ -79,7 +79,8 @@ void tag_polydata_space(vtkPolyData* pd, const std::string& units, const std::st
 
 void use_fast_compression(vtkXMLWriter* writer) {
   writer->SetDataModeToAppended();
-  writer->SetCompressorTypeToZLib();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToLZ4();
   writer->SetCompressionLevel(1);
 }
 

@@ -8,7 +8,7 @@
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
-#include <vtkZLibDataCompressor.h>
+#include <vtkLZ4DataCompressor.h>
 
 #include <filesystem>
 #include <fstream>
@@ -88,21 +88,29 @@ TEST_F(MeshIo, VtpRecordsUnitsAndSpace) {
   EXPECT_EQ(space->GetValue(0), "LPS");
 }
 
-// Every .vtp is appended binary, deflated at zlib level 1 (use_fast_compression), and a written
-// mesh file says so in its header.
-TEST_F(MeshIo, VtpIsAppendedZlibLevelOne) {
+// Every .vtp is appended raw binary in LZ4 blocks (use_fast_compression), a written mesh file says
+// so in its header, and it reads back with the same points and triangles.
+TEST_F(MeshIo, VtpIsAppendedRawLz4) {
   vtkNew<vtkXMLPolyDataWriter> w;
   use_fast_compression(w);
   EXPECT_EQ(w->GetDataMode(), vtkXMLWriter::Appended);
-  EXPECT_NE(vtkZLibDataCompressor::SafeDownCast(w->GetCompressor()), nullptr);
-  EXPECT_EQ(w->GetCompressionLevel(), 1);
-  EXPECT_EQ(w->GetCompressor()->GetCompressionLevel(), 1);
-  write_mesh(synthetic::to_mesh(synthetic::sphere(1, 8, 4)), file("s.vtp"));
+  EXPECT_FALSE(w->GetEncodeAppendedData());
+  EXPECT_NE(vtkLZ4DataCompressor::SafeDownCast(w->GetCompressor()), nullptr);
+  const Mesh m = synthetic::to_mesh(synthetic::sphere(1, 8, 4));
+  write_mesh(m, file("s.vtp"));
   std::ifstream in(file("s.vtp"));
-  std::string header;
-  while (std::getline(in, header) && header.find("<VTKFile") == std::string::npos) {
-  }
-  EXPECT_NE(header.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos) << header;
+  std::string line, text;
+  while (std::getline(in, line) && line.find("<AppendedData") == std::string::npos) text += line + "\n";
+  EXPECT_NE(text.find("compressor=\"vtkLZ4DataCompressor\""), std::string::npos) << text;
+  EXPECT_NE(line.find("encoding=\"raw\""), std::string::npos) << line;
+  vtkNew<vtkXMLPolyDataReader> r;
+  r->SetFileName(file("s.vtp").c_str());
+  r->Update();
+  vtkPolyData* back = r->GetOutput();
+  ASSERT_EQ(back->GetNumberOfPoints(), vtkIdType(m.n_vertices()));
+  ASSERT_EQ(back->GetNumberOfPolys(), vtkIdType(m.n_faces()));
+  for (const auto v : m.vertices())
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(back->GetPoint(v.idx())[k], m.point(v)[k]) << v.idx();
 }
 
 // A missing file is an InputError that names the file.
