@@ -294,6 +294,22 @@ double area_below(const Surface& s, const Embedding& emb, const std::vector<doub
   return a;
 }
 
+// The second (grown) local pass works only on the pieces that still hide wall: a piece whose wall
+// shown below `min_ratio` (coverage_min_ratio) is at most kHiddenWallTolerance of its 3D wall is
+// dropped. The pass runs because the band hides more than that fraction; the pieces dropped hide at
+// most that fraction of their wall together, so they are not why, and their descent would only move
+// area ratios of wall already shown, which the balancing after the local passes bounds (real CT
+// colon band: 8 of the pass's 9 pieces hid 0.1-3.3 mm2 each and took 57 % of its summed time).
+void keep_pieces_hiding_wall(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
+                             double min_ratio, std::vector<std::vector<int>>& pieces) {
+  const auto shown = [&](const std::vector<int>& piece) {
+    double wall = 0;
+    for (int f : piece) wall += area3[f];
+    return !(area_below(s, emb, area3, scale, piece, min_ratio) > kHiddenWallTolerance * wall);
+  };
+  pieces.erase(std::remove_if(pieces.begin(), pieces.end(), shown), pieces.end());
+}
+
 // A crushed spot of a local piece (issue 26, docs/flatten.md session 21): its faces at area ratio
 // below kSpotRatio (at the band's scale; positive: folds are not judged), grown by kSpotRings vertex
 // rings within the piece, corrected as a piece of its own. Such faces can bound every fold-free
@@ -439,6 +455,11 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   // The pieces side by side: each reads and moves only its own vertices (pieces share none), and
   // their results are combined in piece order, so the map is the same for any thread count.
   std::vector<std::vector<int>> pieces = connected_pieces(s, faces);
+  if (grow) {
+    keep_pieces_hiding_wall(s, emb, area3, scale, o.coverage_min_ratio, pieces);
+    res.faces = 0;
+    for (const std::vector<int>& p : pieces) res.faces += p.size();
+  }
   std::vector<AreaCorrection> part(pieces.size());
   std::vector<SpotWork> spots(pieces.size());
   std::vector<CorrectionTimes> part_times(times ? pieces.size() : 0);

@@ -195,7 +195,7 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
   const BoundStats st = bound_stats_in_map(fd);
   const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
   const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
-  return {area || qc_mean > kWholeBandQcMean, hidden > 0.0025 * a3, area, qc_mean};
+  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean};
 }
 
 // When the whole-band pass has done its job, asked after each of its steps (the trigger's own
