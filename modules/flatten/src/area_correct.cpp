@@ -271,6 +271,7 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
                                    scale);
   RegionSystem sys;
   if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return;
+  if (!local) debug_clock("whole-band system built");
   const double build_s = clock.lap();
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   StepTimes* step_times = times ? &times->steps : nullptr;

@@ -5,10 +5,12 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <mutex>
 
 #include <unordered_map>
 
 #include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/union_find.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
@@ -50,6 +52,30 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
   for (const FaceDistortion& d : fd) crowded += !d.degenerate && too_small_in_map(d.area2, d.area3);
   std::fprintf(stderr, "flatten debug %s: crowded %zu, flipped %zu qc mean %.3f p95 %.3f max %.3g area p05 %.4f p50 %.3f p95 %.3f\n",
                step, crowded, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
+}
+
+namespace {
+thread_local bool clock_thread = false;
+}
+
+void debug_clock_start() {
+  clock_thread = true;
+  debug_clock("segment start");
+}
+
+void debug_clock(const char* what) {
+  if (!clock_thread || !std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  static std::mutex m;
+  static const Stopwatch since_start;
+  static const double cpu_start = process_cpu_seconds();
+  static double last_wall = 0, last_cpu = 0;
+  const std::lock_guard<std::mutex> lock(m);
+  const double wall = since_start.seconds(), cpu = process_cpu_seconds() - cpu_start;
+  const double dw = wall - last_wall, dc = cpu - last_cpu;
+  std::fprintf(stderr, "flatten debug clock %s: wall %.2f s (+%.2f), process CPU %.2f s (+%.2f), cores busy %.2f, "
+               "idle core-s %.2f of %d\n", what, wall, dw, cpu, dc, dw > 0 ? dc / dw : 0.0,
+               std::max(0.0, thread_count() * dw - dc), thread_count());
+  last_wall = wall, last_cpu = cpu;
 }
 
 // COLONFLAT_FLATTEN_DEBUG=1: the faces shown below 0.1 (at the band's area scale) by decade of
@@ -275,25 +301,33 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   emb.period = period;
   w.seg.length = band;
   w.seg.period = period;
+  if (!branch) debug_clock("axis chosen, band reparametrised");
   w.seg.untangled_vertices += untangle(w.ann, vf, emb, fixed, degenerate);
+  if (!branch) debug_clock("untangled");
   debug_stats("reparametrised", w, degenerate);
   debug_pockets("reparametrised", w, degenerate, fixed);
   CorrectionNeed need = needs_correction(w, degenerate, o);
+  if (!branch) debug_clock("debug stats, correction need");
   const std::vector<int> order = w.band_order();  // a large band's nested dissection order, for its systems
   const std::vector<int>* band_order = order.empty() ? nullptr : &order;
   if (need.global) {
     w.seg.corrected_iterations =
         correct_pass(w, vf, fixed, degenerate, o, false, false, whole_band_done(w, degenerate, o), band_order);
+    if (!branch) debug_clock("whole-band pass");
     need.local = needs_correction(w, degenerate, o).local;
+    if (!branch) debug_clock("correction need after the whole band");
   }
   for (bool grow : {false, true}) {  // pockets; then, grown until they have room, those left
     if (!need.local) break;
     w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, fixed, degenerate, o, true, grow));
+    if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
     need.local = !grow && needs_correction(w, degenerate, o).local;
+    if (!branch && !grow) debug_clock("correction need after local pass 1");
   }
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;
+  if (!branch) debug_clock("balance");
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug balance: %zu faces, %zu iterations, %zu systems factorised, %.2f s\n", bal.faces,
                  bal.iterations, bal.systems_built, sw.seconds());

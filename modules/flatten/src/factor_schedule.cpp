@@ -2,6 +2,8 @@
 #include "factor_schedule.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -208,6 +210,24 @@ std::vector<RowSchedule> schedule_phases(const std::vector<int>& parent, const s
     phases.push_back(std::move(next));
   }
   return phases;
+}
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
+                        double rest_cpu, double seconds, bool early) {
+  double largest = 0, longest = 0;
+  for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
+  for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
+  std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases%s, largest parts %.3f, rest %.3f "
+               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s\n", parts, n,
+               phases.size(), early ? " (scheduled beside the analysis)" : "", largest,
+               phases.back().rest_work / phases.front().total_work, cpu.size() > 0 ? cpu[0] : 0.0,
+               cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds);
 }
 
 }  // namespace cf::flat_detail

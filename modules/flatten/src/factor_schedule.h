@@ -6,6 +6,7 @@
 // above them (their ancestors) follow. Every row's arithmetic is the same whoever computes it and
 // every column still receives its entries in increasing row order, so the factor is bit for bit
 // the factor of the sequential factorisation, for any split (see spd_solver.cpp).
+#include <cstddef>
 #include <vector>
 
 namespace cf::flat_detail {
@@ -49,5 +50,13 @@ RowSchedule schedule_rows(const std::vector<int>& parent, const std::vector<doub
 std::vector<RowSchedule> schedule_phases(const std::vector<int>& parent, const std::vector<double>& work, int parts);
 constexpr double kPhaseMinGain = 0.05;
 constexpr int kMaxPhases = 8;
+
+// CPU seconds of the calling thread (COLONFLAT_FLATTEN_DEBUG: the threaded factorisation's parts).
+double thread_cpu_seconds();
+// COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured (`cpu`: per part
+// summed over the phases, then each phase's longest; `early`: the schedule was computed beside the
+// symbolic analysis).
+void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
+                        double rest_cpu, double seconds, bool early);
 
 }  // namespace cf::flat_detail

@@ -264,6 +264,7 @@ struct FlattenedBranches {
 std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
   const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
+  if (depth == 0) debug_clock("branches found");
   w.folds_pending = false;
   if (cuts.empty()) {  // this map stays: its folds are untangled now
     w.seg.untangled_vertices = untangle(w.ann, p.vf, w.emb, p.fixed, p.degenerate);
@@ -312,6 +313,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     return b;
   });
   p = prepare(w);  // (an exception here waits for the branches: the future's destructor joins)
+  if (depth == 0) debug_clock("branches cut off, the rest prepared");
   conformal(w, loops, p, o);
   return flattened;
 }
@@ -360,8 +362,9 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.seg.input_kind = nloops == 0 ? "closed" : nloops == 1 ? "one open end" : "tube";
   w.seg.map = o.map;
   auto phase = [depth](const char* what) {  // progress lines for the colon segments, not their branches
-    if (depth == 0) phase_done(what);
+    if (depth == 0) phase_done(what), debug_clock(what);
   };
+  if (depth == 0) debug_clock_start();
   Edges edges;
   auto loops = open_annulus(s, nloops, o, c, w, edges);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);

@@ -3,6 +3,7 @@
 // its edge graph, the harmonic (conformal) solve, the 2D embedding on the periodic cylinder,
 // the centreline, the area balancing and the distortion measures. See docs/flatten.md.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -204,6 +205,14 @@ std::size_t untangle(const Surface& s, const std::vector<std::vector<int>>& vf, 
 
 // Per-face quadratic system on a region: minimises sum_f sum_k w_fk |c_a - c_b - t_fk|^2 over the
 // free vertices (c = corner positions, (a, b) = the corners after k), the others fixed.
+// The lower triangle (compressed columns, rows ascending, the diagonal first) of
+// sum_f sum_k w_fk (e_a - e_b)(e_a - e_b)^T over the unknowns `index` (per vertex of s, -1: fixed;
+// n of them) for the faces `faces` (w: per face of `faces`, the weight of the edge opposite each
+// corner): each entry summed in face order, so bit for bit the matrix Eigen's setFromTriplets
+// gives from the terms in face order (what RegionSystem::build assembled before).
+Eigen::SparseMatrix<double> region_lower(const Surface& s, const std::vector<int>& faces,
+                                         const std::vector<std::array<double, 3>>& w, const std::vector<int>& index, int n);
+
 class RegionSystem {
  public:
   // `free_vertex[v]` true for unknowns; `faces`: faces with at least one free vertex; `w`: per face
@@ -364,6 +373,13 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
                         const FlattenOptions& o, bool branch);
 // COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
 void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate);
+// COLONFLAT_FLATTEN_DEBUG=1: a timeline line on stderr: wall and process CPU seconds (all threads,
+// getrusage) since the first call, and since the previous call (`what`: the stretch just ended),
+// with the cores that stretch kept busy on average (CPU / wall) and the core-seconds left idle of
+// thread_count() cores. Only on a thread that called debug_clock_start() (a colon segment's, not its
+// side branches' on their side thread). Thread-safe; no effect without the variable.
+void debug_clock(const char* what);
+void debug_clock_start();
 
 // Per-face distortion of a map triangle.
 struct FaceDistortion {

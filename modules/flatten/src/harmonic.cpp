@@ -233,7 +233,11 @@ void solve_with(const ConformalFactor& f, const Edges& E, const std::vector<doub
 // still being computed.
 std::vector<int> given_vertex_order(PriorSolve* prior) {
   if (!prior) return {};
-  if (prior->vertex_order.empty() && prior->order_when_ready) prior->vertex_order = prior->order_when_ready();
+  if (prior->vertex_order.empty() && prior->order_when_ready) {
+    debug_clock("first conformal system assembled");
+    prior->vertex_order = prior->order_when_ready();
+    debug_clock("waited for the elimination order");
+  }
   prior->order_when_ready = nullptr;
   return prior->vertex_order;
 }
@@ -256,6 +260,7 @@ UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::
   const Stopwatch sw;
   f->solver.analyze(vs.A, &order);
   if (!f->solver.factorize(vs.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  if (prior) debug_clock("conformal factorisation");
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug conformal factorisation: %ld unknowns, %.3g flops, %.2f s\n", long(vs.A.rows()),
                  f->solver.factor_flops(), sw.seconds());

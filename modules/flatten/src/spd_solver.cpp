@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <functional>
 #include <mutex>
 
@@ -187,13 +186,6 @@ bool columns_have_room(const cholmod_factor* L) {
   return true;
 }
 
-// CPU seconds of the calling thread (COLONFLAT_FLATTEN_DEBUG: the threaded factorisation's parts).
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 // cholmod_rowfac over `rows` (ascending), one call per run of consecutive rows; `cpu` (optional):
 // the thread's CPU seconds it took.
 bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_factor* L, cholmod_common& common,
@@ -224,6 +216,18 @@ std::vector<RowSchedule> factor_schedule(cholmod_sparse* upper, int parts) {
   return schedule_phases(parent, row_work(n, colptr, rowind, parent), parts);
 }
 
+// factor_schedule() of the pattern of triu(A(p,p)), p = `order`, with a cholmod_common of the
+// calling thread's own (empty when the transpose fails): what the analysis of a given order leaves
+// for factorize_on_threads, computed beside it.
+std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vector<int>& order, int parts) {
+  ThreadCommon tc;
+  cholmod_sparse* upper = cholmod_ptranspose(lower, 0, const_cast<int*>(order.data()), nullptr, 0, &tc.c);
+  if (!upper) return {};
+  std::vector<RowSchedule> phases = factor_schedule(upper, parts);
+  cholmod_free_sparse(&upper, &tc.c);
+  return phases;
+}
+
 // One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds.
 bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu) {
   std::vector<char> ok(phase.parts.size(), 0);
@@ -241,39 +245,32 @@ bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_facto
   return std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size());
 }
 
-// COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured.
-void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
-                        double rest_cpu, double seconds) {
-  double largest = 0, longest = 0;
-  for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
-  for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
-  std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases, largest parts %.3f, rest %.3f "
-               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s\n", parts, n,
-               phases.size(), largest, phases.back().rest_work / phases.front().total_work, cpu.size() > 0 ? cpu[0] : 0.0,
-               cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds);
-}
-
 // cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
 // cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over all
 // rows), with the rows split over the worker threads (factor_schedule.h): in each phase, parts of
 // whole subtrees side by side, then the rows above the last phase's. Row k reads only the columns
 // of its subtree and each column gets its entries in increasing row order, so the factor is bit
-// for bit cholmod_factorize's for any thread count. Returns -1 (nothing done) when this does not
-// apply, 0 when the factorisation failed, 1 when it succeeded.
-int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common) {
+// for bit cholmod_factorize's for any thread count. `ready` (may be empty): the schedule of this
+// factor's pattern for thread_count() parts, computed beforehand (pattern_schedule); `early`: it
+// was used. Returns -1
+// (nothing done) when this does not apply, 0 when the factorisation failed, 1 when it succeeded.
+int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common,
+                         std::vector<RowSchedule> ready, bool& early) {
   const int parts = thread_count();
   if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
   const Stopwatch sw;
   cholmod_sparse* upper =
       cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
   if (!upper) return -1;
-  std::vector<RowSchedule> phases = factor_schedule(upper, parts);
+  early = ready.size() > 0 && ready.front().parts.size() == std::size_t(parts);
+  std::vector<RowSchedule> phases = early ? std::move(ready) : factor_schedule(upper, parts);
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
   if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
   bool ok = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
   common.grow2 = grow2;
   if (ok && !columns_have_room(L)) {  // (not expected) every row here, in order
+    early = false;
     phases.assign(1, RowSchedule{});
     phases[0].rest.resize(L->n);
     for (std::size_t k = 0; k < L->n; ++k) phases[0].rest[k] = int(k);
@@ -283,7 +280,7 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   double rest_cpu = 0;
   ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
   cholmod_free_sparse(&upper, &common);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds());
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early);
   return ok ? 1 : 0;
 }
 
@@ -303,6 +300,8 @@ std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) {
 }
 
 void SpdSolver::release() {
+  schedule_.clear();
+  early_schedule_ = false;
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (started_) cholmod_finish(&common_);
   started_ = false;
@@ -324,8 +323,16 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
     common_.nmethods = 1;
     common_.method[0].ordering = CHOLMOD_GIVEN;
     common_.postorder = 0;  // the order as given: its leading block stays the factor's top-left corner
-    factor_ = cholmod_analyze_p(&view, const_cast<int*>(order->data()), nullptr, 0, &common_);
+    const auto symbolic = [&] { factor_ = cholmod_analyze_p(&view, const_cast<int*>(order->data()), nullptr, 0, &common_); };
+    // The threaded factorisation's row schedule reads only the pattern of A in this order: computed
+    // on a second thread beside CHOLMOD's analysis instead of after it, in factorize().
+    const int parts = thread_count();
+    if (parts > 1 && std::size_t(A.rows()) >= kThreadedFactorMinRows)
+      parallel_tasks({symbolic, [&] { schedule_ = pattern_schedule(&view, *order, parts); }});
+    else
+      symbolic();
     if (factor_ && std::equal(order->begin(), order->end(), static_cast<const int*>(factor_->Perm))) given_order_ = *order;
+    else schedule_.clear();
   } else {
     factor_ = cholmod_analyze(&view, &common_);
   }
@@ -334,7 +341,9 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
 bool SpdSolver::factorize(const SpMat& A) {
   if (factor_) {
     cholmod_sparse view = view_lower(A);
-    const int threaded = factorize_on_threads(&view, factor_, common_);
+    early_schedule_ = false;
+    const int threaded = factorize_on_threads(&view, factor_, common_, std::move(schedule_), early_schedule_);
+    schedule_.clear();
     if (threaded < 0) cholmod_factorize(&view, factor_, &common_);
     cholmod_ok_ = threaded != 0 && common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;
     if (cholmod_ok_) return true;

@@ -33,6 +33,8 @@
 #include <cholmod.h>
 #endif
 
+#include "factor_schedule.h"
+
 namespace cf::flat_detail {
 
 class SpdSolver {
@@ -94,12 +96,18 @@ class SpdSolver {
   double modify_flops(const std::vector<const SpMat*>& terms, double limit) const;
   // The elimination order of the analysis (empty without CHOLMOD or before analyze()).
   std::vector<int> order() const;
+  // Whether the last factorize() split its rows over the threads by the schedule computed beside
+  // the symbolic analysis of a given order (analyze() on two threads: CHOLMOD's analysis and the
+  // schedule, both reading only A's pattern in that order), not one computed after it.
+  bool early_schedule() const { return early_schedule_; }
 
  private:
   struct Fallback;  // Eigen's SimplicialLDLT of P A P^T, P the given order (else Eigen's AMD)
   void release();
   bool fall_back(const SpMat& A);
   std::vector<int> given_order_;
+  std::vector<RowSchedule> schedule_;  // from analyze(), for the next factorize() (empty: none)
+  bool early_schedule_ = false;
 #ifdef COLONFLAT_HAVE_CHOLMOD
   mutable cholmod_common common_{};
   bool started_ = false;

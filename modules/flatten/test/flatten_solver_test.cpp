@@ -497,6 +497,34 @@ TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
   for (int i : {1, 2}) EXPECT_EQ(std::memcmp(x[0].data(), x[i].data(), sizeof(double) * std::size_t(x[0].size())), 0) << i;
 }
 
+// A factorisation in a given order on two threads splits its rows by the schedule computed beside
+// its symbolic analysis (analyze() runs both at once), and its solution is the sequential one (one
+// thread: no schedule) to the last bit; without a given order (AMD, known only after the analysis)
+// the schedule is computed afterwards, as before.
+TEST(FlattenSolver, RowScheduleComputedBesideTheAnalysisGivesTheSequentialFactor) {
+  const NestedGrid g = nested_grid();
+  const int n = int(g.A.rows());
+  Eigen::MatrixXd b(n, 1);
+  for (int i = 0; i < n; ++i) b(i, 0) = std::sin(0.011 * i) + 0.2;
+  Eigen::MatrixXd x[2];
+  for (int threads : {1, 2}) {
+    cf::set_thread_count(threads);
+    SpdSolver solver;
+    solver.analyze(g.A, &g.order);
+    ASSERT_TRUE(solver.factorize(g.A));
+    if (!solver.order().empty()) EXPECT_EQ(solver.early_schedule(), threads == 2);  // (with CHOLMOD)
+    x[threads - 1] = solver.solve(b);
+  }
+  SpdSolver amd;
+  cf::set_thread_count(2);
+  ASSERT_TRUE(amd.compute(g.A));
+  EXPECT_FALSE(amd.early_schedule());
+  cf::set_thread_count(0);
+  const SpdSolver::SpMat full = g.A.selfadjointView<Eigen::Lower>();
+  EXPECT_LT((full * x[1] - b).norm(), 1e-9 * b.norm());
+  EXPECT_EQ(std::memcmp(x[0].data(), x[1].data(), sizeof(double) * std::size_t(n)), 0);
+}
+
 // A two-column solve is each column's own one-column solve to the last bit, for 1 and 2 threads,
 // with a factor below the threaded-solve threshold (columns on the calling thread) and one above
 // it (columns on the threads): the threshold cannot change a map.
