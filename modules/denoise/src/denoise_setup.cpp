@@ -1,6 +1,7 @@
 // Setting up a denoise run: the working copy of the input, the input's topology and, with
 // helper threads, the cap guard grid and the first homology basis built at the same time.
 #include <algorithm>
+#include <cstdio>
 #include <iterator>
 
 #include "colonflat/core/error.h"
@@ -8,6 +9,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/face_grid.h"
+#include "denoise_debug.h"
 #include "denoise_internal.h"
 
 namespace cf::detail {
@@ -107,12 +109,14 @@ double mean_edge_length(const Mesh& mesh) {
 void build_ahead(DenoiseState& st, const DenoiseOptions& o) {
   Stopwatch sw;
   if (o.check_caps) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * mean_edge_length(st.mesh));
-  st.t.surgery += sw.seconds();  // where cut_loop() counts it when it builds the grid
+  const double t_guard = sw.seconds();
+  st.t.surgery += t_guard;  // where cut_loop() counts it when it builds the grid
   if (o.method != "exact") return;
   sw.restart();
   st.initial_homology = std::make_unique<HomologyBasis>();
   st.initial_homology->build(st.mesh);
   st.t.homology += sw.seconds();
+  if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: guard grid %.3f s, homology %.3f s\n", t_guard, sw.seconds());
 }
 
 }  // namespace
@@ -141,12 +145,15 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     Stopwatch sw;
     *before = analyze_topology(m);
     *t_analysis = sw.seconds();
+    if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: topology analysis %.3f s\n", *t_analysis);
   };
   if (st.worker && !has_garbage(input)) {  // the copy keeps the input's element ids
     run_both(
         *st.worker,
         [&] {
+          Stopwatch sw;
           copy();
+          if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: copy %.3f s\n", sw.seconds());
           build_ahead(st, o);
         },
         [&] { analyse(input); });
