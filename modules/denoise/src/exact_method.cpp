@@ -240,6 +240,7 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["settled_vertices_alone"] = settled_alone_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;
+  stats["homology_builds_pruned_beside"] = homology_.builds_on_two_threads();
   stats["bounds_carried_at_rebuild"] = bounds_carried_;
   stats["crossing_family_switches"] = crossing_modes_;
   stats["crossing_searches_to_z"] = crossing_searches_to_z_;

@@ -1,6 +1,7 @@
 // The exact method's source sets, search families and per-source bounds (exact_greedy.h).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <unordered_map>
 
@@ -27,7 +28,12 @@ void ExactGreedy::build_homology() {
     homology_ = std::move(*st_.initial_homology);
     st_.initial_homology.reset();
   } else {
-    homology_.build(st_.mesh);
+    HomologyBasis::RunBoth both;  // the cut graph's pruning on the helper beside the annotations
+    if (worker_)
+      both = [this](const std::function<void()>& mine, const std::function<void()>& theirs) {
+        run_both(*worker_, mine, theirs);
+      };
+    homology_.build(st_.mesh, both);
   }
   span_.reset(homology_.words());
   // The searches keep their per-vertex arrays (a fresh one page-faults 40 MB at 1.6 M vertices);

@@ -1,14 +1,17 @@
 #include "colonflat/denoise/homology.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/huge_pages.h"
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/union_find.h"
+#include "denoise_debug.h"
 
 namespace cf {
 
-namespace {
+namespace detail {
 
 // The dual graph of the mesh closed by one virtual face per boundary loop (ids F, F+1, ...).
 struct ClosedDual {
@@ -39,6 +42,12 @@ struct ClosedDual {
     return f < static_cast<int>(real_faces) ? mesh.halfedge_handle(Mesh::FaceHandle(f)) : virtual_start[f - real_faces];
   }
 };
+
+}  // namespace detail
+
+namespace {
+
+using detail::ClosedDual;
 
 // Dual spanning forest by breadth-first search (Algorithm 1): parent_edge[f] = primal edge
 // crossed to reach f (-1 at roots); `order` = faces in visiting order; in_tree flags the edges.
@@ -89,14 +98,46 @@ std::vector<int> cut_graph_leftovers(const Mesh& mesh, const std::vector<std::ui
 
 }  // namespace
 
-void HomologyBasis::build(const Mesh& mesh) {
-  const ClosedDual dual(mesh);
+void HomologyBasis::build(const Mesh& mesh, const RunBoth& run_both) {
+  Stopwatch sw;
+  const detail::ClosedDual dual(mesh);
   std::vector<int> parent_edge, order;
   std::vector<std::uint8_t> in_dual_tree;
   dual_spanning_forest(dual, parent_edge, order, in_dual_tree);
   // Cut graph G = edges not dual to the tree; X = G minus a spanning forest of G.
   cut_edge_.assign(mesh.n_edges(), 0);
   for (std::size_t e = 0; e < mesh.n_edges(); ++e) cut_edge_[e] = !in_dual_tree[e];
+  const double t_forest = sw.seconds();
+  double t_annotate = 0, t_prune = 0;
+  auto annotate = [&] {
+    Stopwatch s;
+    annotate_edges(mesh, dual, parent_edge, order);
+    t_annotate = s.seconds();
+  };
+  auto prune = [&] {
+    Stopwatch s;
+    prune_cut_graph(mesh);
+    t_prune = s.seconds();
+  };
+  // Both read the mesh, the forest and cut_edge_ only and write disjoint members.
+  if (run_both) {
+    run_both(annotate, prune);
+    ++builds_on_two_threads_;
+  } else {
+    annotate();
+    prune();
+  }
+  if (detail::denoise_debug())
+    std::fprintf(stderr, "denoise debug: homology build: dual forest %.3f s, annotation %.3f s, pruning %.3f s%s\n",
+                 t_forest, t_annotate, t_prune, run_both ? " (beside it)" : "");
+}
+
+// Annotations: unit vectors on the leftover edges X (Kruskal's forest of the cut graph), zero on
+// the rest of G, and on the dual forest's edges by leaf peeling, children before parents: the
+// parent edge of a face gets the XOR of its other edges (final by then), so that the face sums
+// to zero.
+void HomologyBasis::annotate_edges(const Mesh& mesh, const detail::ClosedDual& dual, const std::vector<int>& parent_edge,
+                                   const std::vector<int>& order) {
   const std::vector<int> x_edges = cut_graph_leftovers(mesh, cut_edge_);
   rank_ = static_cast<int>(x_edges.size());
   words_ = std::max(1, (rank_ + 63) / 64);
@@ -108,8 +149,6 @@ void HomologyBasis::build(const Mesh& mesh) {
     cls[i / 64] = 1ull << (i % 64);
     row_of_[x_edges[i]] = new_row(cls.data());
   }
-  // Leaf peeling of the dual forest, children before parents: the parent edge of a face gets
-  // the XOR of its other edges (final by then), so that the face sums to zero.
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const int pe = parent_edge[*it];
     if (pe < 0) continue;
@@ -128,7 +167,6 @@ void HomologyBasis::build(const Mesh& mesh) {
     } while (h != h0);
     if (any && !is_zero(cls.data(), words_)) row_of_[pe] = new_row(cls.data());
   }
-  prune_cut_graph(mesh);
 }
 
 // Pruned cut graph: degree-1 vertices removed recursively (the 2-core: the same whatever the

@@ -1,6 +1,9 @@
 // Z2 homology annotations (tree-cotree) and the Z2 span used to quotient out cut classes.
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <thread>
+
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/homology.h"
 
@@ -89,6 +92,40 @@ TEST(DenoiseHomology, TorusWithHoleKeepsRankTwo) {
   hb.build(m);
   EXPECT_EQ(hb.rank(), 2);
   expect_face_boundaries_zero(m, hb);
+}
+
+// A build whose cut-graph pruning runs on a helper thread beside the annotations (counted: the
+// helper ran it) gives the one-thread build's rank, every edge's class, cut graph and pruned cut
+// graph, on a chain of 3 tori with a hole (boundary: a virtual face) - an unequal split would show.
+TEST(DenoiseHomology, BuildOnTwoThreadsIsTheOneThreadBuild) {
+  auto t = torus_chain(3, 3, 1, 16, 8, 10);
+  t.triangles.erase(t.triangles.begin() + 40);
+  const Mesh m = to_mesh(t);
+  HomologyBasis one, two;
+  one.build(m);
+  int on_helper = 0;
+  two.build(m, [&](const std::function<void()>& mine, const std::function<void()>& theirs) {
+    std::thread helper([&] {
+      theirs();
+      ++on_helper;
+    });
+    mine();
+    helper.join();
+  });
+  EXPECT_EQ(one.builds_on_two_threads(), 0);
+  EXPECT_EQ(two.builds_on_two_threads(), 1);
+  EXPECT_EQ(on_helper, 1);
+  ASSERT_EQ(two.rank(), 6);
+  ASSERT_EQ(two.rank(), one.rank());
+  for (auto e : m.edges())
+    ASSERT_EQ(std::vector<std::uint64_t>(two.edge_class(e), two.edge_class(e) + two.words()),
+              std::vector<std::uint64_t>(one.edge_class(e), one.edge_class(e) + one.words()))
+        << e.idx();
+  EXPECT_EQ(two.cut_graph_edges(), one.cut_graph_edges());
+  EXPECT_EQ(two.pruned_cut_graph_edges(), one.pruned_cut_graph_edges());
+  EXPECT_EQ(two.pruned_cut_graph_vertices(), one.pruned_cut_graph_vertices());
+  EXPECT_FALSE(two.pruned_cut_graph_vertices().empty());
+  expect_face_boundaries_zero(m, two);
 }
 
 // Z2Span: membership, reduction and independence.

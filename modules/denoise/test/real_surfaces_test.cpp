@@ -121,13 +121,18 @@ void expect_same_result(const DenoiseResult& a, const DenoiseResult& b) {
   EXPECT_EQ(faces_differ, 0u);
 }
 
-// A sphere with 24 handles far apart: batches of spatially separated group searches run on 2
-// threads (pairs counted), and the loops and the output mesh are identical to 1 thread's.
+// A sphere with 24 handles far apart: batches of spatially separated group searches and every
+// homology build's pruning run on 2 threads (both counted), and the loops and the output mesh are
+// identical to 1 thread's.
 TEST(DenoiseThreads, OneAndTwoThreadsGiveTheSameLoopsAndMeshOnManyHandles) {
   const Mesh m = bench::sphere_with_handles(30, 24, 0.6);
   const DenoiseResult a = denoise_with_threads(m, 1), b = denoise_with_threads(m, 2);
   EXPECT_EQ(a.report["search"]["parallel_search_pairs"].get<long long>(), 0);
   EXPECT_GT(b.report["search"]["parallel_search_pairs"].get<long long>(), 0);
+  // Every homology build of the 2-thread run (the set-up's first one too) pruned on the helper.
+  EXPECT_EQ(a.report["search"]["homology_builds_pruned_beside"].get<int>(), 0);
+  EXPECT_GE(b.report["search"]["homology_builds"].get<int>(), 1);
+  EXPECT_EQ(b.report["search"]["homology_builds_pruned_beside"], b.report["search"]["homology_builds"]);
   EXPECT_EQ(b.report["genus_after"], 0);
   EXPECT_EQ(a.loops.size(), 24u);
   expect_same_result(a, b);

@@ -17,6 +17,7 @@
 // near the root), so each edge holds an index into a pool of its nonzero class rows (row 0 is
 // the zero class) instead of a dense edges x words table (188 MB at 2.3 M edges and genus 300).
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -24,10 +25,21 @@
 
 namespace cf {
 
+namespace detail {
+struct ClosedDual;  // the dual graph with one virtual face per boundary loop (homology.cpp)
+}
+
 class HomologyBasis {
  public:
-  // Precondition: `mesh` is a manifold (garbage-collected) triangle mesh.
-  void build(const Mesh& mesh);
+  // Runs the first job on the calling thread and the second on a helper at once, returning when
+  // both are done (neither may throw); empty: one thread.
+  using RunBoth = std::function<void(const std::function<void()>&, const std::function<void()>&)>;
+  // Precondition: `mesh` is a manifold (garbage-collected) triangle mesh. With `run_both`, the
+  // pruning of the cut graph runs on the helper beside the annotations (both need only the dual
+  // forest): the same result as one thread.
+  void build(const Mesh& mesh, const RunBoth& run_both = {});
+  // Builds whose pruning ran beside the annotations (on a helper through run_both).
+  int builds_on_two_threads() const { return builds_on_two_threads_; }
 
   int rank() const { return rank_; }    // 2 * total genus = |X|
   int words() const { return words_; }  // 64-bit words per class vector
@@ -53,13 +65,15 @@ class HomologyBasis {
   std::vector<int> pruned_cut_graph_vertices() const;
 
  private:
+  void annotate_edges(const Mesh& mesh, const detail::ClosedDual& dual, const std::vector<int>& parent_edge,
+                      const std::vector<int>& order);
   void prune_cut_graph(const Mesh& mesh);
   // Removes degree-1 vertices of the cut graph (rows start / adjacent: per vertex its (cut edge,
   // other end)) until none is left; `degree` ends as each vertex's degree in the pruned graph.
   void peel_leaves(const std::vector<std::uint32_t>& start, const std::vector<std::pair<int, int>>& adjacent,
                    std::vector<int>& degree);
   std::uint32_t new_row(const std::uint64_t* cls);
-  int rank_ = 0, words_ = 1;
+  int rank_ = 0, words_ = 1, builds_on_two_threads_ = 0;
   std::vector<std::uint32_t> row_of_;  // per edge: its row in rows_ (0: the zero class)
   std::vector<std::uint64_t> rows_;    // class rows, words_ each; row 0 is zero
   std::vector<std::uint8_t> cut_edge_, pruned_edge_;
