@@ -20,6 +20,7 @@ void write_png(vtkImageData* image, const std::filesystem::path& path) {
     vtkNew<vtkPNGWriter> w;
     w->SetFileName(tmp.c_str());
     w->SetInputData(image);
+    w->SetCompressionLevel(kPngCompressionLevel);
     w->Write();
     if (!msgs.first_problem().empty() || w->GetErrorCode() != 0 || !std::filesystem::exists(tmp))
       throw Error(path.string() + ": cannot write PNG: " + msgs.write_problem(w, tmp.string()));

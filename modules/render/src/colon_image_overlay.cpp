@@ -4,6 +4,7 @@
 #include <vtkImageCanvasSource2D.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
 
 #include <algorithm>
 #include <array>
@@ -11,9 +12,43 @@
 #include <limits>
 #include <sstream>
 
+#include "colonflat/core/error.h"
 #include "colon_image_steps.h"
 
 namespace cf::detail {
+
+vtkStandardNewMacro(OverlayCanvas);
+
+void OverlayCanvas::draw_on(vtkImageData* image) {
+  if (image->GetScalarType() != VTK_UNSIGNED_CHAR || image->GetNumberOfScalarComponents() != 3)
+    throw Error("overlay canvas: needs an RGB unsigned char image");
+  ImageData->ShallowCopy(image);  // shares the scalar array: drawing writes into `image`
+  image->GetExtent(WholeExtent);
+}
+
+// The tube's pixels lie within radius of the segment, so inside its bounding box grown by
+// radius + 1 (clipped to the image, as VTK clips the segment); there the box canvas, with the
+// image's coordinates, makes the same distance tests as a canvas over the whole image.
+void OverlayCanvas::fill_tube(int a0, int a1, int b0, int b1, double radius) {
+  int e[6];
+  ImageData->GetExtent(e);
+  const int grow = int(std::ceil(radius)) + 1;
+  const int x0 = std::max(e[0], std::min(a0, b0) - grow), x1 = std::min(e[1], std::max(a0, b0) + grow);
+  const int y0 = std::max(e[2], std::min(a1, b1) - grow), y1 = std::min(e[3], std::max(a1, b1) + grow);
+  if (x0 > x1 || y0 > y1) return;
+  ImagePtr sub = ImagePtr::New();
+  sub->SetExtent(x0, x1, y0, y1, 0, 0);
+  sub->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  const int row = 3 * (x1 - x0 + 1);
+  auto at = [](vtkImageData* im, int x, int y) { return static_cast<unsigned char*>(im->GetScalarPointer(x, y, 0)); };
+  for (int y = y0; y <= y1; ++y) std::copy_n(at(ImageData, x0, y), row, at(sub, x0, y));
+  vtkNew<OverlayCanvas> box;
+  box->draw_on(sub);
+  box->SetDrawColor(GetDrawColor());
+  box->FillTube(a0, a1, b0, b1, radius);
+  for (int y = y0; y <= y1; ++y) std::copy_n(at(sub, x0, y), row, at(ImageData, x0, y));
+}
+
 namespace {
 
 std::string fmt2(double v) {
@@ -127,33 +162,29 @@ std::vector<Tick> axis_ticks(const FlatMap& f, const std::vector<Band>& bands, d
 
 }  // namespace
 
-// The shaded bands copied into a VTK canvas, the shapes drawn on it, and the result kept.
+// The shapes drawn by VTK's canvas straight onto the shaded bands: the canvas's image shares the
+// bands' pixels (OverlayCanvas), so nothing is copied. (DrawImage copied every pixel into the
+// canvas through VTK's generic per-pixel path, then the canvas's output was copied again: about
+// 0.15 s CPU on the real CT's 4641 x 1652 px image, and 46 MB of fresh pages.)
 void ColonImagePainter::compose_overlays() {
-  vtkNew<vtkImageCanvasSource2D> canvas;
-  canvas->SetScalarTypeToUnsignedChar();
-  canvas->SetNumberOfScalarComponents(3);
-  canvas->SetExtent(0, width_ - 1, 0, height_ - 1, 0, 0);
-  canvas->DrawImage(0, 0, image_);
+  vtkNew<OverlayCanvas> canvas;
+  canvas->draw_on(image_);
   draw_markers(canvas);
   draw_not_shown_rings(canvas);
   draw_branch_necks(canvas);
   draw_scale_bar(canvas);
   draw_ticks(canvas);
-  canvas->Update();
-  ImagePtr final_img = ImagePtr::New();
-  final_img->DeepCopy(canvas->GetOutput());
-  image_ = final_img;
   pixels_ = nullptr;
 }
 
-void ColonImagePainter::draw_markers(vtkImageCanvasSource2D* canvas) {
+void ColonImagePainter::draw_markers(OverlayCanvas* canvas) {
   for (auto& mk : markers_)
     if (const Band* band = band_of(mk.segment)) draw_marker(canvas, mk, *band);
 }
 
 // A circle (dashed green for a known polyp, yellow for a candidate) with its label beside it; the
 // marker's pixel position is recorded.
-void ColonImagePainter::draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker& mk, const Band& band) {
+void ColonImagePainter::draw_marker(OverlayCanvas* canvas, ImageMarker& mk, const Band& band) {
   const auto [cx, cy] = pixel_of(band, mk.x, mk.y);
   mk.px = cx;
   mk.py = height_ - 1 - cy;
@@ -164,8 +195,8 @@ void ColonImagePainter::draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker&
   for (int k = 0; k < nseg; ++k) {
     if (mk.known && k % 2) continue;
     const double a0 = 2 * M_PI * k / nseg, a1 = 2 * M_PI * (k + 1) / nseg;
-    canvas->FillTube(int(cx + r * std::cos(a0)), int(cy + r * std::sin(a0)), int(cx + r * std::cos(a1)),
-                     int(cy + r * std::sin(a1)), 1.3);
+    canvas->fill_tube(int(cx + r * std::cos(a0)), int(cy + r * std::sin(a0)), int(cx + r * std::cos(a1)),
+                      int(cy + r * std::sin(a1)), 1.3);
   }
   Label l{mk.label, int(cx + r * 0.75), int(height_ - 1 - (cy + r * 0.75)) - 16, {1, 0.9, 0}, 14, 0.55};
   if (mk.known) l.col[0] = 0.25, l.col[1] = 0.95, l.col[2] = 0.4, l.y = int(height_ - 1 - (cy - r * 0.75)) + 2;
@@ -173,7 +204,7 @@ void ColonImagePainter::draw_marker(vtkImageCanvasSource2D* canvas, ImageMarker&
 }
 
 // Wall not shown: a red square ring at its place, labelled with its 3D area.
-void ColonImagePainter::draw_not_shown_rings(vtkImageCanvasSource2D* canvas) {
+void ColonImagePainter::draw_not_shown_rings(OverlayCanvas* canvas) {
   canvas->SetDrawColor(255, 60, 60);
   for (const NotShownMark& m : not_shown_marks(flat_)) {
     const Band* band = band_of(m.segment);
@@ -190,7 +221,7 @@ void ColonImagePainter::draw_not_shown_rings(vtkImageCanvasSource2D* canvas) {
 }
 
 // A side branch's neck on its parent band: a cyan diamond labelled with the branch's band.
-void ColonImagePainter::draw_branch_necks(vtkImageCanvasSource2D* canvas) {
+void ColonImagePainter::draw_branch_necks(OverlayCanvas* canvas) {
   canvas->SetDrawColor(80, 220, 255);
   for (const NeckMark& m : neck_marks(flat_)) {
     const Band* band = band_of(m.segment);
@@ -198,14 +229,14 @@ void ColonImagePainter::draw_branch_necks(vtkImageCanvasSource2D* canvas) {
     const auto pixel = pixel_of(*band, m.x, m.y);
     const int cx = int(pixel[0]), cy = int(pixel[1]), r = 10;
     const int corner[5][2] = {{cx, cy - r}, {cx + r, cy}, {cx, cy + r}, {cx - r, cy}, {cx, cy - r}};
-    for (int k = 0; k < 4; ++k) canvas->FillTube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
+    for (int k = 0; k < 4; ++k) canvas->fill_tube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
     labels_.push_back({"branch: segment " + std::to_string(m.branch + 1), cx + r + 2, height_ - 1 - cy - 6,
                        {0.45, 0.9, 1}, 12, 0.55});
   }
 }
 
 // Scale bar (bottom left), in mm at the mean (area-preserving) scale.
-void ColonImagePainter::draw_scale_bar(vtkImageCanvasSource2D* canvas) {
+void ColonImagePainter::draw_scale_bar(OverlayCanvas* canvas) {
   const int margin = margin_;
   bar_mm_ = nice_length(0.12 * (width_ - 2 * margin) * px_);
   bar_px_ = int(std::lround(bar_mm_ / px_));
@@ -215,7 +246,7 @@ void ColonImagePainter::draw_scale_bar(vtkImageCanvasSource2D* canvas) {
   canvas->FillBox(margin + bar_px_ - 2, margin + bar_px_, 22, 40);
 }
 
-void ColonImagePainter::draw_ticks(vtkImageCanvasSource2D* canvas) {
+void ColonImagePainter::draw_ticks(OverlayCanvas* canvas) {
   ticks_ = axis_ticks(flat_, bands_, px_);
   canvas->SetDrawColor(230, 230, 230);
   for (const Tick& t : ticks_) canvas->FillBox(t.col, t.col + 1, t.row_bottom - t.len, t.row_bottom);
