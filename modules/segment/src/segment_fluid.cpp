@@ -26,7 +26,9 @@ void ColonSegmenter::find_fluid_bodies() {
       if (bright[q]) lab_[q] = kCandidate;
     }
   });
+  step_time("bright");
   split_fluid_bodies(bright);
+  step_time("split_fluid_bodies");
   pool_.assign(fluid_count_ + 1, 0);
   Bytes gas(d_.total);
   for_each_voxel(d_.total, [&](std::size_t q) { gas[q] = lab_[q] == kGas; });

@@ -6,7 +6,11 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <iterator>
+#include <mutex>
 #include <new>
 #include <thread>
 
@@ -21,11 +25,46 @@ namespace cf::segment_detail {
 namespace {
 constexpr std::size_t kHugePage = std::size_t(2) << 20;
 constexpr std::size_t kHugeMin = std::size_t(4) << 20;  // smaller blocks: the ordinary heap
+
+// Freed blocks kept mapped for reuse while a BlockReuse scope is open (one per segmentation; the
+// graph cut's workers allocate concurrently, hence the lock).
+struct KeptBlocks {
+  std::mutex mu;
+  int scopes = 0;
+  std::vector<std::pair<std::size_t, void*>> blocks;  // (mapped size, address), most recently freed last
+  std::size_t bytes = 0;
+  void release() {
+    for (const auto& [size, p] : blocks) ::munmap(p, size);
+    blocks.clear();
+    bytes = 0;
+  }
+};
+KeptBlocks& kept() {
+  static KeptBlocks k;
+  return k;
+}
+std::size_t mapped_size(std::size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+
+// A kept block of exactly `size` bytes (the most recently freed), or nullptr after releasing them all.
+void* take_kept(std::size_t size) {
+  KeptBlocks& k = kept();
+  std::lock_guard<std::mutex> lock(k.mu);
+  for (auto it = k.blocks.rbegin(); it != k.blocks.rend(); ++it)
+    if (it->first == size) {
+      void* p = it->second;
+      k.bytes -= size;
+      k.blocks.erase(std::next(it).base());
+      return p;
+    }
+  k.release();
+  return nullptr;
+}
 }  // namespace
 
 void* huge_page_alloc(std::size_t bytes) {
   if (bytes < kHugeMin) return ::operator new(bytes);
-  const std::size_t size = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  const std::size_t size = mapped_size(bytes);
+  if (void* p = take_kept(size)) return p;
   void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (p == MAP_FAILED) throw std::bad_alloc();
 #ifdef MADV_HUGEPAGE
@@ -37,7 +76,47 @@ void* huge_page_alloc(std::size_t bytes) {
 void huge_page_free(void* p, std::size_t bytes) {
   if (!p) return;
   if (bytes < kHugeMin) return ::operator delete(p);
-  ::munmap(p, (bytes + kHugePage - 1) / kHugePage * kHugePage);
+  const std::size_t size = mapped_size(bytes);
+  KeptBlocks& k = kept();
+  {
+    std::lock_guard<std::mutex> lock(k.mu);
+    if (k.scopes > 0) {
+      k.blocks.emplace_back(size, p);
+      k.bytes += size;
+      return;
+    }
+  }
+  ::munmap(p, size);
+}
+
+BlockReuse::BlockReuse() {
+  std::lock_guard<std::mutex> lock(kept().mu);
+  ++kept().scopes;
+}
+
+BlockReuse::~BlockReuse() {
+  std::lock_guard<std::mutex> lock(kept().mu);
+  if (--kept().scopes == 0) kept().release();
+}
+
+void release_kept_blocks() {
+  std::lock_guard<std::mutex> lock(kept().mu);
+  kept().release();
+}
+
+std::size_t kept_block_bytes() {
+  std::lock_guard<std::mutex> lock(kept().mu);
+  return kept().bytes;
+}
+
+void step_time(const char* name) {
+  static const bool on = std::getenv("COLONFLAT_SEGMENT_TIMES") != nullptr;
+  if (!on) return;
+  static Stopwatch clock;
+  static double cpu = process_cpu_seconds();
+  const double now = process_cpu_seconds();
+  std::fprintf(stderr, "segment step %s: wall %.3f s, cpu %.3f s\n", name, clock.lap(), now - cpu);
+  cpu = now;
 }
 
 Dims make_dims(const std::size_t n[3], const double sp[3]) {

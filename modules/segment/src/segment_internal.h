@@ -28,8 +28,22 @@ struct LocalShape;
 // Large voxel buffers (crop-sized and more): blocks of at least 4 MiB are mapped directly and
 // advised for transparent huge pages, so a fresh buffer costs 1/512 of the page faults (on 2 loaded
 // virtual cores the 4 KiB faults of the ~20 full-crop buffers cost about a third of the CPU time).
+// While a BlockReuse is alive, a freed block is kept mapped and handed to the next request of its
+// mapped size (its pages already backed: no page faults, no zeroing by the kernel); a request no kept
+// block fits releases them all before mapping a new one, so kept blocks never raise the peak.
 void* huge_page_alloc(std::size_t bytes);
 void huge_page_free(void* p, std::size_t bytes);
+class BlockReuse {
+ public:
+  BlockReuse();
+  ~BlockReuse();  // the last open scope releases the kept blocks
+  BlockReuse(const BlockReuse&) = delete;
+  BlockReuse& operator=(const BlockReuse&) = delete;
+};
+// Bytes of freed blocks kept for reuse now (0 outside a BlockReuse scope).
+std::size_t kept_block_bytes();
+// Unmaps the kept blocks now (before allocations of other kinds, e.g. the heap's or ITK's).
+void release_kept_blocks();
 template <class T>
 struct HugePageAllocator {
   using value_type = T;
@@ -61,6 +75,9 @@ struct Dims {
 };
 
 Dims make_dims(const std::size_t n[3], const double sp[3]);
+// COLONFLAT_SEGMENT_TIMES=1: prints "segment step NAME: wall W s, cpu C s" to stderr, the wall and
+// process CPU seconds since the previous call (the sub-steps of the report's phases).
+void step_time(const char* name);
 using cf::process_cpu_seconds;  // core/threads.h
 // Splits [0, n) into one chunk per cf::thread_count() thread (core parallel_for).
 void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size_t)>& body);
@@ -272,6 +289,7 @@ class ColonSegmenter {
   void lap(const char* name);
   void summarize_decisions();
 
+  BlockReuse reuse_;  // first member: released after every buffer below is freed into it
   const CtImage* ct_;
   SegmentOptions opts_;
   SegmentStats st_;

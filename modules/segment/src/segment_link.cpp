@@ -179,6 +179,7 @@ void ColonSegmenter::link_tagged_stretches() {
   Bytes candidate(d_.total);
   for_each_voxel(d_.total, [&](std::size_t q) { candidate[q] = lab_[q] == kCandidate; });
   const RunLabels cl = candidate_bodies(candidate);
+  step_time("candidate_bodies");
   Bytes().swap(candidate);
   Buffer<std::uint32_t>().swap(fluid_label_);  // the pieces' last use: the graph cut reuses these pages
   const std::uint32_t n = cl.count();
@@ -192,7 +193,9 @@ void ColonSegmenter::link_tagged_stretches() {
     else eligible[l] = 1, why[l] = "no colon segment end within --link-gap";
   }
   if (std::getenv("COLONFLAT_SEGMENT_LINKS")) sample_candidates(cl, bodies);
+  step_time("candidate stats");
   interfaces_ = gas_fluid_interfaces(RunLookup(cl));
+  step_time("gas_fluid_interfaces");
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG")) debug_interfaces(bodies);
   std::vector<double> kept_gap(n + 1, -1);
   kept_id_.assign(n + 1, 0);

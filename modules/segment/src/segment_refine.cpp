@@ -58,6 +58,7 @@ void ColonSegmenter::refine_boundary() {
     erode_box(inner, d_, rb);
     for_each_voxel(d_.total, [&](std::size_t q) { state_[q] = lab_[q] == kExcluded ? 0 : (inner[q] || lab_[q] == 3 ? 1 : (outer[q] ? 2 : 0)); });
   }
+  step_time("band");
   Bytes near_fluid(d_.total);
   for_each_voxel(d_.total, [&](std::size_t q) { near_fluid[q] = lab_[q] == 2; });
   const int rf[3] = {rb[0] + 1, rb[1] + 1, rb[2] + 1};
@@ -72,7 +73,9 @@ void ColonSegmenter::refine_boundary() {
   in.fluid = st_.fluid_hu;
   in.smoothness = opts_.smoothness;
   in.edge_sigma = opts_.edge_sigma;
+  step_time("near_fluid");
   const GraphCutOutput out = graph_cut_band(in, state_);
+  release_kept_blocks();  // the workers' slab arrays: no later request has their sizes
   st_.flow = out.flow;
   st_.graph_edges = out.edges;
   timings_["graph_build_cpu"] = out.build_cpu_s;
@@ -148,6 +151,7 @@ void ColonSegmenter::fill_interface_line(const Bytes& lumen, std::size_t base, s
 void ColonSegmenter::final_segments() {
   add_dependent_films();
   add_gas_fluid_interfaces();
+  step_time("films and interfaces");
   const RunLabels cl = component_runs(state_.data(), d_);
   const std::uint32_t n = cl.count();
   std::vector<std::size_t> count(n + 1, 0), core(n + 1, 0);
@@ -178,6 +182,7 @@ void ColonSegmenter::final_segments() {
 }
 
 MaskImage::Pointer ColonSegmenter::paste() const {
+  release_kept_blocks();  // the output is ITK's (heap): freed crop buffers must not add to its peak
   auto out = MaskImage::New();
   out->CopyInformation(ct_);
   out->SetRegions(ct_->GetLargestPossibleRegion());

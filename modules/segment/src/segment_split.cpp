@@ -105,12 +105,17 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
   const bool resolved = kCoreRadiusMm >= kMinCoreVoxels * std::max({d_.sp[0], d_.sp[1], d_.sp[2]});
   if (resolved) {
     Bytes core = erode_ball(bright, d_, kCoreRadiusMm);
+    step_time("erode_ball");
     for_each_voxel(d_.total, [&](std::size_t q) { core[q] = core[q] && hu_[q] >= opts_.fluid_threshold; });  // a wall voxel is no core
     const RunLabels cl = component_runs(core.data(), d_);
+    step_time("core labels");
     fluid_label_.assign(d_.total, 0);  // after the ball's work buffers are freed: the labels reuse their pages
     std::vector<std::size_t> queue = seed_cores(cl);
+    step_time("seed_cores");
     grow_pieces(bright, queue);
+    step_time("grow_pieces");
     const std::vector<std::vector<std::size_t>> other = other_level_cores(bright, core, cl);
+    step_time("other_level_cores");
     Bytes().swap(core);
     if (!other.empty()) {  // each a core of its own (its voxels leave the old cores); all grown again
       fluid_label_.assign(d_.total, 0);
@@ -119,6 +124,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
         for (std::size_t q : other[t]) fluid_label_[q] = cl.count() + std::uint32_t(t) + 1, queue.push_back(q);
       fluid_count_ += std::uint32_t(other.size());
       grow_pieces(bright, queue);
+      step_time("grow_pieces again");
     }
   }
   if (!resolved) fluid_label_.assign(d_.total, 0);
@@ -133,6 +139,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
 // Labels the cores 1.. into fluid_label_ and returns their voxels in label order (the breadth-first
 // queue of grow_pieces); fluid_count_ = the cores' number.
 std::vector<std::size_t> ColonSegmenter::seed_cores(const RunLabels& cl) {
+  release_kept_blocks();  // the queue grows on the heap (to every bright voxel): freed buffers must not add to its peak
   std::vector<std::size_t> queue;
   for (std::uint32_t l = 1; l <= cl.count(); ++l)
     for (const Run* r = cl.begin(l); r != cl.end(l); ++r) {

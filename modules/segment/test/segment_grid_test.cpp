@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 
 #include "../src/segment_internal.h"
@@ -120,6 +121,39 @@ TEST(SegmentGrid, BallErosionMatchesBruteForce) {
   }
   EXPECT_GT(set, 20u);           // some voxels pass,
   EXPECT_LT(set, d.total / 2);  // most are within 3 mm of a hole
+}
+
+// Inside a BlockReuse scope a freed large block goes to the next request of its size with its pages
+// as they were (not mapped and zeroed again: a fresh mapping reads 0), a request of another size
+// releases every kept block before mapping (kept blocks never add to the peak), and closing the
+// scope releases them; outside a scope nothing is kept.
+TEST(SegmentGrid, FreedBlocksReusedInsideScopeReleasedOnMissAndAtEnd) {
+  const std::size_t big = std::size_t(6) << 20;  // 3 huge pages: its mapped size is its size
+  {
+    BlockReuse scope;
+    auto* a = static_cast<unsigned char*>(huge_page_alloc(big));
+    std::memset(a, 0xAB, big);
+    huge_page_free(a, big);
+    EXPECT_EQ(kept_block_bytes(), big);
+    auto* b = static_cast<unsigned char*>(huge_page_alloc(big));
+    EXPECT_EQ(kept_block_bytes(), 0u);
+    EXPECT_EQ(b, a);
+    EXPECT_EQ(b[0], 0xAB);  // the same pages, not zeroed again
+    EXPECT_EQ(b[big - 1], 0xAB);
+    huge_page_free(b, big);
+    void* c = huge_page_alloc(2 * big);  // no kept block of this size: all released first
+    EXPECT_EQ(kept_block_bytes(), 0u);
+    huge_page_free(c, 2 * big);
+    EXPECT_EQ(kept_block_bytes(), 2 * big);
+  }
+  EXPECT_EQ(kept_block_bytes(), 0u);
+  auto* d = static_cast<unsigned char*>(huge_page_alloc(big));
+  std::memset(d, 0xCD, big);
+  huge_page_free(d, big);
+  EXPECT_EQ(kept_block_bytes(), 0u);
+  auto* e = static_cast<unsigned char*>(huge_page_alloc(big));
+  EXPECT_EQ(e[0], 0);  // a fresh mapping
+  huge_page_free(e, big);
 }
 
 // The streamed 3 x 3 x 3 mean equals the brute-force mean with clamped edges, every slice once.
