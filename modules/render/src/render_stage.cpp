@@ -64,10 +64,12 @@ ImagePtr snapshot_before(const Mesh& m, std::optional<int> genus, vtkPolyData* l
 RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const {
   Snapshots s;
   TopologyReport surface_topology;
+  Stopwatch orient;
   for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
     if (bag.has(port))
       ctx.report["orientation"][port] =
           orient_mesh_input(bag, port, ctx, "render", std::string(port) == "surface" ? &surface_topology : nullptr);
+  ctx.report["snapshot_orient_s"] = orient.seconds();
   if (bag.has("loops")) s.loops = loops_to_polydata(bag.get<LoopSet>("loops"));
   s.options.width = s.options.height = opts_.snapshot_size;
   try {
@@ -81,8 +83,11 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   s.images = std::async(std::launch::async, [surface, denoised, &flat, genus = surface_topology.genus,
                                                loops = s.loops.Get(), so = s.options] {
     SnapshotImages im;
+    Stopwatch sw;
     if (surface) im.before = snapshot_before(*surface, genus, loops, so);
+    im.before_s = sw.lap();
     im.after = render_snapshot(denoised ? to_triangle_list(*denoised) : flat_to_surface(flat), loops, so);
+    im.after_s = sw.lap();
     return im;
   });
   return s;
@@ -93,7 +98,10 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
 void RenderStage::finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const {
   try {
     if (!s.error.empty()) throw Error(s.error);
+    Stopwatch wait;
     SnapshotImages im = s.images.get();
+    ctx.report["snapshot_wait_s"] = wait.seconds();
+    ctx.report["snapshot_time_s"] = {{"before", im.before_s}, {"after", im.after_s}};
     phase_done("3D snapshots before and after denoising (beside the colon image)");
     if (im.before) bag.put("snapshot_before", im.before);
     const bool denoised = bag.has("denoised");

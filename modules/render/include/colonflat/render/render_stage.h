@@ -53,6 +53,7 @@ class RenderStage : public StageWithOptions<RenderOptions> {
   struct SnapshotImages {
     ImagePtr before;  // null without a surface before denoising
     ImagePtr after;   // without its caption (it counts the candidates)
+    double before_s = 0, after_s = 0;  // wall seconds of each on the snapshot thread (report "snapshot_time_s")
   };
   struct Snapshots {
     vtkSmartPointer<vtkPolyData> loops;
