@@ -50,7 +50,7 @@ namespace {
 ImagePtr snapshot_before(const Mesh& m, std::optional<int> genus, vtkPolyData* loops, SnapshotOptions so) {
   so.caption = "before denoising: genus " + (genus ? std::to_string(*genus) : std::string("?")) +
                (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
-  return render_snapshot(to_triangle_list(m), loops, so);
+  return render_snapshot(m, loops, so);
 }
 
 }  // namespace
@@ -86,7 +86,7 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
     Stopwatch sw;
     if (surface) im.before = snapshot_before(*surface, genus, loops, so);
     im.before_s = sw.lap();
-    im.after = render_snapshot(denoised ? to_triangle_list(*denoised) : flat_to_surface(flat), loops, so);
+    im.after = denoised ? render_snapshot(*denoised, loops, so) : render_snapshot(flat_to_surface(flat), loops, so);
     im.after_s = sw.lap();
     return im;
   });

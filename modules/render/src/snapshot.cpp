@@ -37,12 +37,16 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <mutex>
+#include <vector>
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
+#include "colonflat/core/topology.h"
 #include "colonflat/core/vertex_corners.h"
 #include "colonflat/core/vtk_messages.h"
 
@@ -115,22 +119,30 @@ std::string ensure_display() {
   return disp;
 }
 
-// Points and triangles copied in bulk into preallocated arrays (one triangle = 3 ids, fixed-size
-// cell storage), rows split over the threads.
-vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
-  const std::size_t P = surface.points.size(), T = surface.triangles.size();
-  vtkNew<vtkDoubleArray> xyz;
+namespace {
+
+// #P points as a double array (#P x 3); at(i) gives point i's 3 coordinates. Rows split over the threads.
+template <class PointAt>
+vtkSmartPointer<vtkDoubleArray> point_array(std::size_t P, const PointAt& at) {
+  auto xyz = vtkSmartPointer<vtkDoubleArray>::New();
   xyz->SetNumberOfComponents(3);
   xyz->SetNumberOfTuples(vtkIdType(P));
   double* x = xyz->GetPointer(0);
   parallel_for(P, [&](std::size_t i0, std::size_t i1) {
-    for (std::size_t i = i0; i < i1; ++i) std::copy(surface.points[i].begin(), surface.points[i].end(), x + 3 * i);
+    for (std::size_t i = i0; i < i1; ++i) std::copy(at(i), at(i) + 3, x + 3 * i);
   });
+  return xyz;
+}
+
+// Points and triangles as a vtkPolyData (one triangle = 3 ids, fixed-size cell storage), the ids
+// copied in bulk, rows split over the threads.
+vtkSmartPointer<vtkPolyData> polydata_of(vtkDoubleArray* xyz, const std::vector<std::array<int, 3>>& triangles) {
+  const std::size_t T = triangles.size();
   vtkNew<vtkIdTypeArray> ids;
   ids->SetNumberOfValues(vtkIdType(3 * T));
   vtkIdType* c = ids->GetPointer(0);
   parallel_for(T, [&](std::size_t t0, std::size_t t1) {
-    for (std::size_t t = t0; t < t1; ++t) std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), c + 3 * t);
+    for (std::size_t t = t0; t < t1; ++t) std::copy(triangles[t].begin(), triangles[t].end(), c + 3 * t);
   });
   vtkNew<vtkPoints> pts;
   pts->SetData(xyz);
@@ -142,13 +154,11 @@ vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
   return pd;
 }
 
-namespace {
-
-// Unit normal of triangle t (zero when degenerate).
-std::array<double, 3> face_normal(const TriangleList& s, std::size_t t) {
-  const auto& p0 = s.points[s.triangles[t][0]];
-  const auto& p1 = s.points[s.triangles[t][1]];
-  const auto& p2 = s.points[s.triangles[t][2]];
+// Unit normal of triangle t over the points xyz (#P x 3; zero when degenerate).
+std::array<double, 3> face_normal(const double* xyz, const std::array<int, 3>& t) {
+  const double* p0 = xyz + 3 * std::size_t(t[0]);
+  const double* p1 = xyz + 3 * std::size_t(t[1]);
+  const double* p2 = xyz + 3 * std::size_t(t[2]);
   const double a[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, b[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
   std::array<double, 3> n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
   const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -156,15 +166,13 @@ std::array<double, 3> face_normal(const TriangleList& s, std::size_t t) {
   return n;
 }
 
-}  // namespace
-
-vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface) {
-  const std::size_t P = surface.points.size(), T = surface.triangles.size();
-  std::vector<std::array<double, 3>> fn(T);
-  parallel_for(T, [&](std::size_t t0, std::size_t t1) {
-    for (std::size_t t = t0; t < t1; ++t) fn[t] = face_normal(surface, t);
+// smooth_point_normals over the points xyz (#P x 3) and the triangles.
+vtkSmartPointer<vtkFloatArray> point_normals(const double* xyz, std::size_t P, const std::vector<std::array<int, 3>>& tris) {
+  std::vector<std::array<double, 3>> fn(tris.size());
+  parallel_for(tris.size(), [&](std::size_t t0, std::size_t t1) {
+    for (std::size_t t = t0; t < t1; ++t) fn[t] = face_normal(xyz, tris[t]);
   });
-  const VertexCorners corners = vertex_corners(surface.triangles, P);
+  const VertexCorners corners = vertex_corners(tris, P);
   auto normals = vtkSmartPointer<vtkFloatArray>::New();
   normals->SetName("Normals");
   normals->SetNumberOfComponents(3);
@@ -182,9 +190,55 @@ vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface)
   return normals;
 }
 
+// The mesh's triangles in face order, each face's corners in fv_range order (as to_triangle_list
+// gives them), faces split over the threads. Precondition: no deleted element.
+std::vector<std::array<int, 3>> mesh_faces(const Mesh& mesh) {
+  std::vector<std::array<int, 3>> tris(mesh.n_faces());
+  parallel_for(tris.size(), [&](std::size_t f0, std::size_t f1) {
+    for (std::size_t f = f0; f < f1; ++f) {
+      int k = 0;
+      for (auto v : mesh.fv_range(Mesh::FaceHandle(int(f))))
+        if (k < 3) tris[f][k++] = v.idx();
+    }
+  });
+  return tris;
+}
+
+// True when a vertex or face is marked deleted (not yet garbage-collected).
+bool has_deleted_elements(const Mesh& mesh) {
+  for (std::size_t f = 0; f < mesh.n_faces(); ++f)
+    if (mesh.status(Mesh::FaceHandle(int(f))).deleted()) return true;
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
+    if (mesh.status(Mesh::VertexHandle(int(v))).deleted()) return true;
+  return false;
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
+  return polydata_of(point_array(surface.points.size(), [&](std::size_t i) { return surface.points[i].data(); }),
+                     surface.triangles);
+}
+
+vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface) {
+  static_assert(sizeof(std::array<double, 3>) == 3 * sizeof(double), "points are packed");
+  return point_normals(surface.points.empty() ? nullptr : surface.points.front().data(), surface.points.size(),
+                       surface.triangles);
+}
+
 vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface) {
   vtkSmartPointer<vtkPolyData> pd = surface_polydata(surface);
   pd->GetPointData()->SetNormals(smooth_point_normals(surface));
+  return pd;
+}
+
+vtkSmartPointer<vtkPolyData> lit_surface_polydata(const Mesh& mesh) {
+  if (has_deleted_elements(mesh)) return lit_surface_polydata(to_triangle_list(mesh));
+  const std::vector<std::array<int, 3>> tris = mesh_faces(mesh);
+  vtkSmartPointer<vtkDoubleArray> xyz =
+      point_array(mesh.n_vertices(), [&](std::size_t i) { return mesh.point(Mesh::VertexHandle(int(i))).data(); });
+  vtkSmartPointer<vtkPolyData> pd = polydata_of(xyz, tris);
+  pd->GetPointData()->SetNormals(point_normals(xyz->GetPointer(0), mesh.n_vertices(), tris));
   return pd;
 }
 
@@ -213,8 +267,8 @@ namespace {
 // the camera, and the off-screen grab.
 class SnapshotScene {
  public:
-  SnapshotScene(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts)
-      : surface_(lit_surface_polydata(surface)), loops_(loops), opts_(opts) {}
+  SnapshotScene(vtkSmartPointer<vtkPolyData> lit_surface, vtkPolyData* loops, const SnapshotOptions& opts)
+      : surface_(std::move(lit_surface)), loops_(loops), opts_(opts) {}
   ImagePtr run();
 
  private:
@@ -350,11 +404,21 @@ ImagePtr SnapshotScene::grab() {
 
 }  // namespace
 
-ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
+namespace {
+ImagePtr render_lit_snapshot(vtkSmartPointer<vtkPolyData> lit_surface, vtkPolyData* loops, const SnapshotOptions& o) {
   ensure_display();
-  ImagePtr img = SnapshotScene(surface, loops, o).run();
+  ImagePtr img = SnapshotScene(std::move(lit_surface), loops, o).run();
   caption_snapshot(img, o.caption);
   return img;
+}
+}  // namespace
+
+ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& o) {
+  return render_lit_snapshot(lit_surface_polydata(surface), loops, o);
+}
+
+ImagePtr render_snapshot(const Mesh& surface, vtkPolyData* loops, const SnapshotOptions& o) {
+  return render_lit_snapshot(lit_surface_polydata(surface), loops, o);
 }
 
 void caption_snapshot(vtkImageData* snapshot, const std::string& caption) {

@@ -22,6 +22,7 @@
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/threads.h"
+#include "colonflat/core/topology.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/flatten/flatten.h"
@@ -280,6 +281,45 @@ TEST(RenderSnapshot, PointNormalsAreVtkPolyDataNormals) {
   ASSERT_EQ(got->GetNumberOfTuples(), want->GetNumberOfTuples());
   for (vtkIdType v = 0; v < got->GetNumberOfTuples(); ++v)
     for (int k = 0; k < 3; ++k) ASSERT_NEAR(got->GetComponent(v, k), want->GetComponent(v, k), 1e-6) << v;
+}
+
+// Bitwise equality of two lit polydata: points, triangle ids in order, point normals.
+void expect_same_lit_polydata(vtkPolyData* got, vtkPolyData* want) {
+  ASSERT_EQ(got->GetNumberOfPoints(), want->GetNumberOfPoints());
+  ASSERT_EQ(got->GetNumberOfPolys(), want->GetNumberOfPolys());
+  for (vtkIdType i = 0; i < got->GetNumberOfPoints(); ++i)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(got->GetPoint(i)[k], want->GetPoint(i)[k]) << i;
+  vtkNew<vtkIdList> a, b;
+  for (vtkIdType c = 0; c < got->GetNumberOfPolys(); ++c) {
+    got->GetCellPoints(c, a);
+    want->GetCellPoints(c, b);
+    ASSERT_EQ(a->GetNumberOfIds(), 3);
+    ASSERT_EQ(b->GetNumberOfIds(), 3);
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(a->GetId(k), b->GetId(k)) << "triangle " << c;
+  }
+  vtkDataArray* na = got->GetPointData()->GetNormals();
+  vtkDataArray* nb = want->GetPointData()->GetNormals();
+  ASSERT_TRUE(na && nb);
+  for (vtkIdType v = 0; v < na->GetNumberOfTuples(); ++v)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(na->GetComponent(v, k), nb->GetComponent(v, k)) << v;
+}
+
+// The snapshot's polydata built straight from a mesh is bit for bit the one of its
+// to_triangle_list (corners in the same order after edge flips moved the faces' halfedges), for
+// 1 and 3 threads, and a mesh with a deleted vertex (not garbage-collected) too.
+TEST(RenderSnapshot, MeshPolydataIsTriangleListPolydata) {
+  Mesh m = synthetic::to_mesh(synthetic::sphere(20, 40, 20));
+  int flipped = 0;
+  for (auto e : m.edges())
+    if (e.idx() % 7 == 0 && m.is_flip_ok(e)) m.flip(e), ++flipped;
+  ASSERT_GT(flipped, 50);
+  for (int threads : {1, 3}) {
+    set_thread_count(threads);
+    expect_same_lit_polydata(lit_surface_polydata(m), lit_surface_polydata(to_triangle_list(m)));
+  }
+  m.delete_vertex(Mesh::VertexHandle(5));  // its faces are deleted with it; no garbage collection
+  expect_same_lit_polydata(lit_surface_polydata(m), lit_surface_polydata(to_triangle_list(m)));
+  set_thread_count(0);
 }
 
 testing::CommandResult render_cli(const std::vector<std::string>& args) {

@@ -6,6 +6,7 @@
 // needs no display).
 #include <string>
 
+#include "colonflat/core/mesh.h"
 #include "colonflat/core/soup.h"
 #include "colonflat/render/artifacts.h"
 
@@ -33,6 +34,10 @@ vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface);
 vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface);
 // surface_polydata with smooth_point_normals as its point normals.
 vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface);
+// The same, bit for bit, as lit_surface_polydata(to_triangle_list(mesh)) but built straight from
+// the mesh (points, faces and normals each filled once, split over the threads; no TriangleList
+// copy). A mesh with deleted elements (not garbage-collected) goes through to_triangle_list.
+vtkSmartPointer<vtkPolyData> lit_surface_polydata(const Mesh& mesh);
 
 // How a wall surface looks: diffuse colour (RGB 0-1) and specular highlight.
 struct SurfaceLook {
@@ -50,6 +55,9 @@ vtkSmartPointer<vtkActor> surface_actor(vtkPolyData* surface, const SurfaceLook&
 // text: OpenGL never runs FreeType here, so a snapshot may render on one thread while another
 // draws text (draw_text); the caption is drawn onto the grabbed image.
 ImagePtr render_snapshot(const TriangleList& surface, vtkPolyData* loops, const SnapshotOptions& opts);
+// The same for a mesh, through lit_surface_polydata(mesh): pixel for pixel the snapshot of
+// to_triangle_list(surface).
+ImagePtr render_snapshot(const Mesh& surface, vtkPolyData* loops, const SnapshotOptions& opts);
 
 // Draws `caption` at the top left of a snapshot (white, 20 px; draw_text). Used by
 // render_snapshot, and for a caption known only after the snapshot was rendered.
