@@ -158,6 +158,24 @@ class RunLookup {
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
+// Inputs of gather_level_heights: the crop, the axis, interface-width in voxels, the contact marks of
+// ColonSegmenter::scan_contacts (1: gas at lower index, 2: higher; 0 none), the crop labels, the
+// fluid pieces and the crop's gas bodies (all arrays of d->total voxels).
+struct LevelGatherInput {
+  const Dims* d;
+  int axis;
+  int wvox;
+  const unsigned char* contact;
+  const unsigned char* lab;
+  const std::uint32_t* fluid_label;
+  const RunLookup* gas;
+};
+// (fluid piece, gas body the contact faces within wvox + 1 voxels, 0 if none) -> contact heights (mm).
+using LevelHeights = std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>>;
+// Appends to heights[side] (side = contact - 1) each contact voxel's height along the axis. Slabs of
+// z over the workers, merged in z order: every list equals the serial raster scan's, for any thread
+// count. Returns the number of slabs used (min(thread_count(), slices)).
+std::size_t gather_level_heights(const LevelGatherInput& in, LevelHeights heights[2]);
 // Erosion of `m` (0/1) by a ball of radius r_mm (voxels outside the volume count as set).
 Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
