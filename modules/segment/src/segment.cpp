@@ -70,6 +70,7 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
   check_input();
   gravity_from_metadata();
   lap("checks");
+  step_time("checks");  // starts the sub-step clock
   find_gas_bodies();
   step_time("crop");
   find_fluid_bodies();

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <mutex>
+#include <utility>
 #include <sstream>
 
 #include "segment_internal.h"
@@ -70,6 +72,47 @@ void ColonSegmenter::scan_contacts(int axis, Bytes* contact, bool layer) {
   });
 }
 
+namespace {
+// Adds the height of each contact voxel of z-slices [k0, k1) to h[side][(fluid piece, gas body)].
+void gather_slab(const LevelGatherInput& in, std::size_t k0, std::size_t k1, LevelHeights h[2]) {
+  const Dims& d = *in.d;
+  const std::size_t stride = d.stride[in.axis];
+  for (std::size_t q = k0 * d.n[0] * d.n[1], end = k1 * d.n[0] * d.n[1]; q < end; ++q) {
+    if (!in.contact[q]) continue;
+    std::size_t c[3];
+    d.coords(q, c[0], c[1], c[2]);
+    const int side = in.contact[q] - 1;
+    std::uint32_t g = 0;  // the gas voxel the contact faces, at most interface-width + 1 voxels away
+    for (long t = 1; t <= in.wvox + 1 && !g; ++t) {
+      const long p = side == 0 ? long(c[in.axis]) - t : long(c[in.axis]) + t;
+      if (p < 0 || p >= long(d.n[in.axis])) break;
+      const std::size_t r = side == 0 ? q - std::size_t(t) * stride : q + std::size_t(t) * stride;
+      if (in.lab[r] == kGas) g = in.gas->at(r);
+    }
+    h[side][{in.fluid_label[q], g}].push_back(float(double(c[in.axis]) * d.sp[in.axis]));
+  }
+}
+}  // namespace
+
+std::size_t gather_level_heights(const LevelGatherInput& in, LevelHeights heights[2]) {
+  std::mutex mu;
+  std::vector<std::pair<std::size_t, std::array<LevelHeights, 2>>> slabs;  // (first slice, its heights)
+  parallel_for(in.d->n[2], [&](std::size_t k0, std::size_t k1) {
+    std::array<LevelHeights, 2> h;
+    gather_slab(in, k0, k1, h.data());
+    std::lock_guard<std::mutex> lock(mu);
+    slabs.emplace_back(k0, std::move(h));
+  });
+  std::sort(slabs.begin(), slabs.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& slab : slabs)  // in z order: each list as the serial raster scan gives it
+    for (int side = 0; side < 2; ++side)
+      for (auto& [key, v] : slab.second[side]) {
+        std::vector<float>& dst = heights[side][key];
+        dst.insert(dst.end(), v.begin(), v.end());
+      }
+  return slabs.size();
+}
+
 // Per fluid body and side (0: gas at lower index, 1: at higher index) along `axis`: the number of
 // contact columns it shares with gas bodies along which they lie at one height (per gas body: a
 // gas body and a fluid body in one lumen meet at one level, since each has one pressure; one fluid
@@ -79,22 +122,10 @@ void ColonSegmenter::scan_contacts(int axis, Bytes* contact, bool layer) {
 std::vector<std::array<std::size_t, 2>> ColonSegmenter::level_contacts(int axis, std::size_t min_gas_voxels) {
   Bytes contact(d_.total, 0);
   scan_contacts(axis, &contact, false);
-  const int wvox = int(std::ceil(opts_.interface_width / d_.sp[axis]));
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> heights[2];  // (fluid, gas) -> heights
-  for (std::size_t q = 0; q < d_.total; ++q) {
-    if (!contact[q]) continue;
-    std::size_t c[3];
-    d_.coords(q, c[0], c[1], c[2]);
-    const int side = contact[q] - 1;
-    std::uint32_t g = 0;  // the gas voxel the contact faces, at most interface-width + 1 voxels away
-    for (long t = 1; t <= wvox + 1 && !g; ++t) {
-      const long p = side == 0 ? long(c[axis]) - t : long(c[axis]) + t;
-      if (p < 0 || p >= long(d_.n[axis])) break;
-      const std::size_t r = side == 0 ? q - std::size_t(t) * d_.stride[axis] : q + std::size_t(t) * d_.stride[axis];
-      if (lab_[r] == kGas) g = gas_lookup_.at(r);
-    }
-    heights[side][{fluid_label_[q], g}].push_back(float(double(c[axis]) * d_.sp[axis]));
-  }
+  const LevelGatherInput in{&d_, axis, int(std::ceil(opts_.interface_width / d_.sp[axis])), contact.data(), lab_.data(),
+                            fluid_label_.data(), &gas_lookup_};
+  LevelHeights heights[2];  // (fluid, gas) -> heights
+  gather_level_heights(in, heights);
   const double pixel_mm2 = d_.sp[0] * d_.sp[1] * d_.sp[2] / d_.sp[axis];
   const std::size_t min_columns = std::max<std::size_t>(8, std::size_t(std::ceil(100.0 / pixel_mm2)));  // 1 cm^2
   std::vector<std::array<std::size_t, 2>> out(fluid_count_ + 1, {0, 0});

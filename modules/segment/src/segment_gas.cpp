@@ -30,6 +30,7 @@ void ColonSegmenter::find_gas_bodies() {
     if (drop[l])
       for (const Run* r = gl.begin(l); r != gl.end(l); ++r) std::fill_n(gas.data() + r->start, r->length, 0);
   lap("gas_components");
+  step_time("gas bodies");
   crop_to_gas(gas.data());
   lap("crop");
 }
@@ -114,14 +115,16 @@ void ColonSegmenter::crop_to_gas(const unsigned char* gas) {
   if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
     std::fprintf(stderr, "crop %zu x %zu x %zu of %zu x %zu x %zu\n", cn[0], cn[1], cn[2], full_.n[0], full_.n[1], full_.n[2]);
   lab_.assign(d_.total, 0);
-  hu_.resize(d_.total);
+  hu_.resize(d_.total);  // not initialised: every row is copied below, slabs of z over the workers
   const float* fhu = ct_->GetBufferPointer();
-  for (std::size_t k = 0; k < cn[2]; ++k)
-    for (std::size_t j = 0; j < cn[1]; ++j) {
-      const std::size_t from = full_.idx(blo_[0], blo_[1] + j, blo_[2] + k), to = (k * cn[1] + j) * cn[0];
-      std::copy_n(gas + from, cn[0], lab_.data() + to);
-      std::copy_n(fhu + from, cn[0], hu_.data() + to);
-    }
+  parallel_for(cn[2], [&](std::size_t k0, std::size_t k1) {
+    for (std::size_t k = k0; k < k1; ++k)
+      for (std::size_t j = 0; j < cn[1]; ++j) {
+        const std::size_t from = full_.idx(blo_[0], blo_[1] + j, blo_[2] + k), to = (k * cn[1] + j) * cn[0];
+        std::copy_n(gas + from, cn[0], lab_.data() + to);
+        std::copy_n(fhu + from, cn[0], hu_.data() + to);
+      }
+  });
   for (std::size_t q : tube_) {  // the rectal tube's channel and wall: never lumen
     std::size_t c[3];
     full_.coords(q, c[0], c[1], c[2]);

@@ -5,12 +5,14 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -60,6 +62,30 @@ struct HugePageAllocator {
 template <class T>
 using Buffer = std::vector<T, HugePageAllocator<T>>;
 using Bytes = Buffer<unsigned char>;
+// The same blocks, but resize(n) leaves new elements default-initialised (no value-initialising
+// pass: a trivial T keeps whatever the block holds). Only for buffers whose every element is then
+// written over the workers (fill_parallel, a parallel copy): a fresh block's pages are then first
+// touched, faulted and zeroed by the kernel on the worker threads, not serially on the caller's.
+template <class T>
+struct RawHugePageAllocator : HugePageAllocator<T> {
+  template <class U>
+  struct rebind {
+    using other = RawHugePageAllocator<U>;
+  };
+  RawHugePageAllocator() = default;
+  template <class U>
+  RawHugePageAllocator(const RawHugePageAllocator<U>&) {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+template <class T>
+using RawBuffer = std::vector<T, RawHugePageAllocator<T>>;
 
 struct Dims {
   std::size_t n[3];
@@ -88,6 +114,16 @@ void for_each_voxel(std::size_t n, F&& f) {
   parallel_for(n, [&](std::size_t q0, std::size_t q1) {
     for (std::size_t q = q0; q < q1; ++q) f(q);
   });
+}
+// Post: v.size() == n and every element == value, written in chunks over the workers (no serial
+// pass over v; when the size changes, the old block is freed before the new one is taken).
+template <class T>
+void fill_parallel(RawBuffer<T>& v, std::size_t n, T value) {
+  if (v.size() != n) {
+    RawBuffer<T>().swap(v);
+    v.resize(n);
+  }
+  parallel_for(n, [&](std::size_t q0, std::size_t q1) { std::fill(v.data() + q0, v.data() + q1, value); });
 }
 // A run of voxels along axis 0: linear index of its first voxel and its length.
 struct Run {
@@ -122,6 +158,24 @@ class RunLookup {
 // In-place binary dilation / erosion of `v` (0/1) by a box of half-widths r[3] voxels (separable).
 void dilate_box(Bytes& v, const Dims& d, const int r[3]);
 void erode_box(Bytes& v, const Dims& d, const int r[3]);
+// Inputs of gather_level_heights: the crop, the axis, interface-width in voxels, the contact marks of
+// ColonSegmenter::scan_contacts (1: gas at lower index, 2: higher; 0 none), the crop labels, the
+// fluid pieces and the crop's gas bodies (all arrays of d->total voxels).
+struct LevelGatherInput {
+  const Dims* d;
+  int axis;
+  int wvox;
+  const unsigned char* contact;
+  const unsigned char* lab;
+  const std::uint32_t* fluid_label;
+  const RunLookup* gas;
+};
+// (fluid piece, gas body the contact faces within wvox + 1 voxels, 0 if none) -> contact heights (mm).
+using LevelHeights = std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>>;
+// Appends to heights[side] (side = contact - 1) each contact voxel's height along the axis. Slabs of
+// z over the workers, merged in z order: every list equals the serial raster scan's, for any thread
+// count. Returns the number of slabs used (min(thread_count(), slices)).
+std::size_t gather_level_heights(const LevelGatherInput& in, LevelHeights heights[2]);
 // Erosion of `m` (0/1) by a ball of radius r_mm (voxels outside the volume count as set).
 Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
@@ -305,10 +359,10 @@ class ColonSegmenter {
   bool gravity_known_ = false;
   std::string gravity_source_;
   std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
-  Buffer<float> hu_;                   // CT in the crop
+  RawBuffer<float> hu_;                // CT in the crop
   std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
   Bytes lab_;                          // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
-  Buffer<std::uint32_t> fluid_label_;  // fluid pieces in the crop (split_fluid_bodies .. candidate_bodies; then released)
+  RawBuffer<std::uint32_t> fluid_label_;  // fluid pieces in the crop (split_fluid_bodies .. candidate_bodies; then released)
   std::uint32_t fluid_count_ = 0;
   std::vector<unsigned char> pool_;    // per fluid label: 1 = level pool
   RunLookup gas_lookup_;                 // crop gas components

@@ -181,7 +181,7 @@ void ColonSegmenter::link_tagged_stretches() {
   const RunLabels cl = candidate_bodies(candidate);
   step_time("candidate_bodies");
   Bytes().swap(candidate);
-  Buffer<std::uint32_t>().swap(fluid_label_);  // the pieces' last use: the graph cut reuses these pages
+  RawBuffer<std::uint32_t>().swap(fluid_label_);  // the pieces' last use: the graph cut reuses these pages
   const std::uint32_t n = cl.count();
   const std::vector<BodyStats> bodies = body_stats(cl, [&](std::size_t q) { return hu_[q] < opts_.air_threshold; });
   mark_grid(cl.raster(std::vector<unsigned char>(n + 1, 1)), false);

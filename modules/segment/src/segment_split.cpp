@@ -109,7 +109,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
     for_each_voxel(d_.total, [&](std::size_t q) { core[q] = core[q] && hu_[q] >= opts_.fluid_threshold; });  // a wall voxel is no core
     const RunLabels cl = component_runs(core.data(), d_);
     step_time("core labels");
-    fluid_label_.assign(d_.total, 0);  // after the ball's work buffers are freed: the labels reuse their pages
+    fill_parallel(fluid_label_, d_.total, std::uint32_t(0));  // after the ball's work buffers are freed: the labels reuse their pages
     std::vector<std::size_t> queue = seed_cores(cl);
     step_time("seed_cores");
     grow_pieces(bright, queue);
@@ -118,7 +118,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
     step_time("other_level_cores");
     Bytes().swap(core);
     if (!other.empty()) {  // each a core of its own (its voxels leave the old cores); all grown again
-      fluid_label_.assign(d_.total, 0);
+      fill_parallel(fluid_label_, d_.total, std::uint32_t(0));
       queue = seed_cores(cl);
       for (std::size_t t = 0; t < other.size(); ++t)
         for (std::size_t q : other[t]) fluid_label_[q] = cl.count() + std::uint32_t(t) + 1, queue.push_back(q);
@@ -127,7 +127,7 @@ void ColonSegmenter::split_fluid_bodies(const Bytes& bright) {
       step_time("grow_pieces again");
     }
   }
-  if (!resolved) fluid_label_.assign(d_.total, 0);
+  if (!resolved) fill_parallel(fluid_label_, d_.total, std::uint32_t(0));
   Bytes rest(d_.total);
   for_each_voxel(d_.total, [&](std::size_t q) { rest[q] = bright[q] && !fluid_label_[q]; });
   const RunLabels thin = component_runs(rest.data(), d_);

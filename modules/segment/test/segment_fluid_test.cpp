@@ -6,10 +6,12 @@
 
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
 #include "colonflat/core/threads.h"
 
+#include "../src/segment_internal.h"
 #include "colonflat/segment/segment.h"
 #include "segment_volumes.h"
 
@@ -264,4 +266,64 @@ TEST(SegmentFluid, SameMaskForOneTwoAndThreeThreads) {
 }
 
 }  // namespace
+namespace segment_detail {
+namespace {
+
+// The contact heights gathered the obvious way: voxels in raster order, the gas body found by
+// stepping from the contact towards the gas side along the axis, at most wvox + 1 voxels.
+void serial_heights(const LevelGatherInput& in, LevelHeights out[2]) {
+  const Dims& d = *in.d;
+  for (std::size_t k = 0; k < d.n[2]; ++k)
+    for (std::size_t j = 0; j < d.n[1]; ++j)
+      for (std::size_t i = 0; i < d.n[0]; ++i) {
+        const std::size_t q = d.idx(i, j, k);
+        if (!in.contact[q]) continue;
+        long c[3] = {long(i), long(j), long(k)};
+        const int side = in.contact[q] - 1;
+        std::uint32_t g = 0;
+        for (int t = 1; t <= in.wvox + 1 && !g; ++t) {
+          c[in.axis] += side == 0 ? -1 : 1;
+          if (c[in.axis] < 0 || c[in.axis] >= long(d.n[in.axis])) break;
+          const std::size_t r = d.idx(std::size_t(c[0]), std::size_t(c[1]), std::size_t(c[2]));
+          if (in.lab[r] == 1) g = in.gas->at(r);
+        }
+        out[side][{in.fluid_label[q], g}].push_back(float(double(in.axis == 0 ? i : in.axis == 1 ? j : k) * d.sp[in.axis]));
+      }
+}
+
+// The level-contact gather split into z-slabs over the workers uses one slab per thread and gives
+// every (fluid piece, gas body) list exactly as the serial raster scan does (same heights, same
+// order), along each axis, for 1, 2 and 3 threads, on a random volume with many keys.
+TEST(SegmentFluid, SlabSplitLevelGatherEqualsSerialScan) {
+  const std::size_t n[3] = {13, 9, 8};
+  const double sp[3] = {0.7, 0.8, 1.5};
+  const Dims d = make_dims(n, sp);
+  std::mt19937 rng(7);
+  Bytes lab(d.total), contact(d.total), gas(d.total);
+  std::vector<std::uint32_t> fluid(d.total);
+  for (std::size_t q = 0; q < d.total; ++q) {
+    gas[q] = lab[q] = rng() % 10 < 3;  // 1: gas
+    contact[q] = lab[q] ? 0 : std::uint8_t(rng() % 3);
+    fluid[q] = 1 + rng() % 4;
+  }
+  const RunLookup gl(component_runs(gas.data(), d));
+  for (int axis = 0; axis < 3; ++axis) {
+    const LevelGatherInput in{&d, axis, 1, contact.data(), lab.data(), fluid.data(), &gl};
+    LevelHeights ref[2];
+    serial_heights(in, ref);
+    std::size_t with_gas = 0;
+    for (const auto& kv : ref[0]) with_gas += kv.first.second != 0;
+    EXPECT_GT(with_gas, 4u) << "axis " << axis;  // several gas bodies found, not only "none"
+    for (int t : {1, 2, 3}) {
+      set_thread_count(t);
+      LevelHeights got[2];
+      EXPECT_EQ(gather_level_heights(in, got), std::size_t(t)) << "axis " << axis << ", " << t << " threads";
+      EXPECT_TRUE(got[0] == ref[0] && got[1] == ref[1]) << "axis " << axis << ", " << t << " threads";
+    }
+  }
+  set_thread_count(0);
+}
+
+}  // namespace
+}  // namespace segment_detail
 }  // namespace cf

@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 #include <itkConnectedComponentImageFilter.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 
 #include "../src/segment_internal.h"
+#include "colonflat/core/threads.h"
 
 namespace cf::segment_detail {
 namespace {
@@ -154,6 +156,31 @@ TEST(SegmentGrid, FreedBlocksReusedInsideScopeReleasedOnMissAndAtEnd) {
   auto* e = static_cast<unsigned char*>(huge_page_alloc(big));
   EXPECT_EQ(e[0], 0);  // a fresh mapping
   huge_page_free(e, big);
+}
+
+// A RawBuffer's resize writes nothing (a reused block keeps its bytes: no serial zeroing pass on the
+// caller's thread), and fill_parallel then sets every element, for 1, 2 and 3 threads and when the
+// size changes.
+TEST(SegmentGrid, RawBufferResizeWritesNothingFillParallelSetsAll) {
+  const std::size_t big = std::size_t(6) << 20;
+  BlockReuse scope;
+  auto* a = static_cast<unsigned char*>(huge_page_alloc(big));
+  std::memset(a, 0xAB, big);
+  huge_page_free(a, big);
+  RawBuffer<std::uint32_t> v;
+  v.resize(big / 4);
+  ASSERT_EQ(static_cast<void*>(v.data()), static_cast<void*>(a));
+  EXPECT_EQ(v.front(), 0xABABABABu);  // value-initialising resize would have written 0
+  EXPECT_EQ(v.back(), 0xABABABABu);
+  for (int t : {1, 2, 3}) {
+    set_thread_count(t);
+    fill_parallel(v, big / 4, std::uint32_t(t));
+    EXPECT_EQ(std::count(v.begin(), v.end(), std::uint32_t(t)), std::ptrdiff_t(big / 4)) << t << " threads";
+  }
+  fill_parallel(v, big / 8 + 3, std::uint32_t(9));  // another size: a new block, every element written
+  EXPECT_EQ(v.size(), big / 8 + 3);
+  EXPECT_EQ(std::count(v.begin(), v.end(), 9u), std::ptrdiff_t(big / 8 + 3));
+  set_thread_count(0);
 }
 
 // The streamed 3 x 3 x 3 mean equals the brute-force mean with clamped edges, every slice once.
