@@ -20,7 +20,9 @@
 #include <numeric>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
+#include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -37,21 +39,47 @@ struct Cluster {
   double area = 0;
 };
 
+// One cluster's search: the branch (when kept), every face inside its neck (kept or not) and the
+// debug line.
+struct Candidate {
+  BranchCut cut;
+  bool kept = false;
+  std::vector<int> region;
+  std::string debug;
+};
+
 class BranchFinder {
  public:
   BranchFinder(const Surface& s, const Edges& E, const Embedding& emb, double length, double lumen_sign)
       : s_(s), E_(E), emb_(emb), length_(length), lumen_sign_(lumen_sign), area3_(s.t.size()), taken_(s.t.size(), 0) {
-    for (std::size_t f = 0; f < s.t.size(); ++f) area3_[f] = face_area_3d(s, int(f));
+    parallel_for(s.t.size(), [&](std::size_t b, std::size_t e) {
+      for (std::size_t f = b; f < e; ++f) area3_[f] = face_area_3d(s, int(f));
+    });
   }
 
-  std::vector<BranchCut> run(double min_area) {
+  // Every cluster searched side by side as if nothing were taken; then, largest first, a cluster
+  // meeting a branch taken before is skipped and a search whose faces meet one is done again
+  // against the taken faces. A search that met no taken face is the one-by-one search's: its flood
+  // (the only step that reads the taken faces) never reached one.
+  std::vector<BranchCut> run(double min_area, BranchSearch& search) {
+    const std::vector<Cluster> clusters = collapsed_clusters(min_area);
+    search.clusters = clusters.size();
+    std::vector<Candidate> ahead(clusters.size());
+    const std::vector<char> none(s_.t.size(), 0);
+    std::vector<std::function<void()>> tasks;
+    for (std::size_t i = 0; i < clusters.size(); ++i)
+      tasks.emplace_back([&, i] { ahead[i] = candidate(clusters[i], none); });
+    parallel_tasks(tasks);
+    const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
     std::vector<BranchCut> cuts;
-    for (const Cluster& c : collapsed_clusters(min_area)) {
-      if (std::any_of(c.faces.begin(), c.faces.end(), [&](int f) { return taken_[f] != 0; })) continue;
-      BranchCut b;
-      if (!cut_branch(c, b)) continue;
-      for (int f : b.faces) taken_[f] = 1;
-      cuts.push_back(std::move(b));
+    for (std::size_t i = 0; i < clusters.size(); ++i) {
+      if (any_taken(clusters[i].faces)) continue;
+      Candidate& c = ahead[i];
+      if (any_taken(c.region)) c = candidate(clusters[i], taken_), ++search.searched_again;
+      if (debug) std::fputs(c.debug.c_str(), stderr);
+      if (!c.kept) continue;
+      for (int f : c.cut.faces) taken_[f] = 1;
+      cuts.push_back(std::move(c.cut));
     }
     return cuts;
   }
@@ -60,8 +88,9 @@ class BranchFinder {
   // Step 1: edge-connected clusters of collapsed faces with at least `min_area` mm^2, largest first.
   std::vector<Cluster> collapsed_clusters(double min_area) const {
     std::vector<char> collapsed(s_.t.size(), 0);
-    for (std::size_t f = 0; f < s_.t.size(); ++f)
-      collapsed[f] = area3_[f] > 0 && emb_.area2(s_, int(f)) < kCollapsedRatio * area3_[f];
+    parallel_for(s_.t.size(), [&](std::size_t b, std::size_t e) {
+      for (std::size_t f = b; f < e; ++f) collapsed[f] = area3_[f] > 0 && emb_.area2(s_, int(f)) < kCollapsedRatio * area3_[f];
+    });
     std::vector<int> label(s_.t.size(), -1);
     std::vector<Cluster> out;
     for (std::size_t f0 = 0; f0 < s_.t.size(); ++f0) {
@@ -151,7 +180,7 @@ class BranchFinder {
   }
 
   // Step 4: faces inside radius r connected to the cluster, plus enclosed islands.
-  std::vector<char> inside(const Cluster& c, const std::vector<double>& d, double r) const {
+  std::vector<char> inside(const Cluster& c, const std::vector<double>& d, double r, const std::vector<char>& taken) const {
     std::vector<char> in(s_.t.size(), 0);
     auto within = [&](int f) {
       const Tri& t = s_.t[f];
@@ -165,7 +194,7 @@ class BranchFinder {
       stack.pop_back();
       for (int e : E_.fe[f])
         for (int g : E_.ef[e])
-          if (g >= 0 && !in[g] && !taken_[g] && within(g)) in[g] = 1, stack.push_back(g);
+          if (g >= 0 && !in[g] && !taken[g] && within(g)) in[g] = 1, stack.push_back(g);
     }
     // The outside must be one piece holding the annulus' own boundary: other pieces are islands
     // (found from the region's border: a flood of the whole band per candidate branch was 7 % of
@@ -237,9 +266,9 @@ class BranchFinder {
     return side > 0 ? 2 * std::abs(emb_.area2(s_, f)) / side / ulp : 0;
   }
 
-  // COLONFLAT_FLATTEN_DEBUG=1: each candidate cluster, its neck and why it is kept or not.
-  void debug_cluster(const Cluster& c, const BranchCut& b, double r, const std::vector<char>& in) const {
-    if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
+  // COLONFLAT_FLATTEN_DEBUG=1: each candidate cluster, its neck and why it is kept or not ("" without).
+  std::string debug_line(const Cluster& c, const BranchCut& b, double r, const std::vector<char>& in) const {
+    if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return std::string();
     V3 m = V3::Zero();
     double lowest = 1e300, finest = 1e300;
     for (int f : c.faces) {
@@ -248,24 +277,36 @@ class BranchFinder {
     }
     m /= double(c.faces.size());
     const bool found = !in.empty();
-    std::fprintf(stderr, "flatten debug cluster %zu faces %.1f mm2 min ratio %.2g height %.3g ulp LPS %.1f %.1f %.1f centre x %.2f: "
+    char line[512];
+    std::snprintf(line, sizeof line, "flatten debug cluster %zu faces %.1f mm2 min ratio %.2g height %.3g ulp LPS %.1f %.1f %.1f centre x %.2f: "
                  "neck radius %.3g, %.1f mm, disk %d, lumen %d, crushed %d\n", c.faces.size(), c.area, lowest, finest, m.x(), m.y(),
                  m.z(), b.centre.x(), r, b.neck_mm, found ? int(is_disk(in)) : -1, found ? int(holds_lumen(in)) : -1,
                  int(crushed(c)));
+    return line;
   }
 
-  bool cut_branch(const Cluster& c, BranchCut& b) const {
+  bool any_taken(const std::vector<int>& faces) const {
+    return std::any_of(faces.begin(), faces.end(), [&](int f) { return taken_[f] != 0; });
+  }
+
+  // Steps 2-4 for one cluster, the faces `taken` by larger branches closed to its flood.
+  Candidate candidate(const Cluster& c, const std::vector<char>& taken) const {
+    Candidate k;
+    BranchCut& b = k.cut;
     b.centre = centre_of(c);
     const std::vector<double> d = flat_distance(b.centre);
     const double r = neck_radius(c, d, b.neck_mm);
-    const std::vector<char> in = r > 0 ? inside(c, d, r) : std::vector<char>();
-    debug_cluster(c, b, r, in);
-    if (in.empty() || !is_disk(in)) return false;
+    const std::vector<char> in = r > 0 ? inside(c, d, r, taken) : std::vector<char>();
+    for (std::size_t f = 0; f < in.size(); ++f)
+      if (in[f]) k.region.push_back(int(f));
+    k.debug = debug_line(c, b, r, in);
+    if (in.empty() || !is_disk(in)) return k;
     b.tissue = !holds_lumen(in);
-    if (b.tissue && !crushed(c)) return false;
-    for (std::size_t f = 0; f < s_.t.size(); ++f)
-      if (in[f]) b.faces.push_back(int(f)), b.area_mm2 += area3_[f];
-    return !b.faces.empty();
+    if (b.tissue && !crushed(c)) return k;
+    for (int f : k.region) b.area_mm2 += area3_[f];
+    b.faces = k.region;
+    k.kept = !b.faces.empty();
+    return k;
   }
 
   const Surface& s_;
@@ -280,8 +321,14 @@ class BranchFinder {
 }  // namespace
 
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
-                                     double lumen_sign, double min_area_mm2) {
-  return BranchFinder(s, E, emb, length, lumen_sign).run(min_area_mm2);
+                                     double lumen_sign, double min_area_mm2, BranchSearch* search) {
+  BranchSearch done;
+  std::vector<BranchCut> cuts = BranchFinder(s, E, emb, length, lumen_sign).run(min_area_mm2, done);
+  if (search) *search = done;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug branches: %zu clusters searched side by side, %zu searched again, %zu cut\n",
+                 done.clusters, done.searched_again, cuts.size());
+  return cuts;
 }
 
 }  // namespace cf::flat_detail

@@ -192,8 +192,16 @@ struct BranchCut {
 // protrusions (a polyp on a stalk) unless their cluster holds a fold (negative 2D area: crushed
 // below what the map's doubles resolve, e.g. a long strand stump). `emb`: conformal embedding at
 // the area-preserving scale (not untangled), band [0, length] in x.
+// The clusters' branches are searched side by side on thread_count() threads, each as if no other
+// branch were cut, then taken in order (largest cluster first); a search whose faces meet a branch
+// taken before it is done again against those faces. The cuts are those of a one-by-one search,
+// for any thread count. `search` (optional): what was done.
+struct BranchSearch {
+  std::size_t clusters = 0;        // collapsed clusters of at least min_area_mm2 (all searched side by side)
+  std::size_t searched_again = 0;  // searches done again against the faces of branches taken before
+};
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
-                                     double lumen_sign, double min_area_mm2);
+                                     double lumen_sign, double min_area_mm2, BranchSearch* search = nullptr);
 
 // Vertex -> incident faces.
 std::vector<std::vector<int>> vertex_faces(const Surface& s);

@@ -6,9 +6,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "../src/flatten_internal.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/flatten_stage.h"
@@ -168,6 +170,120 @@ TEST(FlattenBranches, TissueBandSaysSoInTheFlatFileAndReport) {
   EXPECT_EQ(segs[1].value("kind", ""), "branch");
   EXPECT_EQ(segs[1].value("holds", ""), "tissue");
   EXPECT_FALSE(segs[0].contains("holds"));  // the colon band is no branch
+}
+
+// A plane (0..60 x 0..30 mm, 0.25 mm grid, z = 0) with pouches: inside the disk of radius rn around
+// (cx, cy) the grid rises as a cylinder of radius rn (height hc) topped by a sphere of radius rs (an
+// overhang: the rim is shortest, 2 pi rn, at the neck), and the map squeezes that disk to 1e-3 of
+// its size around its centre (what the conformal map does to a pouch); elsewhere the map is the grid.
+struct PouchesOnAPlane {
+  struct Pouch {
+    double cx, cy, rn, rs, hc;
+    double area() const {  // analytic wall area: the sphere above the neck circle and the cylinder
+      return 2 * M_PI * rs * rs * (1 + std::sqrt(1 - rn * rn / (rs * rs))) + 2 * M_PI * rn * hc;
+    }
+  };
+  static constexpr double kH = 0.25, kSqueeze = 1e-3, kLength = 60, kWidth = 30;
+  std::vector<Pouch> pouches;
+  flat_detail::Surface s;
+  flat_detail::Embedding emb;
+  flat_detail::Edges E;
+
+  explicit PouchesOnAPlane(std::vector<Pouch> ps) : pouches(std::move(ps)) {
+    const int nx = int(kLength / kH) + 1, ny = int(kWidth / kH) + 1;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * kH, j * kH));
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        const int v = j * nx + i;
+        s.t.push_back({v, v + 1, v + nx + 1});
+        s.t.push_back({v, v + nx + 1, v + nx});
+      }
+    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
+    emb.period = 1000;
+    E = flat_detail::build_edges(s.t);
+  }
+  // The pouch whose disk holds grid point q (-1: none).
+  int pouch_of(const flat_detail::V2& q) const {
+    for (std::size_t k = 0; k < pouches.size(); ++k)
+      if ((q - flat_detail::V2(pouches[k].cx, pouches[k].cy)).norm() < pouches[k].rn) return int(k);
+    return -1;
+  }
+  // The pouch all three corners of face f are in (-1: none); `margin` mm widens its disk.
+  int pouch_of_face(int f, double margin = 0) const {
+    for (std::size_t k = 0; k < pouches.size(); ++k) {
+      const flat_detail::V2 c(pouches[k].cx, pouches[k].cy);
+      bool all = true;
+      for (int v : s.t[f]) all = all && (grid_of(v) - c).norm() < pouches[k].rn + margin;
+      if (all) return int(k);
+    }
+    return -1;
+  }
+  flat_detail::V2 grid_of(int v) const {
+    const int nx = int(kLength / kH) + 1;
+    return flat_detail::V2((v % nx) * kH, (v / nx) * kH);
+  }
+
+ private:
+  void place(const flat_detail::V2& q) {
+    const int k = pouch_of(q);
+    if (k < 0) {
+      s.p.push_back(flat_detail::V3(q.x(), q.y(), 0));
+      emb.pos.push_back(q);
+      return;
+    }
+    const Pouch& o = pouches[std::size_t(k)];
+    const flat_detail::V2 c(o.cx, o.cy), off = q - c;
+    const double rho = off.norm(), phi_max = M_PI - std::asin(o.rn / o.rs);
+    const double a = rho / o.rn * (o.rs * phi_max + o.hc);  // arc length from the top along the profile
+    const double zc = o.hc + o.rs * std::sqrt(1 - o.rn * o.rn / (o.rs * o.rs));
+    const double g = a <= o.rs * phi_max ? o.rs * std::sin(a / o.rs) : o.rn;
+    const double z = a <= o.rs * phi_max ? zc + o.rs * std::cos(a / o.rs) : o.hc - (a - o.rs * phi_max);
+    const flat_detail::V2 xy = rho > 0 ? flat_detail::V2(c + off / rho * g) : c;
+    s.p.push_back(flat_detail::V3(xy.x(), xy.y(), z));
+    emb.pos.push_back(c + kSqueeze * off);
+  }
+};
+
+// Two pouches (a larger, then a smaller) are each cut at their neck: all their faces and of the
+// plane only a ring one sampled radius wide (<= 2 grid steps), about their analytic wall area and neck length, disjoint, largest first; both clusters are
+// searched side by side (none again: neither search reaches the other pouch), and one and two
+// threads give the same cuts, face for face.
+TEST(FlattenBranches, PouchClustersAreSearchedSideBySideAndCutAtTheirNecks) {
+  const PouchesOnAPlane g({{15, 15, 4, 8, 3}, {45, 15, 3, 6, 3}});
+  std::vector<std::vector<flat_detail::BranchCut>> runs;
+  for (int threads : {2, 1}) {
+    set_thread_count(threads);
+    flat_detail::BranchSearch search;
+    runs.push_back(flat_detail::find_branches(g.s, g.E, g.emb, g.kLength, 1.0, 50.0, &search));
+    set_thread_count(0);
+    EXPECT_EQ(search.clusters, 2u);
+    EXPECT_EQ(search.searched_again, 0u);
+  }
+  const auto& cuts = runs[0];
+  ASSERT_EQ(cuts.size(), 2u);
+  std::vector<int> owner(g.s.t.size(), -1);
+  for (std::size_t k = 0; k < 2; ++k) {
+    std::size_t inside = 0, near = 0, pouch_faces = 0;
+    for (int f : cuts[k].faces) {
+      EXPECT_EQ(owner[std::size_t(f)], -1) << "face " << f << " in two cuts";
+      owner[std::size_t(f)] = int(k);
+      inside += g.pouch_of_face(f) == int(k);
+      near += g.pouch_of_face(f, 2 * g.kH) == int(k);
+    }
+    for (std::size_t f = 0; f < g.s.t.size(); ++f) pouch_faces += g.pouch_of_face(int(f)) == int(k);
+    EXPECT_EQ(near, cuts[k].faces.size());  // of the plane only the ring at the neck
+    EXPECT_EQ(inside, pouch_faces);
+    EXPECT_NEAR(cuts[k].area_mm2, g.pouches[k].area(), 0.1 * g.pouches[k].area());
+    EXPECT_NEAR(cuts[k].neck_mm, 2 * M_PI * g.pouches[k].rn, 0.3 * 2 * M_PI * g.pouches[k].rn);
+    EXPECT_FALSE(cuts[k].tissue);
+  }
+  ASSERT_EQ(runs[1].size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(runs[1][k].faces, cuts[k].faces);
+    EXPECT_EQ(runs[1][k].area_mm2, cuts[k].area_mm2);
+    EXPECT_EQ(runs[1][k].neck_mm, cuts[k].neck_mm);
+  }
 }
 
 // A negative --branch-min-area is refused by `colonflat flatten` (usage error, one line, no output).
