@@ -154,6 +154,20 @@ double area_below(const SqueezedGrid& g, double ratio) {
   return below;
 }
 
+// The vertex `centre` and the vertices within `rings` vertex rings of it (breadth first).
+std::vector<int> vertex_rings(const SqueezedGrid& g, int centre, int rings) {
+  std::vector<int> spot{centre};
+  for (int k = 0; k < rings; ++k) {
+    std::vector<int> next = spot;
+    for (int u : spot)
+      for (int f : g.vf[u])
+        for (int v : g.s.t[f])
+          if (std::find(next.begin(), next.end(), v) == next.end()) next.push_back(v);
+    spot = next;
+  }
+  return spot;
+}
+
 // The grid (3 x as many vertices each way) squeezed to 0.05 (below coverage_min_ratio: a pocket for
 // the local pass) with a crushed spot inside: the vertices within 2 rings of the middle one drawn
 // towards it by 1e-4 in the map and by 0.1 in 3D (a sub-mm spot), so the 24 faces around the middle
@@ -162,15 +176,7 @@ double area_below(const SqueezedGrid& g, double ratio) {
 SqueezedGrid pinched_grid() {
   SqueezedGrid g(0.05, 3);
   const int centre = (g.ny / 2) * g.nx + g.nx / 2;
-  std::vector<int> spot{centre};
-  for (int k = 0; k < 2; ++k) {
-    std::vector<int> next = spot;
-    for (int u : spot)
-      for (int f : g.vf[u])
-        for (int v : g.s.t[f])
-          if (std::find(next.begin(), next.end(), v) == next.end()) next.push_back(v);
-    spot = next;
-  }
+  const std::vector<int> spot = vertex_rings(g, centre, 2);
   for (int v : spot) {
     g.emb.pos[v] = g.emb.pos[centre] + 1e-4 * (g.emb.pos[v] - g.emb.pos[centre]);
     g.s.p[v] = g.s.p[centre] + 0.1 * (g.s.p[v] - g.s.p[centre]);
@@ -216,15 +222,7 @@ TEST(AreaCorrection, FrozenPiecesCrushedSpotIsMovedIntoTheMap) {
 SqueezedGrid spotted_grid(int rings, double shrink) {
   SqueezedGrid g(1.0, 3);
   const int centre = (g.ny / 2) * g.nx + g.nx / 2;
-  std::vector<int> spot{centre};
-  for (int k = 0; k < rings; ++k) {
-    std::vector<int> next = spot;
-    for (int u : spot)
-      for (int f : g.vf[u])
-        for (int v : g.s.t[f])
-          if (std::find(next.begin(), next.end(), v) == next.end()) next.push_back(v);
-    spot = next;
-  }
+  const std::vector<int> spot = vertex_rings(g, centre, rings);
   for (int v : spot) {
     g.emb.pos[v] = g.emb.pos[centre] + 0.2 * shrink * (g.emb.pos[v] - g.emb.pos[centre]);
     g.s.p[v] = g.s.p[centre] + shrink * (g.s.p[v] - g.s.p[centre]);

@@ -11,6 +11,7 @@
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/core/threads.h"
+#include "squeezed_grid.h"
 #include "colonflat/flatten/flat_artifact.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/flatten_stage.h"
@@ -193,12 +194,7 @@ struct PouchesOnAPlane {
     const int nx = int(kLength / kH) + 1, ny = int(kWidth / kH) + 1;
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * kH, j * kH));
-    for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        const int v = j * nx + i;
-        s.t.push_back({v, v + 1, v + nx + 1});
-        s.t.push_back({v, v + nx + 1, v + nx});
-      }
+    test_shapes::grid_triangles(nx, ny, s.t);
     emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
     emb.period = 1000;
     E = flat_detail::build_edges(s.t);

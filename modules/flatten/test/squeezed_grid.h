@@ -7,6 +7,17 @@
 
 namespace cf::test_shapes {
 
+// Two triangles per cell of an nx x ny vertex grid numbered row by row (v = j * nx + i), both
+// counter-clockwise seen from +z, appended to `t`.
+inline void grid_triangles(int nx, int ny, std::vector<flat_detail::Tri>& t) {
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int v = j * nx + i;
+      t.push_back({v, v + 1, v + nx + 1});
+      t.push_back({v, v + nx + 1, v + nx});
+    }
+}
+
 struct SqueezedGrid {
   static constexpr int kNx = 24, kNy = 12;
   int nx = kNx, ny = kNy;  // vertices along x and y
@@ -24,12 +35,7 @@ struct SqueezedGrid {
         emb.pos.push_back(flat_detail::V2(x, j));
         fixed.push_back(i == 0 || j == 0 || i == nx - 1 || j == ny - 1);
       }
-    for (int j = 0; j + 1 < ny; ++j)
-      for (int i = 0; i + 1 < nx; ++i) {
-        const int v = j * nx + i;
-        s.t.push_back({v, v + 1, v + nx + 1});
-        s.t.push_back({v, v + nx + 1, v + nx});
-      }
+    grid_triangles(nx, ny, s.t);
     emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
     emb.period = 1000;
     degenerate.assign(s.t.size(), 0);
