@@ -358,7 +358,6 @@ TopologyReport analyze_topology(const TriangleList& m) {
   return TopologyAnalysis<std::array<double, 3>>(m.points.data(), m.points.size(), m.triangles).run();
 }
 
-namespace {
 std::vector<std::array<int, 3>> mesh_triangles(const Mesh& mesh) {
   std::vector<std::array<int, 3>> triangles;
   reserve_huge(triangles, mesh.n_faces());
@@ -373,7 +372,6 @@ std::vector<std::array<int, 3>> mesh_triangles(const Mesh& mesh) {
   }
   return triangles;
 }
-}  // namespace
 
 TriangleList to_triangle_list(const Mesh& mesh) {
   TriangleList t;

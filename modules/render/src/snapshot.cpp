@@ -190,20 +190,6 @@ vtkSmartPointer<vtkFloatArray> point_normals(const double* xyz, std::size_t P, c
   return normals;
 }
 
-// The mesh's triangles in face order, each face's corners in fv_range order (as to_triangle_list
-// gives them), faces split over the threads. Precondition: no deleted element.
-std::vector<std::array<int, 3>> mesh_faces(const Mesh& mesh) {
-  std::vector<std::array<int, 3>> tris(mesh.n_faces());
-  parallel_for(tris.size(), [&](std::size_t f0, std::size_t f1) {
-    for (std::size_t f = f0; f < f1; ++f) {
-      int k = 0;
-      for (auto v : mesh.fv_range(Mesh::FaceHandle(int(f))))
-        if (k < 3) tris[f][k++] = v.idx();
-    }
-  });
-  return tris;
-}
-
 // True when a vertex or face is marked deleted (not yet garbage-collected).
 bool has_deleted_elements(const Mesh& mesh) {
   for (std::size_t f = 0; f < mesh.n_faces(); ++f)
@@ -234,7 +220,7 @@ vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface) {
 
 vtkSmartPointer<vtkPolyData> lit_surface_polydata(const Mesh& mesh) {
   if (has_deleted_elements(mesh)) return lit_surface_polydata(to_triangle_list(mesh));
-  const std::vector<std::array<int, 3>> tris = mesh_faces(mesh);
+  const std::vector<std::array<int, 3>> tris = mesh_triangles(mesh);
   vtkSmartPointer<vtkDoubleArray> xyz =
       point_array(mesh.n_vertices(), [&](std::size_t i) { return mesh.point(Mesh::VertexHandle(int(i))).data(); });
   vtkSmartPointer<vtkPolyData> pd = polydata_of(xyz, tris);

@@ -60,5 +60,8 @@ TopologyReport analyze_topology(const Mesh& mesh);
 
 // Conversions between the two representations (same vertex and face order).
 TriangleList to_triangle_list(const Mesh& mesh);
+// The mesh's live faces in face order, each face's corners in fv_range order (#F x 3 vertex ids;
+// the triangles of to_triangle_list).
+std::vector<std::array<int, 3>> mesh_triangles(const Mesh& mesh);
 
 }  // namespace cf

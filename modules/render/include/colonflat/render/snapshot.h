@@ -35,8 +35,8 @@ vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface)
 // surface_polydata with smooth_point_normals as its point normals.
 vtkSmartPointer<vtkPolyData> lit_surface_polydata(const TriangleList& surface);
 // The same, bit for bit, as lit_surface_polydata(to_triangle_list(mesh)) but built straight from
-// the mesh (points, faces and normals each filled once, split over the threads; no TriangleList
-// copy). A mesh with deleted elements (not garbage-collected) goes through to_triangle_list.
+// the mesh (points and normals filled once, split over the threads; the faces by core's
+// mesh_triangles; no TriangleList copy of the points). A mesh with deleted elements (not garbage-collected) goes through to_triangle_list.
 vtkSmartPointer<vtkPolyData> lit_surface_polydata(const Mesh& mesh);
 
 // How a wall surface looks: diffuse colour (RGB 0-1) and specular highlight.
