@@ -60,7 +60,9 @@ class BranchFinder {
   // Every cluster searched side by side as if nothing were taken; then, largest first, a cluster
   // meeting a branch taken before is skipped and a search whose faces meet one is done again
   // against the taken faces. A search that met no taken face is the one-by-one search's: its flood
-  // (the only step that reads the taken faces) never reached one.
+  // (the only step that reads the taken faces) never reached one. A search done again holds a taken
+  // branch only as an island (its flood stops at taken faces): a pouch nested inside this one's
+  // neck, which this branch then replaces (absorb()).
   std::vector<BranchCut> run(double min_area, BranchSearch& search) {
     const std::vector<Cluster> clusters = collapsed_clusters(min_area);
     search.clusters = clusters.size();
@@ -77,7 +79,7 @@ class BranchFinder {
       Candidate& c = ahead[i];
       if (any_taken(c.region)) c = candidate(clusters[i], taken_), ++search.searched_again;
       if (debug) std::fputs(c.debug.c_str(), stderr);
-      if (!c.kept) continue;
+      if (!c.kept || !absorb(c, cuts, search)) continue;
       for (int f : c.cut.faces) taken_[f] = 1;
       cuts.push_back(std::move(c.cut));
     }
@@ -285,6 +287,28 @@ class BranchFinder {
     return line;
   }
 
+  // The branches taken before that `c`'s region holds (islands of its outside: pouches nested
+  // inside its neck) are dropped from `cuts`, `c`'s band holds them (and finds them again when it is
+  // flattened). False (c not taken) if a taken branch lay only partly in the region: never two
+  // branches share a face.
+  bool absorb(const Candidate& c, std::vector<BranchCut>& cuts, BranchSearch& search) const {
+    if (!any_taken(c.region)) return true;
+    std::vector<char> in(s_.t.size(), 0);
+    for (int f : c.region) in[std::size_t(f)] = 1;
+    std::vector<char> held(cuts.size(), 0);
+    for (std::size_t k = 0; k < cuts.size(); ++k) {
+      const std::size_t n = std::size_t(std::count_if(cuts[k].faces.begin(), cuts[k].faces.end(), [&](int f) { return in[f] != 0; }));
+      if (n > 0 && n < cuts[k].faces.size()) return false;
+      held[k] = n > 0;
+    }
+    std::vector<BranchCut> rest;
+    for (std::size_t k = 0; k < cuts.size(); ++k)
+      if (!held[k]) rest.push_back(std::move(cuts[k]));
+    cuts = std::move(rest);
+    search.absorbed += std::size_t(std::count(held.begin(), held.end(), 1));
+    return true;
+  }
+
   bool any_taken(const std::vector<int>& faces) const {
     return std::any_of(faces.begin(), faces.end(), [&](int f) { return taken_[f] != 0; });
   }
@@ -326,8 +350,8 @@ std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Emb
   std::vector<BranchCut> cuts = BranchFinder(s, E, emb, length, lumen_sign).run(min_area_mm2, done);
   if (search) *search = done;
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug branches: %zu clusters searched side by side, %zu searched again, %zu cut\n",
-                 done.clusters, done.searched_again, cuts.size());
+    std::fprintf(stderr, "flatten debug branches: %zu clusters searched side by side, %zu searched again, %zu held by a "
+                 "later branch, %zu cut\n", done.clusters, done.searched_again, done.absorbed, cuts.size());
   return cuts;
 }
 

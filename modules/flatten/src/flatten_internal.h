@@ -187,18 +187,21 @@ struct BranchCut {
   V2 centre;            // flat position of the collapse in the conformal embedding (mm)
   bool tissue = false;  // the region closed over the neck holds tissue (a crushed strand stump), not lumen
 };
-// Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; largest first,
-// disjoint; pouches of the lumen (face normals x `lumen_sign` point out of the lumen), not tissue
+// Branches whose collapsed part (area ratio < 0.01) covers at least `min_area_mm2`; in the order
+// taken, disjoint; pouches of the lumen (face normals x `lumen_sign` point out of the lumen), not tissue
 // protrusions (a polyp on a stalk) unless their cluster holds a fold (negative 2D area: crushed
 // below what the map's doubles resolve, e.g. a long strand stump). `emb`: conformal embedding at
 // the area-preserving scale (not untangled), band [0, length] in x.
 // The clusters' branches are searched side by side on thread_count() threads, each as if no other
 // branch were cut, then taken in order (largest cluster first); a search whose faces meet a branch
-// taken before it is done again against those faces. The cuts are those of a one-by-one search,
-// for any thread count. `search` (optional): what was done.
+// taken before it is done again against those faces. A branch taken before that such a search
+// holds as an island (a pouch nested inside the later branch's neck) is dropped: the later
+// branch's band holds it (its own flatten finds it again). The cuts are those of a one-by-one
+// search, for any thread count, in the order taken. `search` (optional): what was done.
 struct BranchSearch {
   std::size_t clusters = 0;        // collapsed clusters of at least min_area_mm2 (all searched side by side)
   std::size_t searched_again = 0;  // searches done again against the faces of branches taken before
+  std::size_t absorbed = 0;        // branches taken before that a later branch's neck enclosed (dropped: its band holds them)
 };
 std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Embedding& emb, double length,
                                      double lumen_sign, double min_area_mm2, BranchSearch* search = nullptr);

@@ -282,6 +282,144 @@ TEST(FlattenBranches, PouchClustersAreSearchedSideBySideAndCutAtTheirNecks) {
   }
 }
 
+// A pouch with a pouch nested on its wall, on a plane (0..40 x 0..30 mm, 0.1 mm grid, z = 0). The
+// outer pouch: inside the disk of radius kRb around cb = (15, 15) the grid rises as a cylinder of
+// radius kRn (height kHc) topped by a sphere of radius kRs, so its shortest rim is the cylinder (2 pi
+// kRn). Its map squeezes only the sphere's top (grid radius < kRc) to 1e-3; the rest of its wall
+// keeps a few % of its area (not collapsed), the cylinder more. The inner pouch: the grid disk of
+// radius kRa around ca = (17.5, 15) (on the outer sphere's equator) rises from the outer wall, along
+// its normal, as a cylinder of radius kRna (height kHca) topped by a sphere of radius kRsa (its own
+// neck 2 pi kRna, shorter than the outer one's), and the map squeezes its sphere (grid radius <
+// kRaCore) to 1e-3 around its centre and opens linearly back to the outer map over its cylinder.
+// The inner cluster is the larger (~200 mm2 against ~40), so it is taken first, and the outer
+// pouch's neck encloses it: the outer pouch's search meets a branch taken before.
+struct NestedPouches {
+  static constexpr double kH = 0.1, kLength = 40, kWidth = 30, kSqueeze = 1e-3;
+  static constexpr double kRb = 6, kRn = 3, kRs = 10, kHc = 10, kRc = 0.6, kF1 = 3;
+  static constexpr double kRa = 1, kRna = 2, kRsa = 4, kHca = 4, kRaCore = 0.6;
+  const flat_detail::V2 cb{15, 15}, ca{17.5, 15};
+  flat_detail::Surface s;
+  flat_detail::Embedding emb;
+  flat_detail::Edges E;
+
+  NestedPouches() {
+    const int nx = int(kLength / kH) + 1, ny = int(kWidth / kH) + 1;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * kH, j * kH));
+    test_shapes::grid_triangles(nx, ny, s.t);
+    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
+    emb.period = 1000;
+    E = flat_detail::build_edges(s.t);
+  }
+  static double phi_max(double rn, double rs) { return M_PI - std::asin(rn / rs); }
+  // Grid radius (from cb) of the outer sphere's foot.
+  static double rho_sphere() { return kRb * kRs * phi_max(kRn, kRs) / (kRs * phi_max(kRn, kRs) + kHc); }
+  // Wall area of a sphere of radius rs above a neck circle of radius rn.
+  static double sphere_area(double rn, double rs) { return 2 * M_PI * rs * rs * (1 + std::sqrt(1 - rn * rn / (rs * rs))); }
+  flat_detail::V2 grid_of(int v) const {
+    const int nx = int(kLength / kH) + 1;
+    return flat_detail::V2((v % nx) * kH, (v / nx) * kH);
+  }
+  // Whether all corners of face f lie within grid radius r of c.
+  bool face_within(int f, const flat_detail::V2& c, double r) const {
+    return std::all_of(s.t[f].begin(), s.t[f].end(), [&](int v) { return (grid_of(v) - c).norm() < r; });
+  }
+
+ private:
+  // A pouch's profile at grid radius rho of its disk (radius R): (distance from its axis, height).
+  static flat_detail::V2 profile(double rho, double R, double rn, double rs, double hc) {
+    const double pm = phi_max(rn, rs), a = rho / R * (rs * pm + hc);  // arc length from the top
+    const double zc = hc + rs * std::sqrt(1 - rn * rn / (rs * rs));
+    if (a <= rs * pm) return {rs * std::sin(a / rs), zc + rs * std::cos(a / rs)};
+    return {rn, hc - (a - rs * pm)};
+  }
+  // 3D point of grid point q on the plane with the outer pouch.
+  static flat_detail::V3 outer_point(const flat_detail::V2& q) {
+    const flat_detail::V2 c(15, 15), off = q - c;
+    const double rho = off.norm();
+    if (rho >= kRb) return {q.x(), q.y(), 0};
+    const flat_detail::V2 gz = profile(rho, kRb, kRn, kRs, kHc);
+    const flat_detail::V2 xy = rho > 0 ? flat_detail::V2(c + off / rho * gz.x()) : c;
+    return {xy.x(), xy.y(), gz.y()};
+  }
+  // Flat radius of the outer pouch's grid radius rho: squeezed top, then sqrt (its area ratio
+  // constant on the sphere), then linear on the cylinder, reaching the plane's own at kRb.
+  static double flat_radius(double rho) {
+    const double r1 = rho_sphere();
+    if (rho < kRc) return kSqueeze * rho;
+    if (rho < r1) return kSqueeze * kRc + kF1 * std::sqrt((rho - kRc) / (r1 - kRc));
+    return kSqueeze * kRc + kF1 + (kRb - kF1 - kSqueeze * kRc) * (rho - r1) / (kRb - r1);
+  }
+  flat_detail::V2 outer_flat(const flat_detail::V2& q) const {
+    const double rho = (q - cb).norm();
+    return rho > 0 && rho < kRb ? flat_detail::V2(cb + (q - cb) / rho * flat_radius(rho)) : q;
+  }
+  // The inner pouch's 3D point: its profile in the outer wall's frame at ca (normal to the +z side).
+  flat_detail::V3 inner_point(const flat_detail::V2& q) const {
+    const double e = 1e-4;
+    const flat_detail::V3 ex = outer_point(ca + flat_detail::V2(e, 0)) - outer_point(ca - flat_detail::V2(e, 0));
+    const flat_detail::V3 ey = outer_point(ca + flat_detail::V2(0, e)) - outer_point(ca - flat_detail::V2(0, e));
+    const flat_detail::V3 n = ex.cross(ey).normalized(), t1 = ex.normalized(), t2 = n.cross(t1);
+    const flat_detail::V2 off = q - ca;
+    const double rho = off.norm();
+    const flat_detail::V2 gz = profile(rho, kRa, kRna, kRsa, kHca);
+    const flat_detail::V2 dir = rho > 0 ? flat_detail::V2(off / rho) : flat_detail::V2(1, 0);
+    return outer_point(ca) + gz.x() * (dir.x() * t1 + dir.y() * t2) + gz.y() * n;
+  }
+  void place(const flat_detail::V2& q) {
+    const bool inner = (q - ca).norm() < kRa;
+    s.p.push_back(inner ? inner_point(q) : outer_point(q));
+    const flat_detail::V2 fa = outer_flat(ca);
+    const double t = std::clamp(((q - ca).norm() - kRaCore) / (kRa - kRaCore), 0.0, 1.0);
+    emb.pos.push_back(inner ? flat_detail::V2(fa + (kSqueeze + (1 - kSqueeze) * t) * (outer_flat(q) - fa)) : outer_flat(q));
+  }
+};
+
+// The re-search path: the inner pouch's cluster is the larger and is taken first; the outer
+// pouch's neck encloses it, so the outer search meets a taken branch and is done again. The result
+// is one branch, the outer pouch cut at its neck holding the inner pouch (which is found again when
+// the outer band is flattened), never two overlapping ones; the same for 1 and 2 threads.
+TEST(FlattenBranches, PouchNestedInAPouchsNeckIsHeldByTheOuterBranchOnly) {
+  const NestedPouches g;
+  std::vector<std::vector<flat_detail::BranchCut>> runs;
+  for (int threads : {2, 1}) {
+    set_thread_count(threads);
+    flat_detail::BranchSearch search;
+    runs.push_back(flat_detail::find_branches(g.s, g.E, g.emb, g.kLength, 1.0, 20.0, &search));
+    set_thread_count(0);
+    EXPECT_GE(search.clusters, 2u);  // the two pouches' (and pieces of their rims, inside their branches)
+    EXPECT_EQ(search.searched_again, 1u);
+    EXPECT_EQ(search.absorbed, 1u);
+  }
+  const auto& cuts = runs[0];
+  std::vector<int> owner(g.s.t.size(), -1);
+  for (std::size_t k = 0; k < cuts.size(); ++k)
+    for (int f : cuts[k].faces) {
+      EXPECT_EQ(owner[std::size_t(f)], -1) << "face " << f << " in two cuts";
+      owner[std::size_t(f)] = int(k);
+    }
+  ASSERT_EQ(cuts.size(), 1u);
+  const auto& b = cuts[0];
+  std::size_t sphere_faces = 0, sphere_cut = 0, inner_faces = 0, inner_cut = 0;
+  for (std::size_t f = 0; f < g.s.t.size(); ++f) {
+    const bool sphere = g.face_within(int(f), g.cb, g.rho_sphere()), inner = g.face_within(int(f), g.ca, g.kRa);
+    sphere_faces += sphere, inner_faces += inner;
+    sphere_cut += sphere && owner[f] == 0, inner_cut += inner && owner[f] == 0;
+  }
+  EXPECT_GT(inner_faces, 50u);
+  EXPECT_EQ(inner_cut, inner_faces);    // the nested pouch is inside the outer branch
+  EXPECT_EQ(sphere_cut, sphere_faces);  // and so is the outer pouch's whole sphere
+  for (int f : b.faces) EXPECT_TRUE(g.face_within(f, g.cb, g.kRb)) << "face " << f << " beyond the outer pouch";
+  // its wall: the outer sphere (less the patch the inner pouch replaces) and the inner pouch, some cylinder
+  EXPECT_GT(b.area_mm2, g.sphere_area(g.kRn, g.kRs));
+  EXPECT_LT(b.area_mm2, g.sphere_area(g.kRn, g.kRs) + g.sphere_area(g.kRna, g.kRsa) + 2 * M_PI * (g.kRna * g.kHca + g.kRn * g.kHc));
+  EXPECT_NEAR(b.neck_mm, 2 * M_PI * g.kRn, 0.3 * 2 * M_PI * g.kRn);
+  EXPECT_FALSE(b.tissue);
+  ASSERT_EQ(runs[1].size(), 1u);
+  EXPECT_EQ(runs[1][0].faces, b.faces);
+  EXPECT_EQ(runs[1][0].neck_mm, b.neck_mm);
+}
+
 // A negative --branch-min-area is refused by `colonflat flatten` (usage error, one line, no output).
 TEST(FlattenBranches, NegativeMinAreaIsRefused) {
   testing::TempDir tmp;
