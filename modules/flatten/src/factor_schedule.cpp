@@ -218,16 +218,27 @@ double thread_cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+double thread_wait_seconds() {
+  std::FILE* f = std::fopen("/proc/thread-self/schedstat", "r");
+  if (!f) return 0.0;
+  unsigned long long run = 0, wait = 0;
+  const int got = std::fscanf(f, "%llu %llu", &run, &wait);
+  std::fclose(f);
+  return got == 2 ? 1e-9 * double(wait) : 0.0;
+}
+
 void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
-                        double rest_cpu, double seconds, bool early) {
+                        double rest_cpu, double seconds, bool early, const FactorWall& wall) {
   double largest = 0, longest = 0;
   for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
   for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
   std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases%s, largest parts %.3f, rest %.3f "
-               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s\n", parts, n,
-               phases.size(), early ? " (scheduled beside the analysis)" : "", largest,
-               phases.back().rest_work / phases.front().total_work, cpu.size() > 0 ? cpu[0] : 0.0,
-               cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds);
+               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s (wall: transpose "
+               "%.2f, numeric L %.2f, parts %.2f, rest %.2f, free %.2f; parts waited for a core %.2f / %.2f s)\n", parts, n, phases.size(),
+               early ? " (scheduled beside the analysis)" : "", largest, phases.back().rest_work / phases.front().total_work,
+               cpu.size() > 0 ? cpu[0] : 0.0, cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds, wall.transpose,
+               wall.numeric, wall.parts, wall.rest, wall.free,
+               wall.wait.size() > 0 ? wall.wait[0] : 0.0, wall.wait.size() > 1 ? wall.wait[1] : 0.0);
 }
 
 }  // namespace cf::flat_detail

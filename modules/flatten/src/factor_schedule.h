@@ -53,10 +53,22 @@ constexpr int kMaxPhases = 8;
 
 // CPU seconds of the calling thread (COLONFLAT_FLATTEN_DEBUG: the threaded factorisation's parts).
 double thread_cpu_seconds();
+// Seconds the calling thread has waited on a run queue for a core (Linux /proc/thread-self/schedstat;
+// 0 where unavailable): a part's wall beyond its CPU on a shared machine.
+double thread_wait_seconds();
+// Wall seconds of the serial and threaded stretches of one threaded factorisation (debug line).
+struct FactorWall {
+  double transpose = 0;  // the numeric transpose triu(A(p,p)) (cholmod_ptranspose)
+  double numeric = 0;    // L made numeric (cholmod_change_factor: L's arrays allocated, set to the identity)
+  double parts = 0;      // the phases' parts side by side (each phase as long as its longest part)
+  double rest = 0;       // the rows above the last phase's parts, on the calling thread
+  double free = 0;       // the transpose freed
+  std::vector<double> wait;  // per part (summed over phases): seconds its thread waited for a core
+};
 // COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured (`cpu`: per part
 // summed over the phases, then each phase's longest; `early`: the schedule was computed beside the
-// symbolic analysis).
+// symbolic analysis) and the wall of each stretch.
 void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
-                        double rest_cpu, double seconds, bool early);
+                        double rest_cpu, double seconds, bool early, const FactorWall& wall);
 
 }  // namespace cf::flat_detail

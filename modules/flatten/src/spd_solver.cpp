@@ -12,9 +12,9 @@
 #include <mutex>
 
 #include "colonflat/core/error.h"
-#include "colonflat/core/huge_pages.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
+#include "factor_memory.h"
 #include "factor_schedule.h"
 #include "metis_order.h"
 
@@ -87,34 +87,6 @@ cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
 
 namespace {
 
-// CHOLMOD's large blocks (a colon's factor: about 300 MB) on transparent huge pages where the
-// system allows them (core advise_huge_pages): faulting them in as 4 KiB pages cost about a tenth
-// of the flatten time.
-void* huge_malloc(std::size_t bytes) {
-  void* p = std::malloc(bytes);
-  advise_huge_pages(p, bytes);
-  return p;
-}
-void* huge_calloc(std::size_t n, std::size_t size) {
-  void* p = std::calloc(n, size);
-  advise_huge_pages(p, n * size);
-  return p;
-}
-void* huge_realloc(void* old, std::size_t bytes) {
-  void* p = std::realloc(old, bytes);
-  advise_huge_pages(p, bytes);
-  return p;
-}
-void use_huge_pages_for_cholmod() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    SuiteSparse_config.malloc_func = huge_malloc;
-    SuiteSparse_config.calloc_func = huge_calloc;
-    SuiteSparse_config.realloc_func = huge_realloc;
-    SuiteSparse_config.free_func = std::free;
-  });
-}
-
 // A CHOLMOD view of a column-major Eigen matrix.
 cholmod_dense view_dense(const Eigen::MatrixXd& b) {
   cholmod_dense d{};
@@ -146,7 +118,7 @@ std::mutex& metis_mutex() {
 
 // CHOLMOD's AMD (`nested` false) or METIS nested dissection order of A; empty when it fails.
 std::vector<int> cholmod_order(const SpdSolver::SpMat& A, bool nested) {
-  use_huge_pages_for_cholmod();
+  install_for_cholmod();
   cholmod_common common;
   cholmod_start(&common);
   common.print = 0;
@@ -228,15 +200,20 @@ std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vect
   return phases;
 }
 
-// One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds.
-bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu) {
+// One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds,
+// wait[p] += the seconds its thread waited for a core.
+bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu,
+                  std::vector<double>& wait) {
   std::vector<char> ok(phase.parts.size(), 0);
   std::vector<double> seconds(phase.parts.size(), 0.0);
+  wait.resize(std::max(wait.size(), phase.parts.size()), 0.0);
   std::vector<std::function<void()>> tasks;
   for (std::size_t p = 0; p < phase.parts.size(); ++p)
     tasks.push_back([&, p] {
+      const double waited = thread_wait_seconds();
       ThreadCommon tc;
       ok[p] = rowfac_rows(upper, phase.parts[p], L, tc.c, &seconds[p]);
+      wait[p] += thread_wait_seconds() - waited;
     });
   parallel_tasks(tasks);
   cpu.resize(std::max(cpu.size(), seconds.size()), 0.0);
@@ -259,11 +236,14 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   const int parts = thread_count();
   if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
   const Stopwatch sw;
+  Stopwatch lap;
+  FactorWall wall;
   cholmod_sparse* upper =
       cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
   if (!upper) return -1;
   early = ready.size() > 0 && ready.front().parts.size() == std::size_t(parts);
   std::vector<RowSchedule> phases = early ? std::move(ready) : factor_schedule(upper, parts);
+  wall.transpose = lap.lap();
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
   if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
@@ -275,12 +255,21 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
     phases[0].rest.resize(L->n);
     for (std::size_t k = 0; k < L->n; ++k) phases[0].rest[k] = int(k);
   }
+  wall.numeric = lap.lap();
   std::vector<double> cpu(std::size_t(parts), 0.0);  // per part (summed over phases), then each phase's longest
-  for (const RowSchedule& phase : phases) ok = ok && factor_parts(upper, phase, L, cpu);
+  for (const RowSchedule& phase : phases) ok = ok && factor_parts(upper, phase, L, cpu, wall.wait);
+  wall.parts = lap.lap();
   double rest_cpu = 0;
   ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
+  wall.rest = lap.lap();
   cholmod_free_sparse(&upper, &common);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early);
+  wall.free = lap.lap();
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
+    print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early, wall);
+    const BlockCache::Stats s = cholmod_block_cache().stats();
+    std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now\n", s.reused,
+                 s.fresh, s.kept);
+  }
   return ok ? 1 : 0;
 }
 
@@ -312,7 +301,7 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   release();
   fallback_.reset();
   given_order_.clear();
-  use_huge_pages_for_cholmod();
+  install_for_cholmod();
   cholmod_start(&common_);
   common_.print = 0;  // no warnings on stderr: a failed factorisation is reported by status and falls back
   started_ = true;
@@ -323,14 +312,26 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
     common_.nmethods = 1;
     common_.method[0].ordering = CHOLMOD_GIVEN;
     common_.postorder = 0;  // the order as given: its leading block stays the factor's top-left corner
-    const auto symbolic = [&] { factor_ = cholmod_analyze_p(&view, const_cast<int*>(order->data()), nullptr, 0, &common_); };
+    double seconds[2] = {0, 0};  // wall of the analysis and of the schedule (debug)
+    const auto symbolic = [&] {
+      const Stopwatch sw;
+      factor_ = cholmod_analyze_p(&view, const_cast<int*>(order->data()), nullptr, 0, &common_);
+      seconds[0] = sw.seconds();
+    };
     // The threaded factorisation's row schedule reads only the pattern of A in this order: computed
     // on a second thread beside CHOLMOD's analysis instead of after it, in factorize().
     const int parts = thread_count();
     if (parts > 1 && std::size_t(A.rows()) >= kThreadedFactorMinRows)
-      parallel_tasks({symbolic, [&] { schedule_ = pattern_schedule(&view, *order, parts); }});
+      parallel_tasks({symbolic, [&] {
+                        const Stopwatch sw;
+                        schedule_ = pattern_schedule(&view, *order, parts);
+                        seconds[1] = sw.seconds();
+                      }});
     else
       symbolic();
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG") && std::size_t(A.rows()) >= kThreadedFactorMinRows)
+      std::fprintf(stderr, "flatten debug analysis: %ld unknowns, wall s: symbolic %.2f, schedule %.2f (side by side)\n",
+                   long(A.rows()), seconds[0], seconds[1]);
     if (factor_ && std::equal(order->begin(), order->end(), static_cast<const int*>(factor_->Perm))) given_order_ = *order;
     else schedule_.clear();
   } else {
