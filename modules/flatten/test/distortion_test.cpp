@@ -74,3 +74,36 @@ TEST(FlattenDistortion, FrameOfAFaceGivesTheSameBitsAsItsCorners) {
   }
   EXPECT_GE(invalid, 40u);  // the degenerate cases were met (qc infinite in both)
 }
+
+// The quasi-conformal ratio takes its two lengths |(E, H)|, |(F, G)| as the square root of the
+// rounded sum of squares (not std::hypot's scaled form, 2.9 % of the CT flatten's CPU): for 2000
+// random faces its bits are (Qn + R) / |Qn - R| with those square roots; and where the squares
+// would overflow or underflow (the map scaled by 2^530 or 2^-530, ~1e160 and 1e-160: exact scalings)
+// the ratio is still the unscaled map's (qc is scale-free), not infinite: to within 1e-12 qc^2, as
+// the lengths' last bits move qc by about qc^2 ulp (qc = (Qn + R) / |Qn - R|).
+TEST(FlattenDistortion, QuasiConformalRatioTakesSquareRootsWhereTheSquaresAreNormal) {
+  using cf::flat_detail::V2;
+  using cf::flat_detail::V3;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-5, 5);
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p0(u(rng), u(rng), u(rng)), p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    const V2 q0(u(rng), u(rng)), q1(u(rng), u(rng)), q2(u(rng), u(rng));
+    const cf::flat_detail::FaceFrame fr = cf::flat_detail::face_frame(p0, p1, p2);
+    if (!fr.valid) continue;
+    Eigen::Matrix2d Q;
+    Q << (q1 - q0).x(), (q2 - q0).x(), (q1 - q0).y(), (q2 - q0).y();
+    const Eigen::Matrix2d J = Q * fr.s_inv;
+    const double E = (J(0, 0) + J(1, 1)) / 2, F = (J(0, 0) - J(1, 1)) / 2, G = (J(1, 0) + J(0, 1)) / 2,
+                 H = (J(1, 0) - J(0, 1)) / 2;
+    const double Qn = std::sqrt(E * E + H * H), R = std::sqrt(F * F + G * G);
+    const double want = (Qn + R) / std::abs(Qn - R);
+    const double got = cf::flat_detail::face_distortion(fr, q0, q1, q2).qc;
+    EXPECT_EQ(std::memcmp(&got, &want, sizeof(double)), 0) << i << ": " << got << " vs " << want;
+    for (double scale : {std::ldexp(1.0, 530), std::ldexp(1.0, -530)}) {
+      const double scaled = cf::flat_detail::face_distortion(fr, scale * q0, scale * q1, scale * q2).qc;
+      ASSERT_TRUE(std::isfinite(scaled)) << i << " x" << scale;
+      EXPECT_NEAR(scaled, got, 1e-12 * got * got) << i << " x" << scale;
+    }
+  }
+}
