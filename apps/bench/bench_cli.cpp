@@ -17,7 +17,7 @@ BenchCli::BenchCli(std::string name, std::string description) : name_(std::move(
 }
 
 int BenchCli::run(int argc, char** argv, const std::function<int()>& body) {
-  rerun_with_huge_page_malloc(argv);  // measure with the allocator settings colonflat runs with
+  rerun_with_malloc_tunables(argv);  // measure with the allocator settings colonflat runs with
   try {
     app_.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

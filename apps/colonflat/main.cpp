@@ -7,7 +7,7 @@
 #include "colonflat/pipeline/dispatch.h"
 
 int main(int argc, char** argv) {
-  cf::rerun_with_huge_page_malloc(argv);  // large blocks on huge pages (core/malloc_tunables.h)
+  cf::rerun_with_malloc_tunables(argv);  // allocator settings (core/malloc_tunables.h)
   std::vector<std::string> args(argv + 1, argv + argc);
   return cf::colonflat_main(args, std::cout, std::cerr);
 }

@@ -2,8 +2,11 @@
 // one report schema, whole-chain checks before the first stage, kebab-case options, --help and
 // docs checked against the parameter tables, `info` on the tool's own outputs, bounded values.
 
+#include <thread>
+
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/testdata/synthetic.h"
 #include "colonflat/testing/shell.h"
@@ -159,12 +162,13 @@ TEST_F(RobustCli, InfoOnLoopsAndFlatMap) {
 }
 
 #ifdef COLONFLAT_BINARY
-// The colonflat executable itself runs with glibc.malloc.hugetlb=1 (its stage report records the
-// tunables), and a user's own setting of that tunable is kept as given.
-TEST(RobustBinary, RunsWithHugePageMallocUnlessTheUserSetsIt) {
+// The colonflat executable itself runs with ColonFlat's malloc settings (core/malloc_tunables.h;
+// its stage report records the tunables), and a user's own malloc setting is kept as given.
+TEST(RobustBinary, RunsWithColonFlatMallocSettingsUnlessTheUserSetsOne) {
   testing::TempDir dir;
   write_mesh(synthetic::to_mesh(synthetic::sphere(10, 24, 12)), dir.path() / "sphere.off");
-  const std::pair<std::string, std::string> cases[] = {{"env -u GLIBC_TUNABLES", "glibc.malloc.hugetlb=1"},
+  const std::string ours = tunables_for_colonflat(nullptr, std::thread::hardware_concurrency());
+  const std::pair<std::string, std::string> cases[] = {{"env -u GLIBC_TUNABLES", ours},
                                                        {"env GLIBC_TUNABLES=glibc.malloc.hugetlb=0", "glibc.malloc.hugetlb=0"}};
   for (const auto& [env, expected] : cases) {
     const fs::path report = dir.path() / "report.json";

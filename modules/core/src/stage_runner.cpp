@@ -62,6 +62,7 @@ nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ct
     Heartbeat beat(ctx, stage.spec().name, heartbeat_s);
     stage.run(bag, ctx);
   }
+  release_free_memory();  // what the stage freed goes back to the kernel (core/malloc_tunables.h)
   return {{"stage", stage.spec().name},
           {"parameters", stage.params_json()},
           {"result", ctx.report},

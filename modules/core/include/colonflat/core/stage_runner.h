@@ -25,7 +25,8 @@ namespace cf {
 // Runs `stage` on `bag` and returns its record (without "outputs"). While the stage runs, a line
 // "    <stage>: still running (N s)" goes to ctx.log every `heartbeat_s` seconds, and a line
 // "<stage>: <phase> N s" at every phase_done() (core/progress.h) of the stage's code; "phases"
-// records those times.
+// records those times. After the stage, the memory malloc holds free goes back to the kernel
+// (release_free_memory, core/malloc_tunables.h).
 nlohmann::json run_stage_recorded(Stage& stage, ArtifactBag& bag, RunContext& ctx, double heartbeat_s = 10.0);
 
 // Writes the outputs of `stage` found in `targets` (port -> file) through `tx`; a missing
