@@ -3,6 +3,7 @@
 // reuse the per-thread labels of a larger mesh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <queue>
@@ -92,6 +93,34 @@ TEST(GeodesicBall, SameBallsAsAHashMapDijkstraAcrossMeshes) {
         EXPECT_EQ(got_d, want_d);
       }
     }
+}
+
+// vertices_within_until is the ball cut short right after its last target: the same vertices,
+// order and distances as vertices_within up to that target, strictly fewer than the whole ball
+// when the targets are near the seed (a grid corner's ball of radius 1e9 is the whole grid),
+// the whole ball when a target lies outside the radius, and nothing without targets.
+TEST(GeodesicBall, UntilStopsRightAfterTheLastTarget) {
+  const int n = 30;
+  const Mesh m = grid(n, 0.5);
+  const std::vector<Mesh::VertexHandle> seeds = {Mesh::VertexHandle(0)};
+  std::vector<double> full_d;
+  const std::vector<int> full = vertices_within(m, seeds, 1e9, &full_d);
+  ASSERT_EQ(full.size(), m.n_vertices());
+  const std::vector<int> targets = {3 * n + 2, 1, 3 * n + 2, 5};  // (3, 2), (0, 1), again, (0, 5)
+  std::vector<double> got_d;
+  const std::vector<int> got = vertices_within_until(m, seeds, 1e9, targets, &got_d);
+  std::size_t last = 0;
+  for (int t : targets) last = std::max<std::size_t>(last, std::find(full.begin(), full.end(), t) - full.begin());
+  ASSERT_EQ(got.size(), last + 1);
+  EXPECT_LT(got.size(), full.size() / 10);
+  EXPECT_TRUE(std::equal(got.begin(), got.end(), full.begin()));
+  EXPECT_TRUE(std::equal(got_d.begin(), got_d.end(), full_d.begin()));
+  // (29, 29) lies 14.5 sqrt2 = 20.5 from the corner: outside a radius of 3, so the whole ball.
+  std::vector<double> ball_d, until_d;
+  const std::vector<int> ball = vertices_within(m, seeds, 3.0, &ball_d);
+  EXPECT_EQ(vertices_within_until(m, seeds, 3.0, {5, n * n - 1}, &until_d), ball);
+  EXPECT_EQ(until_d, ball_d);
+  EXPECT_TRUE(vertices_within_until(m, seeds, 3.0, {}).empty());
 }
 
 }  // namespace

@@ -83,6 +83,7 @@ class ExactGreedy {
   double best_exact_value();
   double best_known(int* anchor = nullptr);
   int farthest_pending(double best);
+  std::vector<int> ball_targets(int anchor, double best) const;
   void spread_bounds(int centre_slot, double bound, const std::vector<int>& ball, const std::vector<double>& distance);
   void add_surgery_sources(const SurgeryResult& sr);
   void lower_bounds_near(const SurgeryResult& sr);

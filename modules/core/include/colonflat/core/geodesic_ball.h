@@ -16,4 +16,13 @@ namespace cf {
 std::vector<int> vertices_within(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
                                  std::vector<double>* distances = nullptr);
 
+// The first vertices of vertices_within(mesh, seeds, radius, distances), in its order and with its
+// distances, up to and including the one that settles the last of `targets` (vertex ids; repeats
+// allowed); all of them when some target is not within the radius. Every target within the radius
+// is in the result with its exact distance; the search costs only the vertices nearer than the
+// farthest target (issue 26: the far-first order of the denoise loop search, which needs the
+// distances of a few sources, not the whole ball). Empty when `targets` is.
+std::vector<int> vertices_within_until(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& seeds, double radius,
+                                       const std::vector<int>& targets, std::vector<double>* distances = nullptr);
+
 }  // namespace cf
