@@ -176,6 +176,40 @@ using LevelHeights = std::map<std::pair<std::uint32_t, std::uint32_t>, std::vect
 // z over the workers, merged in z order: every list equals the serial raster scan's, for any thread
 // count. Returns the number of slabs used (min(thread_count(), slices)).
 std::size_t gather_level_heights(const LevelGatherInput& in, LevelHeights heights[2]);
+// The growth of the fluid pieces (ColonSegmenter::grow_pieces): the crop, the bright mask (0/1),
+// the CT and fluid-threshold (HU), the labels grown (d->total; 0 = none yet).
+struct GrowInput {
+  const Dims* d;
+  const unsigned char* bright;
+  const float* hu;
+  double fluid_threshold;
+  std::uint32_t* label;
+};
+// The worker (0 .. workers - 1) owning each voxel of `mask` (0/1), found on cells of cell^3 voxels:
+// a cell is set when it holds a voxel of the mask, and each face-connected component of set cells
+// (a union of the mask's components: two face neighbours lie in one cell or in face-neighbouring
+// cells) goes, largest first (mask voxels), to the least-loaded worker (ties: the lower index; LPT).
+// The owners depend only on the mask, `workers` and `cell`. Pre: 1 <= workers <= 255, cell >= 1.
+class ComponentOwners {
+ public:
+  ComponentOwners(const Bytes& mask, const Dims& d, std::size_t workers, std::size_t cell);
+  unsigned char at(std::size_t q) const;  // pre: q in the mask
+  std::size_t workers() const { return workers_; }
+
+ private:
+  const Dims* d_;
+  Dims cells_{};
+  std::size_t cell_, workers_;
+  std::vector<unsigned char> owner_;  // per cell
+};
+// Breadth-first from `queue` (bright voxels, labelled): first through fluid voxels (own HU >=
+// fluid-threshold), then from the voxels with an unlabelled bright non-fluid neighbour into the rest
+// of the mask; each voxel takes the label of the voxel that reaches it first. The queue is split by
+// `owners` into one queue per worker (each in the queue's order) grown concurrently: a component's
+// growth reads and writes only its own voxels and its queue is the subsequence of the whole queue, so
+// the labels equal one serial growth's for any worker count. Returns the number of non-empty queues.
+// Post: queue is empty.
+std::size_t grow_labels(const GrowInput& in, const ComponentOwners& owners, std::vector<std::size_t>& queue);
 // Erosion of `m` (0/1) by a ball of radius r_mm (voxels outside the volume count as set).
 Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // 3 x 3 x 3 box mean (edges clamped; separable x, y, z passes) streamed slice by slice: calls
@@ -294,7 +328,7 @@ class ColonSegmenter {
   // Tagged fluid (segment_fluid.cpp).
   void find_fluid_bodies();
   void split_fluid_bodies(const Bytes& bright);  // segment_split.cpp
-  void grow_pieces(const Bytes& bright, std::vector<std::size_t>& queue);
+  void grow_pieces(const Bytes& bright, const ComponentOwners& owners, std::vector<std::size_t>& queue);
   std::vector<std::size_t> seed_cores(const RunLabels& cl);
   std::vector<float> core_levels(const RunLabels& cl) const;
   float mean3_at(std::size_t q) const;
