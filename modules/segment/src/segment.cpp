@@ -10,6 +10,7 @@
 #include <limits>
 #include <tuple>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <sstream>
 
@@ -143,19 +144,29 @@ void ColonSegmenter::check_input() {
                               " mm (expected 0.1 to 10 mm per axis)");
   }
   voxel_ml_ = full_.sp[0] * full_.sp[1] * full_.sp[2] / 1000.0;
-  const float* fhu = ct_->GetBufferPointer();
-  std::size_t air = 0, soft = 0;
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (std::size_t q = 0; q < full_.total; ++q) {
-    const float v = fhu[q];
-    air += v < -800;
-    soft += v > -200 && v < 200;
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  if (air < full_.total / 1000 + 1 || soft < full_.total / 50)
+  const HuTally t = tally_hu(ct_->GetBufferPointer(), full_.total);
+  if (t.air < full_.total / 1000 + 1 || t.soft < full_.total / 50)
     throw PreconditionError("not a CT volume in HU: no air (< -800 HU) and soft-tissue (-200..200 HU) ranges (values " +
-                            format_number(lo) + " .. " + format_number(hi) + ")");
+                            format_number(t.lo) + " .. " + format_number(t.hi) + ")");
+}
+
+HuTally tally_hu(const float* hu, std::size_t n) {
+  HuTally all;
+  std::mutex mu;
+  parallel_for(n, [&](std::size_t q0, std::size_t q1) {
+    HuTally t;
+    for (std::size_t q = q0; q < q1; ++q) {
+      const float v = hu[q];
+      t.air += v < -800;
+      t.soft += v > -200 && v < 200;
+      t.lo = std::min(t.lo, v);
+      t.hi = std::max(t.hi, v);
+    }
+    std::lock_guard<std::mutex> lock(mu);  // sums and extremes: the same in any order
+    all.air += t.air, all.soft += t.soft;
+    all.lo = std::min(all.lo, t.lo), all.hi = std::max(all.hi, t.hi);
+  });
+  return all;
 }
 
 // Gravity as an LPS vector from the option or the DICOM PatientPosition, then as an image axis.

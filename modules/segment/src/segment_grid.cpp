@@ -178,8 +178,11 @@ std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<u
 }
 
 void dilate_box(Bytes& v, const Dims& d, const int r[3]) {
-  Bytes tmp(v.size());
-  if (cf::dilate_box(v.data(), tmp.data(), {d.n[0], d.n[1], d.n[2]}, r) != v.data()) v.swap(tmp);
+  RawBuffer<unsigned char> tmp;
+  tmp.resize(v.size());  // no serial zeroing: the first axis' pass writes every byte, over the workers
+  const unsigned char* out = cf::dilate_box(v.data(), tmp.data(), {d.n[0], d.n[1], d.n[2]}, r);
+  if (out != v.data())
+    parallel_for(v.size(), [&](std::size_t q0, std::size_t q1) { std::copy(out + q0, out + q1, v.data() + q0); });
 }
 
 void erode_box(Bytes& v, const Dims& d, const int r[3]) {

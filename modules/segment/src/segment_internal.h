@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -176,6 +177,13 @@ using LevelHeights = std::map<std::pair<std::uint32_t, std::uint32_t>, std::vect
 // z over the workers, merged in z order: every list equals the serial raster scan's, for any thread
 // count. Returns the number of slabs used (min(thread_count(), slices)).
 std::size_t gather_level_heights(const LevelGatherInput& in, LevelHeights heights[2]);
+// Voxels below -800 HU (air) and in (-200, 200) HU (soft tissue), lowest and highest value of hu[0 .. n),
+// in chunks over the workers (ColonSegmenter::check_input: is this a CT in HU?).
+struct HuTally {
+  std::size_t air = 0, soft = 0;
+  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+};
+HuTally tally_hu(const float* hu, std::size_t n);
 // The growth of the fluid pieces (ColonSegmenter::grow_pieces): the crop, the bright mask (0/1),
 // the CT and fluid-threshold (HU), the labels grown (d->total; 0 = none yet).
 struct GrowInput {

@@ -28,9 +28,9 @@ constexpr double kMinFluidPairShare = 0.5;  // two pieces are one lumen when thi
 constexpr double kMinOtherLevelMl = 0.05;
 // Workers of the pieces' growth: one per thread, at most one owner byte's values.
 std::size_t grow_workers() { return std::size_t(std::clamp(cf::thread_count(), 1, 255)); }
-// The growth's owners are found on cells of 4^3 voxels (ComponentOwners): 1/64 of the voxels to
+// The growth's owners are found on cells of 2^3 voxels (ComponentOwners): 1/8 of the voxels to
 // label; bright bodies closer than a cell share a worker. Speed only: the pieces are the same for any cell.
-constexpr std::size_t kOwnerCell = 4;
+constexpr std::size_t kOwnerCell = 2;
 }
 
 // Erosion of `m` (0/1) by the ball of radius r_mm (an ellipsoid in voxels): voxels outside the

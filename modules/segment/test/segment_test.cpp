@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <random>
 #include <sstream>
 
 #include "colonflat/core/stage.h"
@@ -21,6 +22,7 @@
 #include "colonflat/testing/stage_command.h"
 #include "colonflat/testing/temp_dir.h"
 #include "segment_volumes.h"
+#include "../src/segment_internal.h"
 
 namespace fs = std::filesystem;
 
@@ -358,3 +360,32 @@ TEST(SegmentRealCt, HeadCtHasNoColon) {
 
 }  // namespace
 }  // namespace cf
+
+namespace cf::segment_detail {
+namespace {
+
+// The input check's HU tally split over the workers (air and soft-tissue counts, lowest and highest
+// value) equals the serial count on a random volume, for 1, 2 and 3 threads.
+TEST(SegmentInput, HuTallyOverWorkersEqualsSerialCount) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> hu(-1024, 2500);
+  std::vector<float> v(100003);
+  for (float& x : v) x = hu(rng);
+  v[77] = -1500, v[99999] = 3100;  // the extremes, in different chunks
+  std::size_t air = 0, soft = 0;
+  for (float x : v) air += x < -800, soft += x > -200 && x < 200;
+  EXPECT_GT(air, 5000u);
+  EXPECT_GT(soft, 5000u);
+  for (int t : {1, 2, 3}) {
+    set_thread_count(t);
+    const HuTally got = tally_hu(v.data(), v.size());
+    EXPECT_EQ(got.air, air) << t << " threads";
+    EXPECT_EQ(got.soft, soft) << t << " threads";
+    EXPECT_EQ(got.lo, -1500.0f) << t << " threads";
+    EXPECT_EQ(got.hi, 3100.0f) << t << " threads";
+  }
+  set_thread_count(0);
+}
+
+}  // namespace
+}  // namespace cf::segment_detail
