@@ -15,9 +15,9 @@
 // with no more fill than the original (docs/flatten.md, "Speed").
 //
 // Threads: from 20 000 unknowns on, the numeric factorisation computes its rows on the worker
-// threads (factor_schedule.h: parts of whole elimination subtrees side by side, the rows above them
-// split again in phases, then the last rows); the factor is bit for bit the sequential one, so
-// nothing depends on the thread count.
+// threads (threaded_factor.h, factor_schedule.h: parts of whole elimination subtrees side by side,
+// the rows above them split again in phases, then the last rows); the factor is bit for bit the
+// sequential one, so nothing depends on the thread count.
 //
 // Leading block: with a given order, the factor of P A P^T = L D L^T holds the factor of the
 // leading k x k block A_II (I: the first k unknowns of the order) as its top-left corner, so

@@ -1,0 +1,147 @@
+// The threaded numeric factorisation of SpdSolver (see threaded_factor.h).
+#include "threaded_factor.h"
+
+#ifdef COLONFLAT_HAVE_CHOLMOD
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+
+#include "colonflat/core/run_stats.h"
+#include "colonflat/core/threads.h"
+#include "factor_memory.h"
+
+namespace cf::flat_detail {
+
+namespace {
+
+// Whether every column of the numeric factor L can hold its column count (then cholmod_rowfac never
+// reallocates L, which would move the arrays other threads write).
+bool columns_have_room(const cholmod_factor* L) {
+  const int* Lp = static_cast<const int*>(L->p);
+  const int* next = static_cast<const int*>(L->next);
+  const int* count = static_cast<const int*>(L->ColCount);
+  for (std::size_t j = 0; j < L->n; ++j)
+    if (Lp[next[j]] - Lp[j] < count[j]) return false;
+  return true;
+}
+
+// cholmod_rowfac over `rows` (ascending), one call per run of consecutive rows; `cpu` (optional):
+// the thread's CPU seconds it took.
+bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_factor* L, cholmod_common& common,
+                 double* cpu = nullptr) {
+  const double start = cpu ? thread_cpu_seconds() : 0.0;
+  double beta[2] = {0.0, 0.0};
+  bool ok = true;
+  for (std::size_t i = 0; i < rows.size() && ok;) {
+    std::size_t j = i + 1;
+    while (j < rows.size() && rows[j] == rows[j - 1] + 1) ++j;
+    ok = cholmod_rowfac(upper, nullptr, beta, std::size_t(rows[i]), std::size_t(rows[j - 1]) + 1, L, &common) &&
+         common.status >= CHOLMOD_OK;
+    i = j;
+  }
+  if (cpu) *cpu = thread_cpu_seconds() - start;
+  return ok;
+}
+
+// The rows of the factor split along the elimination tree of `upper` (= triu(A(p,p))) in phases,
+// each row's work estimated as the up-looking kernel's cost of it (row_work): counted at the row
+// that does it, so the rows above the parts (few, but each updating with long columns) weigh what
+// they cost.
+std::vector<RowSchedule> factor_schedule(cholmod_sparse* upper, int parts) {
+  const int n = int(upper->ncol);
+  const int* colptr = static_cast<const int*>(upper->p);
+  const int* rowind = static_cast<const int*>(upper->i);
+  const std::vector<int> parent = elimination_tree(n, colptr, rowind);
+  return schedule_phases(parent, row_work(n, colptr, rowind, parent), parts);
+}
+
+// One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds,
+// wait[p] += the seconds its thread waited for a core.
+bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu,
+                  std::vector<double>& wait) {
+  std::vector<char> ok(phase.parts.size(), 0);
+  std::vector<double> seconds(phase.parts.size(), 0.0);
+  wait.resize(std::max(wait.size(), phase.parts.size()), 0.0);
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t p = 0; p < phase.parts.size(); ++p)
+    tasks.push_back([&, p] {
+      const double waited = thread_wait_seconds();
+      ThreadCommon tc;
+      ok[p] = rowfac_rows(upper, phase.parts[p], L, tc.c, &seconds[p]);
+      wait[p] += thread_wait_seconds() - waited;
+    });
+  parallel_tasks(tasks);
+  cpu.resize(std::max(cpu.size(), seconds.size()), 0.0);
+  for (std::size_t p = 0; p < seconds.size(); ++p) cpu[p] += seconds[p];
+  cpu.push_back(seconds.empty() ? 0.0 : *std::max_element(seconds.begin(), seconds.end()));  // the phase's longest
+  return std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size());
+}
+
+}  // namespace
+
+// factor_schedule() of the pattern of triu(A(p,p)), p = `order`, with a cholmod_common of the
+// calling thread's own (empty when the transpose fails): what the analysis of a given order leaves
+// for factorize_on_threads, computed beside it.
+std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vector<int>& order, int parts) {
+  ThreadCommon tc;
+  cholmod_sparse* upper = cholmod_ptranspose(lower, 0, const_cast<int*>(order.data()), nullptr, 0, &tc.c);
+  if (!upper) return {};
+  std::vector<RowSchedule> phases = factor_schedule(upper, parts);
+  cholmod_free_sparse(&upper, &tc.c);
+  return phases;
+}
+
+// cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
+// cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over all
+// rows), with the rows split over the worker threads (factor_schedule.h): in each phase, parts of
+// whole subtrees side by side, then the rows above the last phase's. Row k reads only the columns
+// of its subtree and each column gets its entries in increasing row order, so the factor is bit
+// for bit cholmod_factorize's for any thread count. `ready` (may be empty): the schedule of this
+// factor's pattern for thread_count() parts, computed beforehand (pattern_schedule); `early`: it
+// was used. Returns -1
+// (nothing done) when this does not apply, 0 when the factorisation failed, 1 when it succeeded.
+int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common,
+                         std::vector<RowSchedule> ready, bool& early) {
+  const int parts = thread_count();
+  if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
+  const Stopwatch sw;
+  Stopwatch lap;
+  FactorWall wall;
+  cholmod_sparse* upper =
+      cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
+  if (!upper) return -1;
+  early = ready.size() > 0 && ready.front().parts.size() == std::size_t(parts);
+  std::vector<RowSchedule> phases = early ? std::move(ready) : factor_schedule(upper, parts);
+  wall.transpose = lap.lap();
+  L->is_ll = common.final_ll ? 1 : 0;
+  const std::size_t grow2 = common.grow2;
+  if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
+  bool ok = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
+  common.grow2 = grow2;
+  if (ok && !columns_have_room(L)) {  // (not expected) every row here, in order
+    early = false;
+    phases.assign(1, RowSchedule{});
+    phases[0].rest.resize(L->n);
+    for (std::size_t k = 0; k < L->n; ++k) phases[0].rest[k] = int(k);
+  }
+  wall.numeric = lap.lap();
+  std::vector<double> cpu(std::size_t(parts), 0.0);  // per part (summed over phases), then each phase's longest
+  for (const RowSchedule& phase : phases) ok = ok && factor_parts(upper, phase, L, cpu, wall.wait);
+  wall.parts = lap.lap();
+  double rest_cpu = 0;
+  ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
+  wall.rest = lap.lap();
+  cholmod_free_sparse(&upper, &common);
+  wall.free = lap.lap();
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
+    print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early, wall);
+    const BlockCache::Stats s = cholmod_block_cache().stats();
+    std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now\n", s.reused,
+                 s.fresh, s.kept);
+  }
+  return ok ? 1 : 0;
+}
+
+}  // namespace cf::flat_detail
+#endif
