@@ -258,8 +258,7 @@ UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::
   if (by_vertex.empty()) by_vertex = vertex_order_of(SpdSolver::fill_reducing_order(vs.A), vs.unknown_of);
   const std::vector<int> order = loops_last(by_vertex, vs.unknown_of, mark, f->leading);
   const Stopwatch sw;
-  f->solver.analyze(vs.A, &order);
-  if (!f->solver.factorize(vs.A)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
+  if (!f->solver.compute(vs.A, &order)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
   if (prior) debug_clock("conformal factorisation");
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug conformal factorisation: %ld unknowns, %.3g flops, %.2f s\n", long(vs.A.rows()),

@@ -148,16 +148,30 @@ std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) {
   return order.empty() ? fill_reducing_order(A) : order;
 }
 
-void SpdSolver::release() {
+void SpdSolver::release_early() {
   schedule_.clear();
-  early_schedule_ = false;
+  if (early_upper_) cholmod_free_sparse(&early_upper_, &side_.c);
+}
+
+void SpdSolver::release() {
+  release_early();
+  early_schedule_ = early_transpose_ = false;
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (started_) cholmod_finish(&common_);
   started_ = false;
   cholmod_ok_ = false;
 }
 
-void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
+void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) { analyze_for(A, order, false); }
+
+bool SpdSolver::compute(const SpMat& A, const std::vector<int>* order) {
+  analyze_for(A, order, true);
+  return factorize(A);
+}
+
+// analyze(); `numeric_transpose`: A is the matrix the next factorize() is given, so the threaded
+// factorisation's transpose is made with its values beside the analysis (early_upper_).
+void SpdSolver::analyze_for(const SpMat& A, const std::vector<int>* order, bool numeric_transpose) {
   release();
   fallback_.reset();
   given_order_.clear();
@@ -184,7 +198,9 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
     if (parts > 1 && std::size_t(A.rows()) >= kThreadedFactorMinRows)
       parallel_tasks({symbolic, [&] {
                         const Stopwatch sw;
-                        schedule_ = pattern_schedule(&view, *order, parts);
+                        EarlyRows early = early_rows(&view, *order, parts, numeric_transpose, side_.c);
+                        schedule_ = std::move(early.schedule);
+                        early_upper_ = early.upper;
                         seconds[1] = sw.seconds();
                       }});
     else
@@ -193,7 +209,7 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
       std::fprintf(stderr, "flatten debug analysis: %ld unknowns, wall s: symbolic %.2f, schedule %.2f (side by side)\n",
                    long(A.rows()), seconds[0], seconds[1]);
     if (factor_ && std::equal(order->begin(), order->end(), static_cast<const int*>(factor_->Perm))) given_order_ = *order;
-    else schedule_.clear();
+    else release_early();
   } else {
     factor_ = cholmod_analyze(&view, &common_);
   }
@@ -202,9 +218,12 @@ void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
 bool SpdSolver::factorize(const SpMat& A) {
   if (factor_) {
     cholmod_sparse view = view_lower(A);
-    early_schedule_ = false;
-    const int threaded = factorize_on_threads(&view, factor_, common_, std::move(schedule_), early_schedule_);
-    schedule_.clear();
+    ThreadedUse use;
+    const int threaded = factorize_on_threads(&view, factor_, common_, EarlyRows{std::move(schedule_), early_upper_}, use);
+    release_early();  // made for this factorisation only
+    early_schedule_ = use.early_schedule;
+    early_transpose_ = use.early_transpose;
+    threaded_transposes_ += use.transposes;
     if (threaded < 0) cholmod_factorize(&view, factor_, &common_);
     cholmod_ok_ = threaded != 0 && common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;
     if (cholmod_ok_) return true;
@@ -322,6 +341,11 @@ std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) { return Fal
 std::vector<int> SpdSolver::one_call_dissection_order(const SpMat&) { return {}; }
 
 void SpdSolver::release() {}
+
+bool SpdSolver::compute(const SpMat& A, const std::vector<int>* order) {
+  analyze(A, order);
+  return factorize(A);
+}
 
 void SpdSolver::analyze(const SpMat& A, const std::vector<int>* order) {
   fallback_.reset();

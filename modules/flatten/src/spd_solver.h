@@ -34,6 +34,7 @@
 #endif
 
 #include "factor_schedule.h"
+#include "threaded_factor.h"
 
 namespace cf::flat_detail {
 
@@ -62,10 +63,11 @@ class SpdSolver {
   void analyze(const SpMat& A, const std::vector<int>* order = nullptr);
   // Numeric factorisation of A (same pattern as analyzed); false when no factorisation succeeded.
   bool factorize(const SpMat& A);
-  bool compute(const SpMat& A, const std::vector<int>* order = nullptr) {
-    analyze(A, order);
-    return factorize(A);
-  }
+  // analyze(A, order) then factorize(A). With a given order on two or more threads the numeric
+  // transpose triu(A(p,p)) the threaded factorisation starts from is made beside the symbolic
+  // analysis, with the row schedule (A's values are known to be the ones factorised); analyze()
+  // alone makes only the pattern's, since factorize() may be given other values.
+  bool compute(const SpMat& A, const std::vector<int>* order = nullptr);
   // x = A^-1 b (b: n x k), column by column: the columns on the worker threads when the factor has
   // at least kThreadedSolveMinEntries entries, else one after the other on the calling thread. A
   // column's result is the same bits either way (the same one-column solve).
@@ -100,20 +102,34 @@ class SpdSolver {
   // the symbolic analysis of a given order (analyze() on two threads: CHOLMOD's analysis and the
   // schedule, both reading only A's pattern in that order), not one computed after it.
   bool early_schedule() const { return early_schedule_; }
+  // Whether the last factorize() started from the numeric transpose made beside the analysis
+  // (compute() with a given order on threads), and how many numeric transposes this solver's
+  // threaded factorisations have made themselves (not counting those made beside an analysis).
+  bool early_transpose() const { return early_transpose_; }
+  int threaded_transposes() const { return threaded_transposes_; }
 
  private:
   struct Fallback;  // Eigen's SimplicialLDLT of P A P^T, P the given order (else Eigen's AMD)
   void release();
+  void release_early();  // the schedule and transpose made beside the analysis, once used or stale
+  void analyze_for(const SpMat& A, const std::vector<int>* order, bool numeric_transpose);
   bool fall_back(const SpMat& A);
   std::vector<int> given_order_;
   std::vector<RowSchedule> schedule_;  // from analyze(), for the next factorize() (empty: none)
-  bool early_schedule_ = false;
+  bool early_schedule_ = false, early_transpose_ = false;
+  int threaded_transposes_ = 0;
 #ifdef COLONFLAT_HAVE_CHOLMOD
   mutable cholmod_common common_{};
   bool started_ = false;
   cholmod_factor* factor_ = nullptr;
+  ThreadCommon side_;                       // allocates early_upper_ beside the analysis, and frees it
+  cholmod_sparse* early_upper_ = nullptr;   // numeric triu(A(p,p)) from compute(), for its factorize()
   bool cholmod_ok_ = false;
   Eigen::MatrixXd cholmod_leading(const Eigen::MatrixXd& b, int leading) const;
+
+ public:
+  // CHOLMOD's factor (read only; null before analyze()).
+  const cholmod_factor* factor() const { return factor_; }
 #endif
   std::unique_ptr<Fallback> fallback_;
 };

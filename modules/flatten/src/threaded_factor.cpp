@@ -80,16 +80,16 @@ bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_facto
 
 }  // namespace
 
-// factor_schedule() of the pattern of triu(A(p,p)), p = `order`, with a cholmod_common of the
-// calling thread's own (empty when the transpose fails): what the analysis of a given order leaves
-// for factorize_on_threads, computed beside it.
-std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vector<int>& order, int parts) {
-  ThreadCommon tc;
-  cholmod_sparse* upper = cholmod_ptranspose(lower, 0, const_cast<int*>(order.data()), nullptr, 0, &tc.c);
-  if (!upper) return {};
-  std::vector<RowSchedule> phases = factor_schedule(upper, parts);
-  cholmod_free_sparse(&upper, &tc.c);
-  return phases;
+EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int parts, bool numeric,
+                     cholmod_common& common) {
+  EarlyRows out;
+  // values 2: as cholmod_factorize transposes (the conjugate; for real values the same copy)
+  cholmod_sparse* upper = cholmod_ptranspose(lower, numeric ? 2 : 0, const_cast<int*>(order.data()), nullptr, 0, &common);
+  if (!upper) return out;
+  out.schedule = factor_schedule(upper, parts);
+  if (numeric) out.upper = upper;
+  else cholmod_free_sparse(&upper, &common);
+  return out;
 }
 
 // cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
@@ -97,22 +97,24 @@ std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vect
 // rows), with the rows split over the worker threads (factor_schedule.h): in each phase, parts of
 // whole subtrees side by side, then the rows above the last phase's. Row k reads only the columns
 // of its subtree and each column gets its entries in increasing row order, so the factor is bit
-// for bit cholmod_factorize's for any thread count. `ready` (may be empty): the schedule of this
-// factor's pattern for thread_count() parts, computed beforehand (pattern_schedule); `early`: it
-// was used. Returns -1
-// (nothing done) when this does not apply, 0 when the factorisation failed, 1 when it succeeded.
-int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common,
-                         std::vector<RowSchedule> ready, bool& early) {
+// for bit cholmod_factorize's for any thread count (see threaded_factor.h).
+int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common, EarlyRows ready,
+                         ThreadedUse& use) {
   const int parts = thread_count();
   if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
   const Stopwatch sw;
   Stopwatch lap;
   FactorWall wall;
-  cholmod_sparse* upper =
-      cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
+  cholmod_sparse* made = nullptr;  // the transpose made here, when none was ready
+  if (!ready.upper)
+    made = cholmod_ptranspose(lower, 2, L->ordering == CHOLMOD_NATURAL ? nullptr : static_cast<int*>(L->Perm), nullptr, 0, &common);
+  cholmod_sparse* upper = ready.upper ? ready.upper : made;
   if (!upper) return -1;
-  early = ready.size() > 0 && ready.front().parts.size() == std::size_t(parts);
-  std::vector<RowSchedule> phases = early ? std::move(ready) : factor_schedule(upper, parts);
+  use.early_transpose = ready.upper != nullptr;
+  use.transposes = made ? 1 : 0;
+  bool& early = use.early_schedule;
+  early = ready.schedule.size() > 0 && ready.schedule.front().parts.size() == std::size_t(parts);
+  std::vector<RowSchedule> phases = early ? std::move(ready.schedule) : factor_schedule(upper, parts);
   wall.transpose = lap.lap();
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
@@ -132,13 +134,13 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   double rest_cpu = 0;
   ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
   wall.rest = lap.lap();
-  cholmod_free_sparse(&upper, &common);
+  if (made) cholmod_free_sparse(&made, &common);
   wall.free = lap.lap();
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
     print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early, wall);
     const BlockCache::Stats s = cholmod_block_cache().stats();
-    std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now\n", s.reused,
-                 s.fresh, s.kept);
+    std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now; numeric "
+                 "transpose %s\n", s.reused, s.fresh, s.kept, use.early_transpose ? "made beside the analysis" : "made here");
   }
   return ok ? 1 : 0;
 }

@@ -29,21 +29,36 @@ struct ThreadCommon {
 // one factorisation takes a few tens of milliseconds).
 constexpr std::size_t kThreadedFactorMinRows = 20000;
 
-// The row schedule (factor_schedule.h, schedule_phases with row_work) of the pattern of
-// triu(A(p,p)) for `lower` = A's lower triangle (stype -1) and p = `order` (a permutation of
-// 0..n-1), for `parts` threads, with a cholmod_common of the calling thread's own; empty when the
-// transpose fails. What the analysis of a given order leaves for factorize_on_threads, computed
-// beside it.
-std::vector<RowSchedule> pattern_schedule(cholmod_sparse* lower, const std::vector<int>& order, int parts);
+// What the analysis of a given order leaves for factorize_on_threads, computed beside it.
+struct EarlyRows {
+  std::vector<RowSchedule> schedule;  // for the parts it was made for (empty: none)
+  cholmod_sparse* upper = nullptr;    // numeric triu(A(p,p)) (not owned here; null: none)
+};
+
+// The row schedule (factor_schedule.h, schedule_phases with row_work) of triu(A(p,p)) for `lower`
+// = A's lower triangle (stype -1) and p = `order` (a permutation of 0..n-1), for `parts` threads.
+// `numeric`: the transpose is made with A's values and returned in `upper` (allocated with
+// `common`, the caller frees it with the same one), else of the pattern only and freed here.
+// `common`: the calling thread's own. Empty schedule and null upper when the transpose fails.
+EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int parts, bool numeric,
+                     cholmod_common& common);
+
+// How a threaded factorisation went: whether it took the early schedule, the early transpose, and
+// how many numeric transposes it made itself (0 or 1).
+struct ThreadedUse {
+  bool early_schedule = false, early_transpose = false;
+  int transposes = 0;
+};
 
 // cholmod_factorize of the simplicial LDL^T `L` (symbolic, CHOLMOD_PATTERN, from the analysis of
-// `lower`'s pattern) with its rows split over thread_count() worker threads; `ready` (may be empty):
-// the schedule of this factor's pattern for thread_count() parts, computed beforehand
-// (pattern_schedule); `early` is set when it was used. Post: L numeric and bit for bit
-// cholmod_factorize's. Returns -1 (nothing done: one thread, fewer than kThreadedFactorMinRows
-// rows, supernodal or already numeric L), 0 when the factorisation failed, 1 when it succeeded.
-int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common, std::vector<RowSchedule> ready,
-                         bool& early);
+// `lower`'s pattern) with its rows split over thread_count() worker threads. `ready` (may be
+// empty): early_rows() of this factor's pattern for thread_count() parts, computed beforehand; its
+// `upper`, when given, must be the numeric triu of this `lower` in L's order (it is read, not
+// freed). Post: L numeric and bit for bit cholmod_factorize's; `use` says what was taken. Returns
+// -1 (nothing done: one thread, fewer than kThreadedFactorMinRows rows, supernodal or already
+// numeric L), 0 when the factorisation failed, 1 when it succeeded.
+int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common, EarlyRows ready,
+                         ThreadedUse& use);
 
 }  // namespace cf::flat_detail
 #endif

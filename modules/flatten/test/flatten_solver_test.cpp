@@ -525,6 +525,44 @@ TEST(FlattenSolver, RowScheduleComputedBesideTheAnalysisGivesTheSequentialFactor
   EXPECT_EQ(std::memcmp(x[0].data(), x[1].data(), sizeof(double) * std::size_t(n)), 0);
 }
 
+#ifdef COLONFLAT_HAVE_CHOLMOD
+// compute() with a given order on two threads factorises from the numeric transpose made beside the
+// analysis (counted: no transpose of its own) and its factor is the sequential one's (one thread,
+// cholmod_factorize) to the last bit; analyze() then factorize() of other values (2 A) makes its own
+// transpose (the early one could hold A's values) and solves 2 A.
+TEST(FlattenSolver, TransposeMadeBesideTheAnalysisGivesTheSequentialFactorBits) {
+  const NestedGrid g = nested_grid();
+  cf::set_thread_count(1);
+  SpdSolver seq;
+  ASSERT_TRUE(seq.compute(g.A, &g.order));
+  cf::set_thread_count(2);
+  SpdSolver par;
+  ASSERT_TRUE(par.compute(g.A, &g.order));
+  EXPECT_TRUE(par.early_transpose());
+  EXPECT_EQ(par.threaded_transposes(), 0);
+  const cholmod_factor *a = seq.factor(), *b = par.factor();
+  ASSERT_TRUE(a && b && a->n == b->n && !a->is_super && !b->is_super);
+  const int *ap = static_cast<const int*>(a->p), *bp = static_cast<const int*>(b->p);
+  const int *anz = static_cast<const int*>(a->nz), *bnz = static_cast<const int*>(b->nz);
+  for (std::size_t j = 0; j < a->n; ++j) {
+    ASSERT_EQ(anz[j], bnz[j]) << "column " << j;
+    const std::size_t m = std::size_t(anz[j]);
+    ASSERT_EQ(std::memcmp(static_cast<const int*>(a->i) + ap[j], static_cast<const int*>(b->i) + bp[j], sizeof(int) * m), 0);
+    ASSERT_EQ(std::memcmp(static_cast<const double*>(a->x) + ap[j], static_cast<const double*>(b->x) + bp[j], sizeof(double) * m), 0)
+        << "column " << j;
+  }
+  const SpdSolver::SpMat twice = 2.0 * g.A;
+  par.analyze(g.A, &g.order);
+  ASSERT_TRUE(par.factorize(twice));
+  EXPECT_FALSE(par.early_transpose());
+  EXPECT_EQ(par.threaded_transposes(), 1);
+  cf::set_thread_count(0);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(g.A.rows(), 0.5, 1.5);
+  const SpdSolver::SpMat full = twice.selfadjointView<Eigen::Lower>();
+  EXPECT_LT((full * par.solve(rhs) - rhs).norm(), 1e-9 * rhs.norm());
+}
+#endif
+
 // A two-column solve is each column's own one-column solve to the last bit, for 1 and 2 threads,
 // with a factor below the threaded-solve threshold (columns on the calling thread) and one above
 // it (columns on the threads): the threshold cannot change a map.
