@@ -49,7 +49,8 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism) and sets `E` to the annulus' edges. The elimination
+// smallest input vertex id, for determinism) and sets `E` to the annulus' edges (taken from the
+// closed surface's: the corners are walked once). The elimination
 // order of the conformal solve (segment_vertex_order: nested dissection on a large segment, kept in
 // w.dissection for the systems after the first map, else AMD) is computed on a second thread, on
 // the closed surface, meanwhile and until the first solve has assembled its system: it is
@@ -63,6 +64,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     auto order = std::async(side_launch(), [E0, nv, dissect] { return segment_vertex_order(*E0, nv, dissect); }).share();
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
+    E = std::move(op.edges);
     w.seg.removed_faces = op.removed;
     auto to_annulus = std::make_shared<const std::vector<int>>(std::move(op.new_of_old));
     w.prior.order_when_ready = [order, to_annulus] {
@@ -76,7 +78,6 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
       w.dissection_to_annulus = *to_annulus;
     }
   }
-  E = build_edges(w.ann.t);
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
   if (loops.size() != 2 || chi != 0)
@@ -167,7 +168,7 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
 }
 
-// What every step on an annulus needs: its edges (`edges`: those of w.ann, moved in, else built),
+// What every step on an annulus needs: its edges (`edges`: those of w.ann, moved in),
 // degenerate faces, fixed (boundary) vertices and vertex -> faces; also sets the annulus' 3D area.
 struct Prepared {
   Edges E;
@@ -175,10 +176,10 @@ struct Prepared {
   std::vector<std::vector<int>> vf;
 };
 
-Prepared prepare(SegmentWork& w, Edges* edges = nullptr) {
+Prepared prepare(SegmentWork& w, Edges edges) {
   Prepared p;
   const Surface& ann = w.ann;
-  p.E = edges ? std::move(*edges) : build_edges(ann.t);
+  p.E = std::move(edges);
   w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) w.seg.area_3d += face_area_3d(ann, int(f));
   p.degenerate.assign(ann.t.size(), 0);
@@ -277,6 +278,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
   clean_selection(w.ann, p.E, keep);
   std::vector<int> new_of_old;
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
+  Edges rest_edges = sub_edges(p.E, keep, new_of_old);
   std::vector<BranchPiece> pieces;
   for (const auto& cut : cuts) {
     std::vector<char> in(nf, 0);
@@ -312,7 +314,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     b.lost_area = cut_area - placed;
     return b;
   });
-  p = prepare(w);  // (an exception here waits for the branches: the future's destructor joins)
+  p = prepare(w, std::move(rest_edges));  // (an exception here waits for the branches: the future's destructor joins)
   if (depth == 0) debug_clock("branches cut off, the rest prepared");
   conformal(w, loops, p, o);
   return flattened;
@@ -371,7 +373,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
   w.cap_area = surface_area(s) - surface_area(w.ann);
-  Prepared p = prepare(w, &edges);
+  Prepared p = prepare(w, std::move(edges));
   phase("ends opened");
   const bool may_cut = o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth;
   // A colon map that side branches may replace is untangled only if it stays (branch detection

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <future>
 #include <memory>
 #include <string>
@@ -65,13 +66,20 @@ struct Edges {
   std::vector<std::array<int, 3>> fe;
 };
 Edges build_edges(const std::vector<Tri>& t);  // throws PreconditionError on a non-manifold edge
+std::size_t build_edges_count();               // how many edge graphs build_edges built (process)
+// The edges of sub_surface(s, keep, &new_of_old) taken from E = build_edges(s.t): equal to
+// build_edges of the sub-surface's faces, without walking its corners again. Pre: keep has one entry
+// per face of s, new_of_old is sub_surface's vertex map.
+Edges sub_edges(const Edges& E, const std::vector<char>& keep, const std::vector<int>& new_of_old);
 
 struct Csr {  // vertex adjacency with edge lengths (mm)
   std::vector<int> start, nbr;
   std::vector<double> len;
 };
 Csr build_csr(const Surface& s, const Edges& E);
-std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources);
+// Geodesic distance along edges from the nearest source. Distances <= settle_up_to (mm) are final;
+// the search stops beyond: any other vertex holds infinity or a value above settle_up_to.
+std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources, double settle_up_to = std::numeric_limits<double>::infinity());
 int argmax_finite(const std::vector<double>& d);
 std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E);
 double face_area_3d(const Surface& s, int f);
@@ -81,6 +89,7 @@ struct Opened {
   Surface annulus;
   std::size_t removed = 0;
   std::vector<int> new_of_old;  // per vertex of the surface: its id on the annulus, -1 when removed
+  Edges edges;                  // the annulus' edges (= build_edges(annulus.t))
 };
 Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double radius);
 // Keeps the largest edge-connected set of faces among `keep`.

@@ -2,6 +2,7 @@
 #include "flatten_internal.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <queue>
 #include <unordered_map>
@@ -12,10 +13,17 @@
 
 namespace cf::flat_detail {
 
+namespace {
+std::atomic<std::size_t> edge_graphs_built{0};
+}
+
+std::size_t build_edges_count() { return edge_graphs_built.load(); }
+
 // The face corners bucketed by the lower vertex of the edge opposite them (a counting sort), each
 // bucket sorted by the higher vertex (stable, so corners of one edge stay in face order): edges
 // come out sorted by (lo, hi) in O(faces), with the same numbering as a global sort of the keys.
 Edges build_edges(const std::vector<Tri>& t) {
+  ++edge_graphs_built;
   int nv = 0;
   for (const Tri& tri : t) nv = std::max({nv, tri[0] + 1, tri[1] + 1, tri[2] + 1});
   std::vector<int> start(std::size_t(nv) + 1, 0);
@@ -50,6 +58,47 @@ Edges build_edges(const std::vector<Tri>& t) {
   return E;
 }
 
+// The kept edges bucketed by their lower vertex on the sub-surface (a counting sort), each bucket
+// sorted by the higher one: numbered as build_edges numbers them. Faces keep their order (sub_surface)
+// and so do the two faces of an edge.
+Edges sub_edges(const Edges& E, const std::vector<char>& keep, const std::vector<int>& new_of_old) {
+  std::vector<int> face_id(keep.size(), -1);
+  int nf = 0, nv = 0;
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f]) face_id[f] = nf++;
+  for (int v : new_of_old) nv = std::max(nv, v + 1);
+  auto kept = [&](std::size_t e) { return face_id[E.ef[e][0]] >= 0 || (E.ef[e][1] >= 0 && face_id[E.ef[e][1]] >= 0); };
+  auto lo_hi = [&](std::size_t e) {
+    const int a = new_of_old[E.ev[e][0]], b = new_of_old[E.ev[e][1]];
+    return std::pair<int, int>(std::min(a, b), std::max(a, b));
+  };
+  std::vector<int> start(std::size_t(nv) + 1, 0);
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (kept(e)) ++start[lo_hi(e).first + 1];
+  for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<int, int>> slot(std::size_t(start[nv]));  // (hi, edge of E) per bucket
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (kept(e)) slot[fill[lo_hi(e).first]++] = {lo_hi(e).second, int(e)};
+  Edges S;
+  S.ev.resize(slot.size()), S.ef.resize(slot.size());
+  std::vector<int> new_edge(E.ev.size(), -1);
+  for (int lo = 0; lo < nv; ++lo) {
+    std::sort(slot.begin() + start[lo], slot.begin() + start[lo + 1]);  // hi is unique in a bucket
+    for (int i = start[lo]; i < start[lo + 1]; ++i) {
+      const int e = slot[i].second, f0 = face_id[E.ef[e][0]], f1 = E.ef[e][1] >= 0 ? face_id[E.ef[e][1]] : -1;
+      S.ev[i] = {lo, slot[i].first};
+      S.ef[i] = f0 >= 0 ? std::array<int, 2>{f0, f1} : std::array<int, 2>{f1, -1};
+      new_edge[e] = i;
+    }
+  }
+  S.fe.resize(std::size_t(nf));
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f])
+      for (int k = 0; k < 3; ++k) S.fe[face_id[f]][k] = new_edge[E.fe[f][k]];
+  return S;
+}
+
 Csr build_csr(const Surface& s, const Edges& E) {
   Csr g;
   const std::size_t nv = s.p.size();
@@ -67,7 +116,7 @@ Csr build_csr(const Surface& s, const Edges& E) {
   return g;
 }
 
-std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources) {
+std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources, double settle_up_to) {
   std::vector<double> d(g.start.size() - 1, kInf);
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
@@ -76,6 +125,7 @@ std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources) {
     auto [dv, v] = q.top();
     q.pop();
     if (dv > d[v]) continue;
+    if (dv > settle_up_to) break;
     for (int k = g.start[v]; k < g.start[v + 1]; ++k) {
       const double nd = dv + g.len[k];
       if (nd < d[g.nbr[k]]) d[g.nbr[k]] = nd, q.push({nd, g.nbr[k]});
@@ -287,8 +337,8 @@ Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double ra
     const int a = argmax_finite(d0);
     const auto da = dijkstra(g, {a});
     const int b = argmax_finite(da);
-    const auto db = dijkstra(g, {b});
     const double r = std::min(radius, 0.1 * da[b]);
+    const auto db = dijkstra(g, {b}, 3 * r);  // a face's mean below r: its corners below 3 r
     cap(da, a, r);
     cap(db, b, r);
   } else {
@@ -297,14 +347,15 @@ Opened open_ends(const Surface& s, const Edges& E, std::size_t nloops, double ra
       if (E.ef[e][1] < 0) bverts.push_back(E.ev[e][0]), bverts.push_back(E.ev[e][1]);
     const auto dl = dijkstra(g, bverts);
     const int b = argmax_finite(dl);
-    const auto db = dijkstra(g, {b});
-    cap(db, b, std::min(radius, 0.1 * dl[b]));
+    const double r = std::min(radius, 0.1 * dl[b]);
+    cap(dijkstra(g, {b}, 3 * r), b, r);  // a face's mean below r: its corners below 3 r
   }
   std::vector<char> keep(s.t.size());
   for (std::size_t f = 0; f < s.t.size(); ++f) keep[f] = !remove[f];
   clean_selection(s, E, keep);
   Opened o;
   o.annulus = sub_surface(s, keep, &o.new_of_old);
+  o.edges = sub_edges(E, keep, o.new_of_old);
   o.removed = s.t.size() - o.annulus.t.size();
   return o;
 }

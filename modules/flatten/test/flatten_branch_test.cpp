@@ -33,11 +33,14 @@ double wall_area(const TriangleList& t) {
 }
 
 // A pouch (22 mm sphere) behind a 3 mm neck: a second band holding lumen, hanging from the colon
-// band at the neck (LPS ~ (120, 12..32, 0), neck length ~ 2 pi 3 mm), and the whole wall shown.
+// band at the neck (LPS ~ (120, 12..32, 0), neck length ~ 2 pi 3 mm), and the whole wall shown;
+// one edge graph built per band (the opened annulus and the colon left after the cut reuse it).
 TEST(FlattenBranches, PouchBehindNarrowNeckIsABandOfItsOwn) {
   const TriangleList mesh = test_shapes::pouch_behind_neck(3.0);
+  const std::size_t built = flat_detail::build_edges_count();
   const FlatMap f = flatten_colon(mesh);
   ASSERT_EQ(f.segments.size(), 2u);
+  EXPECT_EQ(flat_detail::build_edges_count() - built, 2u);
   const FlatSegment& colon = f.segments[0];
   const FlatSegment& b = f.segments[1];
   EXPECT_EQ(colon.kind, "colon");

@@ -1,0 +1,75 @@
+// The edge graph and the geodesic search of flatten (mesh_graph.cpp): a sub-surface's edges taken
+// from its surface's are build_edges' own; the cap's search stops at its bound and is exact below it.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../src/flatten_internal.h"
+#include "colonflat/core/synthetic.h"
+#include "colonflat/flatten/synthetic_colon.h"
+
+namespace cf {
+namespace {
+
+using namespace flat_detail;
+
+Surface surface_of(const TriangleList& m) {
+  Surface s;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    s.p.emplace_back(m.points[v][0], m.points[v][1], m.points[v][2]);
+    s.src.push_back(int(v));
+  }
+  s.t.assign(m.triangles.begin(), m.triangles.end());
+  return s;
+}
+
+void expect_same_edges(const Edges& a, const Edges& b) {
+  EXPECT_EQ(a.ev, b.ev);
+  EXPECT_EQ(a.ef, b.ef);
+  EXPECT_EQ(a.fe, b.fe);
+}
+
+// sub_edges on a random 70 % of a closed colon's faces (edges that lose their first face, their
+// second, or neither) equals build_edges of the sub-surface: same numbering, faces, opposite edges.
+TEST(FlattenMeshGraph, SubEdgesEqualTheSubSurfacesOwnEdges) {
+  const Surface s = surface_of(synthetic::colon(synthetic::colon_options(200, 15, 1.2, {})).mesh);
+  const Edges E = build_edges(s.t);
+  std::mt19937 rng(7);
+  std::vector<char> keep(s.t.size());
+  for (auto& k : keep) k = std::uniform_real_distribution<double>(0, 1)(rng) < 0.7;
+  std::vector<int> new_of_old;
+  const Surface sub = sub_surface(s, keep, &new_of_old);
+  ASSERT_GT(sub.t.size(), s.t.size() / 2);
+  expect_same_edges(sub_edges(E, keep, new_of_old), build_edges(sub.t));
+}
+
+// The annulus open_ends returns carries its own edges (both caps cut off a closed colon), and
+// opening builds no edge graph: the edges are walked once, on the closed surface.
+TEST(FlattenMeshGraph, OpenedAnnulusCarriesItsEdgesWithoutBuildingThem) {
+  const Surface s = surface_of(synthetic::colon(synthetic::colon_options(200, 15, 1.2, {})).mesh);
+  const Edges E = build_edges(s.t);
+  const std::size_t built = build_edges_count();
+  const Opened o = open_ends(s, E, 0, 15.0);
+  EXPECT_EQ(build_edges_count(), built);
+  ASSERT_GT(o.removed, 0u);
+  expect_same_edges(o.edges, build_edges(o.annulus.t));
+}
+
+// The cap's search (settle_up_to = 30 mm) on a 300 mm tube: every distance up to 30 mm equals the
+// full search's bit for bit, every other vertex is above 30 mm or unreached, and most of the tube
+// is never reached (below a quarter of its vertices hold a finite value).
+TEST(FlattenMeshGraph, BoundedSearchIsExactUpToItsBoundAndStops) {
+  const Surface s = surface_of(synthetic::open_cylinder(10, 300, 96, 300));
+  const Csr g = build_csr(s, build_edges(s.t));
+  const std::vector<double> full = dijkstra(g, {0}), near = dijkstra(g, {0}, 30.0);
+  std::size_t reached = 0;
+  for (std::size_t v = 0; v < full.size(); ++v) {
+    if (full[v] <= 30.0) EXPECT_EQ(near[v], full[v]);
+    else EXPECT_GT(near[v], 30.0);
+    reached += std::isfinite(near[v]);
+  }
+  EXPECT_LT(reached, full.size() / 4);
+}
+
+}  // namespace
+}  // namespace cf
