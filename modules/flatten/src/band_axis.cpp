@@ -20,7 +20,14 @@ namespace cf::flat_detail {
 
 std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate,
                                             const std::vector<FaceFrame>* frames) {
-  std::vector<FaceDistortion> fd(w.ann.t.size());
+  std::vector<FaceDistortion> fd;
+  band_distortion(w, degenerate, frames, fd);
+  return fd;
+}
+
+void band_distortion(const SegmentWork& w, const std::vector<char>& degenerate, const std::vector<FaceFrame>* frames,
+                     std::vector<FaceDistortion>& fd) {
+  fd.resize(w.ann.t.size());
   for_each_block(fd.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f) {
       const Tri& t = w.ann.t[f];
@@ -30,7 +37,6 @@ std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vec
       fd[f].degenerate = degenerate[f];
     }
   });
-  return fd;
 }
 
 std::vector<FaceFrame> band_frames(const SegmentWork& w) {
@@ -216,9 +222,16 @@ struct CorrectionNeed {
   bool area = false;  // the area ratios are out of the whole band's margins
   double qc_mean = 0;
 };
+struct NeedScratch {  // a caller's vectors kept across needs_correction() calls
+  std::vector<FaceDistortion> fd;
+  std::vector<double> ratio;
+};
 static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o,
-                                       const std::vector<FaceFrame>* frames = nullptr) {
-  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate, frames);
+                                       const std::vector<FaceFrame>* frames = nullptr, NeedScratch* scratch = nullptr) {
+  NeedScratch own;
+  NeedScratch& use = scratch ? *scratch : own;
+  std::vector<FaceDistortion>& fd = use.fd;
+  band_distortion(w, degenerate, frames, fd);
   double a2 = 0, a3 = 0;
   for (const FaceDistortion& d : fd)
     if (!d.degenerate) a2 += std::max(d.area2, 0.0), a3 += d.area3;
@@ -226,7 +239,7 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
   for (const FaceDistortion& d : fd)
     if (!d.degenerate && d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
   // the faces out of the map are left out, as measure() does
-  const BoundStats st = bound_stats_in_map(fd);
+  const BoundStats st = bound_stats_in_map(fd, &use.ratio);
   const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
   const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
   return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean};
@@ -244,8 +257,9 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
 static std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<char>& degenerate,
                                              const FlattenOptions& o) {
   auto frames = std::make_shared<const std::vector<FaceFrame>>(band_frames(w));
-  return [&w, &degenerate, &o, frames, last_qc = std::numeric_limits<double>::infinity()]() mutable {
-    const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get());
+  auto scratch = std::make_shared<NeedScratch>();  // the checks' vectors, kept from step to step
+  return [&w, &degenerate, &o, frames, scratch, last_qc = std::numeric_limits<double>::infinity()]() mutable {
+    const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get(), scratch.get());
     const bool angles_done = now.qc_mean <= kWholeBandQcMean || now.qc_mean >= last_qc;
     last_qc = now.qc_mean;
     return !now.area && angles_done;

@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <unordered_map>
 
 #include "colonflat/core/params.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/union_find.h"
 #include "flatten_internal.h"
 
@@ -71,30 +73,97 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd) {
+namespace {
+
+// A value's bucket: the top kBucketBits of its bit pattern (sign, exponent, 4 mantissa bits), which
+// for values >= +0 (-0 counts as +0) orders like the values; 16 buckets per power of two, so a
+// bucket holds a few % of a band's area ratios at most.
+constexpr int kBucketBits = 16;
+constexpr std::size_t kBuckets = std::size_t(1) << kBucketBits;
+std::size_t bucket_of(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return x > 0 ? std::size_t(bits >> (64 - kBucketBits)) : 0;
+}
+
+// The values per bucket, counted in one chunk of v per thread (integer counts: the same for any
+// thread count). False when a value is negative or NaN (the buckets do not order those).
+bool bucket_counts(const std::vector<double>& v, std::vector<std::uint64_t>& total) {
+  const std::size_t chunks = std::size_t(std::max(1, thread_count()));
+  std::vector<std::vector<std::uint32_t>> part(chunks, std::vector<std::uint32_t>(kBuckets, 0));
+  std::vector<char> ordered(chunks, 1);
+  parallel_for(chunks, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      for (std::size_t i = v.size() * c / chunks; i < v.size() * (c + 1) / chunks; ++i) {
+        ordered[c] &= char(v[i] >= 0);
+        ++part[c][bucket_of(v[i])];
+      }
+  });
+  total.assign(kBuckets, 0);
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t b = 0; b < kBuckets; ++b) total[b] += part[c][b];
+  return std::all_of(ordered.begin(), ordered.end(), [](char o) { return o != 0; });
+}
+
+// v's values in `bucket` (in chunk order; their order does not change an order statistic).
+std::vector<double> values_in_bucket(const std::vector<double>& v, std::size_t bucket) {
+  const std::size_t chunks = std::size_t(std::max(1, thread_count()));
+  std::vector<std::vector<double>> part(chunks);
+  parallel_for(chunks, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c)
+      for (std::size_t i = v.size() * c / chunks; i < v.size() * (c + 1) / chunks; ++i)
+        if (bucket_of(v[i]) == bucket) part[c].push_back(v[i]);
+  });
+  std::vector<double> out;
+  for (const std::vector<double>& p : part) out.insert(out.end(), p.begin(), p.end());
+  return out;
+}
+
+}  // namespace
+
+OrderStatistics order_statistics(std::vector<double>& v, const std::vector<std::size_t>& ks) {
+  OrderStatistics out;
+  std::vector<std::uint64_t> count;
+  if (v.size() >= std::numeric_limits<std::uint32_t>::max() || !bucket_counts(v, count)) {
+    for (std::size_t k : ks) {
+      std::nth_element(v.begin(), v.begin() + long(k), v.end());
+      out.values.push_back(v[k]);
+    }
+    out.searched = v.size() * ks.size();
+    return out;
+  }
+  for (std::size_t k : ks) {
+    std::size_t bucket = 0, below = 0;
+    while (below + count[bucket] <= k) below += count[bucket++];
+    std::vector<double> in = values_in_bucket(v, bucket);
+    std::nth_element(in.begin(), in.begin() + long(k - below), in.end());
+    out.values.push_back(in[k - below]);
+    out.searched += in.size();
+  }
+  return out;
+}
+
+BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd, std::vector<double>* scratch) {
   auto in_map = [](const FaceDistortion& d) { return !d.degenerate && !too_small_in_map(d.area2, d.area3); };
   double a3 = 0, a2 = 0, qsum = 0;  // sums in face order, as stats_of adds them
   std::size_t n = 0;
   for (const FaceDistortion& d : fd)
-    if (in_map(d)) a3 += d.area3, a2 += std::abs(d.area2);
+    if (in_map(d)) a3 += d.area3, a2 += std::abs(d.area2), ++n, qsum += std::isfinite(d.qc) ? d.qc : 1e9;
   const double scale = a2 > 0 ? a3 / a2 : 1;
-  std::vector<double> ratio;
+  std::vector<double> own;
+  std::vector<double>& ratio = scratch ? *scratch : own;
+  ratio.clear();
   ratio.reserve(fd.size());
-  for (const FaceDistortion& d : fd) {
-    if (!in_map(d)) continue;
-    ++n, qsum += std::isfinite(d.qc) ? d.qc : 1e9;
-    if (d.area3 > 0) ratio.push_back(std::abs(d.area2) * scale / d.area3);
-  }
+  for (const FaceDistortion& d : fd)
+    if (in_map(d) && d.area3 > 0) ratio.push_back(std::abs(d.area2) * scale / d.area3);
   BoundStats b;
   b.qc_mean = n ? qsum / double(n) : 0;
   if (ratio.empty()) return b;
-  // percentile()'s order statistics; the 95th selected among the values above the 5th
+  // percentile()'s order statistics
   const std::size_t k05 = std::min(ratio.size() - 1, std::size_t(0.05 * double(ratio.size() - 1) + 0.5));
   const std::size_t k95 = std::min(ratio.size() - 1, std::size_t(0.95 * double(ratio.size() - 1) + 0.5));
-  std::nth_element(ratio.begin(), ratio.begin() + long(k05), ratio.end());
-  b.area_p05 = ratio[k05];
-  std::nth_element(ratio.begin() + long(k05), ratio.begin() + long(k95), ratio.end());
-  b.area_p95 = ratio[k95];
+  const OrderStatistics q = order_statistics(ratio, {k05, k95});
+  b.area_p05 = q.values[0], b.area_p95 = q.values[1];
   return b;
 }
 

@@ -426,7 +426,18 @@ DistortionStats stats_of(const std::vector<FaceDistortion>& fd);
 struct BoundStats {
   double area_p05 = 0, area_p95 = 0, qc_mean = 0;
 };
-BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd);
+// `scratch` (optional): the area ratios' vector, kept by a caller that asks every step (no fresh pages).
+BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd, std::vector<double>* scratch = nullptr);
+// The ks[i]-th smallest values of v (0-based, each < v.size()): what std::nth_element leaves at
+// v[k]. Values >= 0 (not NaN) are counted per bucket of their top 16 bits on the worker threads
+// (integer counts: the same for any thread count) and nth_element runs only among the values of
+// the bucket holding k; other values: nth_element over v. v's order is not kept.
+// searched: the values nth_element looked at, summed over ks.
+struct OrderStatistics {
+  std::vector<double> values;
+  std::size_t searched = 0;
+};
+OrderStatistics order_statistics(std::vector<double>& v, const std::vector<std::size_t>& ks);
 double percentile(std::vector<double> v, double p);
 
 // Coverage of the 3D wall by the map (faces shown: in the map, area ratio >= min_ratio).
@@ -466,6 +477,9 @@ struct SegmentWork {
 // `frames` (optional): face_frame() of every face of the annulus (the same numbers, without the 3D half).
 std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate,
                                             const std::vector<FaceFrame>* frames = nullptr);
+// The same into `fd` (resized; a caller that measures every step keeps its pages).
+void band_distortion(const SegmentWork& w, const std::vector<char>& degenerate, const std::vector<FaceFrame>* frames,
+                     std::vector<FaceDistortion>& fd);
 // face_frame() of every face of the segment's annulus (on the worker threads).
 std::vector<FaceFrame> band_frames(const SegmentWork& w);
 
