@@ -124,7 +124,8 @@ std::vector<double> values_in_bucket(const std::vector<double>& v, std::size_t b
 OrderStatistics order_statistics(std::vector<double>& v, const std::vector<std::size_t>& ks) {
   OrderStatistics out;
   std::vector<std::uint64_t> count;
-  if (v.size() >= std::numeric_limits<std::uint32_t>::max() || !bucket_counts(v, count)) {
+  // fewer values than buckets: counting them costs more than nth_element over them
+  if (v.size() < kBuckets || v.size() >= std::numeric_limits<std::uint32_t>::max() || !bucket_counts(v, count)) {
     for (std::size_t k : ks) {
       std::nth_element(v.begin(), v.begin() + long(k), v.end());
       out.values.push_back(v[k]);

@@ -429,7 +429,7 @@ struct BoundStats {
 // `scratch` (optional): the area ratios' vector, kept by a caller that asks every step (no fresh pages).
 BoundStats bound_stats_in_map(const std::vector<FaceDistortion>& fd, std::vector<double>* scratch = nullptr);
 // The ks[i]-th smallest values of v (0-based, each < v.size()): what std::nth_element leaves at
-// v[k]. Values >= 0 (not NaN) are counted per bucket of their top 16 bits on the worker threads
+// v[k]. At least 65 536 values >= 0 (not NaN) are counted per bucket of their top 16 bits on the worker threads
 // (integer counts: the same for any thread count) and nth_element runs only among the values of
 // the bucket holding k; other values: nth_element over v. v's order is not kept.
 // searched: the values nth_element looked at, summed over ks.
