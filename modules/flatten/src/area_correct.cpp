@@ -259,43 +259,32 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
   return pieces;
 }
 
-// The energy and system of one set of faces (free vertices as given), built once: the system depends
-// only on the 3D triangles and the free vertices (a frozen local piece's second descent reuses it).
-struct Descent {
-  Descent(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
-          const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
-          const std::vector<int>* vertex_order = nullptr)
-      : nfaces(faces.size()), local(local),
-        energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight, scale) {
-    built = sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order);
-    if (!local) debug_clock("whole-band system built");
-    build_s = clock.lap();
-  }
-  std::size_t nfaces;
-  bool local, built = false, counted = false;  // counted: its system is in an AreaCorrection's systems_built
-  Stopwatch clock;
-  ConformalAreaEnergy energy;
-  RegionSystem sys;
-  double build_s = 0;
-};
-
-// Newton steps on a Descent's faces; accumulates into `res` (systems_built counts the Descent's
-// system once, on its first run); `times` (optional): where its wall time went.
-void minimise(const Surface& s, Embedding& emb, Descent& r, const std::vector<double>& area3, const FlattenOptions& o,
+// Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
+// (optional): where its wall time went.
+void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
+              const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
               AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
-              CorrectionTimes* times = nullptr) {
-  if (!r.built) return;
-  res.systems_built += r.counted ? 0 : 1, r.counted = true;
-  const int max_steps = iteration_budget(r.nfaces, r.local, o.area_correction_iterations);
+              const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr) {
+  const std::size_t nfaces = faces.size();
+  Stopwatch clock;
+  const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
+                                   scale);
+  RegionSystem sys;
+  if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return;
+  if (!local) debug_clock("whole-band system built");
+  const double build_s = clock.lap();
+  const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   StepTimes* step_times = times ? &times->steps : nullptr;
   const DescentResult d =
-      proxy_descent(s, emb, r.energy, r.sys, r.energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times);
+      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times);
   if (times) {
-    times->build_s = r.build_s, times->longest_s = r.build_s + r.clock.lap();
-    times->longest_faces = r.nfaces, times->longest_steps = d.steps;
+    times->build_s = build_s, times->longest_s = build_s + clock.lap();
+    times->longest_faces = nfaces, times->longest_steps = d.steps;
   }
-  res.energy_before += d.energy_before, res.energy_after += d.energy_after;
-  res.iterations = std::max(res.iterations, d.steps), res.stop = d.stop;
+  res.energy_before += d.energy_before;
+  res.energy_after += d.energy_after;
+  res.iterations = std::max(res.iterations, d.steps);
+  res.stop = d.stop;
 }
 
 // Wall area (3D) of `faces` whose map area ratio at `scale` is below `ratio`.
@@ -334,7 +323,6 @@ constexpr int kSpotRings = 2;
 struct SpotWork {
   std::size_t faces = 0;  // faces of the piece's spot regions
   int steps = 0;          // most steps a spot region took
-  int systems = 0;        // systems the spot regions factorised
 };
 SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<int>& piece, const std::vector<char>& free_vertex,
@@ -363,9 +351,8 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
   work.faces = faces.size();
   for (std::vector<int>& spot : connected_pieces(s, faces)) {
     AreaCorrection res;
-    Descent region(s, emb, std::move(spot), spot_free, area3, scale, o, true);
-    minimise(s, emb, region, area3, o, res, {}, scratch);
-    work.steps = std::max(work.steps, res.iterations), work.systems += res.systems_built;
+    minimise(s, emb, std::move(spot), spot_free, area3, scale, o, true, res, {}, scratch);
+    work.steps = std::max(work.steps, res.iterations);
   }
   return work;
 }
@@ -382,17 +369,15 @@ SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf
                        const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
                        AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
   const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
-  Descent region(s, emb, piece, free_vertex, area3, scale, o, true);
-  minimise(s, emb, region, area3, o, res, {}, scratch, times);
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
   if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
   Stopwatch clock;
   const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, scratch);
   if (spots.faces == 0) return spots;
   AreaCorrection again;
   CorrectionTimes again_times;
-  minimise(s, emb, region, area3, o, again, {}, scratch, &again_times);
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, again, {}, scratch, nullptr, &again_times);
   res.energy_after = again.energy_after, res.iterations += again.iterations, res.stop = again.stop;
-  res.systems_built += spots.systems + again.systems_built;
   if (times) times->longest_s += clock.lap(), times->longest_steps = res.iterations;
   return spots;
 }
@@ -405,9 +390,11 @@ void combine_times(const std::vector<CorrectionTimes>& part, const std::vector<s
   for (std::size_t i = 0; i < part.size(); ++i) {
     const CorrectionTimes& p = part[i];
     out.pieces_s += p.longest_s;
-    if (!(p.longest_s > out.longest_s)) continue;
-    const double sum = out.pieces_s;
-    out = p, out.pieces_s = sum, out.pieces = part.size(), out.longest_place = place[i];
+    if (p.longest_s > out.longest_s) {
+      const double sum = out.pieces_s;
+      out = p;
+      out.pieces_s = sum, out.pieces = part.size(), out.longest_place = place[i];
+    }
   }
 }
 
@@ -418,7 +405,7 @@ class PieceLog {
   PieceLog(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
            const FlattenOptions& o, const std::vector<std::vector<int>>& pieces)
       : s_(s), emb_(emb), area3_(area3), scale_(scale), o_(o), pieces_(pieces) {
-    for (const std::vector<int>& p : pieces_) hidden_before_.push_back(below(p, o_.coverage_min_ratio));
+    for (const std::vector<int>& p : pieces_) hidden_before_.push_back(area_below(p, o_.coverage_min_ratio));
   }
   void print(const std::vector<AreaCorrection>& part, const std::vector<CorrectionTimes>& times,
              const std::vector<std::size_t>& place, const std::vector<SpotWork>& spots) const {
@@ -427,12 +414,14 @@ class PieceLog {
                    "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps\n",
                    i, place[i] + 1, pieces_[i].size(), part[i].iterations,
                    iteration_budget(pieces_[i].size(), true, o_.area_correction_iterations), part[i].stop,
-                   times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i], below(pieces_[i], o_.coverage_min_ratio),
-                   o_.area_ratio_low, below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps);
+                   times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i], area_below(pieces_[i], o_.coverage_min_ratio),
+                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps);
   }
 
  private:
-  double below(const std::vector<int>& f, double ratio) const { return area_below(s_, emb_, area3_, scale_, f, ratio); }
+  double area_below(const std::vector<int>& faces, double ratio) const {
+    return flat_detail::area_below(s_, emb_, area3_, scale_, faces, ratio);
+  }
   const Surface& s_;
   const Embedding& emb_;
   const std::vector<double>& area3_;
@@ -461,8 +450,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
   res.faces = faces.size();
   if (!local) {
-    Descent band(s, emb, std::move(faces), free_vertex, area3, scale, o, false, vertex_order);
-    minimise(s, emb, band, area3, o, res, enough, nullptr, times);
+    minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res, enough, nullptr, vertex_order, times);
     return res;
   }
   // The pieces side by side: each reads and moves only its own vertices (pieces share none), and
@@ -489,7 +477,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
     });
   parallel_tasks(tasks);
   for (const AreaCorrection& p : part) {
-    res.energy_before += p.energy_before, res.energy_after += p.energy_after, res.systems_built += p.systems_built;
+    res.energy_before += p.energy_before, res.energy_after += p.energy_after;
     if (p.iterations >= res.iterations) res.iterations = p.iterations, res.stop = p.stop;
   }
   if (times) combine_times(part_times, place, *times);

@@ -341,7 +341,6 @@ struct AreaCorrection {
   std::size_t faces = 0;  // faces the correction worked on
   double energy_before = 0, energy_after = 0;
   const char* stop = "";  // why the (last) descent stopped (proxy_descent.h)
-  int systems_built = 0;  // region systems factorised (a frozen local piece's re-run reuses its own)
 };
 // Where a correct_area() call's wall time went (COLONFLAT_FLATTEN_DEBUG; filled only when asked
 // for): seconds of the system build (assembly, order, factorisation) and of the steps, of the
