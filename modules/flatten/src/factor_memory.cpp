@@ -63,19 +63,22 @@ void* BlockCache::take_kept(std::size_t bytes) {
   return p;
 }
 
+void* BlockCache::adopt_fresh(void* p, std::size_t bytes) {
+  if (!p) return nullptr;
+  touch_pages(p, bytes);  // faulted in here, on the worker threads
+  std::lock_guard<std::mutex> lock(mutex_);
+  large_[p] = bytes;
+  ++fresh_;
+  return p;
+}
+
 void* BlockCache::allocate(std::size_t bytes) {
   if (bytes < min_bytes_) return advised(std::malloc(bytes), bytes);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (void* p = take_kept(bytes)) return p;
   }
-  void* p = advised(std::malloc(bytes), bytes);
-  if (!p) return nullptr;
-  touch_pages(p, bytes);
-  std::lock_guard<std::mutex> lock(mutex_);
-  large_[p] = bytes;
-  ++fresh_;
-  return p;
+  return adopt_fresh(advised(std::malloc(bytes), bytes), bytes);
 }
 
 void* BlockCache::allocate_zeroed(std::size_t n, std::size_t size) {
@@ -91,13 +94,7 @@ void* BlockCache::allocate_zeroed(std::size_t n, std::size_t size) {
     zero_on_threads(p, bytes);
     return p;
   }
-  p = advised(std::calloc(n, size), bytes);  // fresh pages read as zero; touched to fault them in here
-  if (!p) return nullptr;
-  touch_pages(p, bytes);
-  std::lock_guard<std::mutex> lock(mutex_);
-  large_[p] = bytes;
-  ++fresh_;
-  return p;
+  return adopt_fresh(advised(std::calloc(n, size), bytes), bytes);  // fresh pages read as zero
 }
 
 void* BlockCache::reallocate(void* p, std::size_t bytes) {

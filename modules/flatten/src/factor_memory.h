@@ -65,6 +65,7 @@ class BlockCache {
 
  private:
   void* take_kept(std::size_t bytes);  // (locked) a kept block for `bytes`, or nullptr
+  void* adopt_fresh(void* p, std::size_t bytes);  // (call unlocked) a new large block: touched, recorded; nullptr as is
   const std::size_t min_bytes_, max_kept_;
   mutable std::mutex mutex_;
   std::unordered_map<void*, std::size_t> large_;     // live and kept large blocks: their sizes

@@ -176,6 +176,20 @@ TEST(FlattenBranches, TissueBandSaysSoInTheFlatFileAndReport) {
   EXPECT_FALSE(segs[0].contains("holds"));  // the colon band is no branch
 }
 
+// The faces, flat embedding and edges of a plane grid of spacing h over [0, length] x [0, width] mm,
+// row by row, two triangles per cell; `place(q)` adds grid point q's 3D point and map point.
+template <class Place>
+void plane_grid(double h, double length, double width, Place place, flat_detail::Surface& s,
+                flat_detail::Embedding& emb, flat_detail::Edges& E) {
+  const int nx = int(length / h) + 1, ny = int(width / h) + 1;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * h, j * h));
+  test_shapes::grid_triangles(nx, ny, s.t);
+  emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
+  emb.period = 1000;
+  E = flat_detail::build_edges(s.t);
+}
+
 // A plane (0..60 x 0..30 mm, 0.25 mm grid, z = 0) with pouches: inside the disk of radius rn around
 // (cx, cy) the grid rises as a cylinder of radius rn (height hc) topped by a sphere of radius rs (an
 // overhang: the rim is shortest, 2 pi rn, at the neck), and the map squeezes that disk to 1e-3 of
@@ -194,13 +208,7 @@ struct PouchesOnAPlane {
   flat_detail::Edges E;
 
   explicit PouchesOnAPlane(std::vector<Pouch> ps) : pouches(std::move(ps)) {
-    const int nx = int(kLength / kH) + 1, ny = int(kWidth / kH) + 1;
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * kH, j * kH));
-    test_shapes::grid_triangles(nx, ny, s.t);
-    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
-    emb.period = 1000;
-    E = flat_detail::build_edges(s.t);
+    plane_grid(kH, kLength, kWidth, [this](const flat_detail::V2& q) { place(q); }, s, emb, E);
   }
   // The pouch whose disk holds grid point q (-1: none).
   int pouch_of(const flat_detail::V2& q) const {
@@ -306,13 +314,7 @@ struct NestedPouches {
   flat_detail::Edges E;
 
   NestedPouches() {
-    const int nx = int(kLength / kH) + 1, ny = int(kWidth / kH) + 1;
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) place(flat_detail::V2(i * kH, j * kH));
-    test_shapes::grid_triangles(nx, ny, s.t);
-    emb.dy.assign(s.t.size(), {0.0, 0.0, 0.0});
-    emb.period = 1000;
-    E = flat_detail::build_edges(s.t);
+    plane_grid(kH, kLength, kWidth, [this](const flat_detail::V2& q) { place(q); }, s, emb, E);
   }
   static double phi_max(double rn, double rs) { return M_PI - std::asin(rn / rs); }
   // Grid radius (from cb) of the outer sphere's foot.

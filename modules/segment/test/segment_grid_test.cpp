@@ -11,16 +11,11 @@
 #include <random>
 
 #include "../src/segment_internal.h"
+#include "segment_dims.h"
 #include "colonflat/core/threads.h"
 
 namespace cf::segment_detail {
 namespace {
-
-Dims dims(std::size_t nx, std::size_t ny, std::size_t nz) {
-  const std::size_t n[3] = {nx, ny, nz};
-  const double sp[3] = {1, 1, 1};
-  return make_dims(n, sp);
-}
 
 Bytes random_mask(const Dims& d, double density, unsigned seed) {
   std::mt19937 rng(seed);
@@ -33,7 +28,7 @@ Bytes random_mask(const Dims& d, double density, unsigned seed) {
 // Run labels carry the same label per voxel as ITK's connected components (same numbering), for a
 // mask with many irregular components.
 TEST(SegmentGrid, RunLabelsMatchItkConnectedComponents) {
-  const Dims d = dims(37, 29, 23);
+  const Dims d = unit_dims(37, 29, 23);
   const Bytes m = random_mask(d, 0.45, 7);
   auto image = MaskImage::New();
   image->SetRegions(MaskImage::SizeType{{d.n[0], d.n[1], d.n[2]}});
@@ -80,7 +75,7 @@ void expect_box_matches_brute_force(const Dims& d, const Bytes& m, const Bytes& 
 
 // Box dilation (and erosion, its dual) equals the brute-force maximum over the box.
 TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
-  const Dims d = dims(31, 26, 19);
+  const Dims d = unit_dims(31, 26, 19);
   const int r[3] = {2, 1, 3};
   expect_box_matches_brute_force(d, random_mask(d, 0.03, 11), random_mask(d, 0.9, 12), r);
 }
@@ -89,7 +84,7 @@ TEST(SegmentGrid, BoxDilationAndErosionMatchBruteForce) {
 // (many doubling passes) give the brute-force box too (about one set voxel per line: partly covered
 // lines), as does radius 254.
 TEST(SegmentGrid, BoxDilationWithRadiusOver254MatchesBruteForce) {
-  const Dims dx = dims(300, 3, 6), dy = dims(6, 300, 3), dz = dims(6, 3, 300);
+  const Dims dx = unit_dims(300, 3, 6), dy = unit_dims(6, 300, 3), dz = unit_dims(6, 3, 300);
   const int rx[3] = {257, 0, 0}, ry[3] = {0, 260, 0}, rz[3] = {0, 0, 255}, r254[3] = {1, 254, 0};
   expect_box_matches_brute_force(dx, random_mask(dx, 0.002, 37), random_mask(dx, 0.998, 38), rx);
   expect_box_matches_brute_force(dy, random_mask(dy, 0.002, 31), random_mask(dy, 0.998, 32), ry);
@@ -185,7 +180,7 @@ TEST(SegmentGrid, RawBufferResizeWritesNothingFillParallelSetsAll) {
 
 // The streamed 3 x 3 x 3 mean equals the brute-force mean with clamped edges, every slice once.
 TEST(SegmentGrid, StreamedBoxMeanMatchesBruteForce) {
-  const Dims d = dims(17, 13, 11);
+  const Dims d = unit_dims(17, 13, 11);
   std::mt19937 rng(3);
   std::normal_distribution<float> hu(40, 300);
   std::vector<float> in(d.total);

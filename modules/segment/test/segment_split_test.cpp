@@ -8,16 +8,11 @@
 #include <vector>
 
 #include "../src/segment_internal.h"
+#include "segment_dims.h"
 #include "colonflat/core/threads.h"
 
 namespace cf::segment_detail {
 namespace {
-
-Dims dims(std::size_t nx, std::size_t ny, std::size_t nz) {
-  const std::size_t n[3] = {nx, ny, nz};
-  const double sp[3] = {1, 1, 1};
-  return make_dims(n, sp);
-}
 
 // Bright boxes along x separated by empty planes: [x0, x1) x all y x all z for each (x0, x1).
 Bytes slabs(const Dims& d, const std::vector<std::pair<std::size_t, std::size_t>>& xs) {
@@ -31,7 +26,7 @@ Bytes slabs(const Dims& d, const std::vector<std::pair<std::size_t, std::size_t>
 // with 2 workers the largest goes to worker 0, the next to 1, the third to 1 (load 3 < 4) and the
 // last to 0 (load 4 < 5); with 1 worker every voxel has owner 0.
 TEST(SegmentSplit, ComponentOwnersLargestFirstToLeastLoadedWorker) {
-  const Dims d = dims(14, 5, 4);
+  const Dims d = unit_dims(14, 5, 4);
   const Bytes m = slabs(d, {{0, 1}, {2, 4}, {5, 8}, {9, 13}});  // sizes 1, 2, 3, 4 columns
   const ComponentOwners owners(m, d, 2, 1);
   const unsigned char expect_at_x[14] = {0, 9, 1, 1, 9, 1, 1, 1, 9, 0, 0, 0, 0, 9};  // 9: not in the mask
@@ -47,7 +42,7 @@ TEST(SegmentSplit, ComponentOwnersLargestFirstToLeastLoadedWorker) {
 // [12, 14) (4, 3 and 2 columns) are three components, but the last two share cells 2 and 3 (x 8-11,
 // 12-15), so they are one owner's (5 columns, worker 0) and the first is worker 1's.
 TEST(SegmentSplit, ComponentOwnersOnCellsJoinComponentsInNeighbouringCells) {
-  const Dims d = dims(14, 6, 5);
+  const Dims d = unit_dims(14, 6, 5);
   const Bytes m = slabs(d, {{0, 4}, {8, 11}, {12, 14}});
   const ComponentOwners owners(m, d, 2, 4);
   for (std::size_t q = 0; q < d.total; ++q)
@@ -59,7 +54,7 @@ TEST(SegmentSplit, ComponentOwnersOnCellsJoinComponentsInNeighbouringCells) {
 // queue order, walls entered only in the second pass), and grows one queue per worker: 3 slabs of
 // random bright voxels (70 % fluid, 30 % wall) two empty cells apart, seeds in every slab in random order.
 TEST(SegmentSplit, GrowthPerWorkerEqualsOneSerialGrowth) {
-  const Dims d = dims(32, 12, 10);
+  const Dims d = unit_dims(32, 12, 10);
   Bytes bright = slabs(d, {{0, 8}, {12, 20}, {24, 32}});
   std::mt19937 rng(5);
   std::vector<float> hu(d.total);
