@@ -79,6 +79,15 @@ void touch_pages(void* p, std::size_t bytes);
 
 // The process's cache for CHOLMOD's blocks.
 BlockCache& cholmod_block_cache();
+// Gives cholmod_block_cache()'s kept blocks back when it goes out of scope (also by an exception):
+// one at the top of flatten_colon, so the blocks serve the factorisations of one call and never
+// outlive it (a caller such as the benchmark or a library user holds no factor memory after it).
+struct TrimKeptBlocksAtScopeEnd {
+  TrimKeptBlocksAtScopeEnd() = default;
+  TrimKeptBlocksAtScopeEnd(const TrimKeptBlocksAtScopeEnd&) = delete;
+  TrimKeptBlocksAtScopeEnd& operator=(const TrimKeptBlocksAtScopeEnd&) = delete;
+  ~TrimKeptBlocksAtScopeEnd() { cholmod_block_cache().trim(); }
+};
 // Points SuiteSparse_config's allocator at cholmod_block_cache() (once; CHOLMOD builds only).
 void install_for_cholmod();
 

@@ -15,6 +15,7 @@
 #include "colonflat/core/progress.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
+#include "factor_memory.h"
 #include "flatten_internal.h"
 
 namespace cf {
@@ -449,6 +450,7 @@ FlatMap flatten_colon(const Mesh& mesh, const FlattenOptions& opts) {
 }
 
 FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
+  const flat_detail::TrimKeptBlocksAtScopeEnd factor_memory_given_back;  // factor_memory.h
   if (opts.weights != "cotan" && opts.weights != "clamped" && opts.weights != "auto")
     throw UsageError("--weights must be cotan, clamped or auto (got '" + opts.weights + "')");
   if (opts.map != "area-balanced" && opts.map != "conformal")

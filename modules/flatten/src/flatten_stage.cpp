@@ -5,7 +5,6 @@
 
 #include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/run_stats.h"
-#include "factor_memory.h"
 
 namespace cf {
 
@@ -43,7 +42,6 @@ void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
   const Mesh& mesh = bag.get<Mesh>("denoised");
   Stopwatch sw;
   FlatMap flat = flatten_colon(mesh, opts_);
-  flat_detail::cholmod_block_cache().trim();  // the last factors' kept memory back to the system
   ctx.report = flat_report(flat);
   ctx.report["orientation"] = orientation;
   for (const auto& s : flat.skipped) ctx.progress("flatten: skipped " + s);

@@ -6,6 +6,7 @@
 #include "colonflat/core/synthetic.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/flatten/flatten.h"
+#include "../src/factor_memory.h"
 #include "../src/flatten_internal.h"
 #include "flatten_shapes.h"
 
@@ -95,6 +96,19 @@ TEST(FlattenThreads, LargeColonWithItsDissectionOrderIsTheSameForOneAndTwoThread
   EXPECT_EQ(one.coverage.fraction, two.coverage.fraction);
   EXPECT_GE(one.coverage.fraction, 0.995);
   EXPECT_EQ(one.stats.flipped, 0u);
+}
+
+// flatten_colon keeps no factor memory once it returns: the large colon's factorisations did use
+// the block cache (blocks of >= 32 MiB), and none of its blocks is still kept afterwards.
+TEST(FlattenThreads, LargeColonLeavesNoFactorMemoryKept) {
+  const TriangleList mesh = large_colon_with_a_branch();
+  const flat_detail::BlockCache::Stats before = flat_detail::cholmod_block_cache().stats();
+  const FlatMap flat = flatten_with_threads(mesh, 2);
+  const flat_detail::BlockCache::Stats after = flat_detail::cholmod_block_cache().stats();
+  EXPECT_GE(flat.coverage.fraction, 0.995);
+  EXPECT_GT(after.fresh + after.reused, before.fresh + before.reused);
+  EXPECT_EQ(after.kept, 0u);
+  EXPECT_EQ(after.kept_bytes, 0u);
 }
 
 }  // namespace
