@@ -1,6 +1,7 @@
 #include "colonflat/core/geodesic_ball.h"
 
 #include "colonflat/core/quad_heap.h"
+#include "colonflat/core/vertex_stamps.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -13,41 +14,33 @@ namespace {
 // Per-thread distance labels by vertex id, kept between calls: a label counts only when its stamp
 // is the current call's, so a call touches only the vertices it reaches (a hash map of them cost
 // 1.4 s of CPU in one denoise of a 2.1 M-face surface: the far-first balls and the bounds lowered
-// near each surgery, about a hundred calls of up to the whole surface). Stamp and distance share
-// one 16-byte record (one cache line fetch per neighbour), and the heap keeps its storage
+// near each surgery, about a hundred calls of up to the whole surface). The heap keeps its storage
 // between calls (issue 26, session 23: the far-first balls of the real CT's last cuts settle up
 // to a million vertices each, on the search's critical path).
 struct BallScratch {
-  struct Label {
-    double dist = 0;
-    std::uint32_t stamp = 0;
-    std::uint32_t target = 0;  // == call: a target of this call (vertices_within_until)
-  };
-  std::vector<Label> labels;
-  std::uint32_t call = 0;
+  VertexStamps stamps;   // labelled this call
+  VertexStamps targets;  // a target of this call (vertices_within_until)
+  std::vector<double> dist;
   QuadHeap heap;  // (distance, vertex), stale entries included; pops as std::pair orders
 
   void start(std::size_t vertices) {
-    if (labels.size() < vertices) labels.resize(vertices + vertices / 8);
-    if (++call == 0) {  // wrapped: no old stamp may equal a new call
-      for (auto& l : labels) l.stamp = l.target = 0;
-      call = 1;
-    }
+    stamps.start(vertices);
+    targets.start(vertices);
+    dist.resize(stamps.size(), 0.0);
     heap.clear();
   }
-  bool labelled(int v) const { return labels[std::size_t(v)].stamp == call; }
-  double dist(int v) const { return labels[std::size_t(v)].dist; }
+  bool labelled(int v) const { return stamps.marked(v); }
   void label(int v, double d) {
-    labels[std::size_t(v)].dist = d;
-    labels[std::size_t(v)].stamp = call;
+    stamps.mark(v);
+    dist[std::size_t(v)] = d;
   }
   // Flags v as a target of this call; false when it already was.
   bool add_target(int v) {
-    if (labels[std::size_t(v)].target == call) return false;
-    labels[std::size_t(v)].target = call;
+    if (targets.marked(v)) return false;
+    targets.mark(v);
     return true;
   }
-  bool is_target(int v) const { return labels[std::size_t(v)].target == call; }
+  bool is_target(int v) const { return targets.marked(v); }
 };
 
 // The multi-source Dijkstra of both functions; with `targets`, it stops right after settling the
@@ -71,7 +64,7 @@ std::vector<int> settle_ball(const Mesh& mesh, const std::vector<Mesh::VertexHan
   while (!heap.empty()) {
     const auto [d, v] = heap.top();
     heap.pop();
-    if (d > scratch.dist(v)) continue;
+    if (d > scratch.dist[std::size_t(v)]) continue;
     out.push_back(v);
     if (distances) distances->push_back(d);
     if (targets && scratch.is_target(v) && --remaining == 0) break;
@@ -85,7 +78,7 @@ std::vector<int> settle_ball(const Mesh& mesh, const std::vector<Mesh::VertexHan
     do {
       const Mesh::VertexHandle w = mesh.to_vertex_handle(h);
       const double nd = d + (mesh.point(w) - p).norm();
-      if (nd <= radius && (!scratch.labelled(w.idx()) || nd < scratch.dist(w.idx()))) {
+      if (nd <= radius && (!scratch.labelled(w.idx()) || nd < scratch.dist[std::size_t(w.idx())])) {
         scratch.label(w.idx(), nd);
         heap.push(nd, w.idx());
       }
