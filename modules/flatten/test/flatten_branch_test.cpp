@@ -190,6 +190,17 @@ void plane_grid(double h, double length, double width, Place place, flat_detail:
   E = flat_detail::build_edges(s.t);
 }
 
+// find_branches on a test plane g (lumen sign +1, clusters of at least min_area_mm2) with `threads`
+// worker threads, the default count restored after; `search` receives its counters.
+template <class Plane>
+std::vector<flat_detail::BranchCut> branches_on_threads(const Plane& g, int threads, double min_area_mm2,
+                                                        flat_detail::BranchSearch& search) {
+  set_thread_count(threads);
+  std::vector<flat_detail::BranchCut> cuts = flat_detail::find_branches(g.s, g.E, g.emb, g.kLength, 1.0, min_area_mm2, &search);
+  set_thread_count(0);
+  return cuts;
+}
+
 // A plane (0..60 x 0..30 mm, 0.25 mm grid, z = 0) with pouches: inside the disk of radius rn around
 // (cx, cy) the grid rises as a cylinder of radius rn (height hc) topped by a sphere of radius rs (an
 // overhang: the rim is shortest, 2 pi rn, at the neck), and the map squeezes that disk to 1e-3 of
@@ -260,10 +271,8 @@ TEST(FlattenBranches, PouchClustersAreSearchedSideBySideAndCutAtTheirNecks) {
   const PouchesOnAPlane g({{15, 15, 4, 8, 3}, {45, 15, 3, 6, 3}});
   std::vector<std::vector<flat_detail::BranchCut>> runs;
   for (int threads : {2, 1}) {
-    set_thread_count(threads);
     flat_detail::BranchSearch search;
-    runs.push_back(flat_detail::find_branches(g.s, g.E, g.emb, g.kLength, 1.0, 50.0, &search));
-    set_thread_count(0);
+    runs.push_back(branches_on_threads(g, threads, 50.0, search));
     EXPECT_EQ(search.clusters, 2u);
     EXPECT_EQ(search.searched_again, 0u);
   }
@@ -388,10 +397,8 @@ TEST(FlattenBranches, PouchNestedInAPouchsNeckIsHeldByTheOuterBranchOnly) {
   const NestedPouches g;
   std::vector<std::vector<flat_detail::BranchCut>> runs;
   for (int threads : {2, 1}) {
-    set_thread_count(threads);
     flat_detail::BranchSearch search;
-    runs.push_back(flat_detail::find_branches(g.s, g.E, g.emb, g.kLength, 1.0, 20.0, &search));
-    set_thread_count(0);
+    runs.push_back(branches_on_threads(g, threads, 20.0, search));
     EXPECT_GE(search.clusters, 2u);  // the two pouches' (and pieces of their rims, inside their branches)
     EXPECT_EQ(search.searched_again, 1u);
     EXPECT_EQ(search.absorbed, 1u);
