@@ -17,6 +17,7 @@
 
 #include "bench_cli.h"
 #include "bench_meshes.h"
+#include "colonflat/core/orientation.h"
 
 #include <algorithm>
 #include <array>
@@ -31,6 +32,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "colonflat/core/orientation.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/threads.h"
@@ -276,7 +278,8 @@ void stress_table(const StressOptions& so) {
   cf::FlattenOptions fo;
   fo.map = so.map;
   for (const StressCase& c : cases) {
-    const cf::Mesh mesh = c.load();
+    cf::Mesh mesh = c.load();
+    cf::orient_outward(mesh);  // as the flatten stage does (iso_surface's normals point into the lumen)
     std::vector<std::array<double, 2>> first_uv;
     for (int t : so.thread_counts) stress_row(c.name, mesh, t, fo, first_uv, so.out);
   }
