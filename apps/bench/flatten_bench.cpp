@@ -169,20 +169,24 @@ struct StressCase {
 };
 
 // The generated colon-like surfaces: the 1.07 M-face synthetic colon (folds, polyps) and the
-// U-shaped colon-like mask surface with a 60 mm contact, bridges, strands and hooks (denoised once,
-// cached).
+// U-shaped colon-like mask surface (bridges, strands, hooks) with its limbs touching over 60, 120
+// and 180 mm and not at all, as denoise_bench has them (each denoised once, cached).
 std::vector<StressCase> generated_cases(const std::filesystem::path& cache) {
   std::vector<StressCase> cases;
   cases.push_back({"synthetic colon 1.5 m", [] { return cf::synthetic::to_mesh(cf::synthetic::colon(million_face_colon()).mesh); }});
-  cases.push_back({"colon-like U, contact 60 mm", [cache] {
-                     const auto den = cache / "colonlike_contact60_denoised.vtp";
-                     if (!std::filesystem::exists(den)) {
-                       std::filesystem::create_directories(cache);
-                       cf::write_mesh(cf::denoise(cf::bench::colon_like_surface({0.42, 60, true, true, true}),
-                                                  cf::DenoiseOptions{}).mesh, den);
-                     }
-                     return cf::load_mesh(den).mesh;
-                   }});
+  for (const int contact : {60, 120, 180, 0}) {
+    const std::string tag = contact > 0 ? "contact" + std::to_string(contact) : "nocontact";
+    const std::string name = contact > 0 ? "colon-like U, contact " + std::to_string(contact) + " mm" : "colon-like U, no contact";
+    cases.push_back({name, [cache, contact, tag] {
+                       const auto den = cache / ("colonlike_" + tag + "_denoised.vtp");
+                       if (!std::filesystem::exists(den)) {
+                         std::filesystem::create_directories(cache);
+                         cf::write_mesh(cf::denoise(cf::bench::colon_like_surface({0.42, double(contact), true, true, true}),
+                                                    cf::DenoiseOptions{}).mesh, den);
+                       }
+                       return cf::load_mesh(den).mesh;
+                     }});
+  }
   return cases;
 }
 
