@@ -50,19 +50,19 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 }
 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
-// smallest input vertex id, for determinism) and sets `E` to the annulus' edges (taken from the
-// closed surface's: the corners are walked once). The elimination
-// order of the conformal solve (segment_vertex_order: nested dissection on a large segment, kept in
-// w.dissection for the systems after the first map, else AMD) is computed on a second thread, on
-// the closed surface, meanwhile and until the first solve has assembled its system: it is
-// w.prior.order_when_ready, the order restricted to the annulus.
+// smallest input vertex id, for determinism), sets `E` to the annulus' edges (from the closed
+// surface's). The conformal solve's elimination order (w.prior.order_when_ready, restricted to the
+// annulus) is computed on a second thread meanwhile: on a large segment nested dissection's, kept in
+// w.dissection, launched first (its graph from the faces, not the edges built here); else AMD's.
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
-    auto E0 = std::make_shared<const Edges>(build_edges(s.t));
     const int nv = int(s.p.size());
     const bool dissect = uses_dissection(s.p.size(), o.map);
-    auto order = std::async(side_launch(), [E0, nv, dissect] { return segment_vertex_order(*E0, nv, dissect); }).share();
+    std::shared_future<std::vector<int>> order;
+    if (dissect) order = std::async(side_launch(), [t = s.t, nv] { return nested_dissection_vertex_order(t, nv); });
+    auto E0 = std::make_shared<const Edges>(build_edges(s.t));
+    if (!dissect) order = std::async(side_launch(), [E0, nv] { return fill_reducing_vertex_order(*E0, nv); });
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     E = std::move(op.edges);

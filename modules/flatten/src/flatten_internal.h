@@ -139,9 +139,11 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
 // A fill-reducing elimination order (AMD) of the vertices of the edge graph E (nv vertices); its
 // restriction to part of the surface is one for that part (the annulus once the ends are opened).
 std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
-// Nested dissection's (METIS) order of the same graph (E.ev read): about half the factorisation's
-// operations of AMD's on a colon band, for about 5 x its ordering time (SpdSolver).
-std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv);
+// Nested dissection's (METIS) order of the vertex graph of the faces t (nv vertices, every corner
+// < nv), built from the corners (vertex_graph, metis_order.h; without METIS called directly: from
+// the unit Laplacian of build_edges(t)): about half the factorisation's operations of AMD's on a
+// colon band, for about 5 x its ordering time (SpdSolver).
+std::vector<int> nested_dissection_vertex_order(const std::vector<Tri>& t, int nv);
 // A colon segment from this many vertices on has its systems on the whole band (the first conformal
 // map, the re-solve after cutting side branches, the whole-band area correction, the balancing)
 // solved in nested dissection order, computed beside the opening of its ends. Below it the ordering
@@ -152,9 +154,6 @@ constexpr std::size_t kNestedDissectionMinVertices = 200000;
 // dissection order: from kNestedDissectionMinVertices on, for the area-balanced map (the conformal
 // map alone solves one large system: the ordering would cost about what it saves there).
 bool uses_dissection(std::size_t vertices, const std::string& map);
-// The elimination order of a segment's closed surface (E, nv vertices) for its conformal solve:
-// nested_dissection_vertex_order when `dissect`, else fill_reducing_vertex_order (AMD).
-std::vector<int> segment_vertex_order(const Edges& E, int nv, bool dissect);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.

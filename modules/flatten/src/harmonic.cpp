@@ -15,6 +15,8 @@
 #include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 #include "conformal_factor.h"
+#include "factor_schedule.h"
+#include "metis_order.h"
 #include "spd_solver.h"
 
 namespace cf::flat_detail {
@@ -352,9 +354,17 @@ std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv) {
   return order;
 }
 
-std::vector<int> nested_dissection_vertex_order(const Edges& E, int nv) {
+std::vector<int> nested_dissection_vertex_order(const std::vector<Tri>& t, int nv) {
   const Stopwatch sw;
-  std::vector<int> order = SpdSolver::nested_dissection_order(unit_laplacian(E, nv));
+  std::vector<int> order;
+  if (metis_direct_available()) {
+    const double cpu = thread_cpu_seconds();
+    VertexGraph g = vertex_graph(t, nv);
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug order's graph: %.2f s CPU\n", thread_cpu_seconds() - cpu);
+    order = metis_split_dissection_order(std::move(g));
+  }
+  if (order.empty()) order = SpdSolver::nested_dissection_order(unit_laplacian(build_edges(t), nv));
   print_order_debug("nested dissection", nv, sw);
   return order;
 }
@@ -363,9 +373,6 @@ bool uses_dissection(std::size_t vertices, const std::string& map) {
   return vertices >= kNestedDissectionMinVertices && map == "area-balanced";
 }
 
-std::vector<int> segment_vertex_order(const Edges& E, int nv, bool dissect) {
-  return dissect ? nested_dissection_vertex_order(E, nv) : fill_reducing_vertex_order(E, nv);
-}
 
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {
   const double P = emb.period;

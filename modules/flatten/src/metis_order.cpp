@@ -5,8 +5,12 @@
 
 #include "spd_solver.h"
 
+#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
+#include "factor_schedule.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
@@ -41,6 +45,32 @@ ThreadRand& thread_rand() {
 
 std::uint64_t metis_rand_calls() { return thread_rand().calls; }
 
+// Each corner's two neighbours bucketed by vertex (a counting sort), each bucket sorted and its
+// duplicates (an edge's second face) dropped in place.
+VertexGraph vertex_graph(const std::vector<std::array<int, 3>>& t, int nv) {
+  std::vector<int> start(std::size_t(nv) + 1, 0);
+  for (const auto& tri : t)
+    for (int v : tri) start[std::size_t(v) + 1] += 2;
+  for (int v = 0; v < nv; ++v) start[std::size_t(v) + 1] += start[std::size_t(v)];
+  std::vector<int> nbr(std::size_t(start[std::size_t(nv)])), fill(start.begin(), start.end() - 1);
+  for (const auto& tri : t)
+    for (int k = 0; k < 3; ++k) {
+      const int v = tri[std::size_t(k)];
+      nbr[std::size_t(fill[std::size_t(v)]++)] = tri[std::size_t((k + 1) % 3)];
+      nbr[std::size_t(fill[std::size_t(v)]++)] = tri[std::size_t((k + 2) % 3)];
+    }
+  VertexGraph g;
+  g.xadj.reserve(std::size_t(nv) + 1);
+  g.adjncy.reserve(nbr.size() / 2 + 1);
+  for (int v = 0; v < nv; ++v) {
+    const auto first = nbr.begin() + start[std::size_t(v)], last = nbr.begin() + start[std::size_t(v) + 1];
+    std::sort(first, last);
+    g.adjncy.insert(g.adjncy.end(), first, std::unique(first, last));
+    g.xadj.push_back(int(g.adjncy.size()));
+  }
+  return g;
+}
+
 }  // namespace cf::flat_detail
 
 #if defined(COLONFLAT_HAVE_METIS) && defined(COLONFLAT_HAVE_CHOLMOD)
@@ -63,10 +93,8 @@ namespace cf::flat_detail {
 namespace {
 
 // A graph in METIS's CSR form (each adjacency list ascending, no self loop).
-struct Graph {
-  std::vector<idx_t> xadj{0}, adjncy;
-  idx_t size() const { return idx_t(xadj.size()) - 1; }
-};
+static_assert(sizeof(idx_t) == sizeof(int), "METIS built with 32-bit idx_t");
+using Graph = VertexGraph;
 
 // The adjacency graph of A (both triangles, no diagonal), as cholmod_copy builds it for cholmod_metis.
 Graph graph_of(const MetisSpMat& A) {
@@ -135,27 +163,30 @@ bool node_nd(Graph& g, std::vector<idx_t>& perm) {
 struct SideOrder {
   std::vector<int> global, order;
   bool ok = false;
+  double cpu = 0;  // thread CPU s (COLONFLAT_FLATTEN_DEBUG)
 };
 
 void order_side(const Graph& g, const std::vector<idx_t>& part, idx_t side, SideOrder& out) {
+  const double start = thread_cpu_seconds();
   Graph s = side_graph(g, part, side, out.global);
   std::vector<idx_t> perm;
   out.ok = node_nd(s, perm);
   if (!out.ok) return;
   out.order.reserve(perm.size());
   for (idx_t p : perm) out.order.push_back(out.global[std::size_t(p)]);
+  out.cpu = thread_cpu_seconds() - start;
 }
 
-// order followed by the postorder of the elimination tree of A permuted by it (cholmod_metis's
-// `postorder`): same fill, each subtree's columns contiguous.
-bool postorder(const MetisSpMat& A, std::vector<int>& order) {
+// order followed by the postorder of the elimination tree of the symmetric matrix whose lower
+// triangle is `lower` permuted by it (cholmod_metis's `postorder`): same fill, each subtree's
+// columns contiguous.
+bool postorder(cholmod_sparse& lower, std::vector<int>& order) {
   const std::size_t n = order.size();
   cholmod_common common;
   cholmod_start(&common);
   common.print = 0;
-  cholmod_sparse view = view_lower(A);
   std::vector<int> parent(n), post(n);
-  const bool ok = cholmod_analyze_ordering(&view, CHOLMOD_GIVEN, order.data(), nullptr, 0, parent.data(), post.data(),
+  const bool ok = cholmod_analyze_ordering(&lower, CHOLMOD_GIVEN, order.data(), nullptr, 0, parent.data(), post.data(),
                                            nullptr, nullptr, nullptr, &common) &&
                   common.status == CHOLMOD_OK;
   cholmod_finish(&common);
@@ -166,17 +197,50 @@ bool postorder(const MetisSpMat& A, std::vector<int>& order) {
   return true;
 }
 
-}  // namespace
+// The lower triangle of g's adjacency (no diagonal: the elimination tree does not read it) as a
+// CHOLMOD pattern; `p`, `i`: its storage.
+cholmod_sparse lower_pattern(const Graph& g, std::vector<int>& p, std::vector<int>& i) {
+  const int n = g.size();
+  p.assign(1, 0);
+  i.clear();
+  i.reserve(g.adjncy.size() / 2);
+  for (int j = 0; j < n; ++j) {
+    for (int k = g.xadj[std::size_t(j)]; k < g.xadj[std::size_t(j) + 1]; ++k)
+      if (g.adjncy[std::size_t(k)] > j) i.push_back(g.adjncy[std::size_t(k)]);
+    p.push_back(int(i.size()));
+  }
+  cholmod_sparse m{};
+  m.nrow = m.ncol = std::size_t(n);
+  m.nzmax = std::max<std::size_t>(i.size(), 1);
+  m.p = p.data();
+  m.i = i.empty() ? p.data() : i.data();
+  m.stype = -1;
+  m.itype = CHOLMOD_INT;
+  m.xtype = CHOLMOD_PATTERN;
+  m.dtype = CHOLMOD_DOUBLE;
+  m.sorted = 1;
+  m.packed = 1;
+  return m;
+}
 
-bool metis_direct_available() { return true; }
+// COLONFLAT_FLATTEN_DEBUG: what the split order's parts cost.
+void print_split_debug(double separator_s, const SideOrder (&sides)[2], double sides_s) {
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr,
+                 "flatten debug split order: separator %.2f s, sides %zu / %zu vertices (CPU %.2f / %.2f s, "
+                 "wall %.2f s)\n",
+                 separator_s, sides[0].global.size(), sides[1].global.size(), sides[0].cpu, sides[1].cpu, sides_s);
+}
 
-SplitOrder metis_split_order(const MetisSpMat& A) {
-  if (A.rows() != A.cols() || A.rows() == 0 || !A.isCompressed()) return {};
-  Graph g = graph_of(A);
+// metis_split_order of the graph g.
+SplitOrder split_order(Graph& g) {
+  const Stopwatch sw;
   const std::vector<idx_t> part = top_separator(g);
   if (part.empty()) return {};
+  const double separator_s = sw.seconds();
   SideOrder sides[2];
   cf::parallel_tasks({[&] { order_side(g, part, 0, sides[0]); }, [&] { order_side(g, part, 1, sides[1]); }});
+  print_split_debug(separator_s, sides, sw.seconds() - separator_s);
   if (!sides[0].ok || !sides[1].ok) return {};
   SplitOrder out;
   out.order = sides[0].order;
@@ -189,9 +253,29 @@ SplitOrder metis_split_order(const MetisSpMat& A) {
   return out;
 }
 
+}  // namespace
+
+bool metis_direct_available() { return true; }
+
+SplitOrder metis_split_order(const MetisSpMat& A) {
+  if (A.rows() != A.cols() || A.rows() == 0 || !A.isCompressed()) return {};
+  Graph g = graph_of(A);
+  return split_order(g);
+}
+
 std::vector<int> metis_split_dissection_order(const MetisSpMat& A) {
   std::vector<int> order = metis_split_order(A).order;
-  if (order.empty() || !postorder(A, order)) return {};
+  cholmod_sparse view = view_lower(A);
+  if (order.empty() || !postorder(view, order)) return {};
+  return order;
+}
+
+std::vector<int> metis_split_dissection_order(VertexGraph g) {
+  if (g.size() <= 0) return {};
+  std::vector<int> order = split_order(g).order;
+  std::vector<int> p, i;
+  cholmod_sparse lower = lower_pattern(g, p, i);
+  if (order.empty() || !postorder(lower, order)) return {};
   return order;
 }
 
@@ -204,6 +288,7 @@ namespace cf::flat_detail {
 bool metis_direct_available() { return false; }
 SplitOrder metis_split_order(const MetisSpMat&) { return {}; }
 std::vector<int> metis_split_dissection_order(const MetisSpMat&) { return {}; }
+std::vector<int> metis_split_dissection_order(VertexGraph) { return {}; }
 
 }  // namespace cf::flat_detail
 

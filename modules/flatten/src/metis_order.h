@@ -5,12 +5,25 @@
 
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 namespace cf::flat_detail {
 
 using MetisSpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// A graph in METIS's CSR form: vertex v's neighbours are adjncy[xadj[v] .. xadj[v + 1]), ascending,
+// no self loop, each edge in both lists.
+struct VertexGraph {
+  std::vector<int> xadj{0}, adjncy;
+  int size() const { return int(xadj.size()) - 1; }
+};
+
+// The vertex graph of a triangle surface with nv vertices (every corner < nv): the graph of its unit
+// Laplacian, as graph_of builds it from that matrix, built from the corners alone (no edge list, no
+// matrix: it can start before the surface's edges are built).
+VertexGraph vertex_graph(const std::vector<std::array<int, 3>>& t, int nv);
 
 // Whether this build calls METIS directly (libmetis-dev and CHOLMOD found by CMake).
 bool metis_direct_available();
@@ -34,6 +47,10 @@ SplitOrder metis_split_order(const MetisSpMat& A);
 // cholmod_metis postorders: the same fill, each subtree's columns contiguous). place -> unknown;
 // empty when METIS or CHOLMOD is missing or fails.
 std::vector<int> metis_split_dissection_order(const MetisSpMat& A);
+// The same order of the graph itself (the postorder from its lower triangle): for a surface's
+// vertex_graph, the order of its unit Laplacian element for element (g: moved in, METIS's calls
+// take non-const arrays).
+std::vector<int> metis_split_dissection_order(VertexGraph g);
 
 // How many times rand() has been answered by this library's generator on the calling thread:
 // non-zero after a METIS call on this thread proves libmetis's rand() calls reach it and not the C

@@ -242,7 +242,7 @@ TEST(FlattenSolver, OrderStillBeingComputedGivesTheMapOfTheOrderGivenUpFront) {
   ASSERT_EQ(loops.size(), 2u);
   if (loops[0][0] != 0) std::swap(loops[0], loops[1]);
   const int nv = int(tube.p.size());
-  auto computing = std::async(std::launch::async, [&E, nv] { return nested_dissection_vertex_order(E, nv); }).share();
+  auto computing = std::async(std::launch::async, [&tube, nv] { return nested_dissection_vertex_order(tube.t, nv); }).share();
   int asked = 0;
   PriorSolve pending;
   pending.order_when_ready = [&] {
@@ -295,15 +295,13 @@ TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
   const int nx = 448, nv = nx * nx;  // 200 704 vertices
   const auto big = std::size_t(nv);
   ASSERT_GE(big, cf::flat_detail::kNestedDissectionMinVertices);
-  const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 19));
+  const std::vector<Tri> faces = grid_faces(nx, nx, 19);
+  const auto E = cf::flat_detail::build_edges(faces);
   const std::size_t limit = cf::flat_detail::kNestedDissectionMinVertices;
   EXPECT_TRUE(cf::flat_detail::uses_dissection(limit, "area-balanced"));
   EXPECT_FALSE(cf::flat_detail::uses_dissection(limit - 1, "area-balanced"));
   EXPECT_FALSE(cf::flat_detail::uses_dissection(big, "conformal"));
-  const std::vector<int> order =
-      cf::flat_detail::segment_vertex_order(E, nv, cf::flat_detail::uses_dissection(big, "area-balanced"));
-  EXPECT_EQ(order, cf::flat_detail::nested_dissection_vertex_order(E, nv));
-  EXPECT_EQ(cf::flat_detail::segment_vertex_order(E, nv, false), cf::flat_detail::fill_reducing_vertex_order(E, nv));
+  const std::vector<int> order = cf::flat_detail::nested_dissection_vertex_order(faces, nv);
   std::vector<int> all(nv);
   for (int v = 0; v < nv; ++v) all[v] = v;
   const SpdSolver::SpMat A = grid_system(E, nx, all, nv);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <thread>
 #include <vector>
 
@@ -30,6 +31,18 @@ Tube tube(int around, int along) {
       if (j + 1 < along) t.edges.emplace_back(v, v + around), t.edges.emplace_back(v, right + around);
     }
   return t;
+}
+
+// The tube's faces: each quad (v, right, right + around, v + around) split along (v, right + around).
+std::vector<std::array<int, 3>> tube_faces(const Tube& t) {
+  std::vector<std::array<int, 3>> faces;
+  for (int j = 0; j + 1 < t.along; ++j)
+    for (int i = 0; i < t.around; ++i) {
+      const int v = j * t.around + i, right = j * t.around + (i + 1) % t.around;
+      faces.push_back({v, right, right + t.around});
+      faces.push_back({v, right + t.around, v + t.around});
+    }
+  return faces;
 }
 
 // Unit graph Laplacian + I of the tube (symmetric positive definite, both triangles stored).
@@ -100,6 +113,29 @@ TEST(MetisOrder, OrdersAtTheSameTimeOnAnyThreadCountAreEachTheOrderAlone) {
     EXPECT_EQ(at_once1, alone1) << threads << " threads";
   }
   cf::set_thread_count(0);
+}
+
+// The vertex graph built from a tube's faces (most edges in two faces) is the graph of its
+// Laplacian: each vertex's neighbours once, ascending; and the split order of that graph is the
+// Laplacian's split order element for element (its postorder read from the graph's lower triangle).
+TEST(MetisOrder, VertexGraphOfTheFacesOrdersAsTheirLaplacian) {
+  const Tube t = tube(50, 160);
+  const int n = t.around * t.along;
+  const cf::flat_detail::VertexGraph g = cf::flat_detail::vertex_graph(tube_faces(t), n);
+  std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(n));
+  for (auto [a, b] : t.edges) adjacent[std::size_t(a)].push_back(b), adjacent[std::size_t(b)].push_back(a);
+  ASSERT_EQ(g.size(), n);
+  int differ = 0;
+  for (int v = 0; v < n; ++v) {
+    std::sort(adjacent[std::size_t(v)].begin(), adjacent[std::size_t(v)].end());
+    differ += std::vector<int>(g.adjncy.begin() + g.xadj[std::size_t(v)], g.adjncy.begin() + g.xadj[std::size_t(v) + 1]) !=
+              adjacent[std::size_t(v)];
+  }
+  EXPECT_EQ(differ, 0);
+  if (!cf::flat_detail::metis_direct_available()) GTEST_SKIP() << "built without libmetis-dev";
+  const std::vector<int> from_faces = cf::flat_detail::metis_split_dissection_order(g);
+  ASSERT_TRUE(is_permutation(from_faces, n));
+  EXPECT_EQ(from_faces, cf::flat_detail::metis_split_dissection_order(tube_system(t)));
 }
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
