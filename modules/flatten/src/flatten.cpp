@@ -181,11 +181,11 @@ Prepared prepare(SegmentWork& w, Edges edges) {
   Prepared p;
   const Surface& ann = w.ann;
   p.E = std::move(edges);
+  std::vector<double> area(ann.t.size());  // w.seg.area_3d: summed as surface_area sums
   w.seg.area_3d = 0;
-  for (std::size_t f = 0; f < ann.t.size(); ++f) w.seg.area_3d += face_area_3d(ann, int(f));
+  for (std::size_t f = 0; f < ann.t.size(); ++f) area[f] = face_area_3d(ann, int(f)), w.seg.area_3d += area[f];
   p.degenerate.assign(ann.t.size(), 0);
-  const double mean_area = w.seg.area_3d / double(ann.t.size());
-  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = face_area_3d(ann, int(f)) <= 1e-6 * mean_area;
+  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = area[f] <= 1e-6 * (w.seg.area_3d / double(ann.t.size()));
   p.fixed.assign(ann.p.size(), 0);  // the ends and the rims of cut-off branches
   for (std::size_t e = 0; e < p.E.ev.size(); ++e)
     if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
@@ -373,8 +373,8 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
-  w.cap_area = surface_area(s) - surface_area(w.ann);
   Prepared p = prepare(w, std::move(edges));
+  w.cap_area = surface_area(s) - w.seg.area_3d;  // (prepare: the annulus' area)
   phase("ends opened");
   const bool may_cut = o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth;
   // A colon map that side branches may replace is untangled only if it stays (branch detection
