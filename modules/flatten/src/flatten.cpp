@@ -58,11 +58,12 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const int nv = int(s.p.size());
-    const bool dissect = uses_dissection(s.p.size(), o.map);
-    std::shared_future<std::vector<int>> order;
-    if (dissect) order = std::async(side_launch(), [t = s.t, nv] { return nested_dissection_vertex_order(t, nv); });
+    const bool dissect = uses_dissection(s.p.size(), o.map), measure = o.map == "area-balanced";
+    std::shared_future<SegmentOrder> order;
+    if (dissect)
+      order = std::async(side_launch(), [t = s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(t, nv), true}; });
     auto E0 = std::make_shared<const Edges>(build_edges(s.t));
-    if (!dissect) order = std::async(side_launch(), [E0, nv] { return fill_reducing_vertex_order(*E0, nv); });
+    if (!dissect) order = std::async(side_launch(), [E0, nv, measure] { return small_segment_vertex_order(*E0, nv, measure); });
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     E = std::move(op.edges);
@@ -70,11 +71,11 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     auto to_annulus = std::make_shared<const std::vector<int>>(std::move(op.new_of_old));
     w.prior.order_when_ready = [order, to_annulus] {
       std::vector<int> restricted;
-      for (int v : order.get())
+      for (int v : order.get().order)
         if ((*to_annulus)[std::size_t(v)] >= 0) restricted.push_back((*to_annulus)[std::size_t(v)]);
       return restricted;
     };
-    if (dissect) {
+    if (dissect || measure) {
       w.dissection = order;
       w.dissection_to_annulus = *to_annulus;
     }
@@ -305,7 +306,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     if (v >= 0) v = new_of_old[std::size_t(v)];
   w.prior.new_of_old = new_of_old;  // the re-solve updates the colon's factorisation
   w.ann = std::move(rest);
-  w.prior.vertex_order = w.dissection.valid() ? w.band_order() : std::move(order);
+  w.prior.vertex_order = w.has_band_order() ? w.band_order() : std::move(order);
   const double cut_area = annulus_area - surface_area(w.ann);
   auto flattened = std::async(side_launch(), [pieces = std::move(pieces), component = w.seg.component,
                                                    lumen_sign = w.lumen_sign, o, depth, cut_area] {

@@ -136,8 +136,8 @@ struct Harmonic {
 // updated to this surface (conformal_update.cpp) instead of a new factorisation; consumed.
 Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>& loop_a,
                         const std::vector<int>& loop_b, bool clamp, PriorSolve* prior = nullptr);
-// A fill-reducing elimination order (AMD) of the vertices of the edge graph E (nv vertices); its
-// restriction to part of the surface is one for that part (the annulus once the ends are opened).
+// AMD's elimination order of the vertices of the edge graph E (nv vertices); its restriction to part
+// of the surface is one for that part (the annulus once the ends are opened).
 std::vector<int> fill_reducing_vertex_order(const Edges& E, int nv);
 // Nested dissection's (METIS) order of the vertex graph of the faces t (nv vertices, every corner
 // < nv), built from the corners (vertex_graph, metis_order.h; without METIS called directly: from
@@ -147,13 +147,24 @@ std::vector<int> nested_dissection_vertex_order(const std::vector<Tri>& t, int n
 // A colon segment from this many vertices on has its systems on the whole band (the first conformal
 // map, the re-solve after cutting side branches, the whole-band area correction, the balancing)
 // solved in nested dissection order, computed beside the opening of its ends. Below it the ordering
-// (~5 x AMD's time) costs about what it saves: on a 94 k-vertex side branch 4e8 flops saved (~0.3
-// s) for ~0.8 s of ordering (session 12).
+// (~5 x AMD's time) costs about what it saves on a colon-like segment (a 94 k-vertex side branch: 4e8
+// flops saved, ~0.3 s, for ~0.8 s of ordering, session 12), unless AMD's order costs more than
+// kDissectionMinFlopsPerVertex.
 constexpr std::size_t kNestedDissectionMinVertices = 200000;
-// Whether a segment of `vertices` vertices (closed surface) flattened with `map` gets the nested
-// dissection order: from kNestedDissectionMinVertices on, for the area-balanced map (the conformal
-// map alone solves one large system: the ordering would cost about what it saves there).
+// From kNestedDissectionMinVertices on, area-balanced map (the conformal map solves one system).
 bool uses_dissection(std::size_t vertices, const std::string& map);
+// Below it (area-balanced map), AMD's order costing more than this many factorisation operations per
+// vertex is replaced by nested dissection's: METIS's ~6 us CPU per vertex at ~1.8e9 operations per
+// CPU s, half of AMD's saved on >= 2 factorisations (docs/flatten.md, session 24).
+constexpr double kDissectionMinFlopsPerVertex = 1e4;
+struct SegmentOrder {  // a segment's elimination order; whether it is nested dissection's
+  std::vector<int> order;
+  bool nested = false;
+};
+// The elimination order of a segment below kNestedDissectionMinVertices (closed surface: E, nv
+// vertices) for its first solve: AMD's, or METIS's when `measure` and AMD's costs more than
+// kDissectionMinFlopsPerVertex (a long tube: AMD's order ends in a dense root).
+SegmentOrder small_segment_vertex_order(const Edges& E, int nv, bool measure = false);
 
 // A map of the annulus onto the periodic cylinder [0, L] x R/(period): vertex positions (mm) and,
 // per face, the y offset of each corner (a whole number of periods) so that every face is contiguous.
@@ -457,15 +468,16 @@ struct SegmentWork {
   bool branch = false;        // a side branch's band (flattened from its neck)
   bool folds_pending = false; // the map's folds are not untangled yet (a colon map that may be re-solved)
   PriorSolve prior;           // the last conformal solve's order and factor, for the next one
-  // A large segment's nested dissection order (vertices of its closed surface; invalid: none) and
-  // each of those vertices' id on the annulus now (-1: removed with a cap or a side branch).
-  std::shared_future<std::vector<int>> dissection;
+  // The segment's order (closed surface's vertices; invalid: none), for the band's systems when nested
+  // dissection's, and each vertex's id on the annulus now (-1: removed with a cap or a side branch).
+  std::shared_future<SegmentOrder> dissection;
   std::vector<int> dissection_to_annulus;
+  bool has_band_order() const { return dissection.valid() && dissection.get().nested; }
   // The nested dissection order restricted to the annulus now (empty: none).
   std::vector<int> band_order() const {
     std::vector<int> order;
-    if (!dissection.valid()) return order;
-    for (int v : dissection.get())
+    if (!has_band_order()) return order;
+    for (int v : dissection.get().order)
       if (dissection_to_annulus[std::size_t(v)] >= 0) order.push_back(dissection_to_annulus[std::size_t(v)]);
     return order;
   }

@@ -266,8 +266,9 @@ UvSolution solve_fresh(const Edges& E, const std::vector<double>& w, const std::
   if (!f->solver.compute(vs.A, &order)) throw Error("sparse Cholesky factorisation failed (degenerate surface?)");
   if (prior) debug_clock("conformal factorisation");
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug conformal factorisation: %ld unknowns, %.3g flops, %.2f s\n", long(vs.A.rows()),
-                 f->solver.factor_flops(), sw.seconds());
+    std::fprintf(stderr, "flatten debug conformal factorisation: %ld unknowns, %.3g flops, %.3g entries of L, dense root %d columns, %.2f s\n",
+                 long(vs.A.rows()), f->solver.factor_flops(), double(f->solver.factor_entries()),
+                 f->solver.dense_root_columns(), sw.seconds());
   UvSolution sol;
   solve_with(*f, E, w, eta, mark, vs.unknown_of, sol);
   sol.vertex_order = vertex_order_of(order, vs.unknown_of);
@@ -373,6 +374,22 @@ bool uses_dissection(std::size_t vertices, const std::string& map) {
   return vertices >= kNestedDissectionMinVertices && map == "area-balanced";
 }
 
+SegmentOrder small_segment_vertex_order(const Edges& E, int nv, bool measure) {
+  SegmentOrder amd{fill_reducing_vertex_order(E, nv), false};
+  if (!measure || nv <= 0) return amd;
+  const Stopwatch sw;
+  const SpMat A = unit_laplacian(E, nv);
+  const double per_vertex = SpdSolver::order_flops(A, amd.order) / nv;
+  const bool nested = per_vertex > kDissectionMinFlopsPerVertex;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug order choice: %d vertices, AMD's factorisation %.3g operations per vertex (%.2f s): %s\n",
+                 nv, per_vertex, sw.seconds(), nested ? "nested dissection" : "AMD");
+  if (!nested) return amd;
+  const Stopwatch nd;
+  SegmentOrder out{SpdSolver::nested_dissection_order(A), true};
+  print_order_debug("nested dissection", nv, nd);
+  return out;
+}
 
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {
   const double P = emb.period;

@@ -142,6 +142,21 @@ std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) {
 
 std::vector<int> SpdSolver::one_call_dissection_order(const SpMat& A) { return cholmod_order(A, true); }
 
+double SpdSolver::order_flops(const SpMat& A, const std::vector<int>& order) {
+  if (order.size() != std::size_t(A.rows())) return 0.0;
+  install_for_cholmod();
+  ThreadCommon common;
+  common.c.supernodal = CHOLMOD_SIMPLICIAL;
+  common.c.nmethods = 1;
+  common.c.method[0].ordering = CHOLMOD_GIVEN;
+  common.c.postorder = 0;
+  cholmod_sparse view = view_lower(A);
+  cholmod_factor* L = cholmod_analyze_p(&view, const_cast<int*>(order.data()), nullptr, 0, &common.c);
+  const double flops = L ? common.c.fl : 0.0;
+  if (L) cholmod_free_factor(&L, &common.c);
+  return flops;
+}
+
 std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) {
   std::vector<int> order = metis_split_dissection_order(A);
   if (order.empty()) order = cholmod_order(A, true);
@@ -232,6 +247,15 @@ bool SpdSolver::factorize(const SpMat& A) {
 }
 
 std::size_t SpdSolver::factor_entries() const { return factor_ ? std::size_t(factor_->nzmax) : 0; }
+
+int SpdSolver::dense_root_columns() const {
+  if (!factor_ || !factor_->ColCount) return 0;
+  const int* count = static_cast<const int*>(factor_->ColCount);
+  const long n = long(factor_->n);
+  long j = n - 1;
+  while (j >= 0 && count[j] >= n - j) --j;
+  return int(n - 1 - j);
+}
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   if (!cholmod_ok_) return fallback_->solve(b);
@@ -339,6 +363,10 @@ std::vector<int> SpdSolver::fill_reducing_order(const SpMat& A) { return Fallbac
 std::vector<int> SpdSolver::nested_dissection_order(const SpMat& A) { return Fallback::eigen_amd(A); }
 
 std::vector<int> SpdSolver::one_call_dissection_order(const SpMat&) { return {}; }
+
+double SpdSolver::order_flops(const SpMat&, const std::vector<int>&) { return 0.0; }
+
+int SpdSolver::dense_root_columns() const { return 0; }
 
 void SpdSolver::release() {}
 

@@ -55,6 +55,11 @@ class SpdSolver {
   // ordered on two threads (metis_order.h) when libmetis-dev is there, else cholmod_metis's one
   // call; AMD's order when CHOLMOD or METIS is not there.
   static std::vector<int> nested_dissection_order(const SpMat& A);
+  // Floating-point operations of the numeric factorisation of A (as above) in the elimination order
+  // `order` (a permutation of 0..n-1, used as given): CHOLMOD's count from a symbolic analysis alone
+  // (no schedule, no numeric work; the count factor_flops() gives after analyze(A, &order)). 0
+  // without CHOLMOD or when the analysis fails.
+  static double order_flops(const SpMat& A, const std::vector<int>& order);
   // cholmod_metis's one-call METIS order of A (METIS's defaults, postordered; what
   // nested_dissection_order was before the split); empty without CHOLMOD or when it fails.
   static std::vector<int> one_call_dissection_order(const SpMat& A);
@@ -81,6 +86,10 @@ class SpdSolver {
   static constexpr std::size_t kThreadedSolveMinEntries = 1000000;
   // Entries the numeric factor holds (0 without CHOLMOD or before factorize()).
   std::size_t factor_entries() const;
+  // Columns of the factor's dense root: the last columns j of L that are full below the diagonal
+  // (n - j entries with the diagonal), one clique at the top of the elimination tree that no two
+  // threads can share (factor_schedule.h: its rows are the rest). 0 without CHOLMOD or before analyze().
+  int dense_root_columns() const;
   // x_I = A_II^-1 b_I for I = the first `leading` unknowns of the order given to analyze(), and
   // x = 0 off I (b's entries off I are not read). Throws Error without a given order.
   Eigen::MatrixXd solve_leading(const Eigen::MatrixXd& b, int leading) const;

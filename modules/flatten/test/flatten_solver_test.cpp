@@ -302,6 +302,7 @@ TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
   EXPECT_FALSE(cf::flat_detail::uses_dissection(limit - 1, "area-balanced"));
   EXPECT_FALSE(cf::flat_detail::uses_dissection(big, "conformal"));
   const std::vector<int> order = cf::flat_detail::nested_dissection_vertex_order(faces, nv);
+  EXPECT_EQ(cf::flat_detail::small_segment_vertex_order(E, nv).order, cf::flat_detail::fill_reducing_vertex_order(E, nv));
   std::vector<int> all(nv);
   for (int v = 0; v < nv; ++v) all[v] = v;
   const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
@@ -309,6 +310,63 @@ TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
   first.analyze(A, &order);
   amd.analyze(A);
   if (amd.factor_flops() > 0) EXPECT_LT(first.factor_flops(), 0.9 * amd.factor_flops());
+}
+
+namespace {
+
+// The faces of an open tube of nz rings of na vertices (vertex j * na + i), two triangles per cell.
+std::vector<Tri> tube_faces(int na, int nz) {
+  std::vector<Tri> t;
+  for (int j = 0; j + 1 < nz; ++j)
+    for (int i = 0; i < na; ++i) {
+      const int a = j * na + i, b = j * na + (i + 1) % na, c = a + na, d = b + na;
+      t.push_back({a, b, d});
+      t.push_back({a, d, c});
+    }
+  return t;
+}
+
+// The factorisation of the tube's graph Laplacian (+1 on the diagonal of the first ring) in `order`
+// (analysed only): its operations and its dense root.
+struct OrderCost {
+  double flops = 0;
+  int root = 0;
+};
+OrderCost order_cost(const cf::flat_detail::Edges& E, int na, int nv, const std::vector<int>& order) {
+  std::vector<int> all(nv);
+  for (int v = 0; v < nv; ++v) all[v] = v;
+  SpdSolver s;
+  s.analyze(grid_system(E, na, all, nv), &order);
+  return {s.factor_flops(), s.dense_root_columns()};
+}
+
+}  // namespace
+
+// A long tube below kNestedDissectionMinVertices (a long side branch): AMD's order ends in a dense
+// root of more than two rings and costs more than kDissectionMinFlopsPerVertex operations per
+// vertex, and the segment gets nested dissection's order instead: its dense root is one cut across
+// the tube (at most two rings, 2 na) and it needs at most 0.6 of AMD's operations. A short, wide
+// tube of the same circumference keeps AMD's order.
+TEST(FlattenSolver, LongTubeWhoseAmdOrderHasADenseRootGetsNestedDissection) {
+  using namespace cf::flat_detail;
+  const int na = 160, nz = 600, nv = na * nz;  // 96 000 vertices
+  ASSERT_LT(std::size_t(nv), kNestedDissectionMinVertices);
+  const Edges E = build_edges(tube_faces(na, nz));
+  const SegmentOrder chosen = small_segment_vertex_order(E, nv, true);
+  const OrderCost amd = order_cost(E, na, nv, fill_reducing_vertex_order(E, nv));
+  if (amd.flops == 0) GTEST_SKIP() << "no CHOLMOD: no operation counts";
+  const OrderCost got = order_cost(E, na, nv, chosen.order);
+  EXPECT_GT(amd.flops / nv, kDissectionMinFlopsPerVertex);
+  EXPECT_GT(amd.root, 2 * na);
+  EXPECT_TRUE(chosen.nested);
+  EXPECT_LE(got.root, 2 * na);
+  EXPECT_LT(got.flops, 0.6 * amd.flops);
+  const int short_nz = 60, short_nv = na * short_nz;  // a short, wide tube: AMD's order is kept
+  const Edges Es = build_edges(tube_faces(na, short_nz));
+  const SegmentOrder kept = small_segment_vertex_order(Es, short_nv, true);
+  EXPECT_LT(order_cost(Es, na, short_nv, kept.order).flops / short_nv, kDissectionMinFlopsPerVertex);
+  EXPECT_FALSE(kept.nested);
+  EXPECT_EQ(kept.order, fill_reducing_vertex_order(Es, short_nv));
 }
 
 // Two nested dissection orders computed at the same time (two large colon segments flattened side
