@@ -100,10 +100,10 @@ class ConformalAreaEnergy {
 // positive) shrinks to nothing for the whole band: on the real CT colon's 1.88 M-face band 60 steps
 // left area p05 at 0.153 (holding only faces below 1e-3: 0.155; holding the pockets: 0.325). The
 // pockets are opened afterwards by the local pass, each with its own line search.
-void hold_crushed(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
+void hold_crushed(const Surface& s, const std::vector<double>& area2, const std::vector<double>& area3, double scale,
                   double below, std::vector<char>& free_vertex, std::vector<int>& faces) {
   for (int f : faces)
-    if (scale * emb.area2(s, f) < below * area3[f])
+    if (scale * area2[f] < below * area3[f])
       for (int v : s.t[f]) free_vertex[v] = 0;
   faces.erase(std::remove_if(faces.begin(), faces.end(),
                              [&](int f) {
@@ -148,12 +148,12 @@ void fix_region_rim(const std::vector<std::vector<int>>& vf, Inside&& inside, st
 // piece gets fewer steps and shares its line search with the stumps in it).
 constexpr int kLocalRings = 12, kLocalGrowths = 3;
 constexpr double kLocalRoom = 0.6;
-std::vector<char> local_region(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
+std::vector<char> local_region(const Surface& s, const std::vector<std::vector<int>>& vf, const std::vector<double>& area2,
                                const std::vector<double>& area3, double scale, double min_ratio, int growths) {
   std::vector<char> in(s.t.size(), 0);
   std::vector<int> ring;
   for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (scale * emb.area2(s, int(f)) < min_ratio * std::max(area3[f], 1e-300)) in[f] = 1, ring.push_back(int(f));
+    if (scale * area2[f] < min_ratio * std::max(area3[f], 1e-300)) in[f] = 1, ring.push_back(int(f));
   for (int growth = 0;; ++growth) {
     grow_face_rings(s, vf, kLocalRings, ring, [&](int g) {
       if (in[g]) return false;
@@ -168,7 +168,7 @@ std::vector<char> local_region(const Surface& s, const std::vector<std::vector<i
     for (std::size_t f = 0; f < s.t.size(); ++f)
       if (in[f]) {
         const std::uint32_t root = sets.find(std::uint32_t(s.t[f][0]));
-        a2[root] += scale * std::max(emb.area2(s, int(f)), 0.0), a3[root] += area3[f];
+        a2[root] += scale * std::max(area2[f], 0.0), a3[root] += area3[f];
       }
     std::vector<int> starved;  // the frontier of pieces without room
     for (int f : ring) {
@@ -182,22 +182,22 @@ std::vector<char> local_region(const Surface& s, const std::vector<std::vector<i
 
 // The faces the correction works on: all of them (`local` false), or the local region above;
 // free: their vertices that are not fixed and, when local, not on the region's rim. Folds left by
-// untangle are not judged.
-std::vector<int> correction_faces(const Surface& s, const std::vector<std::vector<int>>& vf, const Embedding& emb,
+// untangle are not judged. area2 / area3: per face its signed map area / 3D area.
+std::vector<int> correction_faces(const Surface& s, const std::vector<std::vector<int>>& vf, const std::vector<double>& area2,
                                   const std::vector<double>& area3, const std::vector<char>& fixed,
                                   const std::vector<char>& degenerate, double scale, const FlattenOptions& o,
                                   bool local, bool grow, std::vector<char>& free_vertex) {
-  const std::vector<char> in = local ? local_region(s, vf, emb, area3, scale, o.coverage_min_ratio, grow ? kLocalGrowths : 0)
+  const std::vector<char> in = local ? local_region(s, vf, area2, area3, scale, o.coverage_min_ratio, grow ? kLocalGrowths : 0)
                                      : std::vector<char>(s.t.size(), 1);
   std::vector<int> faces;
   free_vertex.assign(s.p.size(), 0);
   for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (in[f] && !degenerate[f] && emb.area2(s, int(f)) > 0) {
+    if (in[f] && !degenerate[f] && area2[f] > 0) {
       faces.push_back(int(f));
       for (int v : s.t[f]) free_vertex[v] = !fixed[v];
     }
   if (local) fix_region_rim(vf, [&](int g) { return in[g] != 0; }, free_vertex);
-  if (!local) hold_crushed(s, emb, area3, scale, o.coverage_min_ratio, free_vertex, faces);
+  if (!local) hold_crushed(s, area2, area3, scale, o.coverage_min_ratio, free_vertex, faces);
   return faces;
 }
 
@@ -259,9 +259,8 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
   return pieces;
 }
 
-// A set of faces' descent set up once: its energy (faces, corner weights) and system (assembled,
-// factorised), which depend on the faces, free vertices and 3D surface, not on the map: a piece run
-// again after its crushed spots opened reuses them (the same bits, one factorisation fewer).
+// A set of faces' descent set up once: its energy and system (assembled, factorised) depend on the faces,
+// free vertices and 3D surface only, so a piece run again after its spots opened reuses them (same bits).
 struct RegionDescent {
   RegionDescent(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
                 const std::vector<double>& area3, double scale, const FlattenOptions& o, const std::vector<int>* order)
@@ -272,8 +271,8 @@ struct RegionDescent {
   }
   ConformalAreaEnergy energy;
   RegionSystem sys;
-  bool usable = false;  // the system was factorised
-  double build_s = 0;   // wall s of the system's assembly and factorisation
+  bool usable = false;  // the system was factorised; build_s: its wall s (assembly, factorisation)
+  double build_s = 0;
 };
 
 // Newton steps on a set-up region; accumulates into `res`; `times` (optional): where the wall time
@@ -283,13 +282,12 @@ void descend(const Surface& s, Embedding& emb, const RegionDescent& rd, const st
              std::vector<V2>* scratch, CorrectionTimes* times, bool fresh = true) {
   if (!rd.usable) return;
   Stopwatch clock;
-  const std::size_t nfaces = rd.energy.faces().size();
-  const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
+  const int max_steps = iteration_budget(rd.energy.faces().size(), local, o.area_correction_iterations);
   const DescentResult d = proxy_descent(s, emb, rd.energy, rd.sys, rd.energy.faces(), area3, max_steps, 1e-5, enough,
                                         scratch, times ? &times->steps : nullptr);
   if (times) {
     times->build_s = fresh ? rd.build_s : 0.0, times->longest_s = times->build_s + clock.lap();
-    times->longest_faces = nfaces, times->longest_steps = d.steps;
+    times->longest_faces = rd.energy.faces().size(), times->longest_steps = d.steps;
   }
   res.energy_before += d.energy_before, res.energy_after += d.energy_after;
   res.iterations = std::max(res.iterations, d.steps), res.stop = d.stop;
@@ -449,15 +447,17 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
                             const std::vector<int>* vertex_order, CorrectionTimes* times) {
   AreaCorrection res;
   if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
-  std::vector<double> area3(s.t.size());
+  // Per face its 3D and signed map areas, once, each face on its own (any thread); the sums in face order.
+  std::vector<double> area3(s.t.size()), area2(s.t.size());
+  for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) area3[f] = face_area_3d(s, int(f)), area2[f] = emb.area2(s, int(f));
+  });
   double a2 = 0, a3 = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    area3[f] = face_area_3d(s, int(f));
-    if (!degenerate[f]) a2 += std::max(emb.area2(s, int(f)), 0.0), a3 += area3[f];
-  }
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (!degenerate[f]) a2 += std::max(area2[f], 0.0), a3 += area3[f];
   const double scale = a2 > 0 ? a3 / a2 : 1.0;
   std::vector<char> free_vertex;
-  std::vector<int> faces = correction_faces(s, vf, emb, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
+  std::vector<int> faces = correction_faces(s, vf, area2, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
   res.faces = faces.size();
   if (!local) {
     const RegionDescent band(s, emb, std::move(faces), free_vertex, area3, scale, o, vertex_order);
