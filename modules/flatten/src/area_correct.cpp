@@ -259,38 +259,32 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
   return pieces;
 }
 
-// A set of faces' descent set up once: its energy and system (assembled, factorised) depend on the faces,
-// free vertices and 3D surface only, so a piece run again after its spots opened reuses them (same bits).
-struct RegionDescent {
-  RegionDescent(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
-                const std::vector<double>& area3, double scale, const FlattenOptions& o, const std::vector<int>* order)
-      : energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight, scale) {
-    Stopwatch clock;
-    usable = sys.build(s, free_vertex, energy.faces(), energy.weights(), order);
-    build_s = clock.seconds();
-  }
-  ConformalAreaEnergy energy;
-  RegionSystem sys;
-  bool usable = false;  // the system was factorised; build_s: its wall s (assembly, factorisation)
-  double build_s = 0;
-};
-
-// Newton steps on a set-up region; accumulates into `res`; `times` (optional): where the wall time
-// went (the set-up's build_s counted when `fresh`: made for this descent).
-void descend(const Surface& s, Embedding& emb, const RegionDescent& rd, const std::vector<double>& area3,
-             const FlattenOptions& o, bool local, AreaCorrection& res, const std::function<bool()>& enough,
-             std::vector<V2>* scratch, CorrectionTimes* times, bool fresh = true) {
-  if (!rd.usable) return;
+// Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
+// (optional): where its wall time went.
+void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
+              const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
+              AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
+              const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr) {
+  const std::size_t nfaces = faces.size();
   Stopwatch clock;
-  const int max_steps = iteration_budget(rd.energy.faces().size(), local, o.area_correction_iterations);
-  const DescentResult d = proxy_descent(s, emb, rd.energy, rd.sys, rd.energy.faces(), area3, max_steps, 1e-5, enough,
-                                        scratch, times ? &times->steps : nullptr);
+  const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
+                                   scale);
+  RegionSystem sys;
+  if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return;
+  if (!local) debug_clock("whole-band system built");
+  const double build_s = clock.lap();
+  const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
+  StepTimes* step_times = times ? &times->steps : nullptr;
+  const DescentResult d =
+      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times);
   if (times) {
-    times->build_s = fresh ? rd.build_s : 0.0, times->longest_s = times->build_s + clock.lap();
-    times->longest_faces = rd.energy.faces().size(), times->longest_steps = d.steps;
+    times->build_s = build_s, times->longest_s = build_s + clock.lap();
+    times->longest_faces = nfaces, times->longest_steps = d.steps;
   }
-  res.energy_before += d.energy_before, res.energy_after += d.energy_after;
-  res.iterations = std::max(res.iterations, d.steps), res.stop = d.stop;
+  res.energy_before += d.energy_before;
+  res.energy_after += d.energy_after;
+  res.iterations = std::max(res.iterations, d.steps);
+  res.stop = d.stop;
 }
 
 // Wall area (3D) of `faces` whose map area ratio at `scale` is below `ratio`.
@@ -357,8 +351,7 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
   work.faces = faces.size();
   for (std::vector<int>& spot : connected_pieces(s, faces)) {
     AreaCorrection res;
-    descend(s, emb, RegionDescent(s, emb, std::move(spot), spot_free, area3, scale, o, nullptr), area3, o, true, res, {},
-            scratch, nullptr);
+    minimise(s, emb, std::move(spot), spot_free, area3, scale, o, true, res, {}, scratch);
     work.steps = std::max(work.steps, res.iterations);
   }
   return work;
@@ -376,15 +369,14 @@ SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf
                        const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
                        AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
   const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
-  const RegionDescent rd(s, emb, piece, free_vertex, area3, scale, o, nullptr);
-  descend(s, emb, rd, area3, o, true, res, {}, scratch, times);
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
   if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
   Stopwatch clock;
   const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, scratch);
   if (spots.faces == 0) return spots;
   AreaCorrection again;
   CorrectionTimes again_times;
-  descend(s, emb, rd, area3, o, true, again, {}, scratch, &again_times, false);
+  minimise(s, emb, piece, free_vertex, area3, scale, o, true, again, {}, scratch, nullptr, &again_times);
   res.energy_after = again.energy_after, res.iterations += again.iterations, res.stop = again.stop;
   if (times) times->longest_s += clock.lap(), times->longest_steps = res.iterations;
   return spots;
@@ -460,9 +452,7 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
   std::vector<int> faces = correction_faces(s, vf, area2, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
   res.faces = faces.size();
   if (!local) {
-    const RegionDescent band(s, emb, std::move(faces), free_vertex, area3, scale, o, vertex_order);
-    if (band.usable) debug_clock("whole-band system built");
-    descend(s, emb, band, area3, o, false, res, enough, nullptr, times);
+    minimise(s, emb, std::move(faces), free_vertex, area3, scale, o, false, res, enough, nullptr, vertex_order, times);
     return res;
   }
   // The pieces side by side: each reads and moves only its own vertices (pieces share none), and
