@@ -52,16 +52,16 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 // Opens the segment into an annulus; returns its two end loops (end A first: the loop holding the
 // smallest input vertex id, for determinism), sets `E` to the annulus' edges (from the closed
 // surface's). The conformal solve's elimination order (w.prior.order_when_ready, restricted to the
-// annulus) is computed on a second thread meanwhile: on a large segment nested dissection's, kept in
-// w.dissection, launched first (its graph from the faces, not the edges built here); else AMD's.
+// annulus) is computed on a second thread meanwhile: on a large segment nested dissection's, launched
+// first (its graph from the faces, not the edges built here); else small_segment_vertex_order's (AMD's,
+// or METIS's where AMD's costs too much). Kept in w.dissection for the band's systems (area-balanced).
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const int nv = int(s.p.size());
     const bool dissect = uses_dissection(s.p.size(), o.map), measure = o.map == "area-balanced";
     std::shared_future<SegmentOrder> order;
-    if (dissect)
-      order = std::async(side_launch(), [t = s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(t, nv), true}; });
+    if (dissect) order = std::async(side_launch(), [t = s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(t, nv), true}; });
     auto E0 = std::make_shared<const Edges>(build_edges(s.t));
     if (!dissect) order = std::async(side_launch(), [E0, nv, measure] { return small_segment_vertex_order(*E0, nv, measure); });
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
@@ -75,10 +75,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
         if ((*to_annulus)[std::size_t(v)] >= 0) restricted.push_back((*to_annulus)[std::size_t(v)]);
       return restricted;
     };
-    if (dissect || measure) {
-      w.dissection = order;
-      w.dissection_to_annulus = *to_annulus;
-    }
+    if (measure) w.keep_order(order, *to_annulus);  // (dissect implies measure)
   }
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
@@ -86,7 +83,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     throw Error("could not open the ends of component " + std::to_string(c) + " (" + std::to_string(s.t.size()) +
                 " faces) into a tube: it is not tube-like (" + std::to_string(loops.size()) +
                 " boundary loops after opening, Euler characteristic " + std::to_string(chi) + ")");
-  auto min_src = [&](const std::vector<int>& l) {
+  auto min_src = [&](const std::vector<int>& l) {  // the smallest input vertex id on loop l
     int m = INT32_MAX;
     for (int v : l) m = std::min(m, w.ann.src[v]);
     return m;
