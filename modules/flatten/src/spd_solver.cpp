@@ -259,29 +259,33 @@ int SpdSolver::dense_root_columns() const {
 
 Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
   if (!cholmod_ok_) return fallback_->solve(b);
-  // Column by column, on the worker threads for a large factor: each column's arithmetic is the
-  // same whoever solves it (the same one-column call), so the result does not depend on the thread
-  // count nor on the threshold.
+  // kColumnsPerSolveCall columns per CHOLMOD call (the last group fewer), the groups on the worker
+  // threads for a large factor: each column's arithmetic is that of its one-column call whoever
+  // solves it and whatever its group, so the result depends neither on the thread count nor on the
+  // threshold.
   Eigen::MatrixXd x(b.rows(), b.cols());
-  auto solve_column = [&](Eigen::Index c, cholmod_common& common) {
-    const Eigen::MatrixXd column = b.col(c);
-    cholmod_dense rhs = view_dense(column);
-    cholmod_dense* xc = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common);
-    if (!xc) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.status) + ")");
-    x.col(c) = take_dense(xc, common);
+  const Eigen::Index width = kColumnsPerSolveCall;
+  auto solve_group = [&](Eigen::Index first, cholmod_common& common) {
+    const Eigen::Index k = std::min(width, b.cols() - first);
+    const Eigen::MatrixXd group = b.middleCols(first, k);
+    cholmod_dense rhs = view_dense(group);
+    cholmod_dense* xg = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common);
+    if (!xg) throw Error("sparse solve failed (CHOLMOD status " + std::to_string(common.status) + ")");
+    x.middleCols(first, k) = take_dense(xg, common);
   };
-  if (factor_entries() < kThreadedSolveMinEntries) {
+  solve_calls_ += int((b.cols() + width - 1) / width);
+  if (factor_entries() < kThreadedSolveMinEntries || b.cols() <= width) {
     ThreadCommon common;
-    for (Eigen::Index c = 0; c < b.cols(); ++c) solve_column(c, common.c);
+    for (Eigen::Index c = 0; c < b.cols(); c += width) solve_group(c, common.c);
     return x;
   }
-  std::vector<std::function<void()>> columns;
-  for (Eigen::Index c = 0; c < b.cols(); ++c)
-    columns.push_back([&, c] {
+  std::vector<std::function<void()>> groups;
+  for (Eigen::Index c = 0; c < b.cols(); c += width)
+    groups.push_back([&, c] {
       ThreadCommon common;
-      solve_column(c, common.c);
+      solve_group(c, common.c);
     });
-  parallel_tasks(columns);
+  parallel_tasks(groups);
   return x;
 }
 

@@ -26,6 +26,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -73,10 +74,19 @@ class SpdSolver {
   // analysis, with the row schedule (A's values are known to be the ones factorised); analyze()
   // alone makes only the pattern's, since factorize() may be given other values.
   bool compute(const SpMat& A, const std::vector<int>* order = nullptr);
-  // x = A^-1 b (b: n x k), column by column: the columns on the worker threads when the factor has
-  // at least kThreadedSolveMinEntries entries, else one after the other on the calling thread. A
-  // column's result is the same bits either way (the same one-column solve).
+  // x = A^-1 b (b: n x k), kColumnsPerSolveCall columns per CHOLMOD call: the groups on the worker
+  // threads when the factor has at least kThreadedSolveMinEntries entries and there are two or more,
+  // else one after the other on the calling thread. A column's result is the same bits either way
+  // (those of its one-column solve).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  // Columns one CHOLMOD solve call takes: its simplicial kernels for 2 and 3 right-hand sides read L
+  // once for all of them (a solve is bound by reading L, ~12 bytes an entry) and compute each column
+  // with the one-column kernel's operations (bitwise equal, tested); its 4-column kernel does not.
+  // A 2-column solve of a 1.3e7-entry factor: 0.041-0.044 CPU s against 0.065-0.066 for two calls
+  // (docs/flatten.md, session 24).
+  static constexpr Eigen::Index kColumnsPerSolveCall = 3;
+  // CHOLMOD solve calls solve() has made on this solver (each reads L once).
+  int solve_calls() const { return solve_calls_.load(); }
   // A column's solve reads L twice (about 24 bytes an entry): at 10^6 entries some 10 ms (an
   // estimate at a few GB/s), far above what starting a thread for it costs (tens of microseconds
   // idle; on a loaded machine the new thread also waits for a core). The local area-correction
@@ -127,6 +137,7 @@ class SpdSolver {
   std::vector<RowSchedule> schedule_;  // from analyze(), for the next factorize() (empty: none)
   bool early_schedule_ = false, early_transpose_ = false;
   int threaded_transposes_ = 0;
+  mutable std::atomic<int> solve_calls_{0};  // solve()'s CHOLMOD calls (solve() may run on two threads at once)
 #ifdef COLONFLAT_HAVE_CHOLMOD
   mutable cholmod_common common_{};
   bool started_ = false;

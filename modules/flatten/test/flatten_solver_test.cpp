@@ -674,3 +674,27 @@ TEST(FlattenSolver, EnclosedFacesAreTheIslandsKeepLargestComponentDrops) {
   for (std::size_t budget : {std::size_t(1), std::size_t(400), t.size()})
     EXPECT_EQ(cf::flat_detail::enclosed_by(E, in, budget), island) << "budget " << budget;
 }
+
+// A right-hand side of 5 columns is solved in 2 CHOLMOD calls (3 + 2 columns: L read twice, not 5
+// times), every column the same bits as its own one-column solve, on a factor below
+// kThreadedSolveMinEntries (groups on the calling thread) and on one above it (groups on threads).
+TEST(FlattenSolver, ColumnsAreSolvedThreeToACallWithTheOneColumnBits) {
+  for (const int nx : {40, 320}) {
+    const int nv = nx * nx;
+    const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 11));
+    std::vector<int> all(nv);
+    for (int v = 0; v < nv; ++v) all[v] = v;
+    SpdSolver s;
+    ASSERT_TRUE(s.compute(grid_system(E, nx, all, nv)));
+    if (s.factor_flops() == 0) GTEST_SKIP() << "no CHOLMOD: Eigen's solve";
+    EXPECT_EQ(s.factor_entries() >= SpdSolver::kThreadedSolveMinEntries, nx == 320);
+    const Eigen::MatrixXd b = Eigen::MatrixXd::Random(nv, 5);
+    const Eigen::MatrixXd x = s.solve(b);
+    EXPECT_EQ(s.solve_calls(), 2);
+    for (Eigen::Index c = 0; c < b.cols(); ++c) {
+      const Eigen::MatrixXd alone = s.solve(b.col(c));
+      EXPECT_EQ(alone, x.col(c)) << "column " << c << ", grid " << nx;
+    }
+    EXPECT_EQ(s.solve_calls(), 7);
+  }
+}
