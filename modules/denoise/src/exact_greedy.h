@@ -100,7 +100,6 @@ class ExactGreedy {
     std::vector<int> ball;
     std::vector<double> ball_distance;
     int root_u = -1, root_v = -1;
-    bool spare = false;  // searched beside a batch of one group, used only if still needed (run_with_spare)
   };
   std::vector<int> collect_group(int seed, double best, double radius, std::uint32_t taken,
                                  std::vector<int>* root_parent);
@@ -109,9 +108,6 @@ class ExactGreedy {
   std::size_t batch_size() const;
   void run_group(GroupRun& g, FundamentalCycleSearch& search) const;
   void run_groups(std::vector<GroupRun>& runs);
-  int spare_seed(double best, std::uint32_t taken);
-  bool spare_needed(int seed, double best);
-  std::size_t run_with_spare(std::vector<GroupRun>& runs, double best);
   // Threads for `tasks` independent searches: min(worker threads, tasks), 1 without a worker;
   // makes the search objects lanes 1.. use. lane_search(t): lane t's (lane 0: search_).
   int search_lanes(std::size_t tasks);
@@ -202,9 +198,6 @@ class ExactGreedy {
   long long far_searches_ = 0;
   long long group_searches_ = 0, group_members_ = 0, group_exact_ = 0, parallel_pairs_ = 0;
   long long mixed_batches_ = 0;  // batches holding groups of two crossing families
-  // Spare groups (run_with_spare): formed; searched because still needed; of those, collected
-  // again with the same roots (with a helper: the search made beside the group is used).
-  long long spares_ = 0, spares_used_ = 0, spares_ahead_ = 0;
   std::vector<std::uint32_t> group_mark_;  // per vertex: group_stamp_ when in the group being collected
   std::uint32_t group_stamp_ = 0;
   int alternatives_ = 0;           // loops replaced by another of the same class (caps)

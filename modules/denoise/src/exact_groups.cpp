@@ -11,7 +11,6 @@
 #include <atomic>
 #include <cmath>
 
-#include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
 #include "exact_greedy.h"
 
@@ -74,107 +73,26 @@ void ExactGreedy::search_group(int seed, double best) {
   Stopwatch sw;
   std::vector<GroupRun> runs{prepare_group(seed, best, 0)};
   const std::uint32_t first = group_stamp_;  // the batch's groups have marks >= first
-  const std::size_t want = batch_size();
-  while (runs.size() < want) {
+  for (std::size_t want = batch_size(); runs.size() < want;) {
     const int other = next_seed(runs, best, first);
     if (other < 0) break;
     runs.push_back(prepare_group(other, best, first));
-  }
-  const int spare = want > 1 && runs.size() == 1 ? spare_seed(best, first) : -1;
-  if (spare >= 0) {
-    runs.push_back(prepare_group(spare, best, first));
-    runs.back().spare = true;
   }
   for (const auto& entry : far_skipped_) {  // back into the far-first order
     far_order_.push_back(entry);
     std::push_heap(far_order_.begin(), far_order_.end());
   }
   far_skipped_.clear();
+  run_groups(runs);
   mixed_batches_ += std::any_of(runs.begin(), runs.end(),
                                 [&](const GroupRun& g) { return slots_[g.seed].family != slots_[seed].family; });
-  std::size_t used = runs.size();
-  if (spare >= 0) {
-    used = run_with_spare(runs, best);
-  } else {
-    run_groups(runs);
-    for (const GroupRun& g : runs) finish_group(g, best);
-  }
   std::size_t settled = 0;
-  for (std::size_t i = 0; i < used; ++i) settled += runs[i].settled;
-  last_group_settled_ = settled / used;
+  for (const GroupRun& g : runs) {
+    settled += g.settled;
+    finish_group(g, best);
+  }
+  last_group_settled_ = settled / runs.size();
   st_.t.search += sw.seconds();
-}
-
-// A spare for a batch of one group: the first far-first entry set aside as near the group (the
-// source the one-thread order searches next unless the group's bounds certify it), or -1.
-int ExactGreedy::spare_seed(double best, std::uint32_t taken) {
-  if (far_skipped_.empty()) return -1;
-  const int s = far_skipped_.front().second;
-  if (group_mark_[slots_[s].vertex] >= taken || !spare_needed(s, best)) return -1;
-  far_skipped_.erase(far_skipped_.begin());
-  return s;
-}
-
-// Whether the spare's seed still needs a search after the group's bounds: pending (active, not
-// exact, bound below the best known loop and below --max-loop-length) and the best known loop
-// unchanged. Then the queue's top is a pending entry and the far-first order (unchanged) gives
-// this seed next, so the one-thread order would search it now.
-bool ExactGreedy::spare_needed(int seed, double best) {
-  const SourceBound& b = slots_[seed].bound;
-  return slots_[seed].active && !b.exact && b.value < best && b.value < opts_.max_loop_length && best_known() == best;
-}
-
-// Runs a batch of one group (runs[0]) and its spare (runs[1], collected beside it, whose ball may
-// meet the group's) and returns how many results were used (1 or 2). After the group's bounds,
-// when spare_needed(), the spare's group is collected again as the one-thread order would collect
-// it next (sources the group certified drop out) and that group's result is used: the search
-// made beside the group when it has the same roots, tree and limit (a search's result depends
-// only on the mesh, its roots and limit, not on when it ran), else a new search. With one thread
-// nothing is searched ahead; with a helper the spare is searched beside the group and cancelled
-// as soon as the group's bounds show it is not used. So the bounds, and every later search and
-// loop, are the same for any thread count. The group's bounds are applied while the helper
-// searches: finish_group() writes bounds and the queue, which run_group() does not read
-// (families are not added: no spare while Z is sought).
-std::size_t ExactGreedy::run_with_spare(std::vector<GroupRun>& runs, double best) {
-  GroupRun& spare = runs[1];
-  bool needed = false, same = false;
-  GroupRun fresh;
-  auto first_then_check = [&] {
-    run_group(runs[0], *search_);
-    finish_group(runs[0], best);
-    needed = spare_needed(spare.seed, best);
-    if (!needed) return;
-    fresh = prepare_group(spare.seed, best, 0);
-    same = fresh.members == spare.members && fresh.root_parent == spare.root_parent && fresh.limit == spare.limit;
-  };
-  ++spares_;
-  if (search_lanes(2) == 1) {
-    first_then_check();
-  } else {
-    std::atomic<bool> cancel{false};
-    FundamentalCycleSearch& other = lane_search(1);
-    worker_->run(2, [&](int t) {
-      if (t == 1) {
-        other.set_cancel(&cancel);
-        run_group(spare, other);
-        other.set_cancel(nullptr);
-        return;
-      }
-      first_then_check();
-      cancel.store(!same, std::memory_order_relaxed);
-    });
-    if (same && other.cancelled()) throw Error("denoise: internal error: a used spare search was cancelled");
-  }
-  if (!needed) return 1;
-  ++spares_used_;
-  spares_ahead_ += same;
-  if (!same || search_lanes(2) == 1) {
-    fresh.spare = true;
-    spare = std::move(fresh);
-    run_group(spare, *search_);
-  }
-  finish_group(spare, best);
-  return 2;
 }
 
 // Groups in the next batch: 1 while the Z family is being found (its first loop comes from run

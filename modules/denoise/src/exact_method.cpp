@@ -237,9 +237,6 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["group_exact_bounds"] = group_exact_;
   stats["parallel_search_pairs"] = parallel_pairs_;
   stats["batches_of_two_families"] = mixed_batches_;
-  stats["spare_groups"] = spares_;
-  stats["spare_groups_used"] = spares_used_;
-  stats["spare_groups_same_roots"] = spares_ahead_;
   stats["settled_vertices_alone"] = settled_alone_;
   stats["bounds_lowered_after_surgery"] = bounds_reset_;
   stats["homology_builds"] = builds_;

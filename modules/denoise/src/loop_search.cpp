@@ -33,7 +33,6 @@ void FundamentalCycleSearch::reset_run() {
     run_id_ = 1;
   }
   settled_count_ = 0;
-  cancelled_ = false;
   settled_order_.clear();
   acc_.assign(W_, 0);  // row 0: the zero class, shared by every path whose class is zero
   heap_.clear();
@@ -154,10 +153,6 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
     }
     heap_.pop();
     if (node_[vi].settled || d > node_[vi].dist) continue;
-    if (cancel_ && settled_count_ % kCancelEvery == 0 && cancel_->load(std::memory_order_relaxed)) {
-      cancelled_ = true;
-      break;
-    }
     settle(vi);
     expand(vi, d, limit, accept, best);
   }

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include "brute_force.h"
@@ -177,32 +176,6 @@ TEST(DenoiseLoopSearch, GroupSearchBoundsEveryRootAndIsExactAtItsRoot) {
       }
     }
   }
-}
-
-// A search stops at once when its cancel flag is set (nothing settled, cancelled() true), runs to
-// the same cycle as without a flag when the flag stays false, and the next run without a flag
-// is not marked cancelled (torus: the meridian).
-TEST(DenoiseLoopSearch, CancelledSearchStopsAndIsMarked) {
-  const Mesh m = to_mesh(torus(3, 1, 24, 10));
-  HomologyBasis hb;
-  hb.build(m);
-  Z2Span span(hb.words());
-  FundamentalCycleSearch search(m, hb, span);
-  const CycleCandidate plain = search.run(VH(0), 100);
-  ASSERT_TRUE(plain.found);
-  EXPECT_FALSE(search.cancelled());
-  std::atomic<bool> cancel{false};
-  search.set_cancel(&cancel);
-  const CycleCandidate kept = search.run(VH(0), 100);
-  EXPECT_FALSE(search.cancelled());
-  EXPECT_EQ(kept.value, plain.value);
-  cancel = true;
-  search.run(VH(0), 100);
-  EXPECT_TRUE(search.cancelled());
-  EXPECT_EQ(search.last_settled(), 0u);
-  search.set_cancel(nullptr);
-  EXPECT_EQ(search.run(VH(0), 100).value, plain.value);
-  EXPECT_FALSE(search.cancelled());
 }
 
 // On genus-1 surfaces whose loop must be certified against many sources, the search switches to

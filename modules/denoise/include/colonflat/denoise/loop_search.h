@@ -9,7 +9,6 @@
 // so minimising over a vertex set that every non-separating cycle meets gives the global
 // shortest. Since d(u) + |uv| + d(v) >= 2 max(d(u), d(v)), cycles of value <= L involve only
 // vertices within L/2: the search stops at half the best value found (or of the limit).
-#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -60,10 +59,6 @@ class FundamentalCycleSearch {
   // Vertices flagged in `avoid` (per vertex id) are never entered (the source excepted);
   // nullptr: none. Must outlive the runs.
   void set_avoid(const std::vector<std::uint8_t>* avoid) { avoid_ = avoid; }
-  // A run stops soon after `cancel` turns true (asked every kCancelEvery settled vertices); its
-  // result is then meaningless (cancelled() is true) and must be dropped. nullptr: never.
-  void set_cancel(const std::atomic<bool>* cancel) { cancel_ = cancel; }
-  bool cancelled() const { return cancelled_; }
   // The simple cycle of a candidate from the last run() (the common stem from s is dropped).
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
@@ -105,9 +100,6 @@ class FundamentalCycleSearch {
   const Z2Span& span_;
   const std::vector<std::uint8_t>* cochain_ = nullptr;
   const std::vector<std::uint8_t>* avoid_ = nullptr;
-  const std::atomic<bool>* cancel_ = nullptr;
-  bool cancelled_ = false;
-  static constexpr std::size_t kCancelEvery = 256;
   int W_;
   std::uint32_t run_id_ = 0;
   // Per-vertex search state in one record (one cache line fetch per neighbour visited).
