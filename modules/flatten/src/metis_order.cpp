@@ -209,18 +209,7 @@ cholmod_sparse lower_pattern(const Graph& g, std::vector<int>& p, std::vector<in
       if (g.adjncy[std::size_t(k)] > j) i.push_back(g.adjncy[std::size_t(k)]);
     p.push_back(int(i.size()));
   }
-  cholmod_sparse m{};
-  m.nrow = m.ncol = std::size_t(n);
-  m.nzmax = std::max<std::size_t>(i.size(), 1);
-  m.p = p.data();
-  m.i = i.empty() ? p.data() : i.data();
-  m.stype = -1;
-  m.itype = CHOLMOD_INT;
-  m.xtype = CHOLMOD_PATTERN;
-  m.dtype = CHOLMOD_DOUBLE;
-  m.sorted = 1;
-  m.packed = 1;
-  return m;
+  return view_columns(std::size_t(n), std::size_t(n), p.data(), i.data(), nullptr, -1);
 }
 
 // COLONFLAT_FLATTEN_DEBUG: what the split order's parts cost.

@@ -70,20 +70,25 @@ Eigen::MatrixXd SpdSolver::solve_leading(const Eigen::MatrixXd& b, int leading) 
 }
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
-cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
+cholmod_sparse view_columns(std::size_t nrow, std::size_t ncol, const int* p, const int* i, const double* x, int stype) {
   cholmod_sparse m{};
-  m.nrow = m.ncol = std::size_t(A.rows());
-  m.nzmax = std::size_t(A.nonZeros());
-  m.p = const_cast<int*>(A.outerIndexPtr());
-  m.i = const_cast<int*>(A.innerIndexPtr());
-  m.x = const_cast<double*>(A.valuePtr());
-  m.stype = -1;  // symmetric, lower triangle used
+  m.nrow = nrow;
+  m.ncol = ncol;
+  m.nzmax = std::max<std::size_t>(std::size_t(p[ncol]), 1);
+  m.p = const_cast<int*>(p);
+  m.i = const_cast<int*>(p[ncol] > 0 ? i : p);  // CHOLMOD wants a pointer even without entries
+  m.x = const_cast<double*>(x);
+  m.stype = stype;
   m.itype = CHOLMOD_INT;
-  m.xtype = CHOLMOD_REAL;
+  m.xtype = x ? CHOLMOD_REAL : CHOLMOD_PATTERN;
   m.dtype = CHOLMOD_DOUBLE;
   m.sorted = 1;
   m.packed = 1;
   return m;
+}
+
+cholmod_sparse view_lower(const SpdSolver::SpMat& A) {
+  return view_columns(std::size_t(A.rows()), std::size_t(A.cols()), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr(), -1);
 }
 
 namespace {
@@ -318,10 +323,8 @@ bool SpdSolver::modify(const SpMat& C, bool update) {
     for (SpMat::InnerIterator it(C, j); it; ++it) entries.emplace_back(place[it.row()], j, it.value());
   SpMat permuted(C.rows(), C.cols());
   permuted.setFromTriplets(entries.begin(), entries.end());  // compressed, rows sorted
-  cholmod_sparse view = view_lower(permuted);
-  view.nrow = std::size_t(C.rows());
-  view.ncol = std::size_t(C.cols());
-  view.stype = 0;  // unsymmetric: C itself
+  cholmod_sparse view = view_columns(std::size_t(C.rows()), std::size_t(C.cols()), permuted.outerIndexPtr(),
+                                     permuted.innerIndexPtr(), permuted.valuePtr(), 0);  // unsymmetric: C itself
   cholmod_updown(update ? 1 : 0, &view, factor_, &common_);
   cholmod_ok_ = common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
   return cholmod_ok_;

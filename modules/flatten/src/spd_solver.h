@@ -158,6 +158,10 @@ class SpdSolver {
 // A read-only CHOLMOD view of the lower triangle of a compressed A (stype -1, no copy: valid while
 // A lives and is not changed).
 cholmod_sparse view_lower(const SpdSolver::SpMat& A);
+// A read-only CHOLMOD view of nrow x ncol compressed columns (p: ncol + 1 column starts, i: sorted
+// row indices, x: values, or null for a pattern; no copy); stype -1: symmetric, lower triangle used;
+// 0: unsymmetric.
+cholmod_sparse view_columns(std::size_t nrow, std::size_t ncol, const int* p, const int* i, const double* x, int stype);
 #endif
 
 }  // namespace cf::flat_detail
