@@ -59,11 +59,11 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
     const int nv = int(s.p.size());
-    const bool dissect = uses_dissection(s.p.size(), o.map), measure = o.map == "area-balanced";
+    const bool dissect = uses_dissection(s.p.size(), o.map), balanced = o.map == "area-balanced";
     std::shared_future<SegmentOrder> order;
     if (dissect) order = std::async(side_launch(), [t = s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(t, nv), true}; });
     auto E0 = std::make_shared<const Edges>(build_edges(s.t));
-    if (!dissect) order = std::async(side_launch(), [E0, nv, measure] { return small_segment_vertex_order(*E0, nv, measure); });
+    if (!dissect) order = std::async(side_launch(), [E0, nv, balanced] { return small_segment_vertex_order(*E0, nv, balanced); });
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);
     w.ann = std::move(op.annulus);
     E = std::move(op.edges);
@@ -75,7 +75,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
         if ((*to_annulus)[std::size_t(v)] >= 0) restricted.push_back((*to_annulus)[std::size_t(v)]);
       return restricted;
     };
-    if (measure) w.keep_order(order, *to_annulus);  // (dissect implies measure)
+    if (balanced) w.keep_order(order, *to_annulus);  // (dissect implies balanced)
   }
   auto loops = boundary_loops(w.ann, E);
   const long long chi = (long long)w.ann.p.size() - (long long)E.ev.size() + (long long)w.ann.t.size();
@@ -183,7 +183,8 @@ Prepared prepare(SegmentWork& w, Edges edges) {
   w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) area[f] = face_area_3d(ann, int(f)), w.seg.area_3d += area[f];
   p.degenerate.assign(ann.t.size(), 0);
-  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = area[f] <= 1e-6 * (w.seg.area_3d / double(ann.t.size()));
+  const double mean_area = w.seg.area_3d / double(ann.t.size());
+  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = area[f] <= 1e-6 * mean_area;
   p.fixed.assign(ann.p.size(), 0);  // the ends and the rims of cut-off branches
   for (std::size_t e = 0; e < p.E.ev.size(); ++e)
     if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
