@@ -6,6 +6,7 @@
 #include <deque>
 #include <sstream>
 
+#include "colonflat/core/bucket_slots.h"
 #include "colonflat/core/error.h"
 
 namespace cf {
@@ -34,11 +35,12 @@ double solid_angle(const P3& a0, const P3& b0, const P3& c0, const P3& p) {
 struct FacesByComponent {
   std::vector<std::size_t> start;
   std::vector<std::uint32_t> face;
-  FacesByComponent(const TopologyReport& topo) : start(topo.components.size() + 1, 0), face(topo.face_component.size()) {
-    for (int c : topo.face_component) ++start[std::size_t(c) + 1];
-    for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t f = 0; f < face.size(); ++f) face[fill[std::size_t(topo.face_component[f])]++] = std::uint32_t(f);
+  FacesByComponent(const TopologyReport& topo) : face(topo.face_component.size()) {
+    BucketSlots<std::size_t> slots(topo.components.size());
+    for (int c : topo.face_component) slots.count(std::size_t(c));
+    slots.close();
+    for (std::size_t f = 0; f < face.size(); ++f) face[slots.place(std::size_t(topo.face_component[f]))] = std::uint32_t(f);
+    start = std::move(slots).take_starts();
   }
 };
 
@@ -147,12 +149,12 @@ struct FaceAdjacency {
       if (recs[i].first == recs[i + 1].first && (i + 2 >= recs.size() || recs[i + 2].first != recs[i].first) &&
           (i == 0 || recs[i - 1].first != recs[i].first))
         pairs.emplace_back(recs[i].second, recs[i + 1].second);
-    start.assign(F + 1, 0);
-    for (auto& p : pairs) ++start[p.first + 1], ++start[p.second + 1];
-    for (std::size_t f = 0; f < F; ++f) start[f + 1] += start[f];
-    next.resize(start[F]);
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (auto& p : pairs) next[fill[p.first]++] = p.second, next[fill[p.second]++] = p.first;
+    BucketSlots<std::uint32_t> slots(F);
+    for (auto& p : pairs) slots.count(p.first), slots.count(p.second);
+    slots.close();
+    next.resize(slots.total());
+    for (auto& p : pairs) next[slots.place(p.first)] = p.second, next[slots.place(p.second)] = p.first;
+    start = std::move(slots).take_starts();
   }
 };
 

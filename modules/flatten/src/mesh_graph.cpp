@@ -7,6 +7,7 @@
 #include <queue>
 #include <unordered_map>
 
+#include "colonflat/core/bucket_slots.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/params.h"
 #include "colonflat/core/union_find.h"
@@ -26,17 +27,17 @@ Edges build_edges(const std::vector<Tri>& t) {
   ++edge_graphs_built;
   int nv = 0;
   for (const Tri& tri : t) nv = std::max({nv, tri[0] + 1, tri[1] + 1, tri[2] + 1});
-  std::vector<int> start(std::size_t(nv) + 1, 0);
+  BucketSlots<int> slots{std::size_t(nv)};
   for (const Tri& tri : t)
-    for (int k = 0; k < 3; ++k) ++start[std::min(tri[(k + 1) % 3], tri[(k + 2) % 3]) + 1];
-  for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
+    for (int k = 0; k < 3; ++k) slots.count(std::size_t(std::min(tri[(k + 1) % 3], tri[(k + 2) % 3])));
+  slots.close();
   std::vector<std::pair<int, int>> corner(3 * t.size());  // (hi, 3 f + k) per bucket
-  std::vector<int> fill(start.begin(), start.end() - 1);
   for (std::size_t f = 0; f < t.size(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = t[f][(k + 1) % 3], b = t[f][(k + 2) % 3];
-      corner[fill[std::min(a, b)]++] = {std::max(a, b), int(3 * f + k)};
+      corner[std::size_t(slots.place(std::size_t(std::min(a, b))))] = {std::max(a, b), int(3 * f + k)};
     }
+  const std::vector<int>& start = slots.starts();
   Edges E;
   E.fe.assign(t.size(), {-1, -1, -1});
   E.ev.reserve(3 * t.size() / 2 + 1);
@@ -72,14 +73,14 @@ Edges sub_edges(const Edges& E, const std::vector<char>& keep, const std::vector
     const int a = new_of_old[E.ev[e][0]], b = new_of_old[E.ev[e][1]];
     return std::pair<int, int>(std::min(a, b), std::max(a, b));
   };
-  std::vector<int> start(std::size_t(nv) + 1, 0);
+  BucketSlots<int> slots{std::size_t(nv)};
   for (std::size_t e = 0; e < E.ev.size(); ++e)
-    if (kept(e)) ++start[lo_hi(e).first + 1];
-  for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
-  std::vector<std::pair<int, int>> slot(std::size_t(start[nv]));  // (hi, edge of E) per bucket
-  std::vector<int> fill(start.begin(), start.end() - 1);
+    if (kept(e)) slots.count(std::size_t(lo_hi(e).first));
+  slots.close();
+  std::vector<std::pair<int, int>> slot(std::size_t(slots.total()));  // (hi, edge of E) per bucket
   for (std::size_t e = 0; e < E.ev.size(); ++e)
-    if (kept(e)) slot[fill[lo_hi(e).first]++] = {lo_hi(e).second, int(e)};
+    if (kept(e)) slot[std::size_t(slots.place(std::size_t(lo_hi(e).first)))] = {lo_hi(e).second, int(e)};
+  const std::vector<int>& start = slots.starts();
   Edges S;
   S.ev.resize(slot.size()), S.ef.resize(slot.size());
   std::vector<int> new_edge(E.ev.size(), -1);
@@ -102,17 +103,18 @@ Edges sub_edges(const Edges& E, const std::vector<char>& keep, const std::vector
 Csr build_csr(const Surface& s, const Edges& E) {
   Csr g;
   const std::size_t nv = s.p.size();
-  g.start.assign(nv + 1, 0);
-  for (const auto& e : E.ev) ++g.start[e[0] + 1], ++g.start[e[1] + 1];
-  for (std::size_t i = 0; i < nv; ++i) g.start[i + 1] += g.start[i];
-  g.nbr.resize(g.start[nv]);
-  g.len.resize(g.start[nv]);
-  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  BucketSlots<int> slots(nv);
+  for (const auto& e : E.ev) slots.count(std::size_t(e[0])), slots.count(std::size_t(e[1]));
+  slots.close();
+  g.nbr.resize(std::size_t(slots.total()));
+  g.len.resize(std::size_t(slots.total()));
   for (const auto& e : E.ev) {
     const double l = (s.p[e[0]] - s.p[e[1]]).norm();
-    g.nbr[fill[e[0]]] = e[1], g.len[fill[e[0]]++] = l;
-    g.nbr[fill[e[1]]] = e[0], g.len[fill[e[1]]++] = l;
+    const int i = slots.place(std::size_t(e[0])), j = slots.place(std::size_t(e[1]));
+    g.nbr[std::size_t(i)] = e[1], g.len[std::size_t(i)] = l;
+    g.nbr[std::size_t(j)] = e[0], g.len[std::size_t(j)] = l;
   }
+  g.start = std::move(slots).take_starts();
   return g;
 }
 
