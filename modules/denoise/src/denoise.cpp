@@ -135,7 +135,8 @@ nlohmann::json loops_report(const std::vector<LoopRecord>& loops, nlohmann::json
 
 }  // namespace
 
-DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress) {
+DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress,
+                      const TopologyReport* input_topology) {
   validate_denoise_options(o);
   Stopwatch total;
   DenoiseResult res;
@@ -143,7 +144,7 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
   const int threads = std::min(thread_count(), detail::kMaxThreads);
   if (threads > 1) st.worker = std::make_unique<detail::SearchWorker>(threads);
   double t_analysis = 0;
-  detail::prepare_input(st, input, o, &res.before, &t_analysis);
+  detail::prepare_input(st, input, o, &res.before, &t_analysis, input_topology);
   phase_done("topology analysis");
   const TopologyReport& b = res.before;
   const int needed = std::max(0, *b.genus - o.target_genus);

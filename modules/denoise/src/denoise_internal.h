@@ -57,9 +57,12 @@ struct DenoiseState {
 // Copies `input` into st.mesh (garbage-collected) and analyses the input's topology into
 // `before` (time in *t_analysis). With st.worker, the analysis runs on the helper thread while
 // this one copies the mesh and builds the cap guard grid and (exact method) the first homology
-// basis. Throws PreconditionError when the input is not a valid denoise input.
+// basis. `known` (optional) = analyze_topology(input) made by the caller: taken instead of a new
+// analysis when it fits the input (its size, no garbage), and then the helper builds the grid
+// beside the copy and the first basis. Throws PreconditionError when the input is not a valid
+// denoise input.
 void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
-                   double* t_analysis);
+                   double* t_analysis, const TopologyReport* known = nullptr);
 
 // How hard a surgery looks for clean caps (with --check-caps): kFull, every step; kFirst, every
 // step, but the concentric placements are only searched for a clean one (a loop's first cut,

@@ -105,10 +105,11 @@ double mean_edge_length(const Mesh& mesh) {
 }
 
 // The cap guard grid the first surgery needs, built while the helper thread analyses the input
-// (wasted when the input needs no cut). Reads st.mesh only.
-void build_guard(DenoiseState& st, const DenoiseOptions& o) {
+// (wasted when the input needs no cut). Reads `from` only: st.mesh, or the input when it has no
+// garbage (the copy then has its element ids and points, so the grid is the same).
+void build_guard(DenoiseState& st, const DenoiseOptions& o, const Mesh& from) {
   Stopwatch sw;
-  if (o.check_caps) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * mean_edge_length(st.mesh));
+  if (o.check_caps) st.guard = std::make_unique<FaceGrid>(from, kGuardCellEdges * mean_edge_length(from));
   st.t.surgery += sw.seconds();  // where cut_loop() counts it when it builds the grid
   if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: guard grid %.3f s\n", sw.seconds());
 }
@@ -117,20 +118,32 @@ void build_guard(DenoiseState& st, const DenoiseOptions& o) {
 // to cut, with the cut graph's pruning on the helper beside the annotation (HomologyBasis::build:
 // the same basis). It used to follow the guard grid on this thread while the helper, done with
 // the analysis, waited (real CT surface: copy + grid + basis 1.7-3.0 s, analysis 1.1-1.9 s).
-void build_first_homology(DenoiseState& st, const DenoiseOptions& o, const TopologyReport& b) {
+// With `beside` false the pruning follows the annotation on this thread (the helper is busy):
+// the same basis.
+void build_first_homology(DenoiseState& st, const DenoiseOptions& o, const TopologyReport& b, bool beside = true) {
   if (o.method != "exact" || *b.genus <= o.target_genus) return;
   Stopwatch sw;
   st.initial_homology = std::make_unique<HomologyBasis>();
-  st.initial_homology->build(st.mesh, [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {
-    run_both(*st.worker, mine, theirs);
-  });
+  if (beside)
+    st.initial_homology->build(st.mesh, [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {
+      run_both(*st.worker, mine, theirs);
+    });
+  else
+    st.initial_homology->build(st.mesh);
   st.t.homology += sw.seconds();
+}
+
+// Whether `t` can stand for analyze_topology(input): given, and of a mesh of the input's size
+// with no garbage (analyze_topology's precondition; the caller vouches for the rest).
+bool usable_topology(const TopologyReport* t, const Mesh& input) {
+  return t && t->faces == input.n_faces() && t->vertices + t->unreferenced_vertices == input.n_vertices() &&
+         !has_garbage(input);
 }
 
 }  // namespace
 
 void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o, TopologyReport* before,
-                   double* t_analysis) {
+                   double* t_analysis, const TopologyReport* known) {
   auto copy = [&] {
     // Room for what surgery adds: the element arrays keep their capacity through the copy
     // (doubling the 2 M-edge array at the first surgery that overflows it cost 0.3 s).
@@ -155,14 +168,31 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
     *t_analysis = sw.seconds();
     if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: topology analysis %.3f s\n", *t_analysis);
   };
-  if (st.worker && !has_garbage(input)) {  // the copy keeps the input's element ids
+  auto copy_timed = [&] {
+    Stopwatch sw;
+    copy();
+    if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: copy %.3f s\n", sw.seconds());
+  };
+  if (usable_topology(known, input)) {  // no analysis: the grid on the helper beside the copy and first basis
+    *before = *known;
+    *t_analysis = 0;
+    check_input(*before, o);
+    if (st.worker)
+      run_both(
+          *st.worker,
+          [&] {
+            copy_timed();
+            build_first_homology(st, o, *before, false);
+          },
+          [&] { build_guard(st, o, input); });
+    else
+      copy();
+  } else if (st.worker && !has_garbage(input)) {  // the copy keeps the input's element ids
     run_both(
         *st.worker,
         [&] {
-          Stopwatch sw;
-          copy();
-          if (denoise_debug()) std::fprintf(stderr, "denoise debug: set-up: copy %.3f s\n", sw.seconds());
-          build_guard(st, o);
+          copy_timed();
+          build_guard(st, o, st.mesh);
         },
         [&] { analyse(input); });
     check_input(*before, o);

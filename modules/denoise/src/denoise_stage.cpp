@@ -27,7 +27,8 @@ const ParamTable<DenoiseOptions>& denoise_param_table() {
 }
 
 void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
-  const nlohmann::json orientation = orient_mesh_input(bag, "surface", ctx, "denoise");
+  TopologyReport topology;  // the input's, made on the way: denoise() need not analyse it again
+  const nlohmann::json orientation = orient_mesh_input(bag, "surface", ctx, "denoise", &topology);
   const Mesh& in = bag.get<Mesh>("surface");
   int last_shown = -1;
   auto progress = [&](int removed, int total) {
@@ -39,7 +40,7 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
   };
   DenoiseResult r;
   try {
-    r = denoise(in, opts_, progress);
+    r = denoise(in, opts_, progress, &topology);
   } catch (const CapIntersectionError& e) {  // --strict: the error line names the input file
     if (!bag.has("surface.file")) throw;  // not read from a file (pipeline run)
     throw Error(bag.get<std::string>("surface.file") + ": " + e.problem());

@@ -138,6 +138,35 @@ TEST(DenoiseThreads, OneAndTwoThreadsGiveTheSameLoopsAndMeshOnManyHandles) {
   expect_same_result(a, b);
 }
 
+// The input's topology handed in (as the stage does with orient_mesh_input's): the input is not
+// analysed again (analysis time 0), and the loops and the output mesh are those of a run that
+// analyses it, with 1 and 2 threads (the guard grid then built on the helper from the input). A
+// report of another mesh is not taken (analysed again, the same result).
+TEST(DenoiseThreads, KnownInputTopologyIsTakenWithTheSameResult) {
+  const Mesh m = bench::sphere_with_handles(30, 6, 0.6);
+  const TopologyReport known = analyze_topology(m);
+  const DenoiseResult a = denoise_with_threads(m, 1);
+  auto with_known = [&](int threads, const TopologyReport& t) {
+    set_thread_count(threads);
+    DenoiseResult r = denoise(m, DenoiseOptions{}, {}, &t);
+    set_thread_count(0);
+    return r;
+  };
+  EXPECT_GT(a.report["time_s"]["analysis"].get<double>(), 0.0);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    const DenoiseResult b = with_known(threads, known);
+    EXPECT_EQ(b.report["time_s"]["analysis"].get<double>(), 0.0);
+    EXPECT_EQ(b.report["genus_before"], a.report["genus_before"]);
+    EXPECT_EQ(b.report["genus_after"], 0);
+    expect_same_result(a, b);
+  }
+  const TopologyReport other = analyze_topology(bench::sphere_with_handles(20, 2, 0.6));
+  const DenoiseResult c = with_known(2, other);
+  EXPECT_GT(c.report["time_s"]["analysis"].get<double>(), 0.0);
+  expect_same_result(a, c);
+}
+
 // The colon-like surface (long contact handle, surgery on top of surgery, crossing families for
 // the last loop): identical loops and mesh with 1, 2 and 3 threads.
 TEST(DenoiseThreads, ColonLikeSurfaceIsTheSameForAnyThreadCount) {

@@ -64,7 +64,11 @@ class CapIntersectionError : public Error {
 
 // Throws PreconditionError on invalid input, UsageError on invalid options, Error when a
 // postcondition fails, CapIntersectionError when `strict` and a cap intersects the surface.
-DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {});
+// `input_topology` (optional): analyze_topology(input), when the caller has it (the stage gets it
+// from orient_mesh_input): used instead of analysing the input again if it has the input's
+// vertex and face counts and the input has no deleted elements; the result is the same.
+DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {},
+                      const TopologyReport* input_topology = nullptr);
 
 // Validates options: the table's ranges and choices (denoise_param_table()), then the rules
 // between parameters; throws UsageError.
