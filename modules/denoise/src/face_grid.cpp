@@ -220,35 +220,36 @@ void FaceGrid::StaticCells::finish_counts() {
   cursor_.assign(start_.begin(), start_.end() - 1);
 }
 
-// Two passes over the faces: count the faces of each cell, then fill the rows. Faces spanning
-// more than kMaxCellsPerFace cells go to big_, faces beyond the codes' range to the dynamic cells.
+// One pass over the faces counts each cell's faces and lists (row, face) to fill the rows from; faces
+// spanning over kMaxCellsPerFace cells go to big_, faces beyond the codes' range to the dynamic cells.
 template <class Faces>
 void FaceGrid::build_static(const Mesh& mesh, const Faces& faces) {
   erased_.assign(mesh.n_faces(), 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    std::uint64_t last = StaticCells::kEmpty;
-    std::uint32_t last_row = StaticCells::kNoRow;
-    for (auto f : faces) {
-      Key a, b;
-      if (!cell_range(mesh, f, a, b)) {
-        if (pass == 0 && big_set_.insert(f.idx()).second) big_.push_back(f.idx());
-        continue;
-      }
-      if (StaticCells::code(a) == StaticCells::kEmpty || StaticCells::code(b) == StaticCells::kEmpty) {
-        if (pass == 0) insert_dynamic(mesh, f);
-        continue;
-      }
-      for (long long x = a.x; x <= b.x; ++x)
-        for (long long y = a.y; y <= b.y; ++y)
-          for (long long z = a.z; z <= b.z; ++z) {
-            const std::uint64_t c = StaticCells::code(Key{x, y, z});
-            if (c != last) last = c, last_row = pass == 0 ? static_.find_or_add(c) : static_.find(c);
-            if (pass == 0) static_.count(last_row);
-            else static_.fill(last_row, f.idx());
-          }
+  std::vector<std::pair<std::uint32_t, int>> entries;  // (row, face); most faces lie in 1-2 cells
+  entries.reserve(2 * mesh.n_faces());
+  std::uint64_t last = StaticCells::kEmpty;
+  std::uint32_t last_row = StaticCells::kNoRow;
+  for (auto f : faces) {
+    Key a, b;
+    if (!cell_range(mesh, f, a, b)) {
+      if (big_set_.insert(f.idx()).second) big_.push_back(f.idx());
+      continue;
     }
-    if (pass == 0) static_.finish_counts();
+    if (StaticCells::code(a) == StaticCells::kEmpty || StaticCells::code(b) == StaticCells::kEmpty) {
+      insert_dynamic(mesh, f);
+      continue;
+    }
+    for (long long x = a.x; x <= b.x; ++x)
+      for (long long y = a.y; y <= b.y; ++y)
+        for (long long z = a.z; z <= b.z; ++z) {
+          const std::uint64_t c = StaticCells::code(Key{x, y, z});
+          if (c != last) last = c, last_row = static_.find_or_add(c);
+          static_.count(last_row);
+          entries.emplace_back(last_row, f.idx());
+        }
   }
+  static_.finish_counts();
+  for (const auto& [row, face] : entries) static_.fill(row, face);
   static_.end_fill();
 }
 
