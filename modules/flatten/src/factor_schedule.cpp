@@ -27,20 +27,43 @@ std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind) {
   return parent;
 }
 
-std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent) {
-  std::vector<double> work(std::size_t(n), 0.0);
+namespace {
+
+// Calls update(k, j, held) for every entry L(k, j), j < k, of the factor of the upper triangle given
+// (colptr, rowind) with elimination tree `parent`, rows k ascending: the up-looking kernel's update of
+// row k with column j, which holds `held` entries below its diagonal at that point (rows j < i < k).
+template <class Update>
+void for_each_row_update(int n, const int* colptr, const int* rowind, const std::vector<int>& parent, Update update) {
   std::vector<int> mark(std::size_t(n), -1), held(std::size_t(n), 0);  // held: entries of column j so far
   for (int k = 0; k < n; ++k) {
     mark[std::size_t(k)] = k;
-    double w = 1.0;  // the diagonal
     for (int p = colptr[k]; p < colptr[k + 1]; ++p)
       for (int i = rowind[p]; i >= 0 && i < k && mark[std::size_t(i)] != k; i = parent[std::size_t(i)]) {
-        mark[std::size_t(i)] = k;  // L(k, i) != 0: an update with column i's entries so far, then one more
-        w += 1.0 + double(held[std::size_t(i)]++);
+        mark[std::size_t(i)] = k;  // L(k, i) != 0
+        update(k, i, held[std::size_t(i)]++);
       }
-    work[std::size_t(k)] = w;
   }
+}
+
+}  // namespace
+
+std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent) {
+  std::vector<double> work(std::size_t(n), 1.0);  // the diagonal
+  // an update with column j's entries so far, then one more
+  for_each_row_update(n, colptr, rowind, parent, [&work](int k, int, int held) { work[std::size_t(k)] += 1.0 + held; });
   return work;
+}
+
+RestWork split_rest_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent,
+                         const std::vector<int>& rest) {
+  std::vector<char> in_rest(std::size_t(n), 0);
+  for (int k : rest) in_rest[std::size_t(k)] = 1;
+  RestWork out;
+  out.own = double(rest.size());  // the diagonals
+  for_each_row_update(n, colptr, rowind, parent, [&](int k, int j, int held) {
+    if (in_rest[std::size_t(k)]) (in_rest[std::size_t(j)] ? out.own : out.from_parts) += 1.0 + held;
+  });
+  return out;
 }
 
 namespace {
@@ -228,17 +251,19 @@ double thread_wait_seconds() {
 }
 
 void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
-                        double rest_cpu, double seconds, bool early, const FactorWall& wall) {
+                        double rest_cpu, double seconds, bool early, const FactorWall& wall, const RestWork& rest) {
   double largest = 0, longest = 0;
   for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
   for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
   std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases%s, largest parts %.3f, rest %.3f "
                "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s (wall: transpose "
-               "%.2f, numeric L %.2f, parts %.2f, rest %.2f, free %.2f; parts waited for a core %.2f / %.2f s)\n", parts, n, phases.size(),
+               "%.2f, numeric L %.2f, parts %.2f, rest %.2f, free %.2f; parts waited for a core %.2f / %.2f s); the rest's work: %.3f of "
+               "the estimated work from the parts' columns, %.3f its own\n", parts, n, phases.size(),
                early ? " (scheduled beside the analysis)" : "", largest, phases.back().rest_work / phases.front().total_work,
                cpu.size() > 0 ? cpu[0] : 0.0, cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds, wall.transpose,
                wall.numeric, wall.parts, wall.rest, wall.free,
-               wall.wait.size() > 0 ? wall.wait[0] : 0.0, wall.wait.size() > 1 ? wall.wait[1] : 0.0);
+               wall.wait.size() > 0 ? wall.wait[0] : 0.0, wall.wait.size() > 1 ? wall.wait[1] : 0.0,
+               rest.from_parts / phases.front().total_work, rest.own / phases.front().total_work);
 }
 
 }  // namespace cf::flat_detail

@@ -34,6 +34,18 @@ std::vector<int> elimination_tree(int n, const int* colptr, const int* rowind);
 // counted at the later rows that do it, not at the column's own row. O(entries of L) time, O(n) memory.
 std::vector<double> row_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent);
 
+// The estimated work (row_work) of the rows `rest` (closed under ancestors: the rows above the
+// parts) split by the column each update reads: `from_parts`, the updates with the columns of rows
+// outside `rest` (finished before the rest starts: row k's entries in the columns of one part's
+// subtree depend only on that subtree and on A's column k), and `own`, the updates with the rest's
+// own columns plus one per diagonal (a chain at a dense root). from_parts + own = the rest's work.
+// What a finer split of the rest could at most run side by side (COLONFLAT_FLATTEN_DEBUG).
+struct RestWork {
+  double from_parts = 0, own = 0;
+};
+RestWork split_rest_work(int n, const int* colptr, const int* rowind, const std::vector<int>& parent,
+                         const std::vector<int>& rest);
+
 // Splits the rows of the elimination tree `parent` into `parts` unions of whole subtrees and the
 // rest above them, so that the largest part plus the rest (the time with `parts` threads) is as
 // small as this search finds: starting from the roots, the heaviest subtree is repeatedly replaced
@@ -67,8 +79,8 @@ struct FactorWall {
 };
 // COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured (`cpu`: per part
 // summed over the phases, then each phase's longest; `early`: the schedule was computed beside the
-// symbolic analysis) and the wall of each stretch.
+// symbolic analysis), the wall of each stretch and the last rest's work split (`rest`: split_rest_work).
 void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
-                        double rest_cpu, double seconds, bool early, const FactorWall& wall);
+                        double rest_cpu, double seconds, bool early, const FactorWall& wall, const RestWork& rest);
 
 }  // namespace cf::flat_detail

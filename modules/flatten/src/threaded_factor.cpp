@@ -56,6 +56,15 @@ std::vector<RowSchedule> factor_schedule(cholmod_sparse* upper, int parts) {
   return schedule_phases(parent, row_work(n, colptr, rowind, parent), parts);
 }
 
+// COLONFLAT_FLATTEN_DEBUG: the last rest's estimated work split by the columns its updates read
+// (split_rest_work, of `upper` = triu(A(p,p))).
+RestWork debug_rest_work(const cholmod_sparse* upper, const std::vector<int>& rest) {
+  const int n = int(upper->ncol);
+  const int* colptr = static_cast<const int*>(upper->p);
+  const int* rowind = static_cast<const int*>(upper->i);
+  return split_rest_work(n, colptr, rowind, elimination_tree(n, colptr, rowind), rest);
+}
+
 // One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds,
 // wait[p] += the seconds its thread waited for a core.
 bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_factor* L, std::vector<double>& cpu,
@@ -134,10 +143,13 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   double rest_cpu = 0;
   ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
   wall.rest = lap.lap();
+  const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
+  const RestWork rest_split = debug ? debug_rest_work(upper, phases.back().rest) : RestWork{};  // (before `made` is freed)
+  const double walk = lap.lap();  // (not part of the factorisation's time)
   if (made) cholmod_free_sparse(&made, &common);
   wall.free = lap.lap();
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) {
-    print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds(), early, wall);
+  if (debug) {
+    print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds() - walk, early, wall, rest_split);
     const BlockCache::Stats s = cholmod_block_cache().stats();
     std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now; numeric "
                  "transpose %s\n", s.reused, s.fresh, s.kept, use.early_transpose ? "made beside the analysis" : "made here");

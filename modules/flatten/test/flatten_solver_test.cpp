@@ -532,6 +532,37 @@ TEST(FlattenSolver, RowPhasesSplitTheRestAgainIntoIndependentParts) {
   EXPECT_LT(time, one.largest_part + one.rest_work);
 }
 
+// split_rest_work divides the rest's estimated work by the column each update reads, as counted on
+// the factor itself (Eigen's LDL^T of the permuted grid system: the m-th entry below the diagonal of
+// column j, at row i, costs 1 + m at row i): the updates of rest rows with the columns of rows in
+// the parts, and the rest's own (its columns and diagonals); the two add up to the rest's work.
+TEST(FlattenSolver, RestWorkSplitsIntoTheUpdatesFromThePartsColumnsAndItsOwn) {
+  const GridRows r = grid_rows(nested_grid());
+  const cf::flat_detail::RowSchedule s = cf::flat_detail::schedule_rows(r.parent, r.work, 2);
+  ASSERT_FALSE(s.rest.empty());
+  std::vector<char> in_rest(std::size_t(r.n), 0);
+  for (int k : s.rest) in_rest[std::size_t(k)] = 1;
+  const SpdSolver::SpMat lower = r.upper.transpose();
+  Eigen::SimplicialLDLT<SpdSolver::SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(lower);
+  ASSERT_EQ(ldlt.info(), Eigen::Success);
+  const SpdSolver::SpMat L = ldlt.matrixL();
+  double from_parts = 0, own = double(s.rest.size());  // (the rest's diagonals)
+  for (int j = 0; j < r.n; ++j) {
+    int m = 0;
+    for (SpdSolver::SpMat::InnerIterator it(L, j); it; ++it)
+      if (it.row() > j) {
+        const double cost = 1.0 + m++;
+        if (in_rest[std::size_t(it.row())]) (in_rest[std::size_t(j)] ? own : from_parts) += cost;
+      }
+  }
+  const cf::flat_detail::RestWork got =
+      cf::flat_detail::split_rest_work(r.n, r.upper.outerIndexPtr(), r.upper.innerIndexPtr(), r.parent, s.rest);
+  EXPECT_EQ(got.from_parts, from_parts);
+  EXPECT_EQ(got.own, own);
+  EXPECT_GT(got.from_parts, 0.0);
+  EXPECT_DOUBLE_EQ(got.from_parts + got.own, s.rest_work);
+}
+
 // The factorisation with its rows on two threads (one phase) and on four (two phases: the top
 // separators in a second phase) is bit for bit CHOLMOD's sequential one (one thread): the same
 // solution to the last bit, and it solves the system.
