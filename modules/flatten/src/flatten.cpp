@@ -280,18 +280,18 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
   Edges rest_edges = sub_edges(p.E, keep, new_of_old);
   std::vector<BranchPiece> pieces;
-  for (const auto& cut : cuts) {
-    std::vector<char> in(nf, 0);
-    for (int f : cut.faces) in[f] = 1;
-    clean_selection(w.ann, p.E, in);
+  for (const auto& cut : cuts) {  // each branch from its own faces (not a mask of the annulus' faces)
+    std::vector<int> in = cut.faces;
+    std::sort(in.begin(), in.end());
+    in.erase(std::unique(in.begin(), in.end()), in.end());
+    in = clean_face_set(w.ann, p.E, std::move(in));
     BranchPiece piece;
     piece.surface = sub_surface(w.ann, in);
     piece.neck_mm = cut.neck_mm;
     piece.tissue = cut.tissue;
-    for (std::size_t f = 0; f < nf; ++f)
-      if (in[f])
-        for (int v : w.ann.t[f])
-          if (new_of_old[v] >= 0) piece.neck.push_back(new_of_old[v]);
+    for (int f : in)
+      for (int v : w.ann.t[std::size_t(f)])
+        if (new_of_old[v] >= 0) piece.neck.push_back(new_of_old[v]);
     pieces.push_back(std::move(piece));
   }
   const double annulus_area = surface_area(w.ann);

@@ -105,9 +105,15 @@ std::vector<int> enclosed_by(const Edges& E, const std::vector<char>& in, std::s
 // The kept faces (`keep[f]`), reindexed; src carried over; `new_of_old` (optional): new vertex id
 // of each old one, -1 when dropped.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old = nullptr);
+// The same for the faces `faces` (ascending, no repeats): sub_surface of their mask.
+Surface sub_surface(const Surface& s, const std::vector<int>& faces, std::vector<int>* new_of_old = nullptr);
 // Drops kept faces at pinch vertices and faces with all corners on the boundary, and keeps the
 // largest edge-connected piece, until the selection's boundary is a set of simple loops.
 void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep);
+// clean_selection of the faces `faces` (ascending, no repeats): the faces it keeps, ascending.
+// Walks only these faces and their edges (a side branch is a small part of its annulus: the real CT
+// colon's 9 cuts each walked its 2 M faces and 3 M edges, twice or more, as masks).
+std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces);
 
 // Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
 // eta the cut cocycle (per edge, lo -> hi), period = the conformal period in u units.

@@ -143,31 +143,54 @@ int argmax_finite(const std::vector<double>& d) {
   return best;
 }
 
-// Keeps the largest edge-connected set of faces among `keep`.
-void keep_largest_component(const Edges& E, std::vector<char>& keep) {
-  const std::size_t nf = keep.size();
-  std::vector<int> comp(nf, -1);
-  int best = -1;
+namespace {
+
+// The faces of the largest edge-connected piece of `faces` (ascending, keep[f] set for each; on a
+// tie the piece found first, from the lowest face), ascending; keep cleared for the others. Only
+// these faces and their edges are walked. comp: per face of the surface, -1 (again on return).
+std::vector<int> largest_piece(const Edges& E, const std::vector<int>& faces, std::vector<char>& keep,
+                               std::vector<int>& comp) {
+  int best = -1, ncomp = 0;
   std::size_t best_size = 0;
-  int ncomp = 0;
   std::vector<int> stack;
-  for (std::size_t f0 = 0; f0 < nf; ++f0) {
-    if (!keep[f0] || comp[f0] >= 0) continue;
+  for (int f0 : faces) {
+    if (comp[std::size_t(f0)] >= 0) continue;
     std::size_t size = 0;
-    stack.push_back(int(f0));
-    comp[f0] = ncomp;
+    stack.push_back(f0);
+    comp[std::size_t(f0)] = ncomp;
     while (!stack.empty()) {
       const int f = stack.back();
       stack.pop_back();
       ++size;
-      for (int e : E.fe[f])
-        for (int g : E.ef[e])
-          if (g >= 0 && keep[g] && comp[g] < 0) comp[g] = ncomp, stack.push_back(g);
+      for (int e : E.fe[std::size_t(f)])
+        for (int g : E.ef[std::size_t(e)])
+          if (g >= 0 && keep[std::size_t(g)] && comp[std::size_t(g)] < 0) comp[std::size_t(g)] = ncomp, stack.push_back(g);
     }
     if (size > best_size) best_size = size, best = ncomp;
     ++ncomp;
   }
-  for (std::size_t f = 0; f < nf; ++f) keep[f] = keep[f] && comp[f] == best;
+  std::vector<int> out;
+  for (int f : faces) {
+    keep[std::size_t(f)] = comp[std::size_t(f)] == best;
+    if (keep[std::size_t(f)]) out.push_back(f);
+  }
+  for (int f : faces) comp[std::size_t(f)] = -1;
+  return out;
+}
+
+std::vector<int> kept_faces(const std::vector<char>& keep) {
+  std::vector<int> faces;
+  for (std::size_t f = 0; f < keep.size(); ++f)
+    if (keep[f]) faces.push_back(int(f));
+  return faces;
+}
+
+}  // namespace
+
+// Keeps the largest edge-connected set of faces among `keep`.
+void keep_largest_component(const Edges& E, std::vector<char>& keep) {
+  std::vector<int> comp(keep.size(), -1);
+  largest_piece(E, kept_faces(keep), keep, comp);
 }
 
 namespace {
@@ -255,12 +278,16 @@ std::vector<int> enclosed_by(const Edges& E, const std::vector<char>& in, std::s
 
 // Surface made of the kept faces, reindexed.
 Surface sub_surface(const Surface& s, const std::vector<char>& keep, std::vector<int>* new_of_old) {
+  return sub_surface(s, kept_faces(keep), new_of_old);
+}
+
+Surface sub_surface(const Surface& s, const std::vector<int>& faces, std::vector<int>* new_of_old) {
   Surface r;
   std::vector<int> local;
   std::vector<int>& map = new_of_old ? *new_of_old : local;
   map.assign(s.p.size(), -1);
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!keep[f]) continue;
+  r.t.reserve(faces.size());
+  for (int f : faces) {
     Tri t;
     for (int k = 0; k < 3; ++k) {
       int& m = map[s.t[f][k]];
@@ -295,29 +322,43 @@ std::vector<std::vector<int>> boundary_loops(const Surface& s, const Edges& E) {
 }
 
 void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep) {
+  const std::vector<int> faces = clean_face_set(s, E, kept_faces(keep));
+  keep.assign(keep.size(), 0);
+  for (int f : faces) keep[std::size_t(f)] = 1;
+}
+
+std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces) {
   // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
   // faces around them and keep the largest piece, until the boundary is clean.
+  std::vector<char> keep(s.t.size(), 0);
+  for (int f : faces) keep[std::size_t(f)] = 1;
+  std::vector<int> comp(s.t.size(), -1), bcount(s.p.size(), 0);  // bcount: boundary edges at a vertex
   for (int iter = 0; iter < 200; ++iter) {
-    keep_largest_component(E, keep);
-    std::vector<int> bcount(s.p.size(), 0);
-    for (std::size_t e = 0; e < E.ev.size(); ++e) {
-      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
-      const int k = (f0 >= 0 && keep[f0]) + (f1 >= 0 && keep[f1]);
-      if (k == 1) ++bcount[E.ev[e][0]], ++bcount[E.ev[e][1]];
-    }
+    faces = largest_piece(E, faces, keep, comp);
+    for (int f : faces)  // an edge with one kept face is on the boundary (walked from that face only)
+      for (int e : E.fe[std::size_t(f)]) {
+        const auto& ef = E.ef[std::size_t(e)];
+        const int g = ef[0] == f ? ef[1] : ef[0];
+        if (g < 0 || !keep[std::size_t(g)]) ++bcount[std::size_t(E.ev[std::size_t(e)][0])], ++bcount[std::size_t(E.ev[std::size_t(e)][1])];
+      }
     // Also faces with all three corners on the boundary: the harmonic function, constant along
     // each end, would collapse them.
     bool changed = false;
-    std::vector<char> bad(s.p.size(), 0);
-    for (std::size_t v = 0; v < s.p.size(); ++v) bad[v] = bcount[v] > 2;
-    for (std::size_t f = 0; f < s.t.size(); ++f) {
-      if (!keep[f]) continue;
-      const Tri& t = s.t[f];
-      const bool all_on = bcount[t[0]] > 0 && bcount[t[1]] > 0 && bcount[t[2]] > 0;
-      if (all_on || bad[t[0]] || bad[t[1]] || bad[t[2]]) keep[f] = 0, changed = true;
+    std::vector<int> left;
+    left.reserve(faces.size());
+    for (int f : faces) {
+      const Tri& t = s.t[std::size_t(f)];
+      const auto on = [&](int k) { return bcount[std::size_t(t[k])]; };
+      const bool all_on = on(0) > 0 && on(1) > 0 && on(2) > 0, pinch = on(0) > 2 || on(1) > 2 || on(2) > 2;
+      if (all_on || pinch) keep[std::size_t(f)] = 0, changed = true;
+      else left.push_back(f);
     }
+    for (int f : faces)
+      for (int v : s.t[std::size_t(f)]) bcount[std::size_t(v)] = 0;
+    faces.swap(left);
     if (!changed) break;
   }
+  return faces;
 }
 
 // Removes caps around the ends of a segment with b boundary loops (b = 0 or 1) so that an annulus

@@ -2,6 +2,7 @@
 // from its surface's are build_edges' own; the cap's search stops at its bound and is exact below it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "../src/flatten_internal.h"
@@ -69,6 +70,61 @@ TEST(FlattenMeshGraph, BoundedSearchIsExactUpToItsBoundAndStops) {
     reached += std::isfinite(near[v]);
   }
   EXPECT_LT(reached, full.size() / 4);
+}
+
+// The whole-surface clean-up as it was written before clean_face_set (every face and edge of the
+// surface walked per round): the reference the face-list version must equal.
+std::vector<char> clean_by_mask(const Surface& s, const Edges& E, std::vector<char> keep) {
+  for (int iter = 0; iter < 200; ++iter) {
+    keep_largest_component(E, keep);
+    std::vector<int> bcount(s.p.size(), 0);
+    for (std::size_t e = 0; e < E.ev.size(); ++e) {
+      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
+      if ((f0 >= 0 && keep[f0]) + (f1 >= 0 && keep[f1]) == 1) ++bcount[E.ev[e][0]], ++bcount[E.ev[e][1]];
+    }
+    bool changed = false;
+    for (std::size_t f = 0; f < s.t.size(); ++f) {
+      const Tri& t = s.t[f];
+      if (!keep[f]) continue;
+      const bool all_on = bcount[t[0]] > 0 && bcount[t[1]] > 0 && bcount[t[2]] > 0;
+      if (all_on || bcount[t[0]] > 2 || bcount[t[1]] > 2 || bcount[t[2]] > 2) keep[f] = 0, changed = true;
+    }
+    if (!changed) break;
+  }
+  return keep;
+}
+
+// A branch's faces cleaned from their own list (clean_face_set, walking only them) keep exactly
+// the faces the whole-surface clean-up keeps from their mask, on random selections of a closed
+// colon (holes, pinch vertices) and on a geodesic patch, whole and with holes; sub_surface of the
+// face list is sub_surface of the mask (points, faces, source ids, vertex map).
+TEST(FlattenMeshGraph, FaceSetIsCleanedAsItsMaskIs) {
+  const Surface s = surface_of(synthetic::colon(synthetic::colon_options(200, 15, 1.2, {})).mesh);
+  const Edges E = build_edges(s.t);
+  const std::vector<double> d = dijkstra(build_csr(s, E), {0});
+  std::mt19937 rng(11);
+  for (double share : {0.9, 0.97, -1.0, -0.9}) {
+    std::vector<char> mask(s.t.size());
+    for (std::size_t f = 0; f < s.t.size(); ++f)  // share < 0: that share of the faces within 20 mm of vertex 0
+      mask[f] = (share > 0 || d[s.t[f][0]] < 20) && std::uniform_real_distribution<double>(0, 1)(rng) < std::abs(share);
+    std::vector<int> faces;
+    for (std::size_t f = 0; f < s.t.size(); ++f)
+      if (mask[f]) faces.push_back(int(f));
+    const std::vector<char> want = clean_by_mask(s, E, mask);
+    const std::vector<int> got = clean_face_set(s, E, faces);
+    std::vector<char> got_mask(s.t.size(), 0);
+    for (int f : got) got_mask[f] = 1;
+    EXPECT_EQ(got_mask, want) << "share " << share;
+    EXPECT_TRUE(std::is_sorted(got.begin(), got.end()));
+    ASSERT_GT(got.size(), 0u);
+    EXPECT_LT(got.size(), faces.size()) << "share " << share;  // the clean-up removed faces
+    std::vector<int> map_mask, map_list;
+    const Surface a = sub_surface(s, want, &map_mask), b = sub_surface(s, got, &map_list);
+    EXPECT_EQ(a.p, b.p);
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_EQ(a.src, b.src);
+    EXPECT_EQ(map_mask, map_list);
+  }
 }
 
 }  // namespace
