@@ -4,6 +4,7 @@
 #include <queue>
 #include <unordered_map>
 
+#include "colonflat/core/bucket_slots.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/homology.h"
@@ -64,25 +65,24 @@ void SlicedDisk::build_wedges(const Mesh& mesh, const std::vector<std::uint8_t>&
 // Graph of the disk: wedge(a, f) -- wedge(b, f) for every edge ab of every face f.
 void SlicedDisk::build_graph(const Mesh& mesh) {
   const std::size_t n = wedge_vertex.size();
-  start.assign(n + 1, 0);
+  BucketSlots<int> slots(n);
   for (auto f : mesh.faces())
     for (auto h : mesh.fh_range(f)) {
-      ++start[wedge_of[h.idx()] + 1];
-      ++start[wedge_of[mesh.next_halfedge_handle(h).idx()] + 1];
+      slots.count(std::size_t(wedge_of[h.idx()]));
+      slots.count(std::size_t(wedge_of[mesh.next_halfedge_handle(h).idx()]));
     }
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
-  adj.resize(start[n]);
-  weight.resize(start[n]);
-  std::vector<int> fill(start.begin(), start.end() - 1);
+  slots.close();
+  adj.resize(std::size_t(slots.total()));
+  weight.resize(std::size_t(slots.total()));
   for (auto f : mesh.faces())
     for (auto h : mesh.fh_range(f)) {
       const int a = wedge_of[h.idx()], b = wedge_of[mesh.next_halfedge_handle(h).idx()];
       const double len = mesh.calc_edge_length(h);
-      adj[fill[a]] = b;
-      weight[fill[a]++] = len;
-      adj[fill[b]] = a;
-      weight[fill[b]++] = len;
+      const auto i = std::size_t(slots.place(std::size_t(a))), j = std::size_t(slots.place(std::size_t(b)));
+      adj[i] = b, weight[i] = len;
+      adj[j] = a, weight[j] = len;
     }
+  start = std::move(slots).take_starts();
 }
 
 // Dijkstra from each copy; the globally shortest copy-to-copy path (early stop at it), as mesh

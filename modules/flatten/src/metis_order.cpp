@@ -5,6 +5,7 @@
 
 #include "spd_solver.h"
 
+#include "colonflat/core/bucket_slots.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "factor_schedule.h"
@@ -48,17 +49,18 @@ std::uint64_t metis_rand_calls() { return thread_rand().calls; }
 // Each corner's two neighbours bucketed by vertex (a counting sort), each bucket sorted and its
 // duplicates (an edge's second face) dropped in place.
 VertexGraph vertex_graph(const std::vector<std::array<int, 3>>& t, int nv) {
-  std::vector<int> start(std::size_t(nv) + 1, 0);
+  BucketSlots<int> slots{std::size_t(nv)};
   for (const auto& tri : t)
-    for (int v : tri) start[std::size_t(v) + 1] += 2;
-  for (int v = 0; v < nv; ++v) start[std::size_t(v) + 1] += start[std::size_t(v)];
-  std::vector<int> nbr(std::size_t(start[std::size_t(nv)])), fill(start.begin(), start.end() - 1);
+    for (int v : tri) slots.count(std::size_t(v), 2);
+  slots.close();
+  std::vector<int> nbr(std::size_t(slots.total()));
   for (const auto& tri : t)
     for (int k = 0; k < 3; ++k) {
-      const int v = tri[std::size_t(k)];
-      nbr[std::size_t(fill[std::size_t(v)]++)] = tri[std::size_t((k + 1) % 3)];
-      nbr[std::size_t(fill[std::size_t(v)]++)] = tri[std::size_t((k + 2) % 3)];
+      const auto v = std::size_t(tri[std::size_t(k)]);
+      nbr[std::size_t(slots.place(v))] = tri[std::size_t((k + 1) % 3)];
+      nbr[std::size_t(slots.place(v))] = tri[std::size_t((k + 2) % 3)];
     }
+  const std::vector<int>& start = slots.starts();
   VertexGraph g;
   g.xadj.reserve(std::size_t(nv) + 1);
   g.adjncy.reserve(nbr.size() / 2 + 1);

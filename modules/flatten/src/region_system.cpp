@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "colonflat/core/bucket_slots.h"
 #include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
@@ -45,7 +46,7 @@ int sort_and_merge(int* row, double* value, int m) {
 Eigen::SparseMatrix<double> region_lower(const Surface& s, const std::vector<int>& faces,
                                          const std::vector<std::array<double, 3>>& w, const std::vector<int>& index, int n) {
   std::vector<double> diagonal(std::size_t(n), 0.0);
-  std::vector<int> start(std::size_t(n) + 1, 0);  // entries below the diagonal per column, repeats included
+  BucketSlots<int> slots{std::size_t(n)};  // entries below the diagonal per column, repeats included
   const auto each_term = [&](auto&& term) {
     for (std::size_t i = 0; i < faces.size(); ++i) {
       const Tri& t = s.t[std::size_t(faces[i])];
@@ -55,14 +56,15 @@ Eigen::SparseMatrix<double> region_lower(const Surface& s, const std::vector<int
   each_term([&](int a, int b, double wk) {
     if (a >= 0) diagonal[std::size_t(a)] += wk;
     if (b >= 0) diagonal[std::size_t(b)] += wk;
-    if (a >= 0 && b >= 0) ++start[std::size_t(std::min(a, b)) + 1];
+    if (a >= 0 && b >= 0) slots.count(std::size_t(std::min(a, b)));
   });
-  for (int j = 0; j < n; ++j) start[std::size_t(j) + 1] += start[std::size_t(j)];
-  std::vector<int> row(std::size_t(start[std::size_t(n)])), fill(start.begin(), start.end() - 1);
+  slots.close();
+  const std::vector<int>& start = slots.starts();
+  std::vector<int> row(std::size_t(slots.total()));
   std::vector<double> value(row.size());
   each_term([&](int a, int b, double wk) {
     if (a < 0 || b < 0) return;
-    const int p = fill[std::size_t(std::min(a, b))]++;
+    const int p = slots.place(std::size_t(std::min(a, b)));
     row[std::size_t(p)] = std::max(a, b), value[std::size_t(p)] = -wk;
   });
   std::vector<int> kept(static_cast<std::size_t>(n), 0);
@@ -144,16 +146,16 @@ Eigen::MatrixXd RegionSystem::solve_raw(const Eigen::MatrixXd& b) const {
 
 CornerGather::CornerGather(const Surface& s, const std::vector<int>& faces, const RegionSystem& sys) {
   const std::size_t n = sys.unknowns().size();
-  start_.assign(n + 1, 0);
+  BucketSlots<int> slots(n);
   for (int f : faces)
     for (int v : s.t[f])
-      if (sys.index(v) >= 0) ++start_[std::size_t(sys.index(v)) + 1];
-  for (std::size_t u = 0; u < n; ++u) start_[u + 1] += start_[u];
-  corner_.resize(std::size_t(start_[n]));
-  std::vector<int> fill(start_.begin(), start_.end() - 1);
+      if (sys.index(v) >= 0) slots.count(std::size_t(sys.index(v)));
+  slots.close();
+  corner_.resize(std::size_t(slots.total()));
   for (std::size_t i = 0; i < faces.size(); ++i)  // face order: each unknown's corners come in face order
     for (int k = 0; k < 3; ++k)
-      if (const int u = sys.index(s.t[faces[i]][k]); u >= 0) corner_[std::size_t(fill[u]++)] = int(3 * i) + k;
+      if (const int u = sys.index(s.t[faces[i]][k]); u >= 0) corner_[std::size_t(slots.place(std::size_t(u)))] = int(3 * i) + k;
+  start_ = std::move(slots).take_starts();
 }
 
 Eigen::MatrixXd CornerGather::sum(const std::vector<std::array<V2, 3>>& face_gradients) const {
