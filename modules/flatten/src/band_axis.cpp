@@ -292,6 +292,134 @@ static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf,
   return corr.iterations;
 }
 
+// The edges of the band's boundary that lie on no end (the rims of cut-off branches), each as
+// (face, corner k): the half-edge t[k] -> t[k + 1] of that face, whose reverse no face holds.
+// `ends`: per vertex, on one of the band's two end loops. Order: face order, then k.
+static std::vector<std::array<int, 2>> rim_edges(const Surface& s, const std::vector<char>& fixed,
+                                                 const std::vector<char>& ends) {
+  std::unordered_map<std::uint64_t, char> half;  // the half-edges between boundary vertices
+  const auto key = [&](int a, int b) { return std::uint64_t(a) * s.p.size() + std::uint64_t(b); };
+  for (const Tri& t : s.t)
+    for (int k = 0; k < 3; ++k)
+      if (fixed[t[k]] && fixed[t[(k + 1) % 3]]) half[key(t[k], t[(k + 1) % 3])] = 1;
+  std::vector<std::array<int, 2>> out;
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = s.t[f][k], b = s.t[f][(k + 1) % 3];
+      if (fixed[a] && fixed[b] && !(ends[a] && ends[b]) && !half.count(key(b, a))) out.push_back({int(f), k});
+    }
+  return out;
+}
+
+// A rim edge in the map: its vertices and corners (in its face's frame).
+struct RimSegment {
+  int a, b;
+  V2 p, q;
+};
+static std::vector<RimSegment> rim_segments(const SegmentWork& w, const std::vector<std::array<int, 2>>& rims) {
+  std::vector<RimSegment> seg;
+  for (const auto& [f, k] : rims) {
+    const auto c = w.emb.corners(w.ann, f);
+    seg.push_back({w.ann.t[f][k], w.ann.t[f][(k + 1) % 3], c[k], c[(k + 1) % 3]});
+  }
+  return seg;
+}
+
+// `t` shifted by the period in y to lie nearest `s`.
+static RimSegment nearest_copy(const RimSegment& s, RimSegment t, double period) {
+  const V2 shift(0, period > 0 ? period * std::round(((s.p + s.q) - (t.p + t.q)).y() / (2 * period)) : 0.0);
+  t.p += shift, t.q += shift;
+  return t;
+}
+
+// Pairs of rim edges (rim_edges()) that cross in the map (a rim folded over itself or another rim
+// through the hole it bounds: a fold no face's orientation shows). Edges sharing a vertex are not
+// judged; an edge is compared with the other's copy nearest it (nearest_copy()).
+static std::size_t rim_crossings(const SegmentWork& w, const std::vector<std::array<int, 2>>& rims) {
+  const std::vector<RimSegment> seg = rim_segments(w, rims);
+  const auto side = [](const V2& a, const V2& b, const V2& c) {
+    const double x = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    return (x > 0) - (x < 0);
+  };
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < seg.size(); ++i)
+    for (std::size_t j = i + 1; j < seg.size(); ++j) {
+      const RimSegment& s = seg[i];
+      if (s.a == seg[j].a || s.a == seg[j].b || s.b == seg[j].a || s.b == seg[j].b) continue;
+      const RimSegment t = nearest_copy(s, seg[j], w.emb.period);
+      n += side(s.p, s.q, t.p) * side(s.p, s.q, t.q) < 0 && side(t.p, t.q, s.p) * side(t.p, t.q, s.q) < 0;
+    }
+  return n;
+}
+
+// The vertices held in the local passes: the band's ends, and the rims of holes that are not round
+// in the map (area below kRoundHole x that of the circle of the rim's map length, or a rim that
+// goes around the band): a thin hole (a slit) has no room for its rim to move into, and where its
+// sides move they cross (0.8: an ellipse of axes 2.2 : 1). On the colon-like U (contact 60 mm) the
+// rim that keeps a strip crushed is round (25 x 25 mm, 0.98); freed, a hole beside it of 43 x 15 mm
+// (0.68) had its tip dragged 4 mm along it and crossed its other side.
+constexpr double kRoundHole = 0.8;
+static std::vector<char> held_in_local_passes(const SegmentWork& w, const std::vector<std::array<int, 2>>& rims,
+                                              const std::vector<char>& ends) {
+  std::vector<char> held = ends;
+  const std::vector<RimSegment> seg = rim_segments(w, rims);
+  std::unordered_map<int, std::size_t> from;  // the rim edge leaving each rim vertex
+  for (std::size_t i = 0; i < seg.size(); ++i) from[seg[i].a] = i;
+  std::vector<char> seen(seg.size(), 0);
+  for (std::size_t i = 0; i < seg.size(); ++i) {
+    if (seen[i]) continue;
+    std::vector<std::size_t> loop;  // the rim through edge i, each edge's copy next to the one before
+    std::vector<RimSegment> placed;
+    for (std::size_t k = i; !seen[k];) {
+      seen[k] = 1, loop.push_back(k);
+      placed.push_back(placed.empty() ? seg[k] : nearest_copy(placed.back(), seg[k], w.emb.period));
+      const auto next = from.find(seg[k].b);
+      if (next == from.end()) break;
+      k = next->second;
+    }
+    double area = 0, length = 0;  // shoelace over the edges (the hole's, either orientation)
+    for (const RimSegment& e : placed) area += 0.5 * (e.p.x() * e.q.y() - e.q.x() * e.p.y()), length += (e.q - e.p).norm();
+    const bool wraps = (placed.back().q - placed.front().p).norm() > 0.5 * w.emb.period;  // around the band
+    if (wraps || std::abs(area) < kRoundHole * length * length / (4 * M_PI))
+      for (std::size_t k : loop) held[std::size_t(seg[k].a)] = held[std::size_t(seg[k].b)] = 1;
+  }
+  return held;
+}
+
+// The local passes: pockets; then, grown until they have room, those left. The rims of cut-off
+// branches move in them (the band's two ends stay, and the rims of holes that are not round):
+// a rim held where the conformal map put it (a round hole whose length in the map can be half its
+// 3D length where a limb-sized branch was cut off) leaves the strip of wall along it crushed, and
+// only the rim giving way opens it (issue 26, docs/flatten.md session 25). Each face stays
+// positive in every step, so the map stays injective but for a rim crossing itself or another
+// through its hole; if the passes made a rim cross (rim_crossings()), they are done again with the
+// rims held.
+void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
+                       const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
+                       bool branch) {
+  const std::vector<std::array<int, 2>> rims = rim_edges(w.ann, fixed, ends);
+  const std::size_t crossed = rims.empty() ? 0 : rim_crossings(w, rims);
+  const std::vector<V2> before = rims.empty() ? std::vector<V2>() : w.emb.pos;
+  const std::vector<char> rims_free = rims.empty() ? fixed : held_in_local_passes(w, rims, ends);
+  for (const std::vector<char>* held : {&rims_free, &fixed}) {
+    bool need = true;
+    for (bool grow : {false, true}) {
+      if (!need) break;
+      w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, *held, degenerate, o, true, grow));
+      if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
+      need = !grow && needs_correction(w, degenerate, o).local;
+      if (!branch && !grow) debug_clock("correction need after local pass 1");
+    }
+    const std::size_t now = rims.empty() || held == &fixed ? crossed : rim_crossings(w, rims);
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug local passes, rims %s: %zu rim edges, %zu rim vertices held, crossings %zu -> %zu\n",
+                   held == &fixed ? "held" : "free", rims.size(),
+                   std::size_t(std::count(held->begin(), held->end(), 1) - std::count(ends.begin(), ends.end(), 1)), crossed, now);
+    if (now <= crossed) return;
+    w.emb.pos = before;
+  }
+}
+
 // Band length: the centreline length L, moved towards the conformal length by at most 8 % (the
 // wall of a folded colon is longer than its centreline; within the 10 % the band may differ from
 // L this removes part of the angle distortion a rectangle of length L would impose everywhere).
@@ -302,7 +430,8 @@ constexpr double kBandLengthSlack = 0.08;
 // Area-balanced map: x = B F(u) (the axis chosen above; B the band length), y scaled so that the
 // band's area is the wall area, fold-overs untangled, then the regions still out of bounds
 // balanced (symmetric Dirichlet). centreline_x keeps the true centreline mm of each band x.
-void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends,
+                        const std::vector<std::vector<int>>& vf,
                         const std::vector<char>& fixed, const std::vector<char>& degenerate,
                         const FlattenOptions& o, bool branch) {
   Embedding& emb = w.emb;
@@ -342,12 +471,11 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
     need.local = needs_correction(w, degenerate, o).local;
     if (!branch) debug_clock("correction need after the whole band");
   }
-  for (bool grow : {false, true}) {  // pockets; then, grown until they have room, those left
-    if (!need.local) break;
-    w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, fixed, degenerate, o, true, grow));
-    if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
-    need.local = !grow && needs_correction(w, degenerate, o).local;
-    if (!branch && !grow) debug_clock("correction need after local pass 1");
+  if (need.local) {
+    std::vector<char> on_end(fixed.size(), 0);
+    for (const std::vector<int>& l : ends)
+      for (int v : l) on_end[std::size_t(v)] = 1;
+    local_area_passes(w, vf, fixed, on_end, degenerate, o, branch);
   }
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);

@@ -389,7 +389,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const Centreline cl = centreline_step(w, loops);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
-  if (o.map == "area-balanced") area_balanced_step(w, cl, p.vf, p.fixed, p.degenerate, o, depth > 0);
+  if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.vf, p.fixed, p.degenerate, o, depth > 0);
   if (o.map == "area-balanced") phase("area balance");
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
   w.dissection_to_annulus = {};

@@ -376,10 +376,21 @@ struct SegmentWork;
 // Area-balanced map of a segment from its conformal embedding (band_axis.cpp): x = B F(u) with
 // the least angle-distorting axis F whose area ratios stay in bounds, B the band length (the
 // centreline length within 8 %; a branch's conformal length), y scaled to the wall area, folds
-// untangled, out-of-bounds regions balanced.
-void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& vf,
+// untangled, out-of-bounds regions balanced. `ends`: the band's two end loops (vertex ids of w.ann);
+// `fixed`: every boundary vertex (the ends and the rims of cut-off branches). The rims move in the
+// local area correction passes only (unless a rim would cross itself there), the ends never.
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends,
+                        const std::vector<std::vector<int>>& vf,
                         const std::vector<char>& fixed, const std::vector<char>& degenerate,
                         const FlattenOptions& o, bool branch);
+// The local area correction passes of area_balanced_step (pockets, then grown pockets) on a band
+// whose boundary vertices are `fixed` (per vertex), `ends` (per vertex) those on its two end loops:
+// the other boundary vertices (rims of cut-off branches) move, except the rims of holes that are
+// not round in the map; if that made a rim cross itself or another, the passes are done again
+// with every rim held. Post: every face positive before stays positive.
+void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
+                       const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
+                       bool branch);
 // COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
 void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate);
 // COLONFLAT_FLATTEN_DEBUG=1: a timeline line on stderr: wall and process CPU seconds (all threads,
