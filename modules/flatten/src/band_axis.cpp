@@ -311,8 +311,7 @@ static std::vector<std::array<int, 2>> rim_edges(const Surface& s, const std::ve
   return out;
 }
 
-// A rim edge in the map: its vertices and corners (in its face's frame).
-struct RimSegment {
+struct RimSegment {  // a rim edge in the map: its vertices and corners (in its face's frame)
   int a, b;
   V2 p, q;
 };
@@ -339,8 +338,7 @@ static std::size_t rim_crossings(const SegmentWork& w, const std::vector<std::ar
   const std::vector<RimSegment> seg = rim_segments(w, rims);
   const auto side = [](const V2& a, const V2& b, const V2& c) {
     const double x = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    return (x > 0) - (x < 0);
-  };
+    return (x > 0) - (x < 0); };
   std::size_t n = 0;
   for (std::size_t i = 0; i < seg.size(); ++i)
     for (std::size_t j = i + 1; j < seg.size(); ++j) {
@@ -352,55 +350,69 @@ static std::size_t rim_crossings(const SegmentWork& w, const std::vector<std::ar
   return n;
 }
 
-// The vertices held in the local passes: the band's ends, and the rims of holes that are not round
-// in the map (area below kRoundHole x that of the circle of the rim's map length, or a rim that
-// goes around the band): a thin hole (a slit) has no room for its rim to move into, and where its
-// sides move they cross (0.8: an ellipse of axes 2.2 : 1). On the colon-like U (contact 60 mm) the
-// rim that keeps a strip crushed is round (25 x 25 mm, 0.98); freed, a hole beside it of 43 x 15 mm
-// (0.68) had its tip dragged 4 mm along it and crossed its other side.
-constexpr double kRoundHole = 0.8;
-static std::vector<char> held_in_local_passes(const SegmentWork& w, const std::vector<std::array<int, 2>>& rims,
-                                              const std::vector<char>& ends) {
-  std::vector<char> held = ends;
-  const std::vector<RimSegment> seg = rim_segments(w, rims);
+// The vertices held in the local passes: the band's ends and every rim but those that can open a
+// crushed strip by moving into their hole: at least kCrushedRim of the rim's faces below `min_ratio`
+// (at the band's area scale), a round hole (map area >= kRoundHole x that of the circle of the
+// rim's map length: 0.8, an ellipse of axes 2.2 : 1; not around the band), with room (map area >=
+// kHoleRoom x that of the circle of the rim's 3D length). Freed without these, on the colon-like U
+// (contact 60 mm) a 43 x 15 mm hole (0.68) had its tip dragged 4 mm along it and crossed its other
+// side, and on the real CT colon band small crushed holes (map area 0.05-0.12 of their 3D circle's)
+// crossed 22 times (the passes then ran twice). The U's rim that keeps a strip crushed: 0.98 round,
+// room 0.31.
+constexpr double kRoundHole = 0.8, kCrushedRim = 0.5, kHoleRoom = 0.25;
+// The rims as loops of rim_segments() indices, each edge's copy placed next to the one before.
+static std::vector<std::pair<std::vector<std::size_t>, std::vector<RimSegment>>> rim_loops(const std::vector<RimSegment>& seg,
+                                                                                          double period) {
   std::unordered_map<int, std::size_t> from;  // the rim edge leaving each rim vertex
   for (std::size_t i = 0; i < seg.size(); ++i) from[seg[i].a] = i;
   std::vector<char> seen(seg.size(), 0);
+  std::vector<std::pair<std::vector<std::size_t>, std::vector<RimSegment>>> loops;
   for (std::size_t i = 0; i < seg.size(); ++i) {
     if (seen[i]) continue;
-    std::vector<std::size_t> loop;  // the rim through edge i, each edge's copy next to the one before
-    std::vector<RimSegment> placed;
+    auto& [loop, placed] = loops.emplace_back();
     for (std::size_t k = i; !seen[k];) {
       seen[k] = 1, loop.push_back(k);
-      placed.push_back(placed.empty() ? seg[k] : nearest_copy(placed.back(), seg[k], w.emb.period));
+      placed.push_back(placed.empty() ? seg[k] : nearest_copy(placed.back(), seg[k], period));
       const auto next = from.find(seg[k].b);
       if (next == from.end()) break;
       k = next->second;
     }
-    double area = 0, length = 0;  // shoelace over the edges (the hole's, either orientation)
+  }
+  return loops;
+}
+
+static std::vector<char> held_in_local_passes(const SegmentWork& w, const std::vector<std::array<int, 2>>& rims,
+                                              const std::vector<char>& ends, double min_ratio) {
+  double a2 = 0, a3 = 0;  // the band's area scale
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f) a2 += std::max(w.emb.area2(w.ann, int(f)), 0.0), a3 += face_area_3d(w.ann, int(f));
+  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  std::vector<char> held = ends;
+  const auto seg = rim_segments(w, rims);
+  for (const auto& [loop, placed] : rim_loops(seg, w.emb.period)) {
+    double area = 0, length = 0, length3 = 0;  // shoelace over the edges (either orientation); 3D length
     for (const RimSegment& e : placed) area += 0.5 * (e.p.x() * e.q.y() - e.q.x() * e.p.y()), length += (e.q - e.p).norm();
+    for (std::size_t k : loop) length3 += (w.ann.p[seg[k].a] - w.ann.p[seg[k].b]).norm();
     const bool wraps = (placed.back().q - placed.front().p).norm() > 0.5 * w.emb.period;  // around the band
-    if (wraps || std::abs(area) < kRoundHole * length * length / (4 * M_PI))
+    const auto crushed = std::count_if(loop.begin(), loop.end(), [&](std::size_t k) {
+      return scale * w.emb.area2(w.ann, rims[k][0]) < min_ratio * face_area_3d(w.ann, rims[k][0]); });
+    const bool round = std::abs(area) >= kRoundHole * length * length / (4 * M_PI) && !wraps;
+    const bool room = std::abs(area) >= kHoleRoom * length3 * length3 / (4 * M_PI);
+    if (!round || !room || double(crushed) < kCrushedRim * double(loop.size()))
       for (std::size_t k : loop) held[std::size_t(seg[k].a)] = held[std::size_t(seg[k].b)] = 1;
   }
   return held;
 }
 
-// The local passes: pockets; then, grown until they have room, those left. The rims of cut-off
-// branches move in them (the band's two ends stay, and the rims of holes that are not round):
-// a rim held where the conformal map put it (a round hole whose length in the map can be half its
-// 3D length where a limb-sized branch was cut off) leaves the strip of wall along it crushed, and
-// only the rim giving way opens it (issue 26, docs/flatten.md session 25). Each face stays
-// positive in every step, so the map stays injective but for a rim crossing itself or another
-// through its hole; if the passes made a rim cross (rim_crossings()), they are done again with the
-// rims held.
+// (flatten_internal.h) A rim held where the conformal map put it (a round hole whose length in the
+// map can be half its 3D length where a limb-sized branch was cut off) leaves the strip of wall
+// along it crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25).
 void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                        const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
                        bool branch) {
   const std::vector<std::array<int, 2>> rims = rim_edges(w.ann, fixed, ends);
   const std::size_t crossed = rims.empty() ? 0 : rim_crossings(w, rims);
   const std::vector<V2> before = rims.empty() ? std::vector<V2>() : w.emb.pos;
-  const std::vector<char> rims_free = rims.empty() ? fixed : held_in_local_passes(w, rims, ends);
+  const std::vector<char> rims_free = rims.empty() ? fixed : held_in_local_passes(w, rims, ends, o.coverage_min_ratio);
   for (const std::vector<char>* held : {&rims_free, &fixed}) {
     bool need = true;
     for (bool grow : {false, true}) {
@@ -471,12 +483,10 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
     need.local = needs_correction(w, degenerate, o).local;
     if (!branch) debug_clock("correction need after the whole band");
   }
-  if (need.local) {
-    std::vector<char> on_end(fixed.size(), 0);
-    for (const std::vector<int>& l : ends)
-      for (int v : l) on_end[std::size_t(v)] = 1;
-    local_area_passes(w, vf, fixed, on_end, degenerate, o, branch);
-  }
+  std::vector<char> on_end(fixed.size(), 0);
+  for (const std::vector<int>& l : ends)
+    for (int v : l) on_end[std::size_t(v)] = 1;
+  if (need.local) local_area_passes(w, vf, fixed, on_end, degenerate, o, branch);
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;

@@ -385,8 +385,8 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
                         const FlattenOptions& o, bool branch);
 // The local area correction passes of area_balanced_step (pockets, then grown pockets) on a band
 // whose boundary vertices are `fixed` (per vertex), `ends` (per vertex) those on its two end loops:
-// the other boundary vertices (rims of cut-off branches) move, except the rims of holes that are
-// not round in the map; if that made a rim cross itself or another, the passes are done again
+// the other boundary vertices (rims of cut-off branches) move where at least half of the rim's faces
+// are crushed (below coverage_min_ratio) and its hole is round in the map; if that made a rim cross itself or another, the passes are done again
 // with every rim held. Post: every face positive before stays positive.
 void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                        const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
