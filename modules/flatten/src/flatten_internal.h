@@ -110,9 +110,8 @@ Surface sub_surface(const Surface& s, const std::vector<int>& faces, std::vector
 // Drops kept faces at pinch vertices and faces with all corners on the boundary, and keeps the
 // largest edge-connected piece, until the selection's boundary is a set of simple loops.
 void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep);
-// clean_selection of the faces `faces` (ascending, no repeats): the faces it keeps, ascending.
-// Walks only these faces and their edges (a side branch is a small part of its annulus: the real CT
-// colon's 9 cuts each walked its 2 M faces and 3 M edges, twice or more, as masks).
+// clean_selection of the faces `faces` (ascending, no repeats): the faces it keeps, ascending. Walks
+// only these faces and their edges (a side branch is a small part of its annulus).
 std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces);
 
 // Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
@@ -380,14 +379,13 @@ struct SegmentWork;
 // `fixed`: every boundary vertex (the ends and the rims of cut-off branches). The rims move in the
 // local area correction passes only (unless a rim would cross itself there), the ends never.
 void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends,
-                        const std::vector<std::vector<int>>& vf,
-                        const std::vector<char>& fixed, const std::vector<char>& degenerate,
-                        const FlattenOptions& o, bool branch);
+                        const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
+                        const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
 // The local area correction passes of area_balanced_step (pockets, then grown pockets) on a band
 // whose boundary vertices are `fixed` (per vertex), `ends` (per vertex) those on its two end loops:
 // the other boundary vertices (rims of cut-off branches) move where at least half of the rim's faces
-// are crushed (below coverage_min_ratio) and its hole is round in the map; if that made a rim cross itself or another, the passes are done again
-// with every rim held. Post: every face positive before stays positive.
+// are crushed (below coverage_min_ratio) and its hole is round in the map; if that made a rim cross
+// itself or another, the passes are done again with every rim held. Post: positive faces stay so.
 void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                        const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
                        bool branch);
