@@ -13,20 +13,13 @@
 namespace cf {
 namespace {
 
-FlatMap flatten_with_threads(const TriangleList& mesh, int threads) {
-  set_thread_count(threads);
-  FlatMap f = flatten_colon(mesh);
-  set_thread_count(0);
-  return f;
-}
-
 // A tube (radius 12 mm) forking into a blind limb of radius 11 mm: the limb is cut off at a neck
 // about the tube's girth, and the colon band left with that hole shows >= 99.5 % of its wall, with
 // area ratio p05 >= 0.2 and nothing flipped (with the rim held where the conformal map put it, the
 // strip along it stays crushed below ratio 0.1). The same map, bit for bit, with 1 and 2 threads.
 TEST(FlattenFork, LimbSizedBranchLeavesItsRimStripShown) {
   const TriangleList mesh = test_shapes::tube_with_limb(11.0);
-  const FlatMap f = flatten_with_threads(mesh, 2);
+  const FlatMap f = test_shapes::flatten_with_threads(mesh, 2);
   ASSERT_GE(f.segments.size(), 2u);
   const FlatSegment& colon = f.segments[0];
   const FlatSegment& limb = f.segments[1];
@@ -36,7 +29,7 @@ TEST(FlattenFork, LimbSizedBranchLeavesItsRimStripShown) {
   EXPECT_GE(colon.stats.area_p05, 0.2);
   EXPECT_EQ(colon.stats.flipped, 0u);
   EXPECT_EQ(colon.crowded_faces, 0u);
-  const FlatMap one = flatten_with_threads(mesh, 1);
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
   ASSERT_EQ(one.uv.size(), f.uv.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < f.uv.size(); ++i) differ += one.uv[i][0] != f.uv[i][0] || one.uv[i][1] != f.uv[i][1];

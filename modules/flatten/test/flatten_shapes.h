@@ -15,9 +15,19 @@
 #include <functional>
 
 #include "colonflat/core/soup.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/vtk_convert.h"
+#include "colonflat/flatten/flatten.h"
 
 namespace cf::test_shapes {
+
+// flatten_colon(mesh) with `threads` worker threads (then back to the default count).
+inline FlatMap flatten_with_threads(const TriangleList& mesh, int threads) {
+  set_thread_count(threads);
+  FlatMap f = flatten_colon(mesh);
+  set_thread_count(0);
+  return f;
+}
 
 inline double capsule(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
   const Eigen::Vector3d ab = b - a;

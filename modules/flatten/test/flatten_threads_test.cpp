@@ -22,21 +22,14 @@ TriangleList two_segments_with_a_branch() {
   return synthetic::disjoint_union(test_shapes::pouch_behind_neck(3.0), synthetic::translated(tube, 0, 0, 80));
 }
 
-FlatMap flatten_with_threads(const TriangleList& mesh, int threads) {
-  set_thread_count(threads);
-  FlatMap f = flatten_colon(mesh);
-  set_thread_count(0);
-  return f;
-}
-
 // With 1 and with 2 threads every flat vertex lands on the same coordinates (bit for bit), with the
 // same triangles, bands, coverage and distortion; the case has two segments and a cut-off branch,
 // so the segments, the branch and the per-face loops (regions of several blocks) all run side by side.
 TEST(FlattenThreads, OneAndTwoThreadsGiveTheSameMap) {
   const TriangleList mesh = two_segments_with_a_branch();
   ASSERT_GT(mesh.triangles.size(), 4 * 8192u);  // several blocks of faces per loop
-  const FlatMap one = flatten_with_threads(mesh, 1);
-  const FlatMap two = flatten_with_threads(mesh, 2);
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
+  const FlatMap two = test_shapes::flatten_with_threads(mesh, 2);
   std::size_t branches = 0;
   for (const auto& s : one.segments) branches += s.kind == "branch";
   ASSERT_GE(one.segments.size(), 3u);
@@ -82,8 +75,8 @@ TriangleList large_colon_with_a_branch() {
 TEST(FlattenThreads, LargeColonWithItsDissectionOrderIsTheSameForOneAndTwoThreads) {
   const TriangleList mesh = large_colon_with_a_branch();
   ASSERT_GE(mesh.points.size(), flat_detail::kNestedDissectionMinVertices);
-  const FlatMap one = flatten_with_threads(mesh, 1);
-  const FlatMap two = flatten_with_threads(mesh, 2);
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
+  const FlatMap two = test_shapes::flatten_with_threads(mesh, 2);
   std::size_t branches = 0;
   for (const auto& s : one.segments) branches += s.kind == "branch";
   EXPECT_GE(branches, 1u);
@@ -103,7 +96,7 @@ TEST(FlattenThreads, LargeColonWithItsDissectionOrderIsTheSameForOneAndTwoThread
 TEST(FlattenThreads, LargeColonLeavesNoFactorMemoryKept) {
   const TriangleList mesh = large_colon_with_a_branch();
   const flat_detail::BlockCache::Stats before = flat_detail::cholmod_block_cache().stats();
-  const FlatMap flat = flatten_with_threads(mesh, 2);
+  const FlatMap flat = test_shapes::flatten_with_threads(mesh, 2);
   const flat_detail::BlockCache::Stats after = flat_detail::cholmod_block_cache().stats();
   EXPECT_GE(flat.coverage.fraction, 0.995);
   EXPECT_GT(after.fresh + after.reused, before.fresh + before.reused);
