@@ -5,6 +5,7 @@
 #include <future>
 
 #include <algorithm>
+#include <numeric>
 #include <map>
 #include <cmath>
 #include <random>
@@ -51,6 +52,13 @@ SpdSolver::SpMat grid_system(const cf::flat_detail::Edges& E, int nx, const std:
   SpdSolver::SpMat A(n, n);
   A.setFromTriplets(trip.begin(), trip.end());
   return A;
+}
+
+// grid_system with every vertex its own unknown (vertex v = unknown v), nv = the grid's vertices.
+SpdSolver::SpMat whole_grid_system(const cf::flat_detail::Edges& E, int nx, int nv) {
+  std::vector<int> all(static_cast<std::size_t>(nv));
+  std::iota(all.begin(), all.end(), 0);
+  return grid_system(E, nx, all, nv);
 }
 
 }  // namespace
@@ -131,9 +139,7 @@ TEST(FlattenSolver, RestrictedOrderOfALargerGraphSolvesTheSubgraph) {
 TEST(FlattenSolver, LeadingBlockOfTheOrderSolvesTheSystemWithTheRestHeldAtZero) {
   const int nx = 30, ny = 20, nv = nx * ny;
   const auto E = cf::flat_detail::build_edges(grid_faces(nx, ny, 7));
-  std::vector<int> all(nv);
-  for (int v = 0; v < nv; ++v) all[v] = v;
-  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  const SpdSolver::SpMat A = whole_grid_system(E, nx, nv);
   auto held = [&](int v) { return v % nx == nx - 1 || v / nx == 0; };  // last column and first row
   std::vector<int> order, unknown_of(nv, -1);  // AMD's order with the held unknowns moved last
   const std::vector<int> amd = SpdSolver::fill_reducing_order(A);
@@ -303,9 +309,7 @@ TEST(FlattenSolver, LargeSegmentsFirstSolveIsInNestedDissectionOrder) {
   EXPECT_FALSE(cf::flat_detail::uses_dissection(big, "conformal"));
   const std::vector<int> order = cf::flat_detail::nested_dissection_vertex_order(faces, nv);
   EXPECT_EQ(cf::flat_detail::small_segment_vertex_order(E, nv).order, cf::flat_detail::fill_reducing_vertex_order(E, nv));
-  std::vector<int> all(nv);
-  for (int v = 0; v < nv; ++v) all[v] = v;
-  const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+  const SpdSolver::SpMat A = whole_grid_system(E, nx, nv);
   SpdSolver first, amd;
   first.analyze(A, &order);
   amd.analyze(A);
@@ -333,10 +337,8 @@ struct OrderCost {
   int root = 0;
 };
 OrderCost order_cost(const cf::flat_detail::Edges& E, int na, int nv, const std::vector<int>& order) {
-  std::vector<int> all(nv);
-  for (int v = 0; v < nv; ++v) all[v] = v;
   SpdSolver s;
-  s.analyze(grid_system(E, na, all, nv), &order);
+  s.analyze(whole_grid_system(E, na, nv), &order);
   return {s.factor_flops(), s.dense_root_columns()};
 }
 
@@ -376,9 +378,7 @@ TEST(FlattenSolver, NestedDissectionOrdersAtTheSameTimeAreEachTheOrderAlone) {
   std::vector<SpdSolver::SpMat> systems;
   for (int nx : {200, 210}) {
     const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 23));
-    std::vector<int> all(nx * nx);
-    for (int v = 0; v < nx * nx; ++v) all[v] = v;
-    systems.push_back(grid_system(E, nx, all, nx * nx));
+    systems.push_back(whole_grid_system(E, nx, nx * nx));
   }
   const std::vector<int> alone0 = SpdSolver::nested_dissection_order(systems[0]);
   const std::vector<int> alone1 = SpdSolver::nested_dissection_order(systems[1]);
@@ -404,9 +404,7 @@ struct NestedGrid {
 NestedGrid nested_grid() {
   const int nx = 150, nv = nx * nx;
   const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 17));
-  std::vector<int> all(nv);
-  for (int v = 0; v < nv; ++v) all[v] = v;
-  NestedGrid g{grid_system(E, nx, all, nv), {}};
+  NestedGrid g{whole_grid_system(E, nx, nv), {}};
   g.order = SpdSolver::one_call_dissection_order(g.A);
   if (g.order.empty()) g.order = SpdSolver::nested_dissection_order(g.A);
   return g;
@@ -657,9 +655,7 @@ TEST(FlattenSolver, TwoColumnSolveIsEachColumnsOwnSolveBelowAndAboveTheThreadedT
   for (const int nx : {40, 300}) {
     const int nv = nx * nx;
     const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 17));
-    std::vector<int> all(nv);
-    for (int v = 0; v < nv; ++v) all[v] = v;
-    const SpdSolver::SpMat A = grid_system(E, nx, all, nv);
+    const SpdSolver::SpMat A = whole_grid_system(E, nx, nv);
     const std::vector<int> order = SpdSolver::nested_dissection_order(A);
     Eigen::MatrixXd b(nv, 2);
     for (int i = 0; i < nv; ++i) b(i, 0) = std::sin(0.013 * i) + 0.3, b(i, 1) = std::cos(0.007 * i);
@@ -713,10 +709,8 @@ TEST(FlattenSolver, ColumnsAreSolvedThreeToACallWithTheOneColumnBits) {
   for (const int nx : {40, 320}) {
     const int nv = nx * nx;
     const auto E = cf::flat_detail::build_edges(grid_faces(nx, nx, 11));
-    std::vector<int> all(nv);
-    for (int v = 0; v < nv; ++v) all[v] = v;
     SpdSolver s;
-    ASSERT_TRUE(s.compute(grid_system(E, nx, all, nv)));
+    ASSERT_TRUE(s.compute(whole_grid_system(E, nx, nv)));
     if (s.factor_flops() == 0) GTEST_SKIP() << "no CHOLMOD: Eigen's solve";
     EXPECT_EQ(s.factor_entries() >= SpdSolver::kThreadedSolveMinEntries, nx == 320);
     const Eigen::MatrixXd b = Eigen::MatrixXd::Random(nv, 5);
