@@ -293,34 +293,41 @@ static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf,
   return corr.iterations;
 }
 
+// The local passes once, with the vertices `held` fixed: pockets; then, grown until they have room,
+// those left.
+static void run_local_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& held,
+                             const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
+  for (bool grow : {false, true}) {
+    w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, held, degenerate, o, true, grow));
+    if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
+    if (grow) return;
+    const bool need = needs_correction(w, degenerate, o).local;
+    if (!branch) debug_clock("correction need after local pass 1");
+    if (!need) return;
+  }
+}
 
 // (flatten_internal.h) A rim held where the conformal map put it (a round hole whose length in the
 // map can be half its 3D length where a limb-sized branch was cut off) leaves the strip of wall
-// along it crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25).
+// along it crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25). A band
+// whose rims all stay held (most bands) runs the passes once, without the crossing checks.
 void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                        const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
                        bool branch) {
   const std::vector<std::array<int, 2>> rims = rim_edges(w.ann, fixed, ends);
-  const std::size_t crossed = rims.empty() ? 0 : rim_crossings(w, rims);
-  const std::vector<V2> before = rims.empty() ? std::vector<V2>() : w.emb.pos;
-  const std::vector<char> rims_free = rims.empty() ? fixed : held_in_local_passes(w, rims, ends, o.coverage_min_ratio);
-  for (const std::vector<char>* held : {&rims_free, &fixed}) {
-    bool need = true;
-    for (bool grow : {false, true}) {
-      if (!need) break;
-      w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, *held, degenerate, o, true, grow));
-      if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
-      need = !grow && needs_correction(w, degenerate, o).local;
-      if (!branch && !grow) debug_clock("correction need after local pass 1");
-    }
-    const std::size_t now = rims.empty() || held == &fixed ? crossed : rim_crossings(w, rims);
-    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-      std::fprintf(stderr, "flatten debug local passes, rims %s: %zu rim edges, %zu rim vertices held, crossings %zu -> %zu\n",
-                   held == &fixed ? "held" : "free", rims.size(),
-                   std::size_t(std::count(held->begin(), held->end(), 1) - std::count(ends.begin(), ends.end(), 1)), crossed, now);
-    if (now <= crossed) return;
-    w.emb.pos = before;
-  }
+  const std::vector<char> held = rims.empty() ? fixed : held_in_local_passes(w, rims, ends, o.coverage_min_ratio);
+  if (held == fixed) return run_local_passes(w, vf, fixed, degenerate, o, branch);
+  const std::size_t crossed = rim_crossings(w, rims);
+  const std::vector<V2> before = w.emb.pos;
+  run_local_passes(w, vf, held, degenerate, o, branch);
+  const std::size_t now = rim_crossings(w, rims);
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug local passes, rims free: %zu rim edges, %zu rim vertices held, crossings %zu -> %zu\n",
+                 rims.size(), std::size_t(std::count(held.begin(), held.end(), 1) - std::count(ends.begin(), ends.end(), 1)),
+                 crossed, now);
+  if (now <= crossed) return;
+  w.emb.pos = before;  // a rim crossed: again with every rim held
+  run_local_passes(w, vf, fixed, degenerate, o, branch);
 }
 
 // Band length: the centreline length L, moved towards the conformal length by at most 8 % (the
