@@ -307,25 +307,28 @@ static void run_local_passes(SegmentWork& w, const std::vector<std::vector<int>>
   }
 }
 
-// (flatten_internal.h) A rim held where the conformal map put it (a round hole whose length in the
-// map can be half its 3D length where a limb-sized branch was cut off) leaves the strip of wall
-// along it crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25). A band
-// whose rims all stay held (most bands) runs the passes once, without the crossing checks.
-void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
-                       const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
-                       bool branch) {
-  const std::vector<std::array<int, 2>> rims = rim_edges(w.ann, fixed, ends);
-  const std::vector<char> held = rims.empty() ? fixed : held_in_local_passes(w, rims, ends, o.coverage_min_ratio);
-  if (held == fixed) return run_local_passes(w, vf, fixed, degenerate, o, branch);
-  const std::size_t crossed = rim_crossings(w, rims);
+// (cut_rims.h) A rim held where the conformal map put it (a round hole whose length in the map can
+// be half its 3D length where a limb-sized branch was cut off) leaves the strip of wall along it
+// crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25). A band whose
+// rims all stay held (most bands) runs the passes once, without the crossing checks.
+void local_area_passes(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
+                       const std::vector<char>& fixed, const std::vector<char>& ends,
+                       const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
+  const CutRims rims = cut_rims(w.ann, E, ends);
+  const std::vector<char> freed = free_rims(w, rims, o.coverage_min_ratio);
+  if (std::count(freed.begin(), freed.end(), 1) == 0) return run_local_passes(w, vf, fixed, degenerate, o, branch);
+  const std::vector<char> held = held_vertices(w, rims, freed, ends);
+  const std::vector<std::size_t> crossed = rim_crossings(w, rims);
   const std::vector<V2> before = w.emb.pos;
   run_local_passes(w, vf, held, degenerate, o, branch);
-  const std::size_t now = rim_crossings(w, rims);
+  const std::vector<std::size_t> now = rim_crossings(w, rims);
+  bool more = false;
+  for (std::size_t r = 0; r < now.size(); ++r) more = more || now[r] > crossed[r];
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug local passes, rims free: %zu rim edges, %zu rim vertices held, crossings %zu -> %zu\n",
-                 rims.size(), std::size_t(std::count(held.begin(), held.end(), 1) - std::count(ends.begin(), ends.end(), 1)),
-                 crossed, now);
-  if (now <= crossed) return;
+    std::fprintf(stderr, "flatten debug local passes, rims free: %zu rim edges, %zu rim vertices held, crossings %s\n",
+                 rims.edges.size(), std::size_t(std::count(held.begin(), held.end(), 1) - std::count(ends.begin(), ends.end(), 1)),
+                 more ? "added" : "none added");
+  if (!more) return;
   w.emb.pos = before;  // a rim crossed: again with every rim held
   run_local_passes(w, vf, fixed, degenerate, o, branch);
 }
@@ -340,7 +343,7 @@ constexpr double kBandLengthSlack = 0.08;
 // Area-balanced map: x = B F(u) (the axis chosen above; B the band length), y scaled so that the
 // band's area is the wall area, fold-overs untangled, then the regions still out of bounds
 // balanced (symmetric Dirichlet). centreline_x keeps the true centreline mm of each band x.
-void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends,
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends, const Edges& E,
                         const std::vector<std::vector<int>>& vf,
                         const std::vector<char>& fixed, const std::vector<char>& degenerate,
                         const FlattenOptions& o, bool branch) {
@@ -384,7 +387,7 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   std::vector<char> on_end(fixed.size(), 0);
   for (const std::vector<int>& l : ends)
     for (int v : l) on_end[std::size_t(v)] = 1;
-  if (need.local) local_area_passes(w, vf, fixed, on_end, degenerate, o, branch);
+  if (need.local) local_area_passes(w, E, vf, fixed, on_end, degenerate, o, branch);
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;

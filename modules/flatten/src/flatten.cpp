@@ -280,11 +280,9 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
   Edges rest_edges = sub_edges(p.E, keep, new_of_old);
   std::vector<BranchPiece> pieces;
+  FaceSetScratch scratch;  // one for the cuts
   for (const auto& cut : cuts) {  // each branch from its own faces (not a mask of the annulus' faces)
-    std::vector<int> in = cut.faces;
-    std::sort(in.begin(), in.end());
-    in.erase(std::unique(in.begin(), in.end()), in.end());
-    in = clean_face_set(w.ann, p.E, std::move(in));
+    const std::vector<int> in = clean_face_set(w.ann, p.E, cut.faces, &scratch);
     BranchPiece piece;
     piece.surface = sub_surface(w.ann, in);
     piece.neck_mm = cut.neck_mm;
@@ -389,7 +387,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const Centreline cl = centreline_step(w, loops);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
-  if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.vf, p.fixed, p.degenerate, o, depth > 0);
+  if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.E, p.vf, p.fixed, p.degenerate, o, depth > 0);
   if (o.map == "area-balanced") phase("area balance");
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
   w.dissection_to_annulus = {};

@@ -110,9 +110,15 @@ Surface sub_surface(const Surface& s, const std::vector<int>& faces, std::vector
 // Drops kept faces at pinch vertices and faces with all corners on the boundary, and keeps the
 // largest edge-connected piece, until the selection's boundary is a set of simple loops.
 void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep);
-// clean_selection of the faces `faces` (ascending, no repeats): the faces it keeps, ascending. Walks
-// only these faces and their edges (a side branch is a small part of its annulus).
-std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces);
+// clean_selection of the faces `faces` (any order, repeats allowed): the faces it keeps, ascending. Walks
+// only these faces and their edges (a side branch is a small part of its annulus). `scratch`
+// (optional): per face 0 / -1 and per vertex 0 between calls (sized on first use; the cuts of one
+// annulus share it instead of each allocating three arrays the size of the annulus).
+struct FaceSetScratch {
+  std::vector<char> keep;
+  std::vector<int> comp, bcount;
+};
+std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces, FaceSetScratch* scratch = nullptr);
 
 // Conformal coordinates: u harmonic (0 on loop A, 1 on loop B), v its conjugate with unit period,
 // eta the cut cocycle (per edge, lo -> hi), period = the conformal period in u units.
@@ -376,19 +382,11 @@ struct SegmentWork;
 // the least angle-distorting axis F whose area ratios stay in bounds, B the band length (the
 // centreline length within 8 %; a branch's conformal length), y scaled to the wall area, folds
 // untangled, out-of-bounds regions balanced. `ends`: the band's two end loops (vertex ids of w.ann);
-// `fixed`: every boundary vertex (the ends and the rims of cut-off branches). The rims move in the
-// local area correction passes only (unless a rim would cross itself there), the ends never.
-void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends,
+// `E`: w.ann's edges; `fixed`: every boundary vertex (the ends and the rims of cut-off branches). The
+// rims move in the local area correction passes only (cut_rims.h: local_area_passes), the ends never.
+void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends, const Edges& E,
                         const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                         const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
-// The local area correction passes of area_balanced_step (pockets, then grown pockets) on a band
-// whose boundary vertices are `fixed` (per vertex), `ends` (per vertex) those on its two end loops:
-// the other boundary vertices (rims of cut-off branches) move where at least half of the rim's faces
-// are crushed (below coverage_min_ratio) and its hole is round in the map; if that made a rim cross
-// itself or another, the passes are done again with every rim held. Post: positive faces stay so.
-void local_area_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
-                       const std::vector<char>& ends, const std::vector<char>& degenerate, const FlattenOptions& o,
-                       bool branch);
 // COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
 void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate);
 // COLONFLAT_FLATTEN_DEBUG=1: a timeline line on stderr: wall and process CPU seconds (all threads,

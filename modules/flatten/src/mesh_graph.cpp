@@ -327,12 +327,19 @@ void clean_selection(const Surface& s, const Edges& E, std::vector<char>& keep) 
   for (int f : faces) keep[std::size_t(f)] = 1;
 }
 
-std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces) {
+std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<int> faces, FaceSetScratch* scratch) {
   // Pinch vertices (kept faces forming several fans) make the boundary non-manifold: remove the
   // faces around them and keep the largest piece, until the boundary is clean.
-  std::vector<char> keep(s.t.size(), 0);
+  if (!std::is_sorted(faces.begin(), faces.end())) std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  FaceSetScratch own;
+  FaceSetScratch& use = scratch ? *scratch : own;
+  if (use.keep.size() != s.t.size()) use.keep.assign(s.t.size(), 0), use.comp.assign(s.t.size(), -1);
+  if (use.bcount.size() != s.p.size()) use.bcount.assign(s.p.size(), 0);
+  std::vector<char>& keep = use.keep;
+  std::vector<int>& comp = use.comp;
+  std::vector<int>& bcount = use.bcount;  // boundary edges at a vertex
   for (int f : faces) keep[std::size_t(f)] = 1;
-  std::vector<int> comp(s.t.size(), -1), bcount(s.p.size(), 0);  // bcount: boundary edges at a vertex
   for (int iter = 0; iter < 200; ++iter) {
     faces = largest_piece(E, faces, keep, comp);
     for (int f : faces)  // an edge with one kept face is on the boundary (walked from that face only)
@@ -358,6 +365,7 @@ std::vector<int> clean_face_set(const Surface& s, const Edges& E, std::vector<in
     faces.swap(left);
     if (!changed) break;
   }
+  for (int f : faces) keep[std::size_t(f)] = 0;  // (the faces dropped are 0 already)
   return faces;
 }
 

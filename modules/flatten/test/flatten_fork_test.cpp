@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "../src/cut_rims.h"
 #include "../src/flatten_internal.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/flatten/flatten.h"
@@ -90,7 +91,7 @@ TEST(FlattenFork, RoundRimMovesAndTheStripAlongItOpens) {
   const CrushedRim start;
   const double before = rim.strip_hidden();
   ASSERT_GT(before, 100.0);
-  flat_detail::local_area_passes(rim.w, rim.vf, rim.fixed, rim.ends, rim.degenerate, FlattenOptions{}, false);
+  flat_detail::local_area_passes(rim.w, flat_detail::build_edges(rim.w.ann.t), rim.vf, rim.fixed, rim.ends, rim.degenerate, FlattenOptions{}, false);
   EXPECT_LT(rim.strip_hidden(), 0.01 * before);
   for (std::size_t f = 0; f < rim.w.ann.t.size(); ++f) EXPECT_GT(rim.w.emb.area2(rim.w.ann, int(f)), 0.0);
   std::size_t rim_moved = 0, ends_moved = 0;

@@ -97,12 +97,14 @@ std::vector<char> clean_by_mask(const Surface& s, const Edges& E, std::vector<ch
 // A branch's faces cleaned from their own list (clean_face_set, walking only them) keep exactly
 // the faces the whole-surface clean-up keeps from their mask, on random selections of a closed
 // colon (holes, pinch vertices) and on a geodesic patch, whole and with holes; sub_surface of the
-// face list is sub_surface of the mask (points, faces, source ids, vertex map).
+// face list is sub_surface of the mask (points, faces, source ids, vertex map). One scratch shared
+// by the four selections, each given shuffled with repeats, gives the same faces and is left clean.
 TEST(FlattenMeshGraph, FaceSetIsCleanedAsItsMaskIs) {
   const Surface s = surface_of(synthetic::colon(synthetic::colon_options(200, 15, 1.2, {})).mesh);
   const Edges E = build_edges(s.t);
   const std::vector<double> d = dijkstra(build_csr(s, E), {0});
-  std::mt19937 rng(11);
+  std::mt19937 rng(11), shuffle_rng(5);
+  FaceSetScratch scratch;
   for (double share : {0.9, 0.97, -1.0, -0.9}) {
     std::vector<char> mask(s.t.size());
     for (std::size_t f = 0; f < s.t.size(); ++f)  // share < 0: that share of the faces within 20 mm of vertex 0
@@ -116,6 +118,13 @@ TEST(FlattenMeshGraph, FaceSetIsCleanedAsItsMaskIs) {
     for (int f : got) got_mask[f] = 1;
     EXPECT_EQ(got_mask, want) << "share " << share;
     EXPECT_TRUE(std::is_sorted(got.begin(), got.end()));
+    std::vector<int> shuffled = faces;
+    shuffled.insert(shuffled.end(), faces.begin(), faces.begin() + std::ptrdiff_t(faces.size() / 2));
+    std::shuffle(shuffled.begin(), shuffled.end(), shuffle_rng);
+    EXPECT_EQ(clean_face_set(s, E, shuffled, &scratch), got) << "share " << share;
+    EXPECT_EQ(std::count(scratch.keep.begin(), scratch.keep.end(), 0), std::ptrdiff_t(s.t.size()));
+    EXPECT_EQ(std::count(scratch.comp.begin(), scratch.comp.end(), -1), std::ptrdiff_t(s.t.size()));
+    EXPECT_EQ(std::count(scratch.bcount.begin(), scratch.bcount.end(), 0), std::ptrdiff_t(s.p.size()));
     ASSERT_GT(got.size(), 0u);
     EXPECT_LT(got.size(), faces.size()) << "share " << share;  // the clean-up removed faces
     std::vector<int> map_mask, map_list;
