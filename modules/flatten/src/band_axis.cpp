@@ -294,43 +294,77 @@ static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf,
 }
 
 // The local passes once, with the vertices `held` fixed: pockets; then, grown until they have room,
-// those left.
-static void run_local_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& held,
-                             const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
+// those left (when the band still needs it, or `second`). Returns whether the second pass ran.
+static bool run_local_passes(SegmentWork& w, const std::vector<std::vector<int>>& vf, const std::vector<char>& held,
+                             const std::vector<char>& degenerate, const FlattenOptions& o, bool branch,
+                             bool second = false) {
   for (bool grow : {false, true}) {
     w.seg.corrected_iterations = std::max(w.seg.corrected_iterations, correct_pass(w, vf, held, degenerate, o, true, grow));
     if (!branch) debug_clock(grow ? "local pass 2" : "local pass 1");
-    if (grow) return;
+    if (grow || second) continue;
     const bool need = needs_correction(w, degenerate, o).local;
     if (!branch) debug_clock("correction need after local pass 1");
-    if (!need) return;
+    if (!need) return false;
   }
+  return true;
+}
+
+// The freed rims (`freed`) that cross more often than at the start (`start`: rim_crossings() before
+// the passes); COLONFLAT_FLATTEN_DEBUG: the round's counts.
+static std::vector<char> rims_that_crossed(const SegmentWork& w, const CutRims& rims, const std::vector<char>& freed,
+                                           const std::vector<std::size_t>& start, int round) {
+  const std::vector<std::size_t> now = rim_crossings(w, rims);
+  std::vector<char> crossed(now.size(), 0);
+  std::size_t free_edges = 0, added = 0;
+  for (std::size_t r = 0; r < now.size(); ++r) {
+    crossed[r] = freed[r] && now[r] > start[r];
+    free_edges += freed[r] ? rims.loops[r].size() : 0, added += crossed[r];
+  }
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug local passes, rims free (round %d): %zu rims (%zu edges), %zu freed (%zu edges), "
+                 "%zu of them crossed\n", round, rims.loops.size(), rims.edges.size(),
+                 std::size_t(std::count(freed.begin(), freed.end(), 1)), free_edges, added);
+  return crossed;
 }
 
 // (cut_rims.h) A rim held where the conformal map put it (a round hole whose length in the map can
 // be half its 3D length where a limb-sized branch was cut off) leaves the strip of wall along it
 // crushed; only the rim giving way opens it (issue 26, docs/flatten.md session 25). A band whose
-// rims all stay held (most bands) runs the passes once, without the crossing checks.
+// rims all stay held (most bands) runs the passes once, without the crossing checks. A rim that
+// crosses costs the passes of its own pieces again; the rims that did not keep what they opened.
 void local_area_passes(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
                        const std::vector<char>& fixed, const std::vector<char>& ends,
                        const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
   const CutRims rims = cut_rims(w.ann, E, ends);
-  const std::vector<char> freed = free_rims(w, rims, o.coverage_min_ratio);
-  if (std::count(freed.begin(), freed.end(), 1) == 0) return run_local_passes(w, vf, fixed, degenerate, o, branch);
-  const std::vector<char> held = held_vertices(w, rims, freed, ends);
-  const std::vector<std::size_t> crossed = rim_crossings(w, rims);
-  const std::vector<V2> before = w.emb.pos;
-  run_local_passes(w, vf, held, degenerate, o, branch);
-  const std::vector<std::size_t> now = rim_crossings(w, rims);
-  bool more = false;
-  for (std::size_t r = 0; r < now.size(); ++r) more = more || now[r] > crossed[r];
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug local passes, rims free: %zu rim edges, %zu rim vertices held, crossings %s\n",
-                 rims.edges.size(), std::size_t(std::count(held.begin(), held.end(), 1) - std::count(ends.begin(), ends.end(), 1)),
-                 more ? "added" : "none added");
-  if (!more) return;
-  w.emb.pos = before;  // a rim crossed: again with every rim held
-  run_local_passes(w, vf, fixed, degenerate, o, branch);
+  const std::vector<char> freed = free_rims(w, rims, o);
+  if (std::count(freed.begin(), freed.end(), 1) == 0) {
+    run_local_passes(w, vf, fixed, degenerate, o, branch);
+    return;
+  }
+  local_passes_freeing(w, rims, freed, vf, ends, degenerate, o, branch);
+}
+
+void local_passes_freeing(SegmentWork& w, const CutRims& rims, std::vector<char> freed,
+                          const std::vector<std::vector<int>>& vf, const std::vector<char>& ends,
+                          const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
+  const std::vector<std::size_t> start = rim_crossings(w, rims);
+  std::vector<char> kept(w.emb.pos.size(), 0);  // moved by pieces that keep their result
+  bool second = false;  // the restored pieces get the passes the first round ran
+  for (int round = 1;; ++round) {
+    std::vector<char> held = held_vertices(w, rims, freed, ends);
+    for (std::size_t v = 0; v < held.size(); ++v) held[v] |= kept[v];
+    const std::vector<V2> before = w.emb.pos;
+    second = run_local_passes(w, vf, held, degenerate, o, branch, second);
+    const std::vector<char> crossed = rims_that_crossed(w, rims, freed, start, round);
+    if (std::count(crossed.begin(), crossed.end(), 1) == 0) return;
+    std::vector<char> others(crossed.size());  // the crossed rims are held from now on
+    for (std::size_t r = 0; r < crossed.size(); ++r) others[r] = !crossed[r], freed[r] = freed[r] && !crossed[r];
+    const std::size_t back =
+        restore_touched_pieces(w, before, held_vertices(w, rims, others, std::vector<char>(held.size(), 0)), kept);
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug local passes: %zu vertices restored, %zu kept\n", back,
+                   std::size_t(std::count(kept.begin(), kept.end(), 1)));
+  }
 }
 
 // Band length: the centreline length L, moved towards the conformal length by at most 8 % (the

@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <unordered_map>
+
+#include "colonflat/core/union_find.h"
 
 namespace cf::flat_detail {
 
@@ -70,12 +74,35 @@ CutRims cut_rims(const Surface& s, const Edges& E, const std::vector<char>& ends
   return rims;
 }
 
+// Per rim vertex (the head of each rim edge), the angles of its faces at it summed in the map: above
+// one turn, its fan of faces overlaps itself (the rim folded over at that vertex: its two sides
+// swapped there, which no pair of rim edges shows, as they share the vertex).
+std::vector<double> rim_fan_angles(const SegmentWork& w, const CutRims& rims) {
+  std::vector<char> on_rim(w.ann.p.size(), 0);
+  for (const auto& [f, k] : rims.edges) on_rim[std::size_t(w.ann.t[std::size_t(f)][k])] = 1;
+  std::vector<double> angle(w.ann.p.size(), 0.0);
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
+    const Tri& t = w.ann.t[f];
+    if (!on_rim[std::size_t(t[0])] && !on_rim[std::size_t(t[1])] && !on_rim[std::size_t(t[2])]) continue;
+    const auto c = w.emb.corners(w.ann, int(f));
+    for (int k = 0; k < 3; ++k) {
+      const V2 a = c[(k + 1) % 3] - c[k], b = c[(k + 2) % 3] - c[k];
+      if (on_rim[std::size_t(t[k])]) angle[std::size_t(t[k])] += std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
+    }
+  }
+  std::vector<double> out;
+  for (const auto& [f, k] : rims.edges) out.push_back(angle[std::size_t(w.ann.t[std::size_t(f)][k])]);
+  return out;
+}
+
 std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims) {
   const std::vector<RimSegment> seg = rim_segments(w, rims);
+  const std::vector<double> fan = rim_fan_angles(w, rims);
   const auto side = [](const V2& a, const V2& b, const V2& c) {
     const double x = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
     return (x > 0) - (x < 0); };
   std::vector<std::size_t> n(rims.loops.size(), 0);
+  for (std::size_t i = 0; i < seg.size(); ++i) n[rims.loop_of[i]] += fan[i] > 2 * M_PI * (1 + 1e-9);
   for (std::size_t i = 0; i < seg.size(); ++i)
     for (std::size_t j = i + 1; j < seg.size(); ++j) {
       const RimSegment& s = seg[i];
@@ -93,7 +120,12 @@ std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims
 // 43 x 15 mm hole (0.68 round) had its tip dragged 4 mm along it and crossed its other side, and on
 // the real CT colon band small crushed holes (map area 0.05-0.12 of their 3D circle's) crossed 22
 // times (the passes then ran twice). The U's rim that keeps a strip crushed: 0.98 round, room 0.31.
-std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, double min_ratio) {
+// kHoleRoom 0.15 (session 26, with a crossing rim held alone and folds at a rim vertex counted):
+// U120's small hole (40 edges, room 0.157) then folds over at a vertex (its strip opened only so:
+// session 25's p05 0.209 was that fold) and U180's two rims at 0.17 / 0.19 cross: both restored,
+// nothing gained, 77 k / 13 k vertices corrected twice.
+std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, const FlattenOptions& o) {
+  const double min_ratio = o.coverage_min_ratio;
   double a2 = 0, a3 = 0;  // the band's area scale
   for (std::size_t f = 0; f < w.ann.t.size(); ++f) a2 += std::max(w.emb.area2(w.ann, int(f)), 0.0), a3 += face_area_3d(w.ann, int(f));
   const double scale = a2 > 0 ? a3 / a2 : 1.0;
@@ -102,10 +134,10 @@ std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, double mi
   for (std::size_t r = 0; r < rims.loops.size(); ++r) {
     const std::vector<std::size_t>& loop = rims.loops[r];
     double area = 0, length = 0, length3 = 0;  // shoelace over the edges (either orientation); 3D length
-    RimSegment last{}, first{};
+    const RimSegment first = seg[loop.front()];
+    RimSegment last = first;
     for (std::size_t k : loop) {
-      const RimSegment e = k == loop.front() ? seg[k] : nearest_copy(last, seg[k], w.emb.period);  // placed after the last
-      if (k == loop.front()) first = e;
+      const RimSegment e = k == loop.front() ? first : nearest_copy(last, seg[k], w.emb.period);  // placed after the last
       area += 0.5 * (e.p.x() * e.q.y() - e.q.x() * e.p.y()), length += (e.q - e.p).norm();
       length3 += (w.ann.p[seg[k].a] - w.ann.p[seg[k].b]).norm();
       last = e;
@@ -113,9 +145,12 @@ std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, double mi
     const bool wraps = (last.q - first.p).norm() > 0.5 * w.emb.period;  // around the band
     const auto crushed = std::count_if(loop.begin(), loop.end(), [&](std::size_t k) {
       return scale * w.emb.area2(w.ann, rims.edges[k][0]) < min_ratio * face_area_3d(w.ann, rims.edges[k][0]); });
-    const bool round = std::abs(area) >= kRoundHole * length * length / (4 * M_PI) && !wraps;
-    const bool room = std::abs(area) >= kHoleRoom * length3 * length3 / (4 * M_PI);
-    freed[r] = round && room && double(crushed) >= kCrushedRim * double(loop.size());
+    const double roundness = std::abs(area) / (length * length / (4 * M_PI)), room = std::abs(area) / (length3 * length3 / (4 * M_PI));
+    freed[r] = roundness >= kRoundHole && !wraps && room >= kHoleRoom && double(crushed) >= kCrushedRim * double(loop.size());
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug rim %zu: %zu edges, %.0f mm in 3D, crushed %.2f, round %.2f%s, room %.3f: %s\n", r,
+                   loop.size(), length3, double(crushed) / double(loop.size()), roundness, wraps ? " (around the band)" : "",
+                   room, freed[r] ? "freed" : "held");
   }
   return freed;
 }
@@ -130,6 +165,25 @@ std::vector<char> held_vertices(const SegmentWork& w, const CutRims& rims, const
         held[std::size_t(w.ann.t[std::size_t(f)][c])] = held[std::size_t(w.ann.t[std::size_t(f)][(c + 1) % 3])] = 1;
       }
   return held;
+}
+
+std::size_t restore_touched_pieces(SegmentWork& w, const std::vector<V2>& before, const std::vector<char>& touched,
+                                   std::vector<char>& kept) {
+  const std::vector<V2>& pos = w.emb.pos;
+  UnionFind pieces(pos.size());
+  for (const Tri& t : w.ann.t)
+    if (pos[t[0]] != before[t[0]] || pos[t[1]] != before[t[1]] || pos[t[2]] != before[t[2]])
+      pieces.unite(std::uint32_t(t[0]), std::uint32_t(t[1])), pieces.unite(std::uint32_t(t[0]), std::uint32_t(t[2]));
+  std::vector<char> restore(pos.size(), 0);  // per piece root
+  for (std::size_t v = 0; v < pos.size(); ++v)
+    if (touched[v]) restore[pieces.find(std::uint32_t(v))] = 1;
+  std::size_t back = 0;
+  for (std::size_t v = 0; v < pos.size(); ++v) {
+    if (pos[v] == before[v]) continue;
+    if (restore[pieces.find(std::uint32_t(v))]) w.emb.pos[v] = before[v], ++back;
+    else kept[v] = 1;
+  }
+  return back;
 }
 
 }  // namespace cf::flat_detail

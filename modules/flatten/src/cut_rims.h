@@ -27,25 +27,42 @@ CutRims cut_rims(const Surface& s, const Edges& E, const std::vector<char>& ends
 // rim folded over itself or another rim through the hole it bounds: a fold no face's orientation
 // shows). A pair on one rim counts once for it, a pair across two rims once for each. Edges sharing
 // a vertex are not judged; an edge is compared with the other's copy nearest it across the period.
+// A rim vertex whose faces' angles at it sum above one turn (the rim folded over at that vertex)
+// counts once for its rim.
 std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims);
 
 // Per rim: free to move in the local passes (1) or held (0): a rim that can open a crushed strip by
-// moving into its hole: at least half of the rim's faces below `min_ratio` (area ratio at the band's
-// area scale), a round hole (map area >= 0.8 x that of the circle of the rim's map length; not
-// around the band) with room (map area >= 0.25 x that of the circle of the rim's 3D length).
-std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, double min_ratio);
+// moving into its hole: at least half of the rim's faces below o.coverage_min_ratio (area ratio at
+// the band's area scale), a round hole (map area >= 0.8 x that of the circle of the rim's map length;
+// not around the band) with room (map area >= 0.25 x that of the circle of the rim's 3D length).
+// COLONFLAT_FLATTEN_DEBUG=1: one line per rim with these figures.
+std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, const FlattenOptions& o);
 
 // The vertices held in the local passes (per vertex of w.ann): `ends` and the rims not `freed`.
 std::vector<char> held_vertices(const SegmentWork& w, const CutRims& rims, const std::vector<char>& freed,
                                 const std::vector<char>& ends);
 
+// After passes that moved w.emb.pos from `before`: the moved vertices in pieces (the faces with a
+// moved corner, joined through shared vertices). The pieces holding a vertex `touched` go back to
+// `before` (each of their faces then is as before, so no face folds); the other moved vertices are
+// marked in `kept`. Returns how many vertices went back.
+std::size_t restore_touched_pieces(SegmentWork& w, const std::vector<V2>& before, const std::vector<char>& touched,
+                                   std::vector<char>& kept);
+
 // The local area correction passes of area_balanced_step (band_axis.cpp: pockets, then grown
 // pockets) on a band whose boundary vertices are `fixed` (per vertex), `ends` (per vertex) those on
 // its two end loops, `E` its edges: the ends stay; a rim of a cut-off branch moves where
-// free_rims() lets it; if that made a rim cross itself or another, the passes are done again with
-// every rim held. Post: positive faces stay so.
+// free_rims() lets it; a freed rim that crossed itself or another rim in the passes is held, the
+// pieces it moved in are restored (restore_touched_pieces) and the passes run again with every
+// vertex the other pieces moved held, until no freed rim adds a crossing. Post: positive faces stay
+// so; no freed rim crosses more than before; the same map for any thread count.
 void local_area_passes(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
                        const std::vector<char>& fixed, const std::vector<char>& ends,
                        const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
+
+// local_area_passes once its rims are found and judged: `freed` per rim (cut_rims(), free_rims()).
+void local_passes_freeing(SegmentWork& w, const CutRims& rims, std::vector<char> freed,
+                          const std::vector<std::vector<int>>& vf, const std::vector<char>& ends,
+                          const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
 
 }  // namespace cf::flat_detail
