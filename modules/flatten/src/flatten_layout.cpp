@@ -1,9 +1,13 @@
 // Layout of the flattened segments and the output FlatMap.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <unordered_map>
 
+#include "colonflat/core/run_stats.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -20,6 +24,32 @@ void reverse_segment(SegmentWork& w) {
   std::reverse(w.seg.centreline_x.begin(), w.seg.centreline_x.end());
 }
 
+// The flat vertex id of each (annulus vertex, sheet) pair met so far, keyed as
+// v * 64 + (sheet + 32) (a sheet: how many periods a face's corner lies above its vertex). A
+// vertex's first key lives in two arrays, a second one (a vertex on the period's seam: two sheets)
+// in a hash map: the same ids as one hash map of every key (which, on the real CT's 1.06 M flat
+// vertices, made emitting take 0.40 s against 0.23 s now).
+class SheetIds {
+ public:
+  explicit SheetIds(std::size_t vertices) : id_(vertices, -1), low_(vertices, 0) {}
+  // The id of `key`, or -1 when it is new (then `set` it).
+  int& of(long long key) {
+    const long long v = key >> 6;  // key = v * 64 + low, low in [0, 64): (v, low) <-> key
+    const auto low = std::uint8_t(key & 63);
+    if (v >= 0 && v < (long long)id_.size()) {
+      int& id = id_[std::size_t(v)];
+      if (id < 0) low_[std::size_t(v)] = low;
+      if (id < 0 || low_[std::size_t(v)] == low) return id;
+    }
+    return more_.try_emplace(key, -1).first->second;
+  }
+
+ private:
+  std::vector<int> id_;
+  std::vector<std::uint8_t> low_;
+  std::unordered_map<long long, int> more_;
+};
+
 void emit_one(const SegmentWork& w, FlatMap& out) {
   const Surface& ann = w.ann;
   const FlatSegment& seg = w.seg;
@@ -28,8 +58,7 @@ void emit_one(const SegmentWork& w, FlatMap& out) {
     const V3 n = (ann.p[t[1]] - ann.p[t[0]]).cross(ann.p[t[2]] - ann.p[t[0]]);
     for (int v : t) nrm[v] += n;
   }
-  std::unordered_map<long long, int> vid;
-  vid.reserve(ann.p.size() * 11 / 10);
+  SheetIds vid(ann.p.size());
   const double P = seg.period;
   for (std::size_t f = 0; f < ann.t.size(); ++f) {
     if (!w.in_map[f]) continue;
@@ -38,10 +67,9 @@ void emit_one(const SegmentWork& w, FlatMap& out) {
     for (int k = 0; k < 3; ++k) {
       const int v = ann.t[f][k];
       const long long sheet = std::llround(w.emb.dy[f][k] / P);
-      const long long key = (long long)v * 64 + (sheet + 32);
-      auto it = vid.find(key);
-      if (it == vid.end()) {
-        it = vid.emplace(key, int(out.uv.size())).first;
+      int& id = vid.of((long long)v * 64 + (sheet + 32));
+      if (id < 0) {
+        id = int(out.uv.size());
         out.uv.push_back({seg.x0 + c[k].x(), seg.y0 + c[k].y()});
         out.position.push_back({ann.p[v].x(), ann.p[v].y(), ann.p[v].z()});
         const V3 n = (w.lumen_sign * nrm[v]).normalized();
@@ -52,7 +80,7 @@ void emit_one(const SegmentWork& w, FlatMap& out) {
         const double a = std::fmod(c[k].y() / P, 1.0);
         out.angle_rad.push_back(2 * M_PI * (a < 0 ? a + 1 : a >= 1 ? 0 : a));
       }
-      ot[k] = it->second;
+      ot[k] = id;
     }
     out.triangles.push_back(ot);
   }
@@ -116,10 +144,13 @@ void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reve
   std::vector<int> id_of_work(work.size());
   for (std::size_t k = 0; k < order.size(); ++k) id_of_work[order[k]] = int(k);
   double y_cursor = 0;
+  double seconds[3] = {0, 0, 0};  // normalise, emit, statistics (COLONFLAT_FLATTEN_DEBUG)
+  Stopwatch lap;
   for (std::size_t k = 0; k < order.size(); ++k) {
     SegmentWork& w = work[order[k]];
     if (reversed[order[k]]) reverse_segment(w);
     normalise_corner_offsets(w.ann, w.emb);
+    seconds[0] += lap.lap();
     w.seg.id = int(k);
     w.seg.order = int(k);
     w.seg.parent = w.parent >= 0 ? id_of_work[w.parent] : -1;
@@ -128,9 +159,14 @@ void emit_segments(std::vector<SegmentWork>& work, const std::vector<char>& reve
     y_cursor += w.seg.period + o.segment_gap;
     emit_one(w, out);
     out.segments.push_back(w.seg);
+    seconds[1] += lap.lap();
   }
   out.stats = distortion_stats(out);
   out.coverage = total_coverage(out.segments);
+  seconds[2] = lap.lap();
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug layout: %zu flat vertices, wall s: offsets normalised %.3f, emitted %.3f, statistics %.3f\n",
+                 out.uv.size(), seconds[0], seconds[1], seconds[2]);
 }
 
 }  // namespace cf::flat_detail
