@@ -246,14 +246,22 @@ Coverage coverage_of(const Surface& s, const Edges& E, const std::vector<char>& 
 using flat_detail::FaceDistortion;
 using flat_detail::V3;
 
+// The triangles' distortions (of `segment`'s only when >= 0) in triangle order, on the worker
+// threads (each face on its own: the same values for any thread count).
 DistortionStats distortion_stats(const FlatMap& flat, int segment) {
-  std::vector<FaceDistortion> fd;
-  for (const auto& t : flat.triangles) {
-    if (segment >= 0 && flat.segment[t[0]] != segment) continue;
+  std::vector<std::size_t> picked;  // segment >= 0: its triangles
+  if (segment >= 0)
+    for (std::size_t k = 0; k < flat.triangles.size(); ++k)
+      if (flat.segment[flat.triangles[k][0]] == segment) picked.push_back(k);
+  std::vector<FaceDistortion> fd(segment >= 0 ? picked.size() : flat.triangles.size());
+  parallel_for(fd.size(), [&](std::size_t begin, std::size_t end) {
     auto P = [&](int i) { return V3(flat.position[i][0], flat.position[i][1], flat.position[i][2]); };
     auto Q = [&](int i) { return flat_detail::V2(flat.uv[i][0], flat.uv[i][1]); };
-    fd.push_back(flat_detail::face_distortion(P(t[0]), P(t[1]), P(t[2]), Q(t[0]), Q(t[1]), Q(t[2])));
-  }
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto& t = flat.triangles[segment >= 0 ? picked[k] : k];
+      fd[k] = flat_detail::face_distortion(P(t[0]), P(t[1]), P(t[2]), Q(t[0]), Q(t[1]), Q(t[2]));
+    }
+  });
   double mean = 0;
   for (const auto& d : fd) mean += d.area3;
   mean /= std::max<std::size_t>(1, fd.size());

@@ -150,3 +150,50 @@ TEST(FlattenDistortion, OrderStatisticsAreNthElementsValuesFoundInOneBucket) {
     }
   }
 }
+
+// distortion_stats (the flat map's final statistics, its faces measured on the worker threads)
+// gives the same bits on 1, 2 and 3 threads, for the whole map and per segment, and each
+// segment's statistics count exactly that segment's faces.
+TEST(FlattenDistortion, FlatMapStatisticsAreTheSameOnAnyThreadCount) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  cf::FlatMap flat;
+  const int grid = 120;  // a grid of vertices in 3D and a jittered copy in 2D; rows split in 2 segments
+  for (int i = 0; i < grid; ++i)
+    for (int j = 0; j < grid; ++j) {
+      flat.position.push_back({double(i), double(j), 0.3 * u(rng)});
+      flat.uv.push_back({i + 0.4 * u(rng), j * (0.5 + u(rng))});
+      flat.segment.push_back(i < grid / 3 ? 0 : 1);
+    }
+  for (int i = 0; i + 1 < grid; ++i)
+    for (int j = 0; j + 1 < grid; ++j) {
+      const int a = i * grid + j;
+      flat.triangles.push_back({a, a + grid, a + 1});
+      flat.triangles.push_back({a + 1, a + grid, a + grid + 1});
+    }
+  auto all = [&] {
+    std::vector<cf::DistortionStats> s{cf::distortion_stats(flat), cf::distortion_stats(flat, 0), cf::distortion_stats(flat, 1)};
+    return s;
+  };
+  cf::set_thread_count(1);
+  const std::vector<cf::DistortionStats> one = all();
+  EXPECT_EQ(one[1].faces + one[2].faces, flat.triangles.size());
+  EXPECT_EQ(one[1].faces, std::size_t(2 * (grid / 3) * (grid - 1)));
+  EXPECT_GT(one[0].flipped, 0u);  // the jitter folds some faces: the counts are exercised
+  for (int t : {2, 3}) {
+    cf::set_thread_count(t);
+    const std::vector<cf::DistortionStats> got = all();
+    for (std::size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].faces, one[k].faces) << t;
+      EXPECT_EQ(got[k].flipped, one[k].flipped) << t;
+      EXPECT_EQ(got[k].degenerate, one[k].degenerate) << t;
+      EXPECT_EQ(got[k].qc_mean, one[k].qc_mean) << t;
+      EXPECT_EQ(got[k].qc_p95, one[k].qc_p95) << t;
+      EXPECT_EQ(got[k].area_p05, one[k].area_p05) << t;
+      EXPECT_EQ(got[k].area_median, one[k].area_median) << t;
+      EXPECT_EQ(got[k].area_p95, one[k].area_p95) << t;
+      EXPECT_EQ(got[k].area_log2_mean_abs, one[k].area_log2_mean_abs) << t;
+    }
+  }
+  cf::set_thread_count(0);
+}
