@@ -29,8 +29,8 @@ int default_thread_count();
 
 // Calls body(begin, end) on contiguous chunks covering [0, n), one chunk per thread (at most
 // min(thread_count(), max_threads) threads; fewer when n is small). Chunk c is
-// [n*c/T, n*(c+1)/T). The calling thread runs chunk 0. An exception thrown by any chunk is
-// rethrown here after all chunks finished (the first one by chunk index).
+// [n*c/T, n*(c+1)/T). The calling thread runs chunks too (which ones is not fixed). An exception
+// thrown by any chunk is rethrown here after all chunks finished (the first one by chunk index).
 void parallel_for(std::size_t n, const std::function<void(std::size_t begin, std::size_t end)>& body,
                   int max_threads = 1 << 30);
 
