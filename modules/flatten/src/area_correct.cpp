@@ -260,7 +260,8 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
 }
 
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
-// (optional): where its wall time went.
+// (optional): where its wall time went. A whole band (not `local`) asks `enough` beside its next
+// step's solve (proxy_descent.h).
 void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
               const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
               AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
@@ -276,7 +277,7 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   StepTimes* step_times = times ? &times->steps : nullptr;
   const DescentResult d =
-      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times);
+      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times, !local);
   if (times) {
     times->build_s = build_s, times->longest_s = build_s + clock.lap();
     times->longest_faces = nfaces, times->longest_steps = d.steps;

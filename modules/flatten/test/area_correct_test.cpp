@@ -16,6 +16,7 @@
 
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/synthetic.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/flatten_stage.h"
 #include "colonflat/testing/stage_command.h"
@@ -121,6 +122,36 @@ TEST(AreaCorrection, WholeBandPassEndsWhenItsCallerSaysTheBoundsAreMet) {
   EXPECT_STREQ(one.stop, "bounds met");
   for (const SqueezedGrid* g : {&free_run, &stopped})
     for (std::size_t f = 0; f < g->s.t.size(); ++f) EXPECT_GT(g->emb.area2(g->s, int(f)), 0.0) << f;
+}
+
+// The whole-band pass asks its stop check beside the next step's solve (2 threads) or after the
+// step (1 thread): either way the check sees each step's positions as taken, a check that says
+// stop ends the pass on the positions it saw (the step computed beside it is dropped), and every
+// position the check saw and the final map are the same bits for 1 and 2 threads.
+TEST(AreaCorrection, WholeBandStopCheckBesideTheNextSolveSeesTheSameSteps) {
+  FlattenOptions o;
+  std::vector<std::vector<flat_detail::V2>> seen[2];  // per thread count: the positions at each check
+  std::vector<flat_detail::V2> final_pos[2];
+  for (int threads : {1, 2}) {
+    set_thread_count(threads);
+    SqueezedGrid g(0.2, 4);  // 9 024 faces: more than one face block
+    auto& saw = seen[threads - 1];
+    const flat_detail::AreaCorrection r = flat_detail::correct_area(
+        g.s, g.vf, g.emb, g.fixed, g.degenerate, false, o, false, [&] {
+          saw.push_back(g.emb.pos);
+          return saw.size() >= 3;
+        });
+    EXPECT_EQ(r.iterations, 3) << threads;
+    EXPECT_STREQ(r.stop, "bounds met");
+    ASSERT_EQ(saw.size(), 3u);
+    EXPECT_NE(std::memcmp(saw[0].data(), saw[1].data(), saw[0].size() * sizeof(flat_detail::V2)), 0);
+    EXPECT_EQ(std::memcmp(saw.back().data(), g.emb.pos.data(), g.emb.pos.size() * sizeof(flat_detail::V2)), 0);
+    final_pos[threads - 1] = g.emb.pos;
+  }
+  set_thread_count(0);
+  for (std::size_t k = 0; k < 3; ++k)
+    EXPECT_EQ(std::memcmp(seen[0][k].data(), seen[1][k].data(), seen[0][k].size() * sizeof(flat_detail::V2)), 0) << k;
+  EXPECT_EQ(std::memcmp(final_pos[0].data(), final_pos[1].data(), final_pos[0].size() * sizeof(flat_detail::V2)), 0);
 }
 
 // The local pieces start in the order of their work bound (faces x steps allowed), the largest
