@@ -49,13 +49,19 @@ class CornerGather {
 // side by side (each writes only its own vertices; one allocation of the mesh's size per region
 // instead: 59 local pieces of the real CT colon band zeroed 1 GB).
 // `times` (optional): where the steps' wall time went (COLONFLAT_FLATTEN_DEBUG prints it).
-// `check_beside` (with `enough`): each step's `enough` runs on one thread while the next step's
-// gradient and solve run beside it (parallel_tasks; both only read emb.pos, which changes only when
-// a step is taken), and that next step is dropped when `enough` says stop. The same steps and bits
-// as asking it after the step (the next step's work is that of its own turn); the wall time of the
-// check is hidden behind the one-core solve when the solve is longer, and a check that stops costs
-// one solve's CPU (on one thread the check runs alone, as without it). Worth it where checks often say "go on" (the whole-band pass: 60 steps on the U,
-// each check ~0.03 s beside a ~0.06 s solve); `enough` must not write what the step reads.
+// `check_beside` (with `enough`): past the first kChecksAlone steps, each step's `enough` runs on
+// one thread while the next step's gradient and solve run beside it (parallel_tasks; both only
+// read emb.pos, which changes only when a step is taken), and that next step is dropped when
+// `enough` says stop. The same steps and bits as asking it after the step (the next step's work is
+// that of its own turn); the check's wall time is hidden behind the one-core solve when the solve
+// is longer, and a check that stops costs the dropped step's gradient and solve (CPU; wall where
+// they outlast the check). On one thread the check runs alone, as without it. For descents whose
+// checks mostly say "go on": the whole-band pass (60 steps on the U's colon bands, each check
+// ~0.03 s beside a ~0.08 s gradient and solve); `enough` must not write what the step reads.
+// The first kChecksAlone checks run after their step: a band that meets its bounds does so within
+// a few steps (the real CT colon band at its 3rd, the U's branches at their 1st-3rd), where a step
+// beside the stopping check is wasted (CT, load 7: +0.8 CPU s, +1.6 s wall for its pass).
+constexpr int kChecksAlone = 5;
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
                             const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
@@ -127,7 +133,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       break;
     }
     bool met = false;
-    if (enough && check_beside && res.steps + 1 < max_steps && thread_count() > 1) {
+    if (enough && check_beside && res.steps >= kChecksAlone && res.steps + 1 < max_steps && thread_count() > 1) {
       double check_s = 0;
       parallel_tasks({[&] {
                         const Stopwatch own;

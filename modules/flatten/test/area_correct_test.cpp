@@ -24,6 +24,7 @@
 #include "flatten_shapes.h"
 #include "squeezed_grid.h"
 #include "../src/flatten_internal.h"
+#include "../src/proxy_descent.h"
 
 namespace cf {
 namespace {
@@ -124,14 +125,19 @@ TEST(AreaCorrection, WholeBandPassEndsWhenItsCallerSaysTheBoundsAreMet) {
     for (std::size_t f = 0; f < g->s.t.size(); ++f) EXPECT_GT(g->emb.area2(g->s, int(f)), 0.0) << f;
 }
 
-// The whole-band pass asks its stop check beside the next step's solve (2 threads) or after the
-// step (1 thread): either way the check sees each step's positions as taken, a check that says
-// stop ends the pass on the positions it saw (the step computed beside it is dropped), and every
-// position the check saw and the final map are the same bits for 1 and 2 threads.
+// The whole-band pass asks its stop check beside the next step's solve (2 threads, past the first
+// kChecksAlone checks) or after the step (1 thread): either way the check sees each step's
+// positions as taken, a check that says stop ends the pass on the positions it saw (the step
+// computed beside it is dropped), and every position the check saw and the final map are the same
+// bits for 1 and 2 threads.
 TEST(AreaCorrection, WholeBandStopCheckBesideTheNextSolveSeesTheSameSteps) {
   FlattenOptions o;
-  std::vector<std::vector<flat_detail::V2>> seen[2];  // per thread count: the positions at each check
+  const std::size_t checks = flat_detail::kChecksAlone + 3;  // the last 3 beside the next step on 2 threads
+  std::vector<std::vector<flat_detail::V2>> seen[2];         // per thread count: the positions at each check
   std::vector<flat_detail::V2> final_pos[2];
+  const auto same = [](const std::vector<flat_detail::V2>& a, const std::vector<flat_detail::V2>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(flat_detail::V2)) == 0;
+  };
   for (int threads : {1, 2}) {
     set_thread_count(threads);
     SqueezedGrid g(0.2, 4);  // 9 024 faces: more than one face block
@@ -139,19 +145,18 @@ TEST(AreaCorrection, WholeBandStopCheckBesideTheNextSolveSeesTheSameSteps) {
     const flat_detail::AreaCorrection r = flat_detail::correct_area(
         g.s, g.vf, g.emb, g.fixed, g.degenerate, false, o, false, [&] {
           saw.push_back(g.emb.pos);
-          return saw.size() >= 3;
+          return saw.size() >= checks;
         });
-    EXPECT_EQ(r.iterations, 3) << threads;
+    EXPECT_EQ(r.iterations, int(checks)) << threads;
     EXPECT_STREQ(r.stop, "bounds met");
-    ASSERT_EQ(saw.size(), 3u);
-    EXPECT_NE(std::memcmp(saw[0].data(), saw[1].data(), saw[0].size() * sizeof(flat_detail::V2)), 0);
-    EXPECT_EQ(std::memcmp(saw.back().data(), g.emb.pos.data(), g.emb.pos.size() * sizeof(flat_detail::V2)), 0);
+    ASSERT_EQ(saw.size(), checks);
+    for (std::size_t k = 1; k < checks; ++k) EXPECT_FALSE(same(saw[k - 1], saw[k])) << k;  // every step moved
+    EXPECT_TRUE(same(saw.back(), g.emb.pos));
     final_pos[threads - 1] = g.emb.pos;
   }
   set_thread_count(0);
-  for (std::size_t k = 0; k < 3; ++k)
-    EXPECT_EQ(std::memcmp(seen[0][k].data(), seen[1][k].data(), seen[0][k].size() * sizeof(flat_detail::V2)), 0) << k;
-  EXPECT_EQ(std::memcmp(final_pos[0].data(), final_pos[1].data(), final_pos[0].size() * sizeof(flat_detail::V2)), 0);
+  for (std::size_t k = 0; k < checks; ++k) EXPECT_TRUE(same(seen[0][k], seen[1][k])) << k;
+  EXPECT_TRUE(same(final_pos[0], final_pos[1]));
 }
 
 // The local pieces start in the order of their work bound (faces x steps allowed), the largest
