@@ -48,7 +48,8 @@ class CornerGather {
 // `scratch` (optional): a vector of emb.pos's size for the trial positions, shared by regions that run
 // side by side (each writes only its own vertices; one allocation of the mesh's size per region
 // instead: 59 local pieces of the real CT colon band zeroed 1 GB).
-// `times` (optional): where the steps' wall time went (COLONFLAT_FLATTEN_DEBUG prints it).
+// `times` (optional): where the steps' wall time went (COLONFLAT_FLATTEN_DEBUG prints it; a check
+// beside the next step counts its own wall time, which overlaps that step's gradient and solve).
 // `check_beside` (with `enough`): past the first kChecksAlone steps, each step's `enough` runs on
 // one thread while the next step's gradient and solve run beside it (parallel_tasks; both only
 // read emb.pos, which changes only when a step is taken), and that next step is dropped when
