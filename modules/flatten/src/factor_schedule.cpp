@@ -250,16 +250,16 @@ double thread_wait_seconds() {
   return got == 2 ? 1e-9 * double(wait) : 0.0;
 }
 
-void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
+void print_factor_debug(int parts, int threads, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
                         double rest_cpu, double seconds, bool early, const FactorWall& wall, const RestWork& rest) {
   double largest = 0, longest = 0;
   for (const RowSchedule& phase : phases) largest += phase.largest_part / phases.front().total_work;
   for (std::size_t i = std::size_t(parts); i < cpu.size(); ++i) longest += cpu[i];
-  std::fprintf(stderr, "flatten debug factorisation on %d threads: %zu unknowns, %zu phases%s, largest parts %.3f, rest %.3f "
-               "of the estimated work; CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s (wall: transpose "
+  std::fprintf(stderr, "flatten debug factorisation in %d parts on %d threads: %zu unknowns, %zu phases%s, largest parts %.3f, rest %.3f "
+               "of the estimated work (%.3g); CPU s: parts %.2f / %.2f (longest per phase %.2f), rest %.2f; %.2f s (wall: transpose "
                "%.2f, numeric L %.2f, parts %.2f, rest %.2f, free %.2f; parts waited for a core %.2f / %.2f s); the rest's work: %.3f of "
-               "the estimated work from the parts' columns, %.3f its own\n", parts, n, phases.size(),
-               early ? " (scheduled beside the analysis)" : "", largest, phases.back().rest_work / phases.front().total_work,
+               "the estimated work from the parts' columns, %.3f its own\n", parts, threads, n, phases.size(),
+               early ? " (scheduled beside the analysis)" : "", largest, phases.back().rest_work / phases.front().total_work, phases.back().rest_work,
                cpu.size() > 0 ? cpu[0] : 0.0, cpu.size() > 1 ? cpu[1] : 0.0, longest, rest_cpu, seconds, wall.transpose,
                wall.numeric, wall.parts, wall.rest, wall.free,
                wall.wait.size() > 0 ? wall.wait[0] : 0.0, wall.wait.size() > 1 ? wall.wait[1] : 0.0,

@@ -80,7 +80,7 @@ struct FactorWall {
 // COLONFLAT_FLATTEN_DEBUG: the schedule's estimate against the CPU seconds measured (`cpu`: per part
 // summed over the phases, then each phase's longest; `early`: the schedule was computed beside the
 // symbolic analysis), the wall of each stretch and the last rest's work split (`rest`: split_rest_work).
-void print_factor_debug(int parts, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
+void print_factor_debug(int parts, int threads, std::size_t n, const std::vector<RowSchedule>& phases, const std::vector<double>& cpu,
                         double rest_cpu, double seconds, bool early, const FactorWall& wall, const RestWork& rest);
 
 }  // namespace cf::flat_detail

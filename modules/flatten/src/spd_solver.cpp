@@ -175,7 +175,7 @@ void SpdSolver::release_early() {
 
 void SpdSolver::release() {
   release_early();
-  early_schedule_ = early_transpose_ = false;
+  early_schedule_ = early_transpose_ = rest_blocks_ = false;
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (started_) cholmod_finish(&common_);
   started_ = false;
@@ -214,11 +214,10 @@ void SpdSolver::analyze_for(const SpMat& A, const std::vector<int>* order, bool 
     };
     // The threaded factorisation's row schedule reads only the pattern of A in this order: computed
     // on a second thread beside CHOLMOD's analysis instead of after it, in factorize().
-    const int parts = thread_count();
-    if (parts > 1 && std::size_t(A.rows()) >= kThreadedFactorMinRows)
+    if (thread_count() > 1 && std::size_t(A.rows()) >= kThreadedFactorMinRows)
       parallel_tasks({symbolic, [&] {
                         const Stopwatch sw;
-                        EarlyRows early = early_rows(&view, *order, parts, numeric_transpose, side_.c);
+                        EarlyRows early = early_rows(&view, *order, kFactorParts, numeric_transpose, side_.c);
                         schedule_ = std::move(early.schedule);
                         early_upper_ = early.upper;
                         seconds[1] = sw.seconds();
@@ -243,6 +242,7 @@ bool SpdSolver::factorize(const SpMat& A) {
     release_early();  // made for this factorisation only
     early_schedule_ = use.early_schedule;
     early_transpose_ = use.early_transpose;
+    rest_blocks_ = use.rest_blocks;
     threaded_transposes_ += use.transposes;
     if (threaded < 0) cholmod_factorize(&view, factor_, &common_);
     cholmod_ok_ = threaded != 0 && common_.status >= CHOLMOD_OK && factor_->minor == factor_->n;

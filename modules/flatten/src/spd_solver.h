@@ -15,9 +15,10 @@
 // with no more fill than the original (docs/flatten.md, "Speed").
 //
 // Threads: from 20 000 unknowns on, the numeric factorisation computes its rows on the worker
-// threads (threaded_factor.h, factor_schedule.h: parts of whole elimination subtrees side by side,
-// the rows above them split again in phases, then the last rows); the factor is bit for bit the
-// sequential one, so nothing depends on the thread count.
+// threads (threaded_factor.h, factor_schedule.h: two parts of whole elimination subtrees side by
+// side, the rows above them split again in phases, then the last rows, in blocks shared by the
+// threads when they are many, rest_blocks.h); the factor is the same bits for every thread count
+// (bit for bit cholmod_factorize's when the last rows are not in blocks), so nothing depends on it.
 //
 // Leading block: with a given order, the factor of P A P^T = L D L^T holds the factor of the
 // leading k x k block A_II (I: the first k unknowns of the order) as its top-left corner, so
@@ -125,6 +126,8 @@ class SpdSolver {
   // (compute() with a given order on threads), and how many numeric transposes this solver's
   // threaded factorisations have made themselves (not counting those made beside an analysis).
   bool early_transpose() const { return early_transpose_; }
+  // Whether the last factorize() computed the rows above the threaded parts in blocks (rest_blocks.h).
+  bool rest_blocks() const { return rest_blocks_; }
   int threaded_transposes() const { return threaded_transposes_; }
 
  private:
@@ -135,7 +138,7 @@ class SpdSolver {
   bool fall_back(const SpMat& A);
   std::vector<int> given_order_;
   std::vector<RowSchedule> schedule_;  // from analyze(), for the next factorize() (empty: none)
-  bool early_schedule_ = false, early_transpose_ = false;
+  bool early_schedule_ = false, early_transpose_ = false, rest_blocks_ = false;
   int threaded_transposes_ = 0;
   mutable std::atomic<int> solve_calls_{0};  // solve()'s CHOLMOD calls (solve() may run on two threads at once)
 #ifdef COLONFLAT_HAVE_CHOLMOD

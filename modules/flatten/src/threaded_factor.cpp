@@ -10,6 +10,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "factor_memory.h"
+#include "rest_blocks.h"
 
 namespace cf::flat_detail {
 
@@ -87,6 +88,32 @@ bool factor_parts(cholmod_sparse* upper, const RowSchedule& phase, cholmod_facto
   return std::count(ok.begin(), ok.end(), 1) == std::ptrdiff_t(ok.size());
 }
 
+// Whether the last phase's rest is computed in blocks (threaded_factor.h: kRestBlocksMinRows,
+// kRestBlocksMinWork; the schedule is of kFactorParts parts whatever the thread count).
+bool rest_in_blocks(const RowSchedule& last) {
+  return last.rest.size() >= kRestBlocksMinRows && last.rest_work >= kRestBlocksMinWork;
+}
+
+// The rows above the last phase's parts: in blocks (`blocks`) or by cholmod_rowfac on the calling
+// thread; `rest_cpu`: the calling thread's CPU seconds, `wall` (blocks): the blocks' stretches.
+bool factor_rest(cholmod_sparse* upper, const std::vector<int>& rest, bool blocks, cholmod_factor* L,
+                 cholmod_common& common, double& rest_cpu, RestBlockWall& wall) {
+  if (!blocks) return rowfac_rows(upper, rest, L, common, &rest_cpu) && L->minor == L->n;
+  const double start = thread_cpu_seconds();
+  const int n = int(upper->ncol);
+  const std::vector<int> parent = elimination_tree(n, static_cast<const int*>(upper->p), static_cast<const int*>(upper->i));
+  const bool ok = factor_rest_in_blocks(upper, parent, rest, L, &wall);
+  rest_cpu = thread_cpu_seconds() - start;
+  return ok;
+}
+
+// COLONFLAT_FLATTEN_DEBUG: the rest's blocks.
+void print_blocks_debug(const RestBlockWall& w) {
+  std::fprintf(stderr, "flatten debug factor rest in blocks: %zu rows, %zu entries in the parts' columns; wall s: row "
+               "solves %.2f, copy %.2f, Schur complement %.2f, dense root %.2f\n", w.rows, w.entries_from_parts,
+               w.solves, w.copy, w.schur, w.root);
+}
+
 }  // namespace
 
 EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int parts, bool numeric,
@@ -102,15 +129,16 @@ EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int p
 }
 
 // cholmod_factorize of a simplicial LDL^T, as CHOLMOD does it (upper = triu(A(p,p)) by
-// cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over all
-// rows), with the rows split over the worker threads (factor_schedule.h): in each phase, parts of
-// whole subtrees side by side, then the rows above the last phase's. Row k reads only the columns
-// of its subtree and each column gets its entries in increasing row order, so the factor is bit
-// for bit cholmod_factorize's for any thread count (see threaded_factor.h).
+// cholmod_ptranspose, L made numeric with exactly its column counts, cholmod_rowfac over the rows),
+// with the rows split over the worker threads (factor_schedule.h): in each phase, parts of whole
+// subtrees side by side, then the rows above the last phase's, in blocks when large enough
+// (rest_blocks.h). Row k reads only the columns of its subtree and each column gets its entries in
+// increasing row order, so outside the blocks the factor is bit for bit cholmod_factorize's for any
+// thread count; the blocks' bits do not depend on it either (see threaded_factor.h).
 int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_common& common, EarlyRows ready,
                          ThreadedUse& use) {
-  const int parts = thread_count();
-  if (parts < 2 || L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
+  if (L->n < kThreadedFactorMinRows || L->is_super || L->xtype != CHOLMOD_PATTERN) return -1;
+  const int threads = thread_count();  // (one thread: the parts one after the other)
   const Stopwatch sw;
   Stopwatch lap;
   FactorWall wall;
@@ -122,26 +150,28 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   use.early_transpose = ready.upper != nullptr;
   use.transposes = made ? 1 : 0;
   bool& early = use.early_schedule;
-  early = ready.schedule.size() > 0 && ready.schedule.front().parts.size() == std::size_t(parts);
-  std::vector<RowSchedule> phases = early ? std::move(ready.schedule) : factor_schedule(upper, parts);
+  early = ready.schedule.size() > 0 && ready.schedule.front().parts.size() == std::size_t(kFactorParts);
+  std::vector<RowSchedule> phases = early ? std::move(ready.schedule) : factor_schedule(upper, kFactorParts);
   wall.transpose = lap.lap();
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
   if (common.final_pack) common.grow2 = 0;  // exactly the space required, as cholmod_factorize asks
   bool ok = cholmod_change_factor(CHOLMOD_REAL, L->is_ll, 0, 0, 1, L, &common);
   common.grow2 = grow2;
+  use.rest_blocks = rest_in_blocks(phases.back()) && !L->is_ll;
   if (ok && !columns_have_room(L)) {  // (not expected) every row here, in order
-    early = false;
+    early = use.rest_blocks = false;
     phases.assign(1, RowSchedule{});
     phases[0].rest.resize(L->n);
     for (std::size_t k = 0; k < L->n; ++k) phases[0].rest[k] = int(k);
   }
   wall.numeric = lap.lap();
-  std::vector<double> cpu(std::size_t(parts), 0.0);  // per part (summed over phases), then each phase's longest
+  std::vector<double> cpu(std::size_t(kFactorParts), 0.0);  // per part (summed over phases), then each phase's longest
   for (const RowSchedule& phase : phases) ok = ok && factor_parts(upper, phase, L, cpu, wall.wait);
   wall.parts = lap.lap();
   double rest_cpu = 0;
-  ok = ok && rowfac_rows(upper, phases.back().rest, L, common, &rest_cpu) && L->minor == L->n;
+  RestBlockWall blocks;
+  ok = ok && factor_rest(upper, phases.back().rest, use.rest_blocks, L, common, rest_cpu, blocks);
   wall.rest = lap.lap();
   const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
   const RestWork rest_split = debug ? debug_rest_work(upper, phases.back().rest) : RestWork{};  // (before `made` is freed)
@@ -149,7 +179,8 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   if (made) cholmod_free_sparse(&made, &common);
   wall.free = lap.lap();
   if (debug) {
-    print_factor_debug(parts, L->n, phases, cpu, rest_cpu, sw.seconds() - walk, early, wall, rest_split);
+    print_factor_debug(kFactorParts, threads, L->n, phases, cpu, rest_cpu, sw.seconds() - walk, early, wall, rest_split);
+    if (use.rest_blocks) print_blocks_debug(blocks);
     const BlockCache::Stats s = cholmod_block_cache().stats();
     std::fprintf(stderr, "flatten debug factor memory: large blocks so far %zu reused, %zu fresh; %zu kept now; numeric "
                  "transpose %s\n", s.reused, s.fresh, s.kept, use.early_transpose ? "made beside the analysis" : "made here");

@@ -561,9 +561,9 @@ TEST(FlattenSolver, RestWorkSplitsIntoTheUpdatesFromThePartsColumnsAndItsOwn) {
   EXPECT_DOUBLE_EQ(got.from_parts + got.own, s.rest_work);
 }
 
-// The factorisation with its rows on two threads (one phase) and on four (two phases: the top
-// separators in a second phase) is bit for bit CHOLMOD's sequential one (one thread): the same
-// solution to the last bit, and it solves the system.
+// The factorisation with its rows on two threads and on four (the same two parts: the schedule is of
+// kFactorParts parts for any thread count) is bit for bit the one-thread one (the parts one after
+// the other): the same solution to the last bit, and it solves the system.
 TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
   const NestedGrid g = nested_grid();
   const int n = int(g.A.rows());
@@ -583,8 +583,8 @@ TEST(FlattenSolver, FactorisationOnTwoThreadsIsBitwiseTheSequentialOne) {
 }
 
 // A factorisation in a given order on two threads splits its rows by the schedule computed beside
-// its symbolic analysis (analyze() runs both at once), and its solution is the sequential one (one
-// thread: no schedule) to the last bit; without a given order (AMD, known only after the analysis)
+// its symbolic analysis (analyze() runs both at once), and its solution is the one-thread one (its
+// schedule computed after the analysis) to the last bit; without a given order (AMD, known only after the analysis)
 // the schedule is computed afterwards, as before.
 TEST(FlattenSolver, RowScheduleComputedBesideTheAnalysisGivesTheSequentialFactor) {
   const NestedGrid g = nested_grid();
@@ -612,9 +612,9 @@ TEST(FlattenSolver, RowScheduleComputedBesideTheAnalysisGivesTheSequentialFactor
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
 // compute() with a given order on two threads factorises from the numeric transpose made beside the
-// analysis (counted: no transpose of its own) and its factor is the sequential one's (one thread,
-// cholmod_factorize) to the last bit; analyze() then factorize() of other values (2 A) makes its own
-// transpose (the early one could hold A's values) and solves 2 A.
+// analysis (counted: no transpose of its own) and its factor is the one-thread one's (here, with the
+// rest too small for blocks, cholmod_factorize's bits) to the last bit; analyze() then factorize()
+// of other values (2 A) makes its own transpose (the early one could hold A's values) and solves 2 A.
 TEST(FlattenSolver, TransposeMadeBesideTheAnalysisGivesTheSequentialFactorBits) {
   const NestedGrid g = nested_grid();
   cf::set_thread_count(1);
@@ -625,6 +625,7 @@ TEST(FlattenSolver, TransposeMadeBesideTheAnalysisGivesTheSequentialFactorBits) 
   ASSERT_TRUE(par.compute(g.A, &g.order));
   EXPECT_TRUE(par.early_transpose());
   EXPECT_EQ(par.threaded_transposes(), 0);
+  EXPECT_FALSE(seq.rest_blocks() || par.rest_blocks());  // (the grid's rest: below kRestBlocksMinWork)
   const cholmod_factor *a = seq.factor(), *b = par.factor();
   ASSERT_TRUE(a && b && a->n == b->n && !a->is_super && !b->is_super);
   const int *ap = static_cast<const int*>(a->p), *bp = static_cast<const int*>(b->p);
@@ -723,3 +724,83 @@ TEST(FlattenSolver, ColumnsAreSolvedThreeToACallWithTheOneColumnBits) {
     EXPECT_EQ(s.solve_calls(), 7);
   }
 }
+
+#ifdef COLONFLAT_HAVE_CHOLMOD
+namespace {
+
+// A tube of 300 x 300 vertices (90 000 unknowns), its grid Laplacian and nested dissection's order:
+// the rows above the factorisation's two parts are a ring across the tube (1.4e8 of estimated work,
+// above kRestBlocksMinWork): the rest is computed in blocks.
+NestedGrid nested_tube() {
+  const int na = 300, nz = 300, nv = na * nz;
+  const auto E = cf::flat_detail::build_edges(tube_faces(na, nz));
+  NestedGrid g{whole_grid_system(E, na, nv), {}};
+  g.order = SpdSolver::nested_dissection_order(g.A);
+  return g;
+}
+
+// The largest |difference| of two simplicial factors' values, or -1 when their patterns differ;
+// `bitwise`: whether every column's row indices and values are the same bytes.
+double factor_difference(const cholmod_factor* a, const cholmod_factor* b, bool& bitwise) {
+  bitwise = a->n == b->n;
+  if (!bitwise) return -1;
+  const int *ap = static_cast<const int*>(a->p), *bp = static_cast<const int*>(b->p);
+  const int *anz = static_cast<const int*>(a->nz), *bnz = static_cast<const int*>(b->nz);
+  const double *ax = static_cast<const double*>(a->x), *bx = static_cast<const double*>(b->x);
+  double most = 0;
+  for (std::size_t j = 0; j < a->n; ++j) {
+    const std::size_t m = std::size_t(anz[j]);
+    if (anz[j] != bnz[j] || std::memcmp(static_cast<const int*>(a->i) + ap[j], static_cast<const int*>(b->i) + bp[j], sizeof(int) * m))
+      return bitwise = false, -1.0;
+    bitwise = bitwise && std::memcmp(ax + ap[j], bx + bp[j], sizeof(double) * m) == 0;
+    for (std::size_t t = 0; t < m; ++t) most = std::max(most, std::abs(ax[ap[j] + t] - bx[bp[j] + t]));
+  }
+  return most;
+}
+
+}  // namespace
+
+// On the tube the rows above the two parts are computed in blocks (row solves, Schur complement,
+// dense root), and the factor is the same bytes on 1, 2 and 4 threads; it solves the system.
+TEST(FlattenSolver, RestInBlocksGivesTheSameFactorBitsOnOneTwoAndFourThreads) {
+  const NestedGrid g = nested_tube();
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(g.A.rows(), -1.0, 2.0);
+  SpdSolver solver[3];
+  for (int t = 0; t < 3; ++t) {
+    cf::set_thread_count(1 << t);
+    ASSERT_TRUE(solver[t].compute(g.A, &g.order));
+    EXPECT_TRUE(solver[t].rest_blocks()) << (1 << t) << " threads";
+  }
+  cf::set_thread_count(0);
+  for (int t : {1, 2}) {
+    bool bitwise = false;
+    EXPECT_EQ(factor_difference(solver[0].factor(), solver[t].factor(), bitwise), 0.0);
+    EXPECT_TRUE(bitwise) << (1 << t) << " threads";
+  }
+  const SpdSolver::SpMat full = g.A.selfadjointView<Eigen::Lower>();
+  EXPECT_LT((full * solver[1].solve(b) - b).norm(), 1e-9 * b.norm());
+}
+
+// The factor with the rest in blocks has the pattern of CHOLMOD's own factorisation (cholmod_factorize
+// in the same order) and its entries to rounding (the rest's partial sums differ).
+TEST(FlattenSolver, RestInBlocksIsCholmodsFactorToRounding) {
+  const NestedGrid g = nested_tube();
+  cf::set_thread_count(2);
+  SpdSolver solver;
+  ASSERT_TRUE(solver.compute(g.A, &g.order));
+  cf::set_thread_count(0);
+  ASSERT_TRUE(solver.rest_blocks());
+  cholmod_common c;
+  cholmod_start(&c);
+  c.supernodal = CHOLMOD_SIMPLICIAL, c.final_asis = 1, c.nmethods = 1, c.method[0].ordering = CHOLMOD_GIVEN, c.postorder = 0;
+  cholmod_sparse view = cf::flat_detail::view_lower(g.A);
+  cholmod_factor* ref = cholmod_analyze_p(&view, const_cast<int*>(g.order.data()), nullptr, 0, &c);
+  ASSERT_TRUE(ref && cholmod_factorize(&view, ref, &c));
+  bool bitwise = true;
+  const double diff = factor_difference(ref, solver.factor(), bitwise);
+  cholmod_free_factor(&ref, &c);
+  cholmod_finish(&c);
+  EXPECT_GE(diff, 0.0);  // the same pattern
+  EXPECT_LT(diff, 1e-10);
+}
+#endif
