@@ -62,30 +62,6 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
                step, crowded, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
 }
 
-namespace {
-thread_local bool clock_thread = false;
-}
-
-void debug_clock_start() {
-  clock_thread = true;
-  debug_clock("segment start");
-}
-
-void debug_clock(const char* what) {
-  if (!clock_thread || !std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
-  static std::mutex m;
-  static const Stopwatch since_start;
-  static const double cpu_start = process_cpu_seconds();
-  static double last_wall = 0, last_cpu = 0;
-  const std::lock_guard<std::mutex> lock(m);
-  const double wall = since_start.seconds(), cpu = process_cpu_seconds() - cpu_start;
-  const double dw = wall - last_wall, dc = cpu - last_cpu;
-  std::fprintf(stderr, "flatten debug clock %s: wall %.2f s (+%.2f), process CPU %.2f s (+%.2f), cores busy %.2f, "
-               "idle core-s %.2f of %d\n", what, wall, dw, cpu, dc, dw > 0 ? dc / dw : 0.0,
-               std::max(0.0, thread_count() * dw - dc), thread_count());
-  last_wall = wall, last_cpu = cpu;
-}
-
 // COLONFLAT_FLATTEN_DEBUG=1: the faces shown below 0.1 (at the band's area scale) by decade of
 // their area ratio, and their largest vertex-connected pockets (faces, mm2, smallest ratio, LPS,
 // the band x they span, how many of their vertices are fixed: an end loop or a cut branch's rim).

@@ -364,7 +364,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   auto phase = [depth](const char* what) {  // progress lines for the colon segments, not their branches
     if (depth == 0) phase_done(what), debug_clock(what);
   };
-  if (depth == 0) debug_clock_start();
+  const DebugClockScope clock_scope(depth == 0);
   Edges edges;
   auto loops = open_annulus(s, nloops, o, c, w, edges);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);

@@ -21,6 +21,7 @@
 #include "colonflat/core/orientation.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/flatten/flatten.h"
+#include "debug_clock.h"
 #include "segment_order.h"
 
 namespace cf::flat_detail {
@@ -389,13 +390,6 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
                         const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
 // COLONFLAT_FLATTEN_DEBUG=1: distortion after each step on stderr.
 void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>& degenerate);
-// COLONFLAT_FLATTEN_DEBUG=1: a timeline line on stderr: wall and process CPU seconds (all threads,
-// getrusage) since the first call, and since the previous call (`what`: the stretch just ended),
-// with the cores that stretch kept busy on average (CPU / wall) and the core-seconds left idle of
-// thread_count() cores. Only on a thread that called debug_clock_start() (a colon segment's, not its
-// side branches' on their side thread). Thread-safe; no effect without the variable.
-void debug_clock(const char* what);
-void debug_clock_start();
 
 // Per-face distortion of a map triangle.
 struct FaceDistortion {
