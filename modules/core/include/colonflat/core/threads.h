@@ -29,22 +29,14 @@ int default_thread_count();
 
 // Calls body(begin, end) on contiguous chunks covering [0, n), one chunk per thread (at most
 // min(thread_count(), max_threads) threads; fewer when n is small). Chunk c is
-// [n*c/T, n*(c+1)/T). The calling thread runs chunks too (which ones is not fixed). An exception
-// thrown by any chunk is rethrown here after all chunks finished (the first one by chunk index).
+// [n*c/T, n*(c+1)/T). The calling thread runs chunk 0. An exception thrown by any chunk is
+// rethrown here after all chunks finished (the first one by chunk index).
 void parallel_for(std::size_t n, const std::function<void(std::size_t begin, std::size_t end)>& body,
                   int max_threads = 1 << 30);
 
 // Runs every task, on up to thread_count() threads (tasks are taken in index order; the caller
 // runs some of them). Exceptions as in parallel_for (the first by task index).
 void parallel_tasks(const std::vector<std::function<void()>>& tasks);
-
-// Both run on the calling thread and on worker threads kept in one process-wide pool: started when
-// a call wants more workers than are idle, never ended (they sleep between calls). Every call gets
-// its threads - 1 workers at once, as if it had started them, whatever else runs: a task may call
-// parallel_for / parallel_tasks itself (nested calls), and two threads may call at once.
-// worker_threads_started(): the workers the pool started so far (they are reused: on the real CT's
-// flatten a handful, where starting threads per call started ~3 400).
-std::size_t worker_threads_started();
 
 // User + system CPU seconds of this process so far, all threads (getrusage). CPU over wall time
 // of a stretch of work is the number of cores it kept busy (stage reports record both).
