@@ -62,6 +62,13 @@ void debug_stats(const char* step, const SegmentWork& w, const std::vector<char>
                step, crowded, st.flipped, st.qc_mean, st.qc_p95, st.qc_max, st.area_p05, st.area_median, st.area_p95);
 }
 
+double band_area_scale(const SegmentWork& w, const std::vector<char>* degenerate) {
+  double a2 = 0, a3 = 0;
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f)
+    if (!degenerate || !(*degenerate)[f]) a2 += std::max(w.emb.area2(w.ann, int(f)), 0.0), a3 += face_area_3d(w.ann, int(f));
+  return a2 > 0 ? a3 / a2 : 1.0;
+}
+
 // COLONFLAT_FLATTEN_DEBUG=1: the faces shown below 0.1 (at the band's area scale) by decade of
 // their area ratio, and their largest vertex-connected pockets (faces, mm2, smallest ratio, LPS,
 // the band x they span, how many of their vertices are fixed: an end loop or a cut branch's rim).
@@ -69,11 +76,8 @@ void debug_pockets(const char* step, const SegmentWork& w, const std::vector<cha
                    const std::vector<char>& fixed) {
   if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
   const Surface& s = w.ann;
-  double a2 = 0, a3 = 0;
   std::vector<double> ratio(s.t.size(), 1.0);
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f]) a2 += std::max(w.emb.area2(s, int(f)), 0.0), a3 += face_area_3d(s, int(f));
-  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  const double scale = band_area_scale(w, &degenerate);
   UnionFind sets(s.p.size());
   std::array<double, 9> decade_area{};
   std::array<std::size_t, 9> decade_faces{};

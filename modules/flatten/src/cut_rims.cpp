@@ -126,9 +126,7 @@ std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims
 // nothing gained, 77 k / 13 k vertices corrected twice.
 std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, const FlattenOptions& o) {
   const double min_ratio = o.coverage_min_ratio;
-  double a2 = 0, a3 = 0;  // the band's area scale
-  for (std::size_t f = 0; f < w.ann.t.size(); ++f) a2 += std::max(w.emb.area2(w.ann, int(f)), 0.0), a3 += face_area_3d(w.ann, int(f));
-  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  const double scale = band_area_scale(w, nullptr);  // every face, degenerate ones too
   const auto seg = rim_segments(w, rims);
   std::vector<char> freed(rims.loops.size(), 0);
   for (std::size_t r = 0; r < rims.loops.size(); ++r) {

@@ -467,6 +467,10 @@ struct SegmentWork {
   }
 };
 
+// 3D / map area of the band w.ann in w.emb (each face's map area counted when positive; the faces
+// marked in `degenerate` left out, every face when it is null): the scale at which an area ratio
+// of 1 preserves area. 1 for an empty map.
+double band_area_scale(const SegmentWork& w, const std::vector<char>* degenerate);
 // Per face of the segment's annulus: the distortion of its current embedding, `degenerate` carried.
 // `frames` (optional): face_frame() of every face of the annulus (the same numbers, without the 3D half).
 std::vector<FaceDistortion> band_distortion(const SegmentWork& w, const std::vector<char>& degenerate,
