@@ -20,6 +20,14 @@ struct RowSchedule {
   double largest_part = 0, rest_work = 0, total_work = 0;
 };
 
+// What a threaded factorisation follows: the row schedule's phases and the elimination tree they
+// were made from (the rest's blocks walk the tree again: rest_blocks.h).
+struct FactorPlan {
+  std::vector<RowSchedule> phases;  // schedule_phases() (empty: none)
+  std::vector<int> parent;          // elimination_tree() of triu(A(p,p)), n entries
+  void clear() { phases.clear(), parent.clear(); }
+};
+
 // Elimination tree of a symmetric matrix given by its upper triangle in compressed columns (column
 // k: rows <= k, colptr[n + 1], rowind[colptr[n]]): parent[k] > k, or -1 for a root (Liu's algorithm
 // with path compression).

@@ -218,7 +218,7 @@ void SpdSolver::analyze_for(const SpMat& A, const std::vector<int>* order, bool 
       parallel_tasks({symbolic, [&] {
                         const Stopwatch sw;
                         EarlyRows early = early_rows(&view, *order, kFactorParts, numeric_transpose, side_.c);
-                        schedule_ = std::move(early.schedule);
+                        schedule_ = std::move(early.plan);
                         early_upper_ = early.upper;
                         seconds[1] = sw.seconds();
                       }});

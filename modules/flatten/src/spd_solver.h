@@ -137,7 +137,7 @@ class SpdSolver {
   void analyze_for(const SpMat& A, const std::vector<int>* order, bool numeric_transpose);
   bool fall_back(const SpMat& A);
   std::vector<int> given_order_;
-  std::vector<RowSchedule> schedule_;  // from analyze(), for the next factorize() (empty: none)
+  FactorPlan schedule_;  // from analyze(), for the next factorize() (empty phases: none)
   bool early_schedule_ = false, early_transpose_ = false, rest_blocks_ = false;
   int threaded_transposes_ = 0;
   mutable std::atomic<int> solve_calls_{0};  // solve()'s CHOLMOD calls (solve() may run on two threads at once)

@@ -49,21 +49,21 @@ bool rowfac_rows(cholmod_sparse* upper, const std::vector<int>& rows, cholmod_fa
 // each row's work estimated as the up-looking kernel's cost of it (row_work): counted at the row
 // that does it, so the rows above the parts (few, but each updating with long columns) weigh what
 // they cost.
-std::vector<RowSchedule> factor_schedule(cholmod_sparse* upper, int parts) {
+FactorPlan factor_schedule(cholmod_sparse* upper, int parts) {
   const int n = int(upper->ncol);
   const int* colptr = static_cast<const int*>(upper->p);
   const int* rowind = static_cast<const int*>(upper->i);
-  const std::vector<int> parent = elimination_tree(n, colptr, rowind);
-  return schedule_phases(parent, row_work(n, colptr, rowind, parent), parts);
+  FactorPlan plan;
+  plan.parent = elimination_tree(n, colptr, rowind);
+  plan.phases = schedule_phases(plan.parent, row_work(n, colptr, rowind, plan.parent), parts);
+  return plan;
 }
 
 // COLONFLAT_FLATTEN_DEBUG: the last rest's estimated work split by the columns its updates read
-// (split_rest_work, of `upper` = triu(A(p,p))).
-RestWork debug_rest_work(const cholmod_sparse* upper, const std::vector<int>& rest) {
+// (split_rest_work, of `upper` = triu(A(p,p)) with elimination tree `parent`).
+RestWork debug_rest_work(const cholmod_sparse* upper, const std::vector<int>& parent, const std::vector<int>& rest) {
   const int n = int(upper->ncol);
-  const int* colptr = static_cast<const int*>(upper->p);
-  const int* rowind = static_cast<const int*>(upper->i);
-  return split_rest_work(n, colptr, rowind, elimination_tree(n, colptr, rowind), rest);
+  return split_rest_work(n, static_cast<const int*>(upper->p), static_cast<const int*>(upper->i), parent, rest);
 }
 
 // One phase's parts side by side, each with its own cholmod_common; cpu[p] += part p's CPU seconds,
@@ -94,15 +94,14 @@ bool rest_in_blocks(const RowSchedule& last) {
   return last.rest.size() >= kRestBlocksMinRows && last.rest_work >= kRestBlocksMinWork;
 }
 
-// The rows above the last phase's parts: in blocks (`blocks`) or by cholmod_rowfac on the calling
-// thread; `rest_cpu`: the calling thread's CPU seconds, `wall` (blocks): the blocks' stretches.
-bool factor_rest(cholmod_sparse* upper, const std::vector<int>& rest, bool blocks, cholmod_factor* L,
-                 cholmod_common& common, double& rest_cpu, RestBlockWall& wall) {
+// The rows above the last phase's parts of `plan`: in blocks (`blocks`) or by cholmod_rowfac on the
+// calling thread; `rest_cpu`: the calling thread's CPU seconds, `wall` (blocks): the blocks' stretches.
+bool factor_rest(cholmod_sparse* upper, const FactorPlan& plan, bool blocks, cholmod_factor* L, cholmod_common& common,
+                 double& rest_cpu, RestBlockWall& wall) {
+  const std::vector<int>& rest = plan.phases.back().rest;
   if (!blocks) return rowfac_rows(upper, rest, L, common, &rest_cpu) && L->minor == L->n;
   const double start = thread_cpu_seconds();
-  const int n = int(upper->ncol);
-  const std::vector<int> parent = elimination_tree(n, static_cast<const int*>(upper->p), static_cast<const int*>(upper->i));
-  const bool ok = factor_rest_in_blocks(upper, parent, rest, L, &wall);
+  const bool ok = factor_rest_in_blocks(upper, plan.parent, rest, L, &wall);
   rest_cpu = thread_cpu_seconds() - start;
   return ok;
 }
@@ -122,7 +121,7 @@ EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int p
   // values 2: as cholmod_factorize transposes (the conjugate; for real values the same copy)
   cholmod_sparse* upper = cholmod_ptranspose(lower, numeric ? 2 : 0, const_cast<int*>(order.data()), nullptr, 0, &common);
   if (!upper) return out;
-  out.schedule = factor_schedule(upper, parts);
+  out.plan = factor_schedule(upper, parts);
   if (numeric) out.upper = upper;
   else cholmod_free_sparse(&upper, &common);
   return out;
@@ -150,8 +149,9 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   use.early_transpose = ready.upper != nullptr;
   use.transposes = made ? 1 : 0;
   bool& early = use.early_schedule;
-  early = ready.schedule.size() > 0 && ready.schedule.front().parts.size() == std::size_t(kFactorParts);
-  std::vector<RowSchedule> phases = early ? std::move(ready.schedule) : factor_schedule(upper, kFactorParts);
+  early = ready.plan.phases.size() > 0 && ready.plan.phases.front().parts.size() == std::size_t(kFactorParts);
+  FactorPlan plan = early ? std::move(ready.plan) : factor_schedule(upper, kFactorParts);
+  std::vector<RowSchedule>& phases = plan.phases;
   wall.transpose = lap.lap();
   L->is_ll = common.final_ll ? 1 : 0;
   const std::size_t grow2 = common.grow2;
@@ -171,10 +171,10 @@ int factorize_on_threads(cholmod_sparse* lower, cholmod_factor* L, cholmod_commo
   wall.parts = lap.lap();
   double rest_cpu = 0;
   RestBlockWall blocks;
-  ok = ok && factor_rest(upper, phases.back().rest, use.rest_blocks, L, common, rest_cpu, blocks);
+  ok = ok && factor_rest(upper, plan, use.rest_blocks, L, common, rest_cpu, blocks);
   wall.rest = lap.lap();
   const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
-  const RestWork rest_split = debug ? debug_rest_work(upper, phases.back().rest) : RestWork{};  // (before `made` is freed)
+  const RestWork rest_split = debug ? debug_rest_work(upper, plan.parent, phases.back().rest) : RestWork{};  // (before `made` is freed)
   const double walk = lap.lap();  // (not part of the factorisation's time)
   if (made) cholmod_free_sparse(&made, &common);
   wall.free = lap.lap();

@@ -43,7 +43,7 @@ constexpr double kRestBlocksMinWork = 1.2e8;
 
 // What the analysis of a given order leaves for factorize_on_threads, computed beside it.
 struct EarlyRows {
-  std::vector<RowSchedule> schedule;  // for the parts it was made for (empty: none)
+  FactorPlan plan;                    // for the parts it was made for (empty phases: none)
   cholmod_sparse* upper = nullptr;    // numeric triu(A(p,p)) (not owned here; null: none)
 };
 
@@ -51,7 +51,7 @@ struct EarlyRows {
 // = A's lower triangle (stype -1) and p = `order` (a permutation of 0..n-1), for `parts` threads.
 // `numeric`: the transpose is made with A's values and returned in `upper` (allocated with
 // `common`, the caller frees it with the same one), else of the pattern only and freed here.
-// `common`: the calling thread's own. Empty schedule and null upper when the transpose fails.
+// `common`: the calling thread's own. Empty plan and null upper when the transpose fails.
 EarlyRows early_rows(cholmod_sparse* lower, const std::vector<int>& order, int parts, bool numeric,
                      cholmod_common& common);
 

@@ -54,7 +54,8 @@ TEST(AreaCorrection, StalkedPolypHeadIsShown) {
 
 // A pouch behind a 4 mm neck kept in the colon's band (branch cutting off): the conformal map
 // crushes thousands of its faces to zero area; the correction brings them back into the map
-// without a fold.
+// (the wall missing from it shrinks a hundredfold) without a fold. (The pouch stays compressed
+// below coverage_min_ratio behind its neck, so the shown fraction is about the same either way.)
 TEST(AreaCorrection, PouchLeftInTheBandIsOpened) {
   const TriangleList mesh = test_shapes::pouch_behind_neck(4.0);
   const FlatMap before = flatten_with(mesh, 0, 0);
@@ -62,7 +63,7 @@ TEST(AreaCorrection, PouchLeftInTheBandIsOpened) {
   ASSERT_EQ(after.segments.size(), 1u);
   EXPECT_GT(before.segments[0].crowded_faces, 1000u);
   EXPECT_LE(after.segments[0].crowded_faces * 100, before.segments[0].crowded_faces);
-  EXPECT_GE(after.coverage.fraction, before.coverage.fraction);
+  EXPECT_LE(after.coverage.missing_area_mm2 * 100, before.coverage.missing_area_mm2);
   EXPECT_EQ(after.stats.flipped, 0u);
 }
 
