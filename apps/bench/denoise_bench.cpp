@@ -10,6 +10,8 @@
 //           - the real mask ../shared/real/ctc_lumen_mask_a.nii.gz reconstructed raw: the binary
 //             staircase (--subvoxel off, no smoothing, no fairing): far more handles;
 //           - the same mask reconstructed with the defaults;
+//           - the same mask grown and shrunk by one voxel (mask_variants.h: thinner walls between
+//             touching loops fuse into more and longer handles; thin necks open), then the defaults;
 //           - the real prone CT ../shared/real/ctc_prone_a.nrrd, segmented and reconstructed with
 //             the defaults (as `colonflat run` does: reconstruct also gets the CT);
 //           - the real GCA large-intestine surfaces (../shared/real/*.vtk);
@@ -36,6 +38,7 @@
 
 #include "bench_cli.h"
 #include "bench_meshes.h"
+#include "mask_variants.h"
 #include "colonflat/core/mesh_io.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
@@ -135,6 +138,9 @@ void real_cases() {
       return reconstruct_surface(mask.GetPointer(), raw);
     });
     built("real mask", [&] { return reconstruct_surface(mask.GetPointer(), ReconstructOptions{}); });
+    for (int grow : {1, -1})
+      built(grow > 0 ? "real mask grown 1 vx" : "real mask shrunk 1 vx",
+            [&] { return reconstruct_surface(bench::grown_mask(mask.GetPointer(), grow).GetPointer(), ReconstructOptions{}); });
   }
   if (fs::exists(ct_file)) {
     built("real CT prone", [&] {

@@ -12,11 +12,14 @@
 //                            *.vtk / *.vtp surfaces: denoise; denoised surfaces cached in DIR2,
 //                            default /tmp/flatten_bench_cache), flattened with map M: faces,
 //                            coverage, area ratio p05/p95, qc mean/p95, flipped, time, peak memory;
-//                            DIR3 gets colon.png per case.
+//                            DIR3 gets colon.png per case. --raw-masks: each mask also as its raw
+//                            staircase; --grown-masks: each mask also grown and shrunk by one voxel
+//                            (mask_variants.h: the same anatomy with thinner / thicker walls).
 #include <benchmark/benchmark.h>
 
 #include "bench_cli.h"
 #include "bench_meshes.h"
+#include "mask_variants.h"
 #include "colonflat/core/orientation.h"
 
 #include <algorithm>
@@ -139,20 +142,29 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
 
 // The denoised surface of a real case, computed once and cached; `raw`: a lumen mask reconstructed
 // as its binary staircase (no sub-voxel surface, smoothing or fairing: far more handles).
-std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache, bool raw) {
+// A real case denoised (cached in `cache`): a surface as it is, a mask reconstructed first (`raw`:
+// as its binary staircase; `grow` != 0: the mask grown (> 0) or shrunk (< 0) by that many voxels).
+std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache, bool raw,
+                                    int grow = 0) {
   std::filesystem::create_directories(cache);
   std::string stem = in.filename().string();
-  stem = stem.substr(0, stem.find('.')) + (raw ? "_raw" : "");
+  stem = stem.substr(0, stem.find('.')) + (raw ? "_raw" : "") +
+         (grow > 0 ? "_grown" + std::to_string(grow) : grow < 0 ? "_shrunk" + std::to_string(-grow) : "");
   const auto den = cache / (stem + "_denoised.vtp");
   if (std::filesystem::exists(den)) return den;
+  std::filesystem::path source = in;
+  if (grow != 0) {
+    source = cache / (stem + "_mask.nii.gz");
+    cf::write_mask(cf::bench::grown_mask(cf::read_mask(in).GetPointer(), grow).GetPointer(), source);
+  }
   auto run = [](std::unique_ptr<cf::Stage> (*make)(), const std::vector<std::string>& args) {
     std::ostringstream o, e;
     if (cf::make_stage_tool(make)->run(args, o, e) != 0) throw std::runtime_error(e.str());
   };
-  std::filesystem::path surface = in;
+  std::filesystem::path surface = source;
   if (in.string().size() > 7 && in.string().substr(in.string().size() - 7) == ".nii.gz") {
     surface = cache / (stem + "_surface.vtp");
-    std::vector<std::string> args{in.string(), "-o", surface.string(), "-q"};
+    std::vector<std::string> args{source.string(), "-o", surface.string(), "-q"};
     if (raw)
       for (const char* a : {"--subvoxel", "off", "--smoothing-iterations", "0", "--fairing-iterations", "0"})
         args.push_back(a);
@@ -247,7 +259,7 @@ void stress_row(const std::string& name, const cf::Mesh& mesh, int threads, cons
 struct StressOptions {
   std::string real, cache, map, out;
   std::vector<std::string> surfaces;
-  bool generated = false, raw_masks = false;
+  bool generated = false, raw_masks = false, grown_masks = false;
   std::vector<int> thread_counts{1, 2};
 };
 
@@ -267,6 +279,10 @@ void stress_table(const StressOptions& so) {
         if (!raw || (mask && so.raw_masks))
           cases.push_back({in.filename().string() + (raw ? " raw" : ""),
                            [in, raw, &so] { return cf::load_mesh(denoised_real(in, so.cache, raw)).mesh; }});
+      for (int grow : {1, -1})
+        if (mask && so.grown_masks)
+          cases.push_back({in.filename().string() + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
+                           [in, grow, &so] { return cf::load_mesh(denoised_real(in, so.cache, false, grow)).mesh; }});
     }
   }
   for (const std::string& f : so.surfaces)
@@ -317,6 +333,7 @@ int main(int argc, char** argv) {
   app.add_option("--surface", so.surfaces, "stress set: a denoised (genus 0) surface, flattened as it is (repeatable)");
   app.add_flag("--generated", so.generated, "stress set: the generated colon-like surfaces");
   app.add_flag("--raw-masks", so.raw_masks, "stress set: also each --real mask reconstructed as its raw staircase");
+  app.add_flag("--grown-masks", so.grown_masks, "stress set: also each --real mask grown and shrunk by one voxel");
   app.add_option("--thread-counts", threads, "stress set: thread counts, one row each (e.g. 1,2)");
   app.add_option("--cache", so.cache, "cache of denoised real and generated surfaces");
   app.add_option("--map", so.map, "flatten map")->check(CLI::IsMember({"area-balanced", "conformal"}));

@@ -1,0 +1,15 @@
+#pragma once
+// Variations of a real lumen mask for the stress sets: the same anatomy with its walls a voxel
+// thinner or thicker, as another segmentation of the same scan could give it. Growing the lumen
+// closes the thin walls between touching colon loops (more and longer handles, pockets behind
+// long contacts); shrinking it opens thin necks and strands (fewer handles).
+#include "colonflat/volume/volume_io.h"
+
+namespace cf::bench {
+
+// `mask` (lumen 1, else 0) dilated (voxels > 0) or eroded (voxels < 0) by ITK's binary
+// morphology with a ball of |voxels| voxels along every axis (BinaryBallStructuringElement).
+// Post: the same size, origin, spacing and direction as `mask`; values 0/1; voxels == 0: a copy.
+MaskImage::Pointer grown_mask(const MaskImage* mask, int voxels);
+
+}  // namespace cf::bench
