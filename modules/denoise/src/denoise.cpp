@@ -133,14 +133,13 @@ nlohmann::json loops_report(const std::vector<LoopRecord>& loops, nlohmann::json
   return list;
 }
 
-}  // namespace
-
-DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress,
-                      const TopologyReport* input_topology) {
+// The whole run, its mesh built in `out` (empty) and the rest of the result in `res`.
+void run_denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress,
+                 const TopologyReport* input_topology, Mesh& out, DenoiseResult& res) {
   validate_denoise_options(o);
+  if (out.n_vertices() != 0 || out.n_faces() != 0) throw PreconditionError("denoise_into: the output mesh must be empty");
   Stopwatch total;
-  DenoiseResult res;
-  detail::DenoiseState st(res.mesh);
+  detail::DenoiseState st(out);
   const int threads = std::min(thread_count(), detail::kMaxThreads);
   if (threads > 1) st.worker = std::make_unique<detail::SearchWorker>(threads);
   double t_analysis = 0;
@@ -191,6 +190,21 @@ DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseP
                   {"total", total.seconds()}}},
                 {"units", "mm"},
                 {"coordinate_system", "LPS"}};
+}
+
+}  // namespace
+
+DenoiseResult denoise(const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress,
+                      const TopologyReport* input_topology) {
+  DenoiseResult res;
+  run_denoise(input, o, progress, input_topology, res.mesh, res);
+  return res;
+}
+
+DenoiseResult denoise_into(Mesh& out, const Mesh& input, const DenoiseOptions& o, const DenoiseProgress& progress,
+                           const TopologyReport* input_topology) {
+  DenoiseResult res;
+  run_denoise(input, o, progress, input_topology, out, res);
   return res;
 }
 

@@ -172,6 +172,22 @@ TEST(DenoiseExact, WorkingCopyIsTheInput) {
   expect_same_mesh(denoise(holed, DenoiseOptions{}).mesh, expected);
 }
 
+// denoise_into() builds the result in the caller's mesh (as DenoiseStage does, where its bag keeps
+// it): the mesh and loops denoise() returns, element by element; DenoiseResult::mesh comes back
+// empty, and an output mesh that is not empty is refused.
+TEST(DenoiseExact, IntoTheCallersMeshGivesTheSameResult) {
+  const Mesh m = to_mesh(torus_chain(3, 3, 1, 16, 8, 10));
+  const DenoiseResult a = denoise(m, DenoiseOptions{});
+  Mesh out;
+  const DenoiseResult b = denoise_into(out, m, DenoiseOptions{});
+  EXPECT_EQ(b.mesh.n_vertices(), 0u);
+  EXPECT_EQ(b.after.genus, 0);
+  expect_same_mesh(out, a.mesh);
+  ASSERT_EQ(b.loops.size(), a.loops.size());
+  for (std::size_t i = 0; i < a.loops.size(); ++i) EXPECT_EQ(b.loops[i].vertex_ids, a.loops[i].vertex_ids) << i;
+  EXPECT_THROW(denoise_into(out, m, DenoiseOptions{}), PreconditionError);
+}
+
 // The paper method refuses open meshes with an actionable message.
 TEST(DenoisePaper, RefusesOpenMesh) {
   Mesh m = to_mesh(open_cylinder(1, 3, 12, 4));

@@ -70,6 +70,13 @@ class CapIntersectionError : public Error {
 DenoiseResult denoise(const Mesh& input, const DenoiseOptions& options, const DenoiseProgress& progress = {},
                       const TopologyReport* input_topology = nullptr);
 
+// denoise() with the result's mesh built in `out` (precondition: empty, else PreconditionError)
+// instead of DenoiseResult::mesh, which is returned empty; the same mesh element by element. For
+// a caller that keeps the mesh elsewhere (DenoiseStage: in the std::any its bag holds): OpenMesh
+// meshes have no move operations, so handing DenoiseResult::mesh on copies every array.
+DenoiseResult denoise_into(Mesh& out, const Mesh& input, const DenoiseOptions& options,
+                           const DenoiseProgress& progress = {}, const TopologyReport* input_topology = nullptr);
+
 // Validates options: the table's ranges and choices (denoise_param_table()), then the rules
 // between parameters; throws UsageError.
 void validate_denoise_options(const DenoiseOptions& o);
