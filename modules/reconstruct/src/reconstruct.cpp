@@ -126,25 +126,26 @@ std::string describe_topology_failure(const TopologyReport& r) {
   return s.str();
 }
 
-Mesh to_openmesh(const TriangleList& t) {
-  Mesh m;
+// `t` added to the empty mesh `m` (built in place: an OpenMesh mesh has no move operations, so a
+// returned or assigned mesh is copied).
+void add_to_openmesh(const TriangleList& t, Mesh& m) {
   m.reserve(t.points.size(), t.points.size() + t.triangles.size(), t.triangles.size());
   for (const auto& p : t.points) m.add_vertex(Vec3(p[0], p[1], p[2]));
   for (const auto& tri : t.triangles) {
     const auto f = m.add_face(Mesh::VertexHandle(tri[0]), Mesh::VertexHandle(tri[1]), Mesh::VertexHandle(tri[2]));
     if (!f.is_valid()) throw Error("reconstruct: internal error: surface triangle rejected by the halfedge mesh");
   }
-  return m;
 }
 
 
 // The steps of reconstruct_surface, sharing the mask's geometry and the surface being built.
 class SurfaceReconstruction {
  public:
-  SurfaceReconstruction(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options)
-      : mask_(mask), ct_(ct), opts_(options) {}
+  // `out`: an empty mesh the surface is built in.
+  SurfaceReconstruction(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options, Mesh& out)
+      : mask_(mask), ct_(ct), opts_(options), mesh_(out) {}
 
-  Mesh run(ReconstructStats* stats_out) {
+  void run(ReconstructStats* stats_out) {
     read_geometry();
     check_ct();
     extract();
@@ -155,7 +156,7 @@ class SurfaceReconstruction {
     smooth_mesh();
     fair_mesh();
     phase_done("smoothing");
-    mesh_ = to_openmesh(tris_);
+    add_to_openmesh(tris_, mesh_);
     tris_ = TriangleList{};
     staircase_ = {};
     decimate();
@@ -163,7 +164,6 @@ class SurfaceReconstruction {
     phase_done("decimation and final check");
     st_.time_total_s = total_.seconds();
     if (stats_out) *stats_out = std::move(st_);
-    return std::move(mesh_);
   }
 
  private:
@@ -460,16 +460,24 @@ class SurfaceReconstruction {
   std::vector<ReconstructComponent> comps_;
   std::vector<char> keep_;
   P3 ref_{0, 0, 0};
-  Mesh mesh_;
+  Mesh& mesh_;  // the caller's
 };
 
 }  // namespace
 
-Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
-                         ReconstructStats* stats) {
+void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
+                              ReconstructStats* stats) {
   validate(options);
   if (!mask) throw PreconditionError("no mask");
-  return SurfaceReconstruction(mask, ct, options).run(stats);
+  if (out.n_vertices() != 0 || out.n_faces() != 0) throw PreconditionError("reconstruct: the output mesh is not empty");
+  SurfaceReconstruction(mask, ct, options, out).run(stats);
+}
+
+Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
+                         ReconstructStats* stats) {
+  Mesh m;
+  reconstruct_surface_into(m, mask, ct, options, stats);
+  return m;
 }
 
 Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& options, ReconstructStats* stats) {

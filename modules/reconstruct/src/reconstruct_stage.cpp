@@ -1,5 +1,6 @@
 #include "colonflat/reconstruct/reconstruct_stage.h"
 
+#include <any>
 #include <iomanip>
 #include <sstream>
 
@@ -23,7 +24,8 @@ void ReconstructStage::run(ArtifactBag& bag, RunContext& ctx) {
   const auto& mask = bag.get<MaskImage::Pointer>("mask");
   const CtImage* ct = bag.has("ct") ? bag.get<CtImage::Pointer>("ct").GetPointer() : nullptr;
   ReconstructStats st;
-  Mesh surface = reconstruct_surface(mask.GetPointer(), ct, opts_, &st);
+  std::any surface;  // the mesh built where the bag keeps it (reconstruct_surface_into: no copy)
+  reconstruct_surface_into(surface.emplace<Mesh>(), mask.GetPointer(), ct, opts_, &st);
   ctx.report = st.to_json();
   std::ostringstream line;
   line << "  reconstruct: " << st.lumen_voxels << " lumen voxels -> " << st.extracted_faces << " triangles ("

@@ -250,6 +250,35 @@ TEST(ReconstructTopology, TorusIsGenusOneWithEveryMethodAndStep) {
   }
 }
 
+// reconstruct_surface_into builds, in the caller's empty mesh, the surface reconstruct_surface
+// returns (the same points, in order, and the same faces, smoothed and faired), and refuses a
+// mesh that is not empty.
+TEST(ReconstructTopology, SurfaceBuiltInTheCallersMeshIsTheReturnedOne) {
+  MaskSpec s;
+  s.size = {40, 40, 16};
+  s.spacing = {1.0, 1.0, 1.2};
+  s.origin = {-20, -20, -9};
+  auto m = rasterize(s, [](const std::array<double, 3>& p) {
+    const double q = std::sqrt(p[0] * p[0] + p[1] * p[1]) - 12.0;
+    return q * q + p[2] * p[2] <= 16.0;
+  });
+  const ReconstructOptions o;  // (no decimation: OpenMesh's multiple-choice decimater samples with rand())
+  const Mesh a = reconstruct_surface(m, o);
+  Mesh b;
+  reconstruct_surface_into(b, m, nullptr, o);
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  ASSERT_EQ(a.n_faces(), b.n_faces());
+  ASSERT_GT(a.n_faces(), 0u);
+  for (const auto v : a.vertices()) EXPECT_EQ(a.point(v), b.point(v));
+  for (const auto f : a.faces()) {
+    std::vector<int> fa, fb;
+    for (const auto v : a.fv_range(f)) fa.push_back(v.idx());
+    for (const auto v : b.fv_range(f)) fb.push_back(v.idx());
+    EXPECT_EQ(fa, fb);
+  }
+  EXPECT_THROW(reconstruct_surface_into(b, m, nullptr, o), PreconditionError);
+}
+
 // The three VTK filters give the same surface (same faces and the same set of points).
 TEST(ReconstructTopology, MethodsAgree) {
   MaskSpec s;

@@ -94,6 +94,11 @@ Mesh reconstruct_surface(const MaskImage* mask, const ReconstructOptions& option
 // CT is a PreconditionError.
 Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
                          ReconstructStats* stats = nullptr);
+// The same, built in the caller's empty mesh `out` (e.g. one a std::any holds): an OpenMesh mesh
+// has no move operations, so returning one copies it (on a 2 M-face surface, every array written
+// again into fresh pages). PreconditionError when `out` is not empty.
+void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
+                              ReconstructStats* stats = nullptr);
 
 // Euler characteristic of the lumen (non-zero voxels) in the (6,18) digital topology, i.e. of
 // the solid the marching-cubes surface bounds: #voxels - #face-adjacent pairs + #2x2 squares
