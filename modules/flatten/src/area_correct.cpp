@@ -22,6 +22,7 @@
 #include "face_blocks.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
+#include "whole_band_stop.h"
 
 namespace cf::flat_detail {
 namespace {
@@ -103,7 +104,7 @@ class ConformalAreaEnergy {
 void hold_crushed(const Surface& s, const std::vector<double>& area2, const std::vector<double>& area3, double scale,
                   double below, std::vector<char>& free_vertex, std::vector<int>& faces) {
   for (int f : faces)
-    if (scale * area2[f] < below * area3[f])
+    if (crushed_in_band(scale, area2[f], area3[f], below))
       for (int v : s.t[f]) free_vertex[v] = 0;
   faces.erase(std::remove_if(faces.begin(), faces.end(),
                              [&](int f) {
@@ -440,15 +441,8 @@ AreaCorrection correct_area(const Surface& s, const std::vector<std::vector<int>
                             const std::vector<int>* vertex_order, CorrectionTimes* times) {
   AreaCorrection res;
   if (o.area_correction_iterations <= 0 || s.t.empty()) return res;
-  // Per face its 3D and signed map areas, once, each face on its own (any thread); the sums in face order.
-  std::vector<double> area3(s.t.size()), area2(s.t.size());
-  for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t f = begin; f < end; ++f) area3[f] = face_area_3d(s, int(f)), area2[f] = emb.area2(s, int(f));
-  });
-  double a2 = 0, a3 = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f]) a2 += std::max(area2[f], 0.0), a3 += area3[f];
-  const double scale = a2 > 0 ? a3 / a2 : 1.0;
+  std::vector<double> area3, area2;
+  const double scale = band_areas(s, emb, degenerate, area3, area2);
   std::vector<char> free_vertex;
   std::vector<int> faces = correction_faces(s, vf, area2, area3, fixed, degenerate, scale, o, local, grow, free_vertex);
   res.faces = faces.size();

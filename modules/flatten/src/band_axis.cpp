@@ -16,6 +16,7 @@
 #include "cut_rims.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
+#include "whole_band_stop.h"
 
 namespace cf::flat_detail {
 
@@ -197,11 +198,13 @@ std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double ban
 // 5, 1.5 and 99.5 %). A band within all of them is left as it is: on a large colon a whole-band
 // correction costs several times the conformal solve. The whole-band pass holds crushed pockets
 // (area_correct.cpp), so pockets left after it are opened by a local pass.
-constexpr double kWholeBandAreaLow = 0.25, kWholeBandAreaHigh = 4.0, kWholeBandQcMean = 1.45;
+// (kWholeBandAreaLow, kWholeBandAreaHigh, kWholeBandQcMean: whole_band_stop.h)
 struct CorrectionNeed {
   bool global = false, local = false;
   bool area = false;  // the area ratios are out of the whole band's margins
   double qc_mean = 0;
+  BoundStats all;      // over the faces in the map
+  double hidden = 0;   // fraction of the wall shown below coverage_min_ratio
 };
 struct NeedScratch {  // a caller's vectors kept across needs_correction() calls
   std::vector<FaceDistortion> fd;
@@ -223,27 +226,40 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
   const BoundStats st = bound_stats_in_map(fd, &use.ratio);
   const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
   const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
-  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean};
+  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean, st, hidden / a3};
 }
 
-// When the whole-band pass has done its job, asked after each of its steps (the trigger's own
-// statistics): the area ratios are within the margins and the angle distortion is within its
-// margin or no longer falls (qc mean not lower than after the previous step; the first step, a
-// full Newton step on the quadratic part, may raise it). Each step costs a solve on the whole band
-// (0.9 M unknowns on the real CT colon band); past that point the steps only trade angle against
-// area distortion in wall that is already readable, and the pockets are the local pass's job. On
-// the real CT colon band the pass took 9 steps instead of 60; after the local passes and the
-// balancing: shown 99.30 % both, qc mean 1.739 (60 steps: 1.758), area p05 0.271 (0.319).
-// The faces' 3D frames are computed once for the pass (the check's numbers are the same bits).
-static std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<char>& degenerate,
-                                             const FlattenOptions& o) {
+// When the whole-band pass has done its job, asked after each of its steps: WholeBandStop
+// (whole_band_stop.h) on the trigger's own statistics, over all faces and then, when those say go on,
+// over the faces the pass moves (none of their corners held: the pass holds the corners of the faces
+// crushed when it starts, whole_band_held()). Each step costs a solve on the whole band (0.9 M
+// unknowns on the real CT colon band); past that point the steps only trade angle against area
+// distortion in wall that is already readable, and the pockets are the local pass's job. The faces'
+// 3D frames are computed once for the pass (the check's numbers are the same bits).
+// COLONFLAT_FLATTEN_DEBUG: one line per check.
+std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o) {
   auto frames = std::make_shared<const std::vector<FaceFrame>>(band_frames(w));
   auto scratch = std::make_shared<NeedScratch>();  // the checks' vectors, kept from step to step
-  return [&w, &degenerate, &o, frames, scratch, last_qc = std::numeric_limits<double>::infinity()]() mutable {
+  auto moved = std::make_shared<std::vector<char>>(degenerate.size(), 0);  // faces with no corner held
+  const std::vector<char> held = whole_band_held(w.ann, w.emb, degenerate, o.coverage_min_ratio);
+  for (std::size_t f = 0; f < moved->size(); ++f) {
+    const Tri& t = w.ann.t[f];
+    (*moved)[f] = !degenerate[f] && !held[t[0]] && !held[t[1]] && !held[t[2]];
+  }
+  const std::size_t moved_faces = std::size_t(std::count(moved->begin(), moved->end(), 1));
+  const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
+  return [&w, &degenerate, &o, frames, scratch, moved, moved_faces, debug, rule = WholeBandStop(), step = 0]() mutable {
     const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get(), scratch.get());
-    const bool angles_done = now.qc_mean <= kWholeBandQcMean || now.qc_mean >= last_qc;
-    last_qc = now.qc_mean;
-    return !now.area && angles_done;
+    ++step;
+    if (rule.all_done(now.all)) return true;
+    std::vector<FaceDistortion>& fd = scratch->fd;  // the held faces left out, as degenerate ones are
+    for (std::size_t f = 0; f < fd.size(); ++f) fd[f].degenerate = !(*moved)[f];
+    const BoundStats free = bound_stats_in_map(fd, &scratch->ratio);
+    if (debug)
+      std::fprintf(stderr, "flatten debug whole-band check %d: all p05 %.4f p95 %.4f qc %.4f hidden %.6f; "
+                   "free (%zu of %zu faces) p05 %.4f p95 %.4f qc %.4f\n", step, now.all.area_p05, now.all.area_p95,
+                   now.all.qc_mean, now.hidden, moved_faces, fd.size(), free.area_p05, free.area_p95, free.qc_mean);
+    return rule.free_done(free);
   };
 }
 

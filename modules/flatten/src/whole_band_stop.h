@@ -1,0 +1,88 @@
+#pragma once
+// When the whole-band area pass stops (band_axis.cpp whole_band_done): the faces it can move and
+// the rule on their measures, asked after each of its steps.
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+
+// The whole band's margins (under the targets 0.2, 5, 1.5): area ratio 5th / 95th percentiles and
+// quasi-conformal mean. A band out of them gets the whole-band pass (band_axis.cpp needs_correction).
+constexpr double kWholeBandAreaLow = 0.25, kWholeBandAreaHigh = 4.0, kWholeBandQcMean = 1.45;
+
+// Whether the whole-band pass holds a face's corners (area_correct.cpp hold_crushed): its map area
+// `area2` at the band's area scale `scale` is below `below` (coverage_min_ratio) x its 3D area.
+inline bool crushed_in_band(double scale, double area2, double area3, double below) {
+  return scale * area2 < below * area3;
+}
+
+// Per face of s its 3D area and signed map area (area3, area2: resized to s.t.size()), each face on
+// its own (any thread); returns the band's area scale, 3D / map area summed in face order over the
+// faces not degenerate (map areas below 0 as 0): correct_area()'s scale.
+double band_areas(const Surface& s, const Embedding& emb, const std::vector<char>& degenerate, std::vector<double>& area3,
+                  std::vector<double>& area2);
+
+// The vertices the whole-band pass holds on `emb` as it is (per vertex 1: a corner of a face in the
+// map, not degenerate, crushed_in_band() at the band's scale): what correct_area() holds when it
+// starts on this embedding. Size s.p.size().
+std::vector<char> whole_band_held(const Surface& s, const Embedding& emb, const std::vector<char>& degenerate,
+                                  double below);
+
+// The stop rule, fed the measures after each step (area p05 / p95, qc mean of the faces in the map):
+// `all` over every face of the band, `free` over the faces the pass moves (no corner held by it).
+// Stop when either
+//  (a) all faces are within the area margins and their angles are settled: qc mean within its margin
+//      or not lower than after the previous step (the first step, a full Newton step on the quadratic
+//      part, may raise it): the rule before session 27; the real CT colon band stops at its 3rd step;
+//  (b) the free faces are within the area margins and the pass has stopped improving them: over the
+//      last kStallSteps steps their area p05 rose, their p95 fell and (unless within its margin) their
+//      qc mean fell each by less than kStallGain a step (relative to its value kStallSteps steps before).
+// (a) alone never holds on a band whose held faces (crushed pockets, 5-13 % of the U's colon bands)
+// are over 5 % of it: they cannot move in this pass (the local passes open them), so its p05 stays
+// where they put it and the pass used to run its whole budget.
+// kStallGain: 0.1 % a step, below what the final qc mean moves by when the factor changes at rounding
+// level (U120 2.602 -> 2.581, U60 2.353 -> 2.393: docs/flatten.md, session 26 "factor"). kStallSteps:
+// longer than the lulls in the U bands' measures (U120's colon band: free p05 0.3023 -> 0.3027 over
+// steps 45-49, then 2 % more by step 60; a 5-step window stopped it there and its final p05 fell
+// 0.159 -> 0.154), and past the first steps, where (a) stops the bands that meet their bounds (1-5
+// on every row measured). docs/flatten.md, session 27 "stoprule".
+class WholeBandStop {
+ public:
+  static constexpr int kStallSteps = 8;
+  static constexpr double kStallGain = 0.001;
+  static bool within_area(const BoundStats& b) {
+    return b.area_p05 >= kWholeBandAreaLow && b.area_p95 <= kWholeBandAreaHigh;
+  }
+  // (a); the caller measures the free faces only when this says go on.
+  bool all_done(const BoundStats& all) {
+    const bool angles = all.qc_mean <= kWholeBandQcMean || all.qc_mean >= last_qc_;
+    last_qc_ = all.qc_mean;
+    return within_area(all) && angles;
+  }
+  // (b), once per step after all_done() said go on.
+  bool free_done(const BoundStats& free) {
+    free_.push_back(free);
+    const std::size_t n = free_.size();
+    if (!within_area(free) || n <= std::size_t(kStallSteps)) return false;
+    const BoundStats& before = free_[n - 1 - kStallSteps];
+    const auto stalled = [](double from, double gain) { return gain < kStallGain * kStallSteps * from; };
+    return stalled(before.area_p05, free.area_p05 - before.area_p05) &&
+           stalled(before.area_p95, before.area_p95 - free.area_p95) &&
+           (free.qc_mean <= kWholeBandQcMean || stalled(before.qc_mean, before.qc_mean - free.qc_mean));
+  }
+
+ private:
+  double last_qc_ = std::numeric_limits<double>::infinity();
+  std::vector<BoundStats> free_;  // the free faces' measures after each step
+};
+
+// The whole-band pass's stop check for band `w` as it is now (asked after each step; band_axis.cpp):
+// WholeBandStop on the band's statistics over all faces in the map and over the faces none of whose
+// corners whole_band_held() holds now. Keeps references to w, degenerate and o.
+std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<char>& degenerate, const FlattenOptions& o);
+
+}  // namespace cf::flat_detail
