@@ -226,7 +226,8 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
   const BoundStats st = bound_stats_in_map(fd, &use.ratio);
   const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
   const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
-  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean, st, hidden / a3};
+  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean, st,
+          a3 > 0 ? hidden / a3 : 0.0};
 }
 
 // When the whole-band pass has done its job, asked after each of its steps: WholeBandStop
@@ -250,8 +251,8 @@ std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<ch
   const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
   return [&w, &degenerate, &o, frames, scratch, moved, moved_faces, debug, rule = WholeBandStop(), step = 0]() mutable {
     const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get(), scratch.get());
-    ++step;
     if (rule.all_done(now.all)) return true;
+    if (!WholeBandStop::judges_free(++step)) return false;
     std::vector<FaceDistortion>& fd = scratch->fd;  // the held faces left out, as degenerate ones are
     for (std::size_t f = 0; f < fd.size(); ++f) fd[f].degenerate = !(*moved)[f];
     const BoundStats free = bound_stats_in_map(fd, &scratch->ratio);

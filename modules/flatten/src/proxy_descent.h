@@ -61,7 +61,11 @@ class CornerGather {
 // ~0.03 s beside a ~0.08 s gradient and solve); `enough` must not write what the step reads.
 // The first kChecksAlone checks run after their step: a band that meets its bounds does so within
 // a few steps (the real CT colon band at its 3rd, the U's branches at their 1st-3rd), where a step
-// beside the stopping check is wasted (CT, load 7: +0.8 CPU s, +1.6 s wall for its pass).
+// beside the stopping check is wasted (CT, load 7: +0.8 CPU s, +1.6 s wall for its pass). Session
+// 27 (whole_band_stop.h): the whole-band rule's first part stops bands at steps 1-5 on every row
+// measured, its second part only at multiples of 8 from 16 on (U180's colon band at 24, the U's
+// 140-150 k-face branch bands at 16), where the one dropped step is the price of 11+ checks hidden
+// behind the solve before it: kept at 5.
 constexpr int kChecksAlone = 5;
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
