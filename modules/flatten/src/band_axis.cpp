@@ -331,9 +331,11 @@ static std::vector<char> rims_that_crossed(const SegmentWork& w, const CutRims& 
 // crosses costs the passes of its own pieces again; the rims that did not keep what they opened.
 void local_area_passes(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
                        const std::vector<char>& fixed, const std::vector<char>& ends,
-                       const std::vector<char>& degenerate, const FlattenOptions& o, bool branch) {
+                       const std::vector<char>& degenerate, const FlattenOptions& o, bool branch, bool pockets) {
   const CutRims rims = cut_rims(w.ann, E, ends);
   const std::vector<char> freed = free_rims(w, rims, o);
+  const std::vector<char> widened = widen_short_rims(w, rims, freed, ends, o);  // (held from then on)
+  if (!pockets && std::count(widened.begin(), widened.end(), 1) == 0) return;
   if (std::count(freed.begin(), freed.end(), 1) == 0) {
     run_local_passes(w, vf, fixed, degenerate, o, branch);
     return;
@@ -408,6 +410,9 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
   if (!branch) debug_clock("debug stats, correction need");
   const std::vector<int> order = w.band_order();  // a large band's nested dissection order, for its systems
   const std::vector<int>* band_order = order.empty() ? nullptr : &order;
+  std::vector<char> on_end(fixed.size(), 0);
+  for (const std::vector<int>& l : ends)
+    for (int v : l) on_end[std::size_t(v)] = 1;
   if (need.global) {
     w.seg.corrected_iterations =
         correct_pass(w, vf, fixed, degenerate, o, false, false, whole_band_done(w, degenerate, o), band_order);
@@ -415,10 +420,7 @@ void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<
     need.local = needs_correction(w, degenerate, o).local;
     if (!branch) debug_clock("correction need after the whole band");
   }
-  std::vector<char> on_end(fixed.size(), 0);
-  for (const std::vector<int>& l : ends)
-    for (int v : l) on_end[std::size_t(v)] = 1;
-  if (need.local) local_area_passes(w, E, vf, fixed, on_end, degenerate, o, branch);
+  local_area_passes(w, E, vf, fixed, on_end, degenerate, o, branch, need.local);
   const Stopwatch sw;
   const BalanceResult bal = balance_area(w.ann, vf, emb, fixed, degenerate, o, band_order);
   w.seg.balanced_vertices = bal.vertices;

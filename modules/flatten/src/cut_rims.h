@@ -38,6 +38,21 @@ std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims
 // COLONFLAT_FLATTEN_DEBUG=1: one line per rim with these figures.
 std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, const FlattenOptions& o);
 
+// Rims much shorter in the map than in 3D widened, each as one curve (issue 26, docs/flatten.md
+// session 27 "rim"): the conformal map shrinks the wall beside a rim of map / 3D length l about
+// isotropically by l, so that wall sits at area ratio ~ l^2 and no pass that holds the rim opens
+// it. A rim at least 0.5 x the band's period long in 3D (a limb-sized branch's neck), not around the
+// band, with l^2 < o.area_ratio_low: its hole scaled about its centroid by sqrt(area_ratio_low) / l
+// (the rim's shape kept), the rings of wall around it (2 mm wide, out to 0.45 x the period or 1 mm
+// short of an end) each given the area factor that brings its mean ratio up to area_ratio_low, paid
+// by the rings above it (down to 0.6 x their area): a radial map increasing in the radius, so the
+// band stays embedded and the rim cannot cross itself. Rims `freed` (free_rims(): the passes move
+// them) are left alone; `ends`: per vertex of w.ann, on an end loop. Not done (the rim as it was)
+// when the disc lacks the room or a face would fold. Returns per rim whether it was widened (then
+// hold it).
+std::vector<char> widen_short_rims(SegmentWork& w, const CutRims& rims, const std::vector<char>& freed,
+                                   const std::vector<char>& ends, const FlattenOptions& o);
+
 // The vertices held in the local passes (per vertex of w.ann): `ends` and the rims not `freed`.
 std::vector<char> held_vertices(const SegmentWork& w, const CutRims& rims, const std::vector<char>& freed,
                                 const std::vector<char>& ends);
@@ -55,10 +70,12 @@ std::size_t restore_touched_pieces(SegmentWork& w, const std::vector<V2>& before
 // free_rims() lets it; a freed rim that crossed itself or another rim in the passes is held, the
 // pieces it moved in are restored (restore_touched_pieces) and the passes run again with every
 // vertex the other pieces moved held, until no freed rim adds a crossing. Post: positive faces stay
-// so; no freed rim crosses more than before; the same map for any thread count.
+// so; no freed rim crosses more than before; the same map for any thread count. The rims are judged
+// first; then the held ones widen_short_rims() widens (held still); the passes run when `pockets`
+// (the band needs them) or a rim was widened.
 void local_area_passes(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
                        const std::vector<char>& fixed, const std::vector<char>& ends,
-                       const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);
+                       const std::vector<char>& degenerate, const FlattenOptions& o, bool branch, bool pockets);
 
 // local_area_passes once its rims are found and judged: `freed` per rim (cut_rims(), free_rims()).
 void local_passes_freeing(SegmentWork& w, const CutRims& rims, std::vector<char> freed,

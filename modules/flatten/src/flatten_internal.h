@@ -384,7 +384,8 @@ struct SegmentWork;
 // centreline length within 8 %; a branch's conformal length), y scaled to the wall area, folds
 // untangled, out-of-bounds regions balanced. `ends`: the band's two end loops (vertex ids of w.ann);
 // `E`: w.ann's edges; `fixed`: every boundary vertex (the ends and the rims of cut-off branches). The
-// rims move in the local area correction passes only (cut_rims.h: local_area_passes), the ends never.
+// rims move in the local area correction passes only (cut_rims.h: local_area_passes: freed, or a
+// short one widened as one curve first), the ends never.
 void area_balanced_step(SegmentWork& w, const Centreline& cl, const std::vector<std::vector<int>>& ends, const Edges& E,
                         const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                         const std::vector<char>& degenerate, const FlattenOptions& o, bool branch);

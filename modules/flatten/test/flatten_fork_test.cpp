@@ -92,7 +92,7 @@ TEST(FlattenFork, RoundRimMovesAndTheStripAlongItOpens) {
   const CrushedRim start;
   const double before = rim.strip_hidden();
   ASSERT_GT(before, 100.0);
-  flat_detail::local_area_passes(rim.w, flat_detail::build_edges(rim.w.ann.t), rim.vf, rim.fixed, rim.ends, rim.degenerate, FlattenOptions{}, false);
+  flat_detail::local_area_passes(rim.w, flat_detail::build_edges(rim.w.ann.t), rim.vf, rim.fixed, rim.ends, rim.degenerate, FlattenOptions{}, false, true);
   EXPECT_LT(rim.strip_hidden(), 0.01 * before);
   for (std::size_t f = 0; f < rim.w.ann.t.size(); ++f) EXPECT_GT(rim.w.emb.area2(rim.w.ann, int(f)), 0.0);
   std::size_t rim_moved = 0, ends_moved = 0;
@@ -207,6 +207,63 @@ TEST(FlattenFork, OnlyTheRimThatCrossesIsHeldAgain) {
   EXPECT_EQ(rim0_moved, band.rim[0].size());
   EXPECT_EQ(rim1_moved, 0u);
   for (std::size_t f = 0; f < band.w.ann.t.size(); ++f) EXPECT_GT(band.w.emb.area2(band.w.ann, int(f)), 0.0);
+}
+
+// The wall's mean area ratio (at the band's area scale) over the faces whose 3D corners all lie
+// within `radius` of the origin.
+double mean_ratio_within(const flat_detail::SegmentWork& w, double radius) {
+  const double scale = flat_detail::band_area_scale(w, nullptr);
+  double a2 = 0, a3 = 0;
+  for (std::size_t f = 0; f < w.ann.t.size(); ++f) {
+    const auto& t = w.ann.t[f];
+    if (std::max({w.ann.p[t[0]].norm(), w.ann.p[t[1]].norm(), w.ann.p[t[2]].norm()}) > radius) continue;
+    a2 += scale * w.emb.area2(w.ann, int(f)), a3 += flat_detail::face_area_3d(w.ann, int(f));
+  }
+  return a2 / a3;
+}
+
+// A limb-sized branch's rim held short: a flat ring (3D radius 10 to 45 mm, the band's period 100 mm)
+// whose map keeps the hole's rim at 0.4 x its 3D length and the wall out to 3D radius 20 shrunk
+// alike (x 0.4 both ways: area ratio ~0.16, what the conformal map leaves beside such a rim), the
+// rest stretched out to the outer circle (an end). widen_short_rims() moves the rim as one curve
+// (every rim vertex scaled about one centre by one factor > 1: no crossing, its shape kept), folds no
+// face, moves no end, and the wall beside the rim ends at a mean ratio >= 0.3 (area_ratio_low 0.4
+// is its aim); held (main's rule), the local passes leave that wall below 0.2. local_area_passes()
+// widens it alike first and holds it there.
+TEST(FlattenFork, ShortRimGivesWayAsOneCurveAndTheWallBesideItOpens) {
+  RingBand band;
+  band.add_ring(0, 45, [](double r, double a) -> V2 {
+    return (r < 20 ? 0.4 * r : 8 + (r - 20) * (45 - 8) / 25) * V2(std::cos(a), std::sin(a));
+  });
+  band.finish();
+  band.w.emb.period = 100;
+  const auto E = flat_detail::build_edges(band.w.ann.t);
+  const auto rims = flat_detail::cut_rims(band.w.ann, E, band.ends);
+  ASSERT_EQ(rims.loops.size(), 1u);
+  const double held_before = mean_ratio_within(band.w, 20);
+  ASSERT_LT(held_before, 0.2);
+  RingBand held = band;
+  flat_detail::local_passes_freeing(held.w, rims, {0}, held.vf, held.ends, held.degenerate, FlattenOptions{}, false);
+  EXPECT_LT(mean_ratio_within(held.w, 20), 0.2);
+  const RingBand start = band;
+  ASSERT_EQ(flat_detail::widen_short_rims(band.w, rims, {0}, band.ends, FlattenOptions{}), std::vector<char>{1});
+  const auto at = [](const RingBand& b, int i) { return b.w.emb.pos[std::size_t(b.rim[0][std::size_t(i)])]; };
+  const double s = (at(band, 0) - at(band, 32)).norm() / (at(start, 0) - at(start, 32)).norm();
+  EXPECT_GT(s, 1.5);
+  for (int i = 0; i < RingBand::kSectors; ++i)  // one similarity: every chord scaled by s
+    for (int j : {i + 1, i + 7, i + 29})
+      EXPECT_NEAR((at(band, i) - at(band, j % 64)).norm(), s * (at(start, i) - at(start, j % 64)).norm(), 1e-9 * s);
+  EXPECT_EQ(flat_detail::rim_crossings(band.w, rims), std::vector<std::size_t>{0});
+  for (std::size_t v = 0; v < band.ends.size(); ++v)
+    if (band.ends[v]) EXPECT_EQ(band.w.emb.pos[v], start.w.emb.pos[v]);
+  for (std::size_t f = 0; f < band.w.ann.t.size(); ++f) EXPECT_GT(band.w.emb.area2(band.w.ann, int(f)), 0.0);
+  EXPECT_GE(mean_ratio_within(band.w, 20), 0.3);
+  RingBand passes = start;  // the local passes widen it alike and hold it there
+  std::vector<char> fixed = passes.ends;
+  for (int v : passes.rim[0]) fixed[std::size_t(v)] = 1;
+  flat_detail::local_area_passes(passes.w, E, passes.vf, fixed, passes.ends, passes.degenerate, FlattenOptions{}, false, false);
+  for (int i = 0; i < RingBand::kSectors; ++i) EXPECT_EQ(at(passes, i), at(band, i));
+  EXPECT_GE(mean_ratio_within(passes.w, 20), 0.3);
 }
 
 }  // namespace
