@@ -56,6 +56,30 @@ void chain_rims(const Surface& s, CutRims& rims) {
   }
 }
 
+// (free_rims, widen_short_rims) A rim's hole in the map, its edges chained across the period.
+struct RimShape {
+  double area = 0, length = 0, length3 = 0;  // map area (signed, shoelace), map and 3D lengths
+  V2 centre = V2::Zero();                      // the hole's area centroid (in the first edge's copy)
+  double reach = 0;                            // largest map distance of a rim vertex from centre
+  bool wraps = false;                          // the rim runs around the band
+};
+RimShape rim_shape(const SegmentWork& w, const std::vector<RimSegment>& seg, const std::vector<std::size_t>& loop) {
+  RimShape h;
+  std::vector<V2> at;  // the rim's vertices, placed one after the other
+  RimSegment last = seg[loop.front()];
+  for (std::size_t k : loop) {
+    const RimSegment e = k == loop.front() ? last : nearest_copy(last, seg[k], w.emb.period);  // placed after the last
+    const double cross = e.p.x() * e.q.y() - e.q.x() * e.p.y();
+    h.area += 0.5 * cross, h.length += (e.q - e.p).norm(), h.centre += cross * (e.p + e.q) / 6;
+    h.length3 += (w.ann.p[seg[k].a] - w.ann.p[seg[k].b]).norm();
+    at.push_back(e.p), last = e;
+  }
+  h.wraps = (last.q - seg[loop.front()].p).norm() > 0.5 * w.emb.period;  // around the band
+  h.centre = h.area != 0 ? V2(h.centre / h.area) : at.front();
+  for (const V2& p : at) h.reach = std::max(h.reach, (p - h.centre).norm());
+  return h;
+}
+
 // (free_rims) the share of a rim's faces crushed, how round its hole, how much room.
 constexpr double kRoundHole = 0.8, kCrushedRim = 0.5, kHoleRoom = 0.25;
 
@@ -125,30 +149,6 @@ std::vector<std::size_t> rim_crossings(const SegmentWork& w, const CutRims& rims
 // U120's small hole (40 edges, room 0.157) then folds over at a vertex (its strip opened only so:
 // session 25's p05 0.209 was that fold) and U180's two rims at 0.17 / 0.19 cross: both restored,
 // nothing gained, 77 k / 13 k vertices corrected twice.
-// (free_rims, widen_short_rims) A rim's hole in the map, its edges chained across the period.
-struct RimShape {
-  double area = 0, length = 0, length3 = 0;  // map area (signed, shoelace), map and 3D lengths
-  V2 centre = V2::Zero();                      // the hole's area centroid (in the first edge's copy)
-  double reach = 0;                            // largest map distance of a rim vertex from centre
-  bool wraps = false;                          // the rim runs around the band
-};
-RimShape rim_shape(const SegmentWork& w, const std::vector<RimSegment>& seg, const std::vector<std::size_t>& loop) {
-  RimShape h;
-  std::vector<V2> at;  // the rim's vertices, placed one after the other
-  RimSegment last = seg[loop.front()];
-  for (std::size_t k : loop) {
-    const RimSegment e = k == loop.front() ? last : nearest_copy(last, seg[k], w.emb.period);  // placed after the last
-    const double cross = e.p.x() * e.q.y() - e.q.x() * e.p.y();
-    h.area += 0.5 * cross, h.length += (e.q - e.p).norm(), h.centre += cross * (e.p + e.q) / 6;
-    h.length3 += (w.ann.p[seg[k].a] - w.ann.p[seg[k].b]).norm();
-    at.push_back(e.p), last = e;
-  }
-  h.wraps = (last.q - seg[loop.front()].p).norm() > 0.5 * w.emb.period;  // around the band
-  h.centre = h.area != 0 ? V2(h.centre / h.area) : at.front();
-  for (const V2& p : at) h.reach = std::max(h.reach, (p - h.centre).norm());
-  return h;
-}
-
 std::vector<char> free_rims(const SegmentWork& w, const CutRims& rims, const FlattenOptions& o) {
   const double min_ratio = o.coverage_min_ratio;
   const double scale = band_area_scale(w, nullptr);  // every face, degenerate ones too
