@@ -36,20 +36,60 @@ const ArtifactType& mesh_artifact() {
   return t;
 }
 
-nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
-                                 const std::string& stage, TopologyReport* topology) {
-  // In place: the bag's value is not const (ArtifactBag::take does the same), and a copy of a
-  // 1.4 M-face mesh costs more than the check.
-  Mesh& mesh = const_cast<Mesh&>(bag.get<Mesh>(port));
+namespace {
+// What the reader turned or reversed (kReadOrientationProperty), taken off the mesh.
+OrientationReport read_orientation(Mesh& mesh) {
   OrientationReport r;
   OpenMesh::MPropHandleT<std::string> h;
   if (mesh.get_property_handle(h, kReadOrientationProperty)) {
     r = OrientationReport::from_json(nlohmann::json::parse(mesh.property(h)));
     mesh.remove_property(h);
   }
-  r.append(orient_outward(mesh, topology));
+  return r;
+}
+
+// The bag's mesh `port`, in place: the bag's value is not const (ArtifactBag::take does the
+// same), and a copy of a 1.4 M-face mesh costs more than the check.
+Mesh& bag_mesh(ArtifactBag& bag, const std::string& port) { return const_cast<Mesh&>(bag.get<Mesh>(port)); }
+
+nlohmann::json noted(const OrientationReport& r, const RunContext& ctx, const std::string& stage,
+                     const std::string& port) {
   for (const std::string& note : r.notes()) ctx.progress(stage + ": " + port + ": " + note);
   return r.to_json();
+}
+}  // namespace
+
+nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage, TopologyReport* topology) {
+  Mesh& mesh = bag_mesh(bag, port);
+  OrientationReport r = read_orientation(mesh);
+  r.append(orient_outward(mesh, topology));
+  return noted(r, ctx, stage, port);
+}
+
+std::string topology_entry(const std::string& port) { return port + ".topology"; }
+
+OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage) {
+  Mesh& mesh = bag_mesh(bag, port);
+  OrientationReport r = read_orientation(mesh);
+  OrientedMesh in;
+  in.triangles = to_triangle_list(mesh);
+  const std::string entry = topology_entry(port);
+  bool taken = false;
+  if (bag.has(entry)) {
+    TopologyReport handed = bag.take<TopologyReport>(entry);
+    if ((taken = topology_fits(handed, in.triangles))) in.topology = std::move(handed);
+  }
+  if (!taken) in.topology = analyze_topology(in.triangles);
+  const OrientationReport turned = orient_outward(in.triangles, in.topology);
+  if (!turned.empty()) {  // the bag's mesh reversed as orient_mesh_input does, and the list read back from it
+    mesh = build_mesh(in.triangles);
+    in.triangles = to_triangle_list(mesh);
+  }
+  r.append(turned);
+  in.orientation = noted(r, ctx, stage, port);
+  return in;
 }
 
 namespace {

@@ -384,6 +384,17 @@ TriangleList to_triangle_list(const Mesh& mesh) {
   return t;
 }
 
+bool topology_fits(const TopologyReport& t, const TriangleList& mesh) {
+  if (t.faces != mesh.triangles.size() || t.face_component.size() != mesh.triangles.size() ||
+      t.vertices + t.unreferenced_vertices != mesh.points.size())
+    return false;
+  if (t.unreferenced_vertices != 0 || mesh.points.empty()) return true;
+  std::array<double, 3> lo = mesh.points[0], hi = mesh.points[0];
+  for (const auto& p : mesh.points)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  return lo == t.bbox_min && hi == t.bbox_max;
+}
+
 // The mesh's points are read in place (no copy of 24 bytes per vertex).
 TopologyReport analyze_topology(const Mesh& mesh) {
   return TopologyAnalysis<Vec3>(mesh.points(), mesh.n_vertices(), mesh_triangles(mesh)).run();

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "colonflat/core/error.h"
@@ -218,6 +219,55 @@ TEST(CoreOrientation, StageInputHandsBackTheMeshTopology) {
     EXPECT_EQ(topo.components[c].faces, after.components[c].faces);
     EXPECT_EQ(topo.components[c].euler, after.components[c].euler);
   }
+}
+
+// oriented_mesh_input orients as orient_mesh_input does (an inward torus reversed in the bag, the
+// same report and progress line) and hands back the bag mesh's triangle list with its topology.
+TEST(CoreOrientation, OrientedInputEqualsOrientMeshInput) {
+  const TriangleList inward = reversed(synthetic::torus(30, 10, 40, 16));
+  ArtifactBag a, b;
+  a.put("denoised", synthetic::to_mesh(inward));
+  b.put("denoised", synthetic::to_mesh(inward));
+  std::ostringstream log_a, log_b;
+  RunContext ctx_a, ctx_b;
+  ctx_a.log = &log_a, ctx_b.log = &log_b;
+  const nlohmann::json ja = orient_mesh_input(a, "denoised", ctx_a, "flatten");
+  const OrientedMesh in = oriented_mesh_input(b, "denoised", ctx_b, "flatten");
+  EXPECT_EQ(in.orientation, ja);
+  EXPECT_EQ(in.orientation["reversed_components"], 1);
+  EXPECT_EQ(log_b.str(), log_a.str());
+  const TriangleList bag_list = to_triangle_list(b.get<Mesh>("denoised"));
+  EXPECT_EQ(to_triangle_list(a.get<Mesh>("denoised")).triangles, bag_list.triangles);
+  EXPECT_EQ(in.triangles.triangles, bag_list.triangles);
+  EXPECT_EQ(in.topology.face_component, analyze_topology(bag_list).face_component);
+  EXPECT_EQ(in.topology.genus, std::optional<int>(1));
+}
+
+// A topology handed on in the bag ("<port>.topology", as denoise leaves it) is taken only when it
+// fits the mesh: a report of the same mesh is taken as it is (a marked field survives), reports of
+// another mesh (other counts) or of the mesh moved by 1 mm (same counts) are not (a new analysis);
+// the entry is erased in every case.
+TEST(CoreOrientation, HandedOnTopologyIsTakenOnlyWhenItFitsTheMesh) {
+  const TriangleList sphere = synthetic::sphere(10, 24, 12);
+  const TopologyReport own = analyze_topology(sphere);
+  auto mean_edge_taken = [&](TopologyReport handed) {
+    handed.mean_edge_length = -1;  // the mark: no analysis gives it
+    ArtifactBag bag;
+    bag.put("denoised", synthetic::to_mesh(sphere));
+    bag.put(topology_entry("denoised"), std::move(handed));
+    RunContext ctx;
+    const OrientedMesh in = oriented_mesh_input(bag, "denoised", ctx, "flatten");
+    EXPECT_FALSE(bag.has(topology_entry("denoised")));
+    EXPECT_EQ(in.triangles.triangles, sphere.triangles);
+    EXPECT_EQ(in.topology.face_component, own.face_component);
+    EXPECT_EQ(in.topology.faces, own.faces);
+    return in.topology.mean_edge_length;
+  };
+  EXPECT_EQ(mean_edge_taken(own), -1);
+  EXPECT_EQ(mean_edge_taken(analyze_topology(synthetic::sphere(10, 20, 10))), own.mean_edge_length);
+  EXPECT_EQ(mean_edge_taken(analyze_topology(synthetic::translated(sphere, 1, 0, 0))), own.mean_edge_length);
+  EXPECT_TRUE(topology_fits(own, sphere));
+  EXPECT_FALSE(topology_fits(own, synthetic::translated(sphere, 0, 0, -1)));
 }
 
 // Reading a non-orientable file fails with one line naming the file and the reason.

@@ -65,6 +65,9 @@ void DenoiseStage::run(ArtifactBag& bag, RunContext& ctx) {
   ctx.report = r.report;
   ctx.report["orientation"] = orientation;
   bag.put("denoised", std::move(denoised));
+  // The output's topology (the verification's analysis) for the next stage (flatten), which then
+  // need not analyse the mesh again: core oriented_mesh_input.
+  bag.put(topology_entry("denoised"), std::move(r.after));
   bag.put("loops", LoopSet(std::move(r.loops)));
 }
 

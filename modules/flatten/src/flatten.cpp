@@ -446,13 +446,15 @@ FlatMap flatten_colon(const Mesh& mesh, const FlattenOptions& opts) {
   return flatten_colon(to_triangle_list(mesh), opts);
 }
 
-FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts) {
+FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts, const TopologyReport* topology) {
   const flat_detail::TrimKeptBlocksAtScopeEnd factor_memory_given_back;  // factor_memory.h
   if (opts.weights != "cotan" && opts.weights != "clamped" && opts.weights != "auto")
     throw UsageError("--weights must be cotan, clamped or auto (got '" + opts.weights + "')");
   if (opts.map != "area-balanced" && opts.map != "conformal")
     throw UsageError("--map must be area-balanced or conformal (got '" + opts.map + "')");
-  const TopologyReport topo = analyze_topology(mesh);
+  TopologyReport analysed;  // unless the caller's fits the mesh
+  const TopologyReport& topo =
+      topology && topology_fits(*topology, mesh) ? *topology : (analysed = analyze_topology(mesh));
   FlatMap out;
   out.input_vertices = topo.vertices;
   out.input_faces = topo.faces;

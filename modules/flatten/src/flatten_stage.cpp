@@ -38,12 +38,13 @@ std::string left_out(const FlatSegment& s) {
 }  // namespace
 
 void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
-  const nlohmann::json orientation = orient_mesh_input(bag, "denoised", ctx, "flatten");
-  const Mesh& mesh = bag.get<Mesh>("denoised");
+  // Oriented as orient_mesh_input does; the list and its topology (denoise's, handed on in the
+  // run) go to flatten_colon, which converts and analyses nothing again.
+  OrientedMesh in = oriented_mesh_input(bag, "denoised", ctx, "flatten");
   Stopwatch sw;
-  FlatMap flat = flatten_colon(mesh, opts_);
+  FlatMap flat = flatten_colon(in.triangles, opts_, &in.topology);
   ctx.report = flat_report(flat);
-  ctx.report["orientation"] = orientation;
+  ctx.report["orientation"] = std::move(in.orientation);
   for (const auto& s : flat.skipped) ctx.progress("flatten: skipped " + s);
   ctx.report["flatten_time_s"] = sw.seconds();
   for (const auto& s : flat.segments) {

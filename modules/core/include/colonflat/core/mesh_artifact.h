@@ -29,6 +29,24 @@ inline constexpr const char* kReadOrientationProperty = "colonflat:read_orientat
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage, TopologyReport* topology = nullptr);
 
+// The bag entry in which a stage may leave analyze_topology of its mesh output `port` for the next
+// stage ("<port>.topology", a TopologyReport; denoise leaves its verification's report of
+// "denoised"). Not a port: never written; taken (erased) by oriented_mesh_input.
+std::string topology_entry(const std::string& port);
+
+// A stage's input mesh as orient_mesh_input leaves it, as a triangle list with its topology.
+struct OrientedMesh {
+  TriangleList triangles;      // to_triangle_list of the bag's mesh after orienting (same order)
+  TopologyReport topology;     // analyze_topology(triangles)
+  nlohmann::json orientation;  // OrientationReport::to_json(), as orient_mesh_input returns it
+};
+// orient_mesh_input for a stage that works on a triangle list: the same orientation, notes and
+// bag mesh, and the list and its topology without converting or analysing twice. The topology is
+// the bag's topology_entry(port) when one is there and fits the mesh (topology_fits, topology.h), else a new
+// analysis; the entry is erased either way.
+OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage);
+
 nlohmann::json topology_to_json(const TopologyReport& t);
 nlohmann::json diagnosis_to_json(const MeshDiagnosis& d);
 // Human-readable report, one fact per line.

@@ -57,6 +57,10 @@ struct TopologyReport {
 TopologyReport analyze_topology(const TriangleList& mesh);
 // Topology of an OpenMesh mesh (deleted elements must have been garbage-collected).
 TopologyReport analyze_topology(const Mesh& mesh);
+// Whether `t` (a report handed on with a mesh) can stand for analyze_topology(mesh) without a new
+// analysis: one face_component per triangle, the mesh's face and vertex counts, and (every vertex
+// referenced) its exact bounding box. O(#P); a cheap guard, not a proof (callers vouch for the rest).
+bool topology_fits(const TopologyReport& t, const TriangleList& mesh);
 
 // Conversions between the two representations (same vertex and face order).
 TriangleList to_triangle_list(const Mesh& mesh);

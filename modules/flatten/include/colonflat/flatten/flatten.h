@@ -24,6 +24,7 @@
 
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/soup.h"
+#include "colonflat/core/topology.h"
 
 #include "colonflat/core/params.h"
 namespace cf {
@@ -127,9 +128,11 @@ struct FlatMap {
 // input first with core's orient_outward). Throws PreconditionError naming the component, its
 // size and the cause when a component has genus > 0 ("run denoise first"), more than two boundary
 // loops, is not a manifold or has its normals into the lumen, and when no component is left to
-// flatten (each skipped one named: too small, a cavity's wall).
+// flatten (each skipped one named: too small, a cavity's wall). `topology` (optional):
+// analyze_topology(mesh) when the caller has it (the stage gets it from oriented_mesh_input), used
+// instead of a new analysis when it fits the mesh (core topology_fits); the map is the same.
 FlatMap flatten_colon(const Mesh& mesh, const FlattenOptions& opts = {});
-FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts = {});
+FlatMap flatten_colon(const TriangleList& mesh, const FlattenOptions& opts = {}, const TopologyReport* topology = nullptr);
 
 // Distortion of a flat map's triangles (3D positions vs uv).
 DistortionStats distortion_stats(const FlatMap& flat, int segment = -1);
