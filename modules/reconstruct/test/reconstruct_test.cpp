@@ -216,17 +216,22 @@ TEST(ReconstructGeometry, OutwardNormalsForEveryDirection) {
   }
 }
 
-// A solid torus gives one genus-1 surface, also after smoothing and decimation with every method;
-// decimation reaches about the target face count.
-TEST(ReconstructTopology, TorusIsGenusOneWithEveryMethodAndStep) {
+// A solid torus (ring radius 12 mm, tube radius 4 mm) in a 40 x 40 x 16 mask of 1 x 1 x 1.2 mm voxels.
+MaskImage::Pointer solid_torus() {
   MaskSpec s;
   s.size = {40, 40, 16};
   s.spacing = {1.0, 1.0, 1.2};
   s.origin = {-20, -20, -9};
-  auto m = rasterize(s, [](const std::array<double, 3>& p) {
+  return rasterize(s, [](const std::array<double, 3>& p) {
     const double q = std::sqrt(p[0] * p[0] + p[1] * p[1]) - 12.0;
     return q * q + p[2] * p[2] <= 16.0;
   });
+}
+
+// A solid torus gives one genus-1 surface, also after smoothing and decimation with every method;
+// decimation reaches about the target face count.
+TEST(ReconstructTopology, TorusIsGenusOneWithEveryMethodAndStep) {
+  auto m = solid_torus();
   for (const std::string method : {"flying-edges", "discrete-flying-edges", "marching-cubes"}) {
     ReconstructOptions o = raw();
     o.method = method;
@@ -254,14 +259,7 @@ TEST(ReconstructTopology, TorusIsGenusOneWithEveryMethodAndStep) {
 // returns (the same points, in order, and the same faces, smoothed and faired), and refuses a
 // mesh that is not empty.
 TEST(ReconstructTopology, SurfaceBuiltInTheCallersMeshIsTheReturnedOne) {
-  MaskSpec s;
-  s.size = {40, 40, 16};
-  s.spacing = {1.0, 1.0, 1.2};
-  s.origin = {-20, -20, -9};
-  auto m = rasterize(s, [](const std::array<double, 3>& p) {
-    const double q = std::sqrt(p[0] * p[0] + p[1] * p[1]) - 12.0;
-    return q * q + p[2] * p[2] <= 16.0;
-  });
+  auto m = solid_torus();
   const ReconstructOptions o;  // (no decimation: OpenMesh's multiple-choice decimater samples with rand())
   const Mesh a = reconstruct_surface(m, o);
   Mesh b;
