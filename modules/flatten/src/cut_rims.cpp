@@ -262,14 +262,16 @@ std::size_t count_not_positive(const SegmentWork& w) {
   return n;
 }
 
-// One rim widened by its plan, unless a face would fold (then nothing moves). Returns whether it moved.
-bool widen_rim(SegmentWork& w, const RimShape& h, double ratio, const std::vector<char>& ends, const FlattenOptions& o) {
+// One rim widened by its plan, unless a face would fold (then nothing moves); `scale`: the band's
+// area scale (band_area_scale, every face). Returns whether it moved.
+bool widen_rim(SegmentWork& w, const RimShape& h, double ratio, double scale, const std::vector<char>& ends,
+               const FlattenOptions& o) {
   RadialPlan plan{h.centre, std::sqrt(o.area_ratio_low) / ratio, {}, {}};
   const double r1 = room_about(w, h.centre, ends);
   if (!(r1 > plan.s * h.reach)) return false;
   const std::size_t n = std::size_t(std::ceil((r1 - h.reach) / kRingWidth));
   for (std::size_t i = 0; i <= n; ++i) plan.r.push_back(h.reach + (r1 - h.reach) * double(i) / double(n));
-  if (!fit_rings(plan, ring_ratios(w, plan, band_area_scale(w, nullptr)), o.area_ratio_low)) return false;
+  if (!fit_rings(plan, ring_ratios(w, plan, scale), o.area_ratio_low)) return false;
   const std::vector<V2> before = w.emb.pos;
   const std::size_t folded = count_not_positive(w);
   apply_plan(w.emb, plan);
@@ -283,12 +285,16 @@ bool widen_rim(SegmentWork& w, const RimShape& h, double ratio, const std::vecto
 std::vector<char> widen_short_rims(SegmentWork& w, const CutRims& rims, const std::vector<char>& freed,
                                    const std::vector<char>& ends, const FlattenOptions& o) {
   std::vector<char> widened(rims.loops.size(), 0);
+  // The rims' map segments and the band's area scale, measured again only after a rim moved the map.
+  std::vector<RimSegment> seg = rim_segments(w, rims);
+  double scale = band_area_scale(w, nullptr);
   for (std::size_t r = 0; r < rims.loops.size(); ++r) {
     if (freed[r]) continue;  // the passes move it
-    const RimShape h = rim_shape(w, rim_segments(w, rims), rims.loops[r]);  // (after the rims widened before)
-    const double ratio = std::sqrt(band_area_scale(w, nullptr)) * h.length / h.length3;  // map / 3D length
+    const RimShape h = rim_shape(w, seg, rims.loops[r]);
+    const double ratio = std::sqrt(scale) * h.length / h.length3;  // map / 3D length
     if (h.wraps || h.length3 < kLongRim * w.emb.period || ratio * ratio >= o.area_ratio_low) continue;
-    widened[r] = widen_rim(w, h, ratio, ends, o);
+    widened[r] = widen_rim(w, h, ratio, scale, ends, o);
+    if (widened[r]) seg = rim_segments(w, rims), scale = band_area_scale(w, nullptr);
     if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
       std::fprintf(stderr, "flatten debug rim %zu widened: %.0f mm in 3D, %.0f in the map (x %.3f), centre %.1f %.1f, reach %.1f mm: %s\n",
                    r, h.length3, h.length, std::sqrt(o.area_ratio_low) / ratio, h.centre.x(), h.centre.y(), h.reach,
