@@ -201,8 +201,6 @@ std::vector<double> choose_axis(SegmentWork& w, const Centreline& cl, double ban
 // (kWholeBandAreaLow, kWholeBandAreaHigh, kWholeBandQcMean: whole_band_stop.h)
 struct CorrectionNeed {
   bool global = false, local = false;
-  bool area = false;  // the area ratios are out of the whole band's margins
-  double qc_mean = 0;
   BoundStats all;      // over the faces in the map
   double hidden = 0;   // fraction of the wall shown below coverage_min_ratio
 };
@@ -224,10 +222,8 @@ static CorrectionNeed needs_correction(const SegmentWork& w, const std::vector<c
     if (!d.degenerate && d.area2 * a3 < o.coverage_min_ratio * d.area3 * a2) hidden += d.area3;
   // the faces out of the map are left out, as measure() does
   const BoundStats st = bound_stats_in_map(fd, &use.ratio);
-  const double p05 = st.area_p05, p95 = st.area_p95, qc_mean = st.qc_mean;
-  const bool area = p05 < kWholeBandAreaLow || p95 > kWholeBandAreaHigh;
-  return {area || qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, area, qc_mean, st,
-          a3 > 0 ? hidden / a3 : 0.0};
+  const bool area = st.area_p05 < kWholeBandAreaLow || st.area_p95 > kWholeBandAreaHigh;
+  return {area || st.qc_mean > kWholeBandQcMean, hidden > kHiddenWallTolerance * a3, st, a3 > 0 ? hidden / a3 : 0.0};
 }
 
 // When the whole-band pass has done its job, asked after each of its steps: WholeBandStop
