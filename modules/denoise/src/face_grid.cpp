@@ -326,11 +326,12 @@ bool segment_hits_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Ve
   return ray_triangle(p, q - p, a, b, c) <= 1.0;
 }
 
-// Improper intersection of two triangles (ids = mesh vertex ids): disjoint ones by VTK's
-// triangle test; sharing one vertex v: an edge of one pierces the other away from v; sharing an
-// edge: the two fold flat onto each other.
-bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p, const std::array<int, 3>& gids,
-                           const std::array<Vec3, 3>& q) {
+}  // namespace
+
+// Disjoint triangles by VTK's triangle test; sharing one vertex v: an edge of one pierces the
+// other away from v; sharing an edge: the two fold flat onto each other.
+bool triangles_intersect_improperly(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
+                                    const std::array<int, 3>& gids, const std::array<Vec3, 3>& q) {
   int shared = 0, ia = -1, ib = -1;
   for (int i1 = 0; i1 < 3; ++i1)
     for (int i2 = 0; i2 < 3; ++i2)
@@ -354,7 +355,6 @@ bool improper_intersection(const std::array<int, 3>& ids, const std::array<Vec3,
   if (na.norm() == 0 || nb.norm() == 0) return false;
   return OpenMesh::dot(na, nb) / (na.norm() * nb.norm()) < -0.9999999;
 }
-}  // namespace
 
 bool FaceGrid::segment_hits(const Mesh& mesh, int a, int b) const {
   const Vec3 p = mesh.point(Mesh::VertexHandle(a)), q = mesh.point(Mesh::VertexHandle(b));
@@ -396,13 +396,13 @@ double FaceGrid::free_distance(const Mesh& mesh, const Vec3& origin, const Vec3&
 }
 
 std::size_t FaceGrid::count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces,
-                                          std::size_t stop_at) const {
-  return intersecting_pairs(mesh, faces, stop_at).size();
+                                          std::size_t stop_at, const PairFilter& skip) const {
+  return intersecting_pairs(mesh, faces, stop_at, skip).size();
 }
 
 std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
                                                               const std::vector<Mesh::FaceHandle>& faces,
-                                                              std::size_t stop_at) const {
+                                                              std::size_t stop_at, const PairFilter& skip) const {
   std::vector<std::pair<int, int>> pairs;
   if (stop_at == 0) return pairs;
   std::unordered_set<int> in_set;
@@ -429,7 +429,7 @@ std::vector<std::pair<int, int>> FaceGrid::intersecting_pairs(const Mesh& mesh,
       face_box(mesh, g, glo, ghi, gids, q);
       if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
         continue;
-      if (improper_intersection(ids, p, gids, q)) {
+      if (triangles_intersect_improperly(ids, p, gids, q) && !(skip && skip(f.idx(), gi))) {
         pairs.emplace_back(f.idx(), gi);
         if (pairs.size() >= stop_at) return pairs;
       }
@@ -455,7 +455,7 @@ std::size_t FaceGrid::grid_hits(const Mesh& mesh, const std::array<int, 3>& ids,
     face_box(mesh, Mesh::FaceHandle(gi), glo, ghi, gids, q);
     if (glo[0] > hi[0] || glo[1] > hi[1] || glo[2] > hi[2] || ghi[0] < lo[0] || ghi[1] < lo[1] || ghi[2] < lo[2])
       return false;
-    return improper_intersection(ids, p, gids, q);
+    return triangles_intersect_improperly(ids, p, gids, q);
   };
   if (first_only) {
     if (std::any_of(big_.begin(), big_.end(), hit)) return 1;
@@ -476,7 +476,7 @@ std::size_t FaceGrid::count_triangles(const Mesh& mesh, const std::vector<std::a
   for (std::size_t t = 0; t < tris.size(); ++t) {
     count += grid_hits(mesh, tris[t], pts[t], false);
     for (std::size_t u = t + 1; u < tris.size(); ++u)
-      if (improper_intersection(tris[t], pts[t], tris[u], pts[u])) ++count;
+      if (triangles_intersect_improperly(tris[t], pts[t], tris[u], pts[u])) ++count;
   }
   return count;
 }
@@ -492,7 +492,7 @@ bool FaceGrid::hits(const Mesh& mesh, const std::array<int, 3>& tri,
     for (int a = 0; a < 3 && !apart; ++a)
       apart = std::min({q[0][a], q[1][a], q[2][a]}) > std::max({p[0][a], p[1][a], p[2][a]}) ||
               std::max({q[0][a], q[1][a], q[2][a]}) < std::min({p[0][a], p[1][a], p[2][a]});
-    if (!apart && improper_intersection(tri, p, o, q)) return true;
+    if (!apart && triangles_intersect_improperly(tri, p, o, q)) return true;
   }
   return grid_hits(mesh, tri, p, true) > 0;
 }

@@ -10,6 +10,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/vertex_stamps.h"
+#include "colonflat/denoise/face_grid.h"
 #include "denoise_debug.h"
 #include "surgery_steps.h"
 
@@ -19,6 +20,8 @@ namespace detail {
 
 SurgeryResult Surgery::run() {
   check_loop();
+  first_new_vertex_ = static_cast<int>(mesh_.n_vertices());
+  first_new_face_ = static_cast<int>(mesh_.n_faces());
   gather_left_side();
   record_undo();
   add_left_copies();
@@ -39,6 +42,39 @@ SurgeryResult Surgery::run() {
     std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s, concentric %.2f s\n",
                  k_, cap_kind_, result_.intersections, t_tri, sw.seconds() - t_tri);
   return result_;
+}
+
+// Face f (older than the surgery) as it was before the cut: a left copy (ids from
+// first_new_vertex_, in loop order) is the loop vertex it copies, and ring vertices are where the
+// loop was; no other old vertex moves.
+void Surgery::original_triangle(int f, std::array<int, 3>* ids, std::array<Vec3, 3>* p) const {
+  int i = 0;
+  for (auto v : mesh_.fv_range(Mesh::FaceHandle(f))) {
+    int id = v.idx();
+    std::size_t at = k_;
+    if (id >= first_new_vertex_ && id < first_new_vertex_ + static_cast<int>(k_)) {
+      at = static_cast<std::size_t>(id - first_new_vertex_);
+      id = loop_[at].idx();
+    } else {
+      at = static_cast<std::size_t>(std::find(loop_.begin(), loop_.end(), v) - loop_.begin());
+    }
+    (*ids)[i] = id;
+    (*p)[i++] = at < k_ ? original_[at] : mesh_.point(v);
+  }
+}
+
+bool Surgery::intersected_before(int f, int g) const {
+  if (f >= first_new_face_ || g >= first_new_face_) return false;
+  std::array<int, 3> a, b;
+  std::array<Vec3, 3> p, q;
+  original_triangle(f, &a, &p);
+  original_triangle(g, &b, &q);
+  return triangles_intersect_improperly(a, p, b, q);
+}
+
+std::size_t Surgery::new_pairs(const std::vector<Mesh::FaceHandle>& faces, std::size_t stop_at) const {
+  return opts_.guard->count_intersections(mesh_, faces, stop_at,
+                                          [this](int f, int g) { return intersected_before(f, g); });
 }
 
 // Preconditions: simple, >= 3 vertices, no boundary vertex, consecutive vertices share an edge.

@@ -180,7 +180,7 @@ std::vector<Surgery::Placement> Surgery::placements() const {
 bool Surgery::place_checked(const Placement& tr) {
   place_rings(tr.pull, tr.along_edge ? edge_left_ : target_left_, tr.along_edge ? edge_right_ : target_right_);
   for (auto f : ring_faces_) opts_.guard->insert(mesh_, f);
-  return opts_.guard->count_intersections(mesh_, ring_faces_, 1) == 0;
+  return new_pairs(ring_faces_, 1) == 0;
 }
 
 // 7a. With a guard, loops up to kMaxTriangulatedLoop vertices first try minimum-area
@@ -394,7 +394,7 @@ void Surgery::search_concentric_placement() {
     for (auto f : moving) opts_.guard->insert(mesh_, f);
   };
   refresh();
-  std::size_t best = opts_.guard->count_intersections(mesh_, moving);
+  std::size_t best = new_pairs(moving);
   double best_pull = opts_.ring_pull, best_dome = 0;
   if (best > 0 && k_ <= kMaxTriangulatedLoop && !opts_.trial) {
     double radius = 0, edge = 0;
@@ -406,7 +406,7 @@ void Surgery::search_concentric_placement() {
         place_concentric(pull, dome);
         refresh();
         // Only n < best matters; probing, only n == 0 (the first pair ends the count).
-        const std::size_t n = opts_.guard->count_intersections(mesh_, moving, opts_.probe_concentric ? 1 : best);
+        const std::size_t n = new_pairs(moving, opts_.probe_concentric ? 1 : best);
         if (n < best && (n == 0 || !opts_.probe_concentric)) {
           best = n;
           best_pull = pull;

@@ -62,6 +62,15 @@ class Surgery {
   };
   std::vector<Placement> placements() const;
   bool place_checked(const Placement& tr);
+  // Crossings the input already had (surgery.cpp). The cap checks count only pairs this surgery
+  // makes: a pair of faces older than it that intersected before the cut (the surface's own
+  // crossings, e.g. the folds of a mask grown until its walls fuse) is not the caps' doing, and
+  // no placement can remove it.
+  bool intersected_before(int f, int g) const;
+  void original_triangle(int f, std::array<int, 3>* ids, std::array<Vec3, 3>* p) const;
+  // Intersecting pairs of `faces` (inserted in the guard at their current place) that are not
+  // intersected_before(), at most stop_at.
+  std::size_t new_pairs(const std::vector<Mesh::FaceHandle>& faces, std::size_t stop_at = SIZE_MAX) const;
   bool try_triangulated_caps();
   bool mirror_cap(const std::vector<std::array<int, 3>>& right, std::vector<std::array<int, 3>>* left);
   void add_triangulated_caps(const std::vector<std::array<int, 3>>& right, const std::vector<std::array<int, 3>>& left);
@@ -136,6 +145,7 @@ class Surgery {
   HomologyBasis* homology_;
   const std::size_t k_;
   const int words_;
+  int first_new_vertex_ = 0, first_new_face_ = 0;  // the mesh's counts before the cut (elements are only appended)
   std::vector<Mesh::HalfedgeHandle> loop_halfedges_;       // h_i: loop_i -> loop_(i+1), left face = left side
   std::vector<std::vector<Mesh::HalfedgeHandle>> fan_;     // interior outgoing halfedges of each left fan
   std::vector<Mesh::FaceHandle> left_faces_;               // faces left of some h_i

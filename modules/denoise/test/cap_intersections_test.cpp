@@ -8,6 +8,7 @@
 #include "bench_meshes.h"
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/denoise.h"
+#include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/surgery.h"
 #include "self_intersections.h"
@@ -253,6 +254,83 @@ TEST(DenoiseCapIntersections, UncappableLoopIsReportedAndStrictFails) {
   DenoiseOptions strict;
   strict.strict = true;
   EXPECT_THROW(denoise(m, strict), Error);
+}
+
+// A torus (R 4 mm, tube 1 mm, 48 sections of 16 points) with a waist at section 7 (radius 0.85:
+// the shortest loop is that meridian, vertices [7 * 16, 8 * 16)), and a thin spike (a tetrahedron,
+// its own component) piercing the wall between sections 7 and 8 from outside, its tip 0.04 mm
+// inside: the input crosses itself at a face around the meridian, as the folds of a mask grown
+// until its walls fuse do at their tiny tunnels (issue 26: 946 such pairs on the real mask grown
+// by one voxel), away from any disk of the meridian. Sets *first_new_face to the face count.
+Mesh waisted_torus_with_piercing_spike(int* first_new_face) {
+  constexpr int kN = 16, kNu = 48;
+  std::vector<std::array<double, 2>> circle;
+  for (int j = 0; j < kN; ++j) circle.push_back({std::cos(2 * kPi * j / kN), std::sin(2 * kPi * j / kN)});
+  TriangleList t = testing::swept_profile(circle, kNu, 0, 4);
+  for (int i = 0; i < kNu; ++i) {
+    const double d = std::min(std::abs(i - 7), kNu - std::abs(i - 7)), s = 1 - 0.15 * std::exp(-d * d / 4);
+    const Vec3 c(4 * std::cos(2 * kPi * i / kNu), 4 * std::sin(2 * kPi * i / kNu), 0);
+    for (int j = 0; j < kN; ++j) {
+      auto& p = t.points[i * kN + j];
+      for (int a = 0; a < 3; ++a) p[a] = c[a] + s * (p[a] - c[a]);
+    }
+  }
+  auto at = [&](int i, int j) { const auto& p = t.points[i * kN + j]; return Vec3(p[0], p[1], p[2]); };
+  const Vec3 wall = 0.2 * (at(7, 4) + at(7, 5)) + 0.3 * (at(8, 4) + at(8, 5));  // 0.6 of the way to section 8
+  const Vec3 axis = 0.5 * (at(7, 4) + at(8, 5) - at(7, 12) - at(8, 13));      // across the tube: outward
+  const Vec3 out = axis / axis.norm(), side = OpenMesh::cross(out, Vec3(0, 0, 1)).normalized(),
+             up = OpenMesh::cross(out, side);
+  const Vec3 tip = wall - 0.04 * out, base = wall + 0.3 * out;
+  std::vector<Vec3> spike{tip};
+  for (int k = 0; k < 3; ++k)
+    spike.push_back(base + 0.08 * (std::cos(2 * kPi * k / 3) * side + std::sin(2 * kPi * k / 3) * up));
+  const Vec3 centre = 0.25 * (spike[0] + spike[1] + spike[2] + spike[3]);
+  const int o = static_cast<int>(t.points.size());
+  for (const Vec3& p : spike) t.points.push_back({p[0], p[1], p[2]});
+  for (std::array<int, 3> f : {std::array<int, 3>{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 3, 2}}) {
+    const Vec3 n = OpenMesh::cross(spike[f[1]] - spike[f[0]], spike[f[2]] - spike[f[0]]);
+    if (OpenMesh::dot(n, spike[f[0]] - centre) < 0) std::swap(f[1], f[2]);  // outward
+    t.triangles.push_back({o + f[0], o + f[1], o + f[2]});
+  }
+  Mesh m = synthetic::to_mesh(t);
+  *first_new_face = static_cast<int>(m.n_faces());
+  return m;
+}
+
+// The cap checks count only crossings the surgery makes (issue 26, session 28): with the input
+// crossing itself at a face around the shortest loop (a spike through the wall next to it), that
+// loop itself is cut and capped with triangulated caps and 0 pairs, not replaced (before, every
+// placement failed on the spike's pairs, which no cap can remove, and a loop elsewhere was cut); by
+// CGAL, no cap face intersects anything and the input's own crossings are all that is left;
+// genus 0 per component; 1 and 2 threads give the same loops and mesh.
+TEST(DenoiseCapIntersections, CrossingsTheInputHadAreNotTheCaps) {
+  int first_new_face = 0;
+  const Mesh m = waisted_torus_with_piercing_spike(&first_new_face);
+  const std::size_t input_pairs = testing::count_self_intersections(m);
+  ASSERT_GT(input_pairs, 0u) << "the spike must pierce the wall";
+  set_thread_count(1);
+  const DenoiseResult r = denoise(m, DenoiseOptions{});
+  ASSERT_EQ(r.loops.size(), 1u);
+  const double waist = 2 * kPi * 0.85;
+  EXPECT_NEAR(r.loops[0].length, waist, 0.05 * waist) << "the waist meridian itself";
+  std::vector<int> expected_ids;
+  for (int j = 0; j < 16; ++j) expected_ids.push_back(7 * 16 + j);
+  std::vector<int> ids = r.loops[0].vertex_ids;
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(ids, expected_ids);
+  EXPECT_EQ(r.loops[0].cap_intersections, 0u);
+  EXPECT_EQ(r.report["search"]["loops_replaced_for_clean_caps"], 0);
+  const auto pairs = testing::self_intersecting_pairs(r.mesh);
+  for (const auto& [f, g] : pairs) EXPECT_LT(g, first_new_face) << "cap face " << g << " crosses face " << f;
+  EXPECT_EQ(pairs.size(), input_pairs);
+  for (const auto& c : analyze_topology(r.mesh).components) EXPECT_EQ(c.genus, 0);
+  set_thread_count(2);
+  const DenoiseResult two = denoise(m, DenoiseOptions{});
+  set_thread_count(0);
+  ASSERT_EQ(two.loops.size(), 1u);
+  EXPECT_EQ(two.loops[0].vertex_ids, r.loops[0].vertex_ids);
+  ASSERT_EQ(two.mesh.n_vertices(), r.mesh.n_vertices());
+  for (auto v : r.mesh.vertices()) EXPECT_EQ(two.mesh.point(v), r.mesh.point(v)) << v.idx();
 }
 
 }  // namespace

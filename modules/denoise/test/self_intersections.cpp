@@ -4,6 +4,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <algorithm>
 #include <iterator>
 #include <vector>
 
@@ -31,12 +32,20 @@ SM to_surface_mesh(const Mesh& mesh, std::vector<SM::Face_index>* face_of = null
 }
 }  // namespace
 
-std::size_t count_self_intersections(const Mesh& mesh) {
-  const SM sm = to_surface_mesh(mesh);
+std::vector<std::pair<int, int>> self_intersecting_pairs(const Mesh& mesh) {
+  std::vector<SM::Face_index> face_of;
+  const SM sm = to_surface_mesh(mesh, &face_of);
+  std::vector<int> id_of(sm.number_of_faces(), -1);
+  for (std::size_t f = 0; f < face_of.size(); ++f) id_of[std::size_t(face_of[f])] = static_cast<int>(f);
   std::vector<std::pair<SM::Face_index, SM::Face_index>> pairs;
   CGAL::Polygon_mesh_processing::self_intersections(sm, std::back_inserter(pairs));
-  return pairs.size();
+  std::vector<std::pair<int, int>> out;
+  for (const auto& [a, b] : pairs)
+    out.emplace_back(std::min(id_of[std::size_t(a)], id_of[std::size_t(b)]), std::max(id_of[std::size_t(a)], id_of[std::size_t(b)]));
+  return out;
 }
+
+std::size_t count_self_intersections(const Mesh& mesh) { return self_intersecting_pairs(mesh).size(); }
 
 std::size_t count_self_intersections_in(const Mesh& mesh, const std::vector<std::array<Vec3, 2>>& boxes) {
   std::vector<SM::Face_index> face_of;

@@ -14,6 +14,7 @@
 #include <limits>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -22,6 +23,11 @@
 #include "colonflat/core/mesh.h"
 
 namespace cf {
+
+// The grid's test for two triangles given by mesh vertex ids and points (p[i] the point of
+// ids[i]): true when they intersect beyond the corners or edge they share (rules above).
+bool triangles_intersect_improperly(const std::array<int, 3>& ids, const std::array<Vec3, 3>& p,
+                                    const std::array<int, 3>& gids, const std::array<Vec3, 3>& q);
 
 // A spatial hash of the mesh's triangles, to check new geometry for intersections with the
 // rest of the surface (triangles sharing corners count when they meet beyond those corners).
@@ -37,12 +43,16 @@ class FaceGrid {
   // the mesh no longer has); faces below keep their entries (moved back faces: stale cells only
   // cost time). Costs one pass over the inserted faces' cells, not a rebuild.
   void forget_faces_from(int first);
+  // A pair (f, g) of face ids that a count leaves out when it returns true (called only for
+  // pairs that intersect; an empty filter leaves out nothing).
+  using PairFilter = std::function<bool(int f, int g)>;
   // Pairs (f in `faces`, g any face) that intersect improperly; pairs inside `faces` count once.
   // The count stops at `stop_at` (a result below it is exact): a caller that only compares the
-  // count with a best one so far stops there.
+  // count with a best one so far stops there. Pairs `skip` accepts are not counted.
   // Precondition: every face in `faces` was insert()ed at its current position.
   std::size_t count_intersections(const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces,
-                                  std::size_t stop_at = std::numeric_limits<std::size_t>::max()) const;
+                                  std::size_t stop_at = std::numeric_limits<std::size_t>::max(),
+                                  const PairFilter& skip = {}) const;
   // Intersections of triangles not (yet) in the mesh, given by mesh vertex ids, with the grid's
   // faces and with each other.
   std::size_t count_triangles(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris) const;
@@ -60,7 +70,7 @@ class FaceGrid {
   // The intersecting pairs themselves (same rules as count_intersections; at most `stop_at`).
   std::vector<std::pair<int, int>> intersecting_pairs(
       const Mesh& mesh, const std::vector<Mesh::FaceHandle>& faces,
-      std::size_t stop_at = std::numeric_limits<std::size_t>::max()) const;
+      std::size_t stop_at = std::numeric_limits<std::size_t>::max(), const PairFilter& skip = {}) const;
 
  private:
   struct Key {
