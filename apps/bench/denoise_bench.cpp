@@ -14,6 +14,8 @@
 //             touching loops fuse into more and longer handles; thin necks open), then the defaults;
 //           - the real prone CT ../shared/real/ctc_prone_a.nrrd, segmented and reconstructed with
 //             the defaults (as `colonflat run` does: reconstruct also gets the CT);
+//           - its lumen mask reconstructed from the mask alone, raw, with the defaults, grown
+//             and shrunk by one voxel (the rows of the real mask, for a second real colon);
 //           - the real GCA large-intestine surfaces (../shared/real/*.vtk);
 //           - generated colon-like surfaces at 0.42 mm voxels (bench_meshes.h): limbs touching
 //             over 60, 120 and 180 mm, no contact;
@@ -125,29 +127,32 @@ void built(const std::string& name, const std::function<Mesh()>& build) {
   rows(name, m);
 }
 
+// The rows of one real lumen mask: its raw staircase (no sub-voxel surface, no smoothing or
+// fairing: far more handles), reconstruct's defaults, and the defaults on the mask grown and shrunk
+// by one voxel (mask_variants.h).
+void mask_cases(const std::string& name, const MaskImage* mask) {
+  built(name + " raw", [&] {
+    ReconstructOptions raw;
+    raw.subvoxel = "off";
+    raw.smoothing_iterations = 0;
+    raw.fairing_iterations = 0;
+    return reconstruct_surface(mask, raw);
+  });
+  built(name, [&] { return reconstruct_surface(mask, ReconstructOptions{}); });
+  for (int grow : {1, -1})
+    built(name + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
+          [&] { return reconstruct_surface(bench::grown_mask(mask, grow).GetPointer(), ReconstructOptions{}); });
+}
+
 void real_cases() {
   const fs::path real = fs::path(COLONFLAT_SHARED_DIR) / "real";
   const fs::path mask_file = real / "ctc_lumen_mask_a.nii.gz", ct_file = real / "ctc_prone_a.nrrd";
-  if (fs::exists(mask_file)) {
-    const MaskImage::Pointer mask = read_mask(mask_file);
-    built("real mask raw", [&] {
-      ReconstructOptions raw;  // the binary staircase: no sub-voxel surface, no smoothing or fairing
-      raw.subvoxel = "off";
-      raw.smoothing_iterations = 0;
-      raw.fairing_iterations = 0;
-      return reconstruct_surface(mask.GetPointer(), raw);
-    });
-    built("real mask", [&] { return reconstruct_surface(mask.GetPointer(), ReconstructOptions{}); });
-    for (int grow : {1, -1})
-      built(grow > 0 ? "real mask grown 1 vx" : "real mask shrunk 1 vx",
-            [&] { return reconstruct_surface(bench::grown_mask(mask.GetPointer(), grow).GetPointer(), ReconstructOptions{}); });
-  }
+  if (fs::exists(mask_file)) mask_cases("real mask", read_mask(mask_file).GetPointer());
   if (fs::exists(ct_file)) {
-    built("real CT prone", [&] {
-      const CtImage::Pointer ct = read_ct_volume(ct_file);
-      const MaskImage::Pointer mask = segment_colon(ct.GetPointer());
-      return reconstruct_surface(mask.GetPointer(), ct.GetPointer(), ReconstructOptions{});
-    });
+    const CtImage::Pointer ct = read_ct_volume(ct_file);
+    const MaskImage::Pointer mask = segment_colon(ct.GetPointer());
+    built("real CT prone", [&] { return reconstruct_surface(mask.GetPointer(), ct.GetPointer(), ReconstructOptions{}); });
+    mask_cases("real CT mask", mask.GetPointer());  // the CT's lumen as a mask-only tool reconstructs it
   }
   for (const char* f : {"gca_large_intestine_100k.vtk", "gca_large_intestine_20k.vtk"})
     if (fs::exists(real / f)) rows(std::string("real GCA ") + (std::strstr(f, "100k") ? "100k" : "20k"), load_mesh(real / f).mesh);

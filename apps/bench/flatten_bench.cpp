@@ -9,7 +9,9 @@
 //                            the colon images (with the known polyps) and the candidate JSON.
 //   flatten_bench --real DIR [--cache DIR2] [--map M] [--out DIR3]
 //                            the real cases in DIR (*.nii.gz lumen masks: reconstruct + denoise;
-//                            *.vtk / *.vtp surfaces: denoise; denoised surfaces cached in DIR2,
+//                            *.nrrd CT volumes: segmented with segment's defaults, then as a mask
+//                            (the surface a mask-only tool would give; `colonflat run` reconstructs
+//                            with the CT instead); *.vtk / *.vtp surfaces: denoise; cached in DIR2,
 //                            default /tmp/flatten_bench_cache), flattened with map M: faces,
 //                            coverage, area ratio p05/p95, qc mean/p95, flipped, time, peak memory;
 //                            DIR3 gets colon.png per case. --raw-masks: each mask also as its raw
@@ -43,6 +45,7 @@
 #include "colonflat/core/stage.h"
 #include "colonflat/denoise/denoise_stage.h"
 #include "colonflat/reconstruct/reconstruct_stage.h"
+#include "colonflat/segment/segment_stage.h"
 #include "colonflat/denoise/denoise.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
@@ -174,6 +177,19 @@ std::filesystem::path denoised_real(const std::filesystem::path& in, const std::
   return den;
 }
 
+// The lumen mask of a real CT volume `ct` (segment's defaults), computed once and cached as
+// cache/<stem>_segmented.nii.gz: from there on a mask case like any other.
+std::filesystem::path segmented_mask(const std::filesystem::path& ct, const std::filesystem::path& cache) {
+  std::filesystem::create_directories(cache);
+  const std::string name = ct.filename().string();
+  const auto mask = cache / (name.substr(0, name.find('.')) + "_segmented.nii.gz");
+  if (std::filesystem::exists(mask)) return mask;
+  std::ostringstream o, e;
+  if (cf::make_stage_tool(cf::make_segment_stage)->run({ct.string(), "-o", mask.string(), "-q"}, o, e) != 0)
+    throw std::runtime_error(e.str());
+  return mask;
+}
+
 // One surface of the stress set: its name and how to get it (genus 0, ready to flatten).
 struct StressCase {
   std::string name;
@@ -269,11 +285,13 @@ void stress_table(const StressOptions& so) {
     std::vector<std::filesystem::path> files;
     for (const auto& e : std::filesystem::directory_iterator(so.real)) {
       const std::string n = e.path().filename().string();
-      if (n.find(".nii.gz") != std::string::npos || e.path().extension() == ".vtk" || e.path().extension() == ".vtp")
+      if (n.find(".nii.gz") != std::string::npos || e.path().extension() == ".vtk" || e.path().extension() == ".vtp" ||
+          e.path().extension() == ".nrrd")
         files.push_back(e.path());
     }
     std::sort(files.begin(), files.end());
-    for (const auto& in : files) {
+    for (auto in : files) {
+      if (in.extension() == ".nrrd") in = segmented_mask(in, so.cache);
       const bool mask = in.string().find(".nii.gz") != std::string::npos;
       for (bool raw : {false, true})
         if (!raw || (mask && so.raw_masks))
