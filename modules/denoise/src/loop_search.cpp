@@ -243,10 +243,11 @@ std::vector<std::uint64_t> FundamentalCycleSearch::cycle_class(const std::vector
   return c;
 }
 
-std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop) {
+std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop,
+                                           bool closed) {
   std::vector<std::uint8_t> bits(mesh.n_edges(), 0);
   const std::size_t k = loop.size();
-  for (std::size_t i = 0; i < k; ++i) {
+  for (std::size_t i = closed ? 0 : 1; i + (closed ? 0 : 1) < k; ++i) {
     const auto out = mesh.find_halfedge(loop[i], loop[(i + 1) % k]);
     const auto back = mesh.find_halfedge(loop[i], loop[(i + k - 1) % k]);
     for (auto h = mesh.ccw_rotated_halfedge_handle(out); h != back; h = mesh.ccw_rotated_halfedge_handle(h))

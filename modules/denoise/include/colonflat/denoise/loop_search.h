@@ -126,8 +126,10 @@ class FundamentalCycleSearch {
 // the edges leaving the loop's vertices on its left side, toggled (the loop pushed off into its
 // left faces crosses exactly these; a chord on that side is crossed twice). Shape: one flag per
 // edge id. Precondition: `loop` is a simple edge cycle through interior vertices of an oriented
-// manifold mesh.
-std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);
+// manifold mesh. closed = false: `loop` is an open simple path (its ends toggle nothing), and the
+// sum counts the crossings of a cycle with the path away from its two ends.
+std::vector<std::uint8_t> crossing_cochain(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop,
+                                           bool closed = true);
 
 // Euclidean length of a closed loop.
 double loop_length(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop);
