@@ -24,16 +24,19 @@ namespace cf::detail {
 //     such loops (235-242 vertices) and never found clean caps.
 // If none is, `loop` is cut again and its intersections are reported as before. Precondition:
 // `reduced` = loop's class reduced modulo the span (nonzero). *cut_class receives the class of
-// the loop actually cut. Throws when a cut separates.
+// the loop actually cut, *cut_loop (optional) the loop. Throws when a cut separates.
 SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& loop,
                                        const std::vector<std::uint64_t>& reduced, int iteration,
-                                       std::vector<std::uint64_t>* cut_class) {
+                                       std::vector<std::uint64_t>* cut_class,
+                                       std::vector<Mesh::VertexHandle>* cut_loop) {
+  if (cut_loop) *cut_loop = loop;
   SurgeryResult sr = cut_recorded(loop, iteration, CapAttempt::kFirst);
   if (sr.intersections == 0 || !opts_.check_caps) return sr;
   const double length = st_.loops.back().length;
   const std::size_t intersections = sr.intersections;
   const double delta = std::max(5.0 * st_.mean_edge, length / 8.0);
   auto clean = [&](const std::vector<Mesh::VertexHandle>& other, CapAttempt attempt, int* counter) {
+    if (shortcut_guard_ && !keeps_shortcut(other)) return false;
     sr = cut_recorded(other, iteration, attempt);
     if (sr.intersections > 0) {
       revert_cut(sr);
@@ -41,6 +44,7 @@ SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& lo
     }
     st_.loops.back().replaced_length = length;
     st_.loops.back().replaced_intersections = intersections;
+    if (cut_loop) *cut_loop = other;
     ++*counter;
     return true;
   };
@@ -129,7 +133,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::same_class_loop(const std::vector<M
 
 // The shortest fundamental cycle of value below `limit` (with `cochain`: crossing it oddly,
 // else of a class outside the span; approved by `accept` when given; never entering `avoid`)
-// from up to kFallbackSources of `sources`, spread evenly; empty if none. The sources are
+// from up to `max_sources` of `sources`, spread evenly; empty if none. The sources are
 // searched kBatchLanes at a time, each to the best value known before its batch, on the
 // worker's threads; the results are then taken in source order, a strictly shorter one
 // replacing the best. A search to a higher limit finds the same shortest cycle through its
@@ -139,9 +143,10 @@ std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vec
                                                                   double limit,
                                                                   const FundamentalCycleSearch::Accept* accept,
                                                                   const std::vector<std::uint8_t>* cochain,
-                                                                  const std::vector<std::uint8_t>* avoid) {
+                                                                  const std::vector<std::uint8_t>* avoid,
+                                                                  std::size_t max_sources) {
   std::vector<Mesh::VertexHandle> picked;
-  const std::size_t stride = std::max<std::size_t>(1, sources.size() / kFallbackSources);
+  const std::size_t stride = std::max<std::size_t>(1, sources.size() / std::max<std::size_t>(1, max_sources));
   for (std::size_t i = 0; i < sources.size(); i += stride) picked.push_back(sources[i]);
   const int lanes = search_lanes(kBatchLanes);
   double best = limit;

@@ -13,6 +13,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/denoise/loop_search.h"
 #include "denoise_internal.h"
+#include "exact_shortcut.h"
 #include "search_worker.h"
 
 namespace cf::detail {
@@ -129,12 +130,14 @@ class ExactGreedy {
   static constexpr std::size_t kBatchLanes = 2;
   // exact_fallback.cpp
   SurgeryResult cut_cleanly(const std::vector<Mesh::VertexHandle>& loop, const std::vector<std::uint64_t>& reduced,
-                            int iteration, std::vector<std::uint64_t>* cut_class);
+                            int iteration, std::vector<std::uint64_t>* cut_class,
+                            std::vector<Mesh::VertexHandle>* cut_loop = nullptr);
   std::vector<Mesh::VertexHandle> crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit);
   std::vector<Mesh::VertexHandle> shortest_from_spread(const std::vector<Mesh::VertexHandle>& sources, double limit,
                                                        const FundamentalCycleSearch::Accept* accept,
                                                        const std::vector<std::uint8_t>* cochain,
-                                                       const std::vector<std::uint8_t>* avoid);
+                                                       const std::vector<std::uint8_t>* avoid,
+                                                       std::size_t max_sources = kFallbackSources);
   SurgeryResult cut_recorded(const std::vector<Mesh::VertexHandle>& loop, int iteration,
                              CapAttempt attempt = CapAttempt::kFull);
   void revert_cut(const SurgeryResult& sr);
@@ -150,6 +153,25 @@ class ExactGreedy {
   static constexpr double kNearTubeEdges[] = {2.0, 4.0};
   static constexpr double kRerouteFactor = 2.0;  // Z's reroute searched to 2 |Z| (docs/denoise.md)
   static constexpr double kBestFactor = 2.0;  // search limit once a loop of value U is known: 2U (4U measured worse)
+  // exact_shortcut.cpp ("shortcut first", exact_shortcut.h)
+  bool shortcut_gate(const std::vector<Mesh::VertexHandle>& pick);
+  SurgeryResult shortcut_first(const SurgeryResult& done, int iteration, const std::vector<Mesh::VertexHandle>& pick,
+                               std::vector<Mesh::VertexHandle>* loop, std::vector<std::uint64_t>* cut_class);
+  std::vector<Mesh::VertexHandle> across_path(const ShortcutTest& t, double length);
+  std::vector<Mesh::VertexHandle> loop_across(const std::vector<Mesh::VertexHandle>& path, double limit, double spacing);
+  std::vector<int> shortcut_ids(const std::vector<Mesh::VertexHandle>& loop) const;
+  bool lengthens(const ShortcutTest& t) const;
+  bool keeps_shortcut(const std::vector<Mesh::VertexHandle>& loop);  // its cut lengthens d
+  // Sources of loop_across() along the path every this many times the pick's length: the loop
+  // found through the nearest source is at most that much longer than the loop across (an eighth:
+  // ~11 mm for a 90 mm girth), and the path of a grown real mask (1-2 m) gets ~100-200 sources.
+  static constexpr double kShortcutSpacing = 0.125;
+  std::unique_ptr<ShortcutPaths> shortcut_;  // built at the first wide handle pick
+  // The loop being cut replaces a wide pick: a loop cut_cleanly() tries instead of it (caps) must
+  // lengthen d as well (the same class modulo the cuts holds the bypassed girth).
+  bool shortcut_guard_ = false;
+  int shortcut_tests_ = 0, shortcut_replaced_ = 0;
+  double shortcut_s_ = 0;
   // exact_method.cpp
   double search_limit(int slot);
   CycleCandidate search_from(int slot, double limit);

@@ -185,14 +185,18 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
 void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
   set_bound(slot, SourceBound{0, false, -1, 0});  // searched again after the surgery
   last_cut_value_ = c.value;
-  const std::vector<Mesh::VertexHandle> loop = search_->extract(c);
-  std::vector<std::uint64_t> cls = search_->cycle_class(loop);
+  const std::vector<Mesh::VertexHandle> pick = search_->extract(c);
+  std::vector<Mesh::VertexHandle> loop;  // the loop cut
+  std::vector<std::uint64_t> cls = search_->cycle_class(pick);
   std::vector<std::uint64_t> reduced = cls;
   if (span_.reduce(reduced.data())) throw Error("denoise: internal error: a chosen loop's class was already cut");
-  const int comp = st_.component[loop.front().idx()];
+  const int comp = st_.component[pick.front().idx()];
   const double surgery0 = st_.t.surgery;
-  const SurgeryResult sr = cut_cleanly(loop, reduced, iteration, &cls);
+  const bool wide = shortcut_gate(pick);
+  SurgeryResult sr = cut_cleanly(pick, reduced, iteration, &cls, &loop);
+  if (wide) sr = shortcut_first(sr, iteration, pick, &loop, &cls);  // may cut another loop instead
   if (denoise_debug()) debug_cut(iteration, st_.t.surgery - surgery0);
+  if (shortcut_) shortcut_->block(shortcut_ids(loop));
   span_.insert(cls.data());  // the class of the loop cut (a same-class replacement: the same span)
   --st_.genus_left[comp];
   if (crossing_) return;  // back to the span family on the new mesh
@@ -252,6 +256,9 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["first_search_radius_mm"] = first_radius_;
   stats["largest_search_limit_mm"] = largest_limit_;
   stats["sources_last"] = active_.size();
+  stats["shortcut_tests"] = shortcut_tests_;
+  stats["shortcut_loops_replaced"] = shortcut_replaced_;
+  stats["shortcut_seconds"] = shortcut_s_;
   stats["schedule"] = "per-source limits, bounds shared within each search ball; crossing families at genus 1";
 }
 
