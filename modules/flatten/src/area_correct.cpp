@@ -407,17 +407,22 @@ class PieceLog {
   PieceLog(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
            const FlattenOptions& o, const std::vector<std::vector<int>>& pieces)
       : s_(s), emb_(emb), area3_(area3), scale_(scale), o_(o), pieces_(pieces) {
-    for (const std::vector<int>& p : pieces_) hidden_before_.push_back(area_below(p, o_.coverage_min_ratio));
+    for (const std::vector<int>& p : pieces_) {
+      hidden_before_.push_back(area_below(p, o_.coverage_min_ratio));
+      double a2 = 0, a3 = 0;
+      for (int f : p) a2 += scale_ * std::max(emb_.area2(s_, f), 0.0), a3 += area3_[f];
+      room_.push_back(a3 > 0 ? a2 / a3 : 1.0);
+    }
   }
   void print(const std::vector<AreaCorrection>& part, const std::vector<CorrectionTimes>& times,
              const std::vector<std::size_t>& place, const std::vector<SpotWork>& spots) const {
     for (std::size_t i = 0; i < part.size(); ++i)
       std::fprintf(stderr, "flatten debug local piece %zu (started %zu-th): %zu faces, %d steps of %d, %s, %.3f s; "
-                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps\n",
+                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps; room %.3f\n",
                    i, place[i] + 1, pieces_[i].size(), part[i].iterations,
                    iteration_budget(pieces_[i].size(), true, o_.area_correction_iterations), part[i].stop,
                    times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i], area_below(pieces_[i], o_.coverage_min_ratio),
-                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps);
+                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps, room_[i]);
   }
 
  private:
@@ -430,7 +435,7 @@ class PieceLog {
   double scale_;
   const FlattenOptions& o_;
   std::vector<std::vector<int>> pieces_;  // a copy: the pieces are moved into their tasks
-  std::vector<double> hidden_before_;
+  std::vector<double> hidden_before_, room_;  // room: the piece's map area at the band's scale / its 3D area
 };
 
 }  // namespace

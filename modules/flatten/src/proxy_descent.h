@@ -12,6 +12,8 @@
 // Every per-face loop runs on all worker threads in fixed blocks (face_blocks.h): the steps are
 // the same for any thread count.
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 
 #include "colonflat/core/run_stats.h"
@@ -40,6 +42,37 @@ class CornerGather {
 
  private:
   std::vector<int> start_, corner_;  // unknown u's corners (3 i + k): corner_[start_[u] .. start_[u + 1])
+};
+
+// COLONFLAT_FLATTEN_DEBUG_DESCENT=N: one stderr line per step taken by every descent over exactly N
+// faces (a local piece's face count, as its "local piece" debug line gives it): the step length as a
+// fraction of the proxy's full step, the energy, its relative gain, and the judged faces' smallest map /
+// 3D area ratio (the map unscaled) with how many are below 1e-3. It tells a piece's ramp (crushed faces
+// growing at a bounded factor a step) from its tail (a step length held by the fold-free cut while the
+// energy creeps down): docs/flatten.md, session 28 "localpass". Reads the map only.
+class DescentTrace {
+ public:
+  explicit DescentTrace(std::size_t faces) {
+    const char* want = std::getenv("COLONFLAT_FLATTEN_DEBUG_DESCENT");
+    on_ = want && std::strtoull(want, nullptr, 10) == faces;
+    faces_ = faces;
+  }
+  void step(const Surface& s, const Embedding& emb, const std::vector<int>& judged, const std::vector<double>& area3,
+            int step, double t, double energy, double gain) const {
+    if (!on_) return;
+    double least = 1e300;
+    std::size_t below = 0;
+    for (int f : judged) {
+      const double r = emb.area2(s, f) / std::max(area3[f], 1e-300);
+      least = std::min(least, r), below += r < 1e-3;
+    }
+    std::fprintf(stderr, "flatten debug descent %zu faces, step %d: t %.3g, energy %.8g, gain %.3g, least ratio %.3g, "
+                 "%zu below 1e-3\n", faces_, step, t, energy, gain, least, below);
+  }
+
+ private:
+  bool on_ = false;
+  std::size_t faces_ = 0;
 };
 
 // At most `max_steps` steps moving the unknowns of `sys` in emb.pos; stops when E gains less than
@@ -106,6 +139,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     spent.solve += clock.lap();
   };
   bool ready = false;  // g and d are the next step's (computed beside the last check)
+  const DescentTrace trace(energy.faces().size());
   for (; res.steps < max_steps; ++res.steps) {
     if (!ready) direction();
     ready = false;
@@ -132,6 +166,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     }
     for (int v : unknowns) emb.pos[v] = trial[v];
     const double gain = (e0 - e1) / e0;
+    trace.step(s, emb, judged, area3, res.steps, t, e1, gain);
     e0 = res.energy_after = e1;
     if (!(gain > min_gain)) {
       res.stop = "converged";

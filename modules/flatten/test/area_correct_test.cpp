@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -158,6 +160,30 @@ TEST(AreaCorrection, WholeBandStopCheckBesideTheNextSolveSeesTheSameSteps) {
   set_thread_count(0);
   for (std::size_t k = 0; k < checks; ++k) EXPECT_TRUE(same(seen[0][k], seen[1][k])) << k;
   EXPECT_TRUE(same(final_pos[0], final_pos[1]));
+}
+
+// COLONFLAT_FLATTEN_DEBUG_DESCENT=N traces every step of a descent over N faces (one stderr line a
+// step taken, the last "converged" one included) and only reads the map: the traced pass ends on the
+// same positions, bit for bit, as the same pass untraced.
+TEST(AreaCorrection, TracedDescentPrintsEachStepAndLeavesTheMapAsItIs) {
+  FlattenOptions o;
+  SqueezedGrid plain, traced;
+  const flat_detail::AreaCorrection r =
+      flat_detail::correct_area(plain.s, plain.vf, plain.emb, plain.fixed, plain.degenerate, false, o);
+  ASSERT_GT(r.iterations, 1);
+  setenv("COLONFLAT_FLATTEN_DEBUG_DESCENT", std::to_string(r.faces).c_str(), 1);
+  ::testing::internal::CaptureStderr();
+  const flat_detail::AreaCorrection t =
+      flat_detail::correct_area(traced.s, traced.vf, traced.emb, traced.fixed, traced.degenerate, false, o);
+  const std::string out = ::testing::internal::GetCapturedStderr();
+  unsetenv("COLONFLAT_FLATTEN_DEBUG_DESCENT");
+  std::size_t lines = 0;
+  for (std::size_t at = out.find("flatten debug descent"); at != std::string::npos; at = out.find("flatten debug descent", at + 1))
+    ++lines;
+  EXPECT_EQ(t.iterations, r.iterations);
+  EXPECT_EQ(lines, std::size_t(r.iterations) + (std::string(r.stop) == "converged"));
+  ASSERT_EQ(plain.emb.pos.size(), traced.emb.pos.size());
+  EXPECT_EQ(std::memcmp(plain.emb.pos.data(), traced.emb.pos.data(), plain.emb.pos.size() * sizeof(flat_detail::V2)), 0);
 }
 
 // The local pieces start in the order of their work bound (faces x steps allowed), the largest
