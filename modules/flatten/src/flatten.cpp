@@ -15,6 +15,7 @@
 #include "colonflat/core/progress.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
+#include "branch_bands.h"
 #include "factor_memory.h"
 #include "flatten_internal.h"
 
@@ -198,58 +199,20 @@ void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const
   w.seg.period = w.emb.period;
 }
 
-double surface_area(const Surface& s) {
-  double a = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) a += face_area_3d(s, int(f));
-  return a;
-}
-
 constexpr int kMaxBranchDepth = 3;  // branches of branches of branches
 std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
                                          const FlattenOptions& o, int depth);
 
-// Appends the works of a flattened branch (its own first, parents relative to the list) to `out`,
-// the branch hanging from the work at index -1 (the caller's segment).
-void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out) {
-  const int base = int(out.size());
-  for (std::size_t i = 0; i < sub.size(); ++i) {
-    if (i > 0) sub[i].parent += base;
-    out.push_back(std::move(sub[i]));
-  }
-  out[base].parent = -1;
-}
-
-// One side branch cut off an annulus: its surface and its neck's vertices in what remains.
-struct BranchPiece {
-  Surface surface;
-  std::vector<int> neck;
-  double neck_mm = 0;
-  bool tissue = false;  // holds tissue (a strand stump), not lumen
-};
-
-// Flattens the cut-off branches (each as a band of its own, recursively); returns their works and
-// adds their wall area to `placed`. A branch that cannot be flattened counts as wall not shown.
+// Flattens the cut-off branches (each as a band of its own, recursively, side by side:
+// branch_bands.h); returns their works and adds their wall area to `placed`. A branch that cannot
+// be flattened counts as wall not shown.
 std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces, int component, double lumen_sign,
                                           const FlattenOptions& o, int depth, double& placed) {
   FlattenOptions bo = o;
   bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
-  std::vector<SegmentWork> out;
-  for (const BranchPiece& piece : pieces) {
-    try {
-      std::vector<SegmentWork> sub =
-          flatten_surface(piece.surface, 1, std::size_t(component), lumen_sign, bo, depth + 1);
-      sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
-      sub[0].cap_area = 0;
-      sub[0].seg.neck_mm = piece.neck_mm;
-      sub[0].seg.holds = piece.tissue ? "tissue" : "lumen";
-      sub[0].neck = piece.neck;
-      placed += surface_area(piece.surface);
-      append_branch(sub, out);
-    } catch (const std::exception&) {
-      // not flattenable as a band: its wall counts as not shown
-    }
-  }
-  return out;
+  return flatten_branch_pieces(pieces, [&](const Surface& s) {
+    return flatten_surface(s, 1, std::size_t(component), lumen_sign, bo, depth + 1);
+  }, placed);
 }
 
 // The side branches' works and the wall area the cut leaves in no band (faces dropped at a neck,
@@ -387,7 +350,8 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const Centreline cl = centreline_step(w, loops);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
-  if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.E, p.vf, p.fixed, p.degenerate, o, depth > 0);
+  const bool pouch = depth > 0 && !colon_stretch(cl.length, w.seg.length, w.seg.period, w.ann.t.size());  // a long branch: the band's axis
+  if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.E, p.vf, p.fixed, p.degenerate, o, pouch);
   if (o.map == "area-balanced") phase("area balance");
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
   w.dissection_to_annulus = {};

@@ -140,16 +140,17 @@ inline TriangleList tube_and_strand(double length) {
       {-15, -15, -15}, {215, 15, 15}, 0.8);
 }
 
-// Closed tube along x (radius 12 mm, 0..200 mm) forking at x = 100 into a blind limb of about its
-// own girth (radius `limb` mm, 90 mm long along +y), at 1.0 mm: what denoise leaves where the limbs of
-// a colon loop touched (the lumen forks; flatten cuts the limb off as a branch whose neck is about
-// the band's girth, and the band keeps a hole of that size).
-inline TriangleList tube_with_limb(double limb) {
+// Closed tube along x (radius 12 mm, 0..`tube` mm) forking at its middle into a blind limb of about
+// its own girth (radius `limb` mm, `length` mm long along +y), at 1.0 mm: what denoise leaves where
+// the limbs of a colon loop touched (the lumen forks; flatten cuts the limb off as a branch whose neck
+// is about the band's girth, and the band keeps a hole of that size). A long limb (length >> its
+// girth) is a severed colon: a whole colon stretch hanging off a contact.
+inline TriangleList tube_with_limb(double limb, double length = 90, double tube = 200) {
   return surface_of(
-      [limb](const Eigen::Vector3d& p) {
-        return std::min(capsule(p, {0, 0, 0}, {200, 0, 0}, 12), capsule(p, {100, 0, 0}, {100, 90, 0}, limb));
+      [limb, length, tube](const Eigen::Vector3d& p) {
+        return std::min(capsule(p, {0, 0, 0}, {tube, 0, 0}, 12), capsule(p, {tube / 2, 0, 0}, {tube / 2, length, 0}, limb));
       },
-      {-15, -15, -15}, {215, 105, 15}, 1.0);
+      {-15, -15, -15}, {tube + 15, length + 15, 15}, 1.0);
 }
 
 }  // namespace cf::test_shapes

@@ -1,0 +1,79 @@
+// The side branches cut off a band, flattened as bands of their own (see branch_bands.h).
+#include "branch_bands.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <numeric>
+
+#include "colonflat/core/threads.h"
+
+namespace cf::flat_detail {
+double surface_area(const Surface& s) {
+  double a = 0;
+  for (std::size_t f = 0; f < s.t.size(); ++f) a += face_area_3d(s, int(f));
+  return a;
+}
+
+namespace {
+
+// Appends the works of a flattened branch (its own first, parents relative to the list) to `out`,
+// the branch hanging from the work at index -1 (the caller's segment).
+void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out) {
+  const int base = int(out.size());
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    if (i > 0) sub[i].parent += base;
+    out.push_back(std::move(sub[i]));
+  }
+  out[base].parent = -1;
+}
+
+}  // namespace
+
+bool colon_stretch(double centreline_mm, double conformal_mm, double period_mm, std::size_t faces) {
+  const bool stretch = period_mm > 0 && conformal_mm >= kColonStretchAspect * period_mm &&
+                       centreline_mm <= kCentrelineAgreement * conformal_mm &&
+                       conformal_mm <= kCentrelineAgreement * centreline_mm;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug branch band: %zu faces, centreline %.1f mm, conformal length %.1f mm, period %.1f mm: %s\n",
+                 faces, centreline_mm, conformal_mm, period_mm, stretch ? "a colon stretch (the band's axis)" : "a pouch");
+  return stretch;
+}
+
+std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& pieces, const FlattenBand& band,
+                                               double& placed) {
+  std::vector<std::vector<SegmentWork>> subs(pieces.size());
+  std::vector<char> done(pieces.size(), 0);
+  std::vector<std::size_t> by_size(pieces.size());  // the largest first: the longest task starts first
+  std::iota(by_size.begin(), by_size.end(), std::size_t(0));
+  std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) {
+    return pieces[a].surface.t.size() > pieces[b].surface.t.size();
+  });
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t i : by_size)
+    tasks.emplace_back([&, i] {
+      try {
+        subs[i] = band(pieces[i].surface);
+        done[i] = 1;
+      } catch (const std::exception&) {
+        // not flattenable as a band: its wall counts as not shown
+      }
+    });
+  parallel_tasks(tasks);
+  std::vector<SegmentWork> out;
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    if (!done[i]) continue;
+    std::vector<SegmentWork>& sub = subs[i];
+    const BranchPiece& piece = pieces[i];
+    sub[0].lost_area += sub[0].cap_area;  // the tip's cap counts as wall not shown
+    sub[0].cap_area = 0;
+    sub[0].seg.neck_mm = piece.neck_mm;
+    sub[0].seg.holds = piece.tissue ? "tissue" : "lumen";
+    sub[0].neck = piece.neck;
+    placed += surface_area(piece.surface);
+    append_branch(sub, out);
+  }
+  return out;
+}
+
+}  // namespace cf::flat_detail

@@ -1,0 +1,50 @@
+#pragma once
+// The side branches cut off a band, flattened as bands of their own (flatten, internal): side by
+// side, and a long one (a colon stretch a severed colon hangs off a contact) given the colon band's
+// axis instead of a pouch's (issue 26, docs/flatten.md session 28 "branch").
+#include <functional>
+#include <vector>
+
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+
+// One side branch cut off an annulus: its surface and its neck's vertices in what remains.
+struct BranchPiece {
+  Surface surface;
+  std::vector<int> neck;
+  double neck_mm = 0;
+  bool tissue = false;  // holds tissue (a strand stump), not lumen
+};
+
+// The 3D area of s (mm^2; its faces' areas summed in face order).
+double surface_area(const Surface& s);
+
+// A branch's band is a colon stretch (a tube much longer than it is wide: a severed colon's loop
+// hanging off a fused contact, not a pouch) when its conformal rectangle is at least this many
+// periods (its mean girth) long: the conformal modulus, well defined on any annulus. A pouch behind
+// a neck (a diverticulum) is about 1, the grown real mask's cut-off colon stretches 2.2-3.4 and its
+// pouches <= 1.1 (docs/flatten.md session 28 "branch").
+constexpr double kColonStretchAspect = 2.0;
+// ... and its centreline (from the level sets of u) is within this factor of the conformal length:
+// the band's length is the centreline's (within 8 %), so a centreline the level sets make up (a
+// stump whose neck is a hole in its side) keeps the pouch's conformal spacing.
+constexpr double kCentrelineAgreement = 1.5;
+// Pre: lengths >= 0 (mm). True when the band is a colon stretch (COLONFLAT_FLATTEN_DEBUG: a line
+// with its `faces` and figures).
+bool colon_stretch(double centreline_mm, double conformal_mm, double period_mm, std::size_t faces);
+
+// Flattens one branch's surface (nloops = 1: its neck open) as a band and its own branches: the
+// works, its own first (parents relative to the list, the first's -1).
+using FlattenBand = std::function<std::vector<SegmentWork>(const Surface&)>;
+
+// The works of the cut-off `pieces` flattened by `band` (side by side on up to thread_count()
+// threads, the largest first; each on its own, so the same works for any thread count), each
+// branch's list after the previous one's in piece order, its first work's parent -1 (the caller's
+// segment) and its fields set from the piece (neck, neck mm, what it holds, its tip's cap counted
+// as wall not shown). A piece that cannot be flattened (band throws) counts as wall not shown.
+// `placed` += the wall area of the pieces flattened (summed in piece order).
+std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& pieces, const FlattenBand& band,
+                                               double& placed);
+
+}  // namespace cf::flat_detail

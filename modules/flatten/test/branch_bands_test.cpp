@@ -1,0 +1,51 @@
+// Branch bands (branch_bands.cpp): a colon that reaches flatten in pieces (a whole colon stretch
+// cut off as a side branch) is flattened as well as a whole one: the long branch gets the colon
+// band's axis and band length, the branches are flattened side by side with the same bits.
+#include <gtest/gtest.h>
+
+#include "../src/branch_bands.h"
+#include "colonflat/flatten/flatten.h"
+#include "flatten_shapes.h"
+
+namespace cf {
+namespace {
+
+// A tube whose conformal rectangle is much longer than its girth, with a centreline that agrees, is
+// a colon stretch; a pouch (about as long as it is wide), a band of no girth and a band whose
+// centreline disagrees with its conformal length (made up by the level sets) are not.
+TEST(BranchBands, LongTubeIsAColonStretchAndAPouchIsNot) {
+  EXPECT_TRUE(flat_detail::colon_stretch(400, 420, 100, 1000));
+  EXPECT_TRUE(flat_detail::colon_stretch(150, 160, 80, 1000));
+  EXPECT_FALSE(flat_detail::colon_stretch(110, 120, 135, 1000));  // a pouch
+  EXPECT_FALSE(flat_detail::colon_stretch(50, 60, 0, 1000));
+  EXPECT_FALSE(flat_detail::colon_stretch(624, 300, 72, 1000));  // a centreline the level sets made up
+}
+
+// A severed colon: a tube (radius 12 mm, 400 mm) with a blind limb of radius 10 mm and 180 mm from
+// its middle (a colon stretch hanging off a contact, ~3 girths long; the tube's ends stay the
+// farthest apart, so the tube is the colon band). The limb is cut off as a branch and, as a
+// colon stretch, gets the colon band's band length (its centreline length within the band's 8 %
+// slack, not the conformal length a pouch keeps); the whole map shows >= 99.5 % of the wall with
+// area ratio p05 >= 0.2 (the floors of issue 26), nothing flipped, and 1 and 2 threads give the
+// same map bit for bit (the branches are flattened side by side).
+TEST(BranchBands, SeveredColonsLongBranchIsFlattenedAsABand) {
+  const TriangleList mesh = test_shapes::tube_with_limb(10.0, 180.0, 400.0);
+  const FlatMap f = test_shapes::flatten_with_threads(mesh, 2);
+  ASSERT_GE(f.segments.size(), 2u);
+  const FlatSegment& limb = f.segments[1];
+  EXPECT_EQ(limb.kind, "branch");
+  EXPECT_GT(limb.centreline_length, 120.0);
+  EXPECT_NEAR(limb.length, limb.centreline_length, 0.08 * limb.centreline_length + 1e-9);
+  EXPECT_GE(f.coverage.fraction, 0.995);
+  EXPECT_GE(f.stats.area_p05, 0.2);
+  EXPECT_EQ(f.stats.flipped, 0u);
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
+  ASSERT_EQ(one.uv.size(), f.uv.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < f.uv.size(); ++i) differ += one.uv[i][0] != f.uv[i][0] || one.uv[i][1] != f.uv[i][1];
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(one.triangles, f.triangles);
+}
+
+}  // namespace
+}  // namespace cf
