@@ -53,7 +53,7 @@ std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& p
   for (std::size_t i : by_size)
     tasks.emplace_back([&, i] {
       try {
-        subs[i] = band(pieces[i].surface);
+        subs[i] = band(pieces[i]);
         done[i] = 1;
       } catch (const std::exception&) {
         // not flattenable as a band: its wall counts as not shown

@@ -15,7 +15,13 @@ struct BranchPiece {
   std::vector<int> neck;
   double neck_mm = 0;
   bool tissue = false;  // holds tissue (a strand stump), not lumen
+  bool limb = false;    // limb-sized: its neck at least kLimbNeck x the band's period (a fork of the lumen)
 };
+
+// A branch whose neck is at least this fraction of its band's period (mm around) is limb-sized: the
+// lumen forks there (the figure of cut_rims.cpp's long rims). Only a limb-sized branch can be a colon
+// stretch: a thin strand or small bowel-like tube off the colon keeps a pouch's map.
+constexpr double kLimbNeck = 0.5;
 
 // The 3D area of s (mm^2; its faces' areas summed in face order).
 double surface_area(const Surface& s);
@@ -36,7 +42,7 @@ bool colon_stretch(double centreline_mm, double conformal_mm, double period_mm, 
 
 // Flattens one branch's surface (nloops = 1: its neck open) as a band and its own branches: the
 // works, its own first (parents relative to the list, the first's -1).
-using FlattenBand = std::function<std::vector<SegmentWork>(const Surface&)>;
+using FlattenBand = std::function<std::vector<SegmentWork>(const BranchPiece&)>;
 
 // The works of the cut-off `pieces` flattened by `band` (side by side on up to thread_count()
 // threads, the largest first; each on its own, so the same works for any thread count), each

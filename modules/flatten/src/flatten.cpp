@@ -201,7 +201,7 @@ void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const
 
 constexpr int kMaxBranchDepth = 3;  // branches of branches of branches
 std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
-                                         const FlattenOptions& o, int depth);
+                                         const FlattenOptions& o, int depth, bool limb = false);
 
 // Flattens the cut-off branches (each as a band of its own, recursively, side by side:
 // branch_bands.h); returns their works and adds their wall area to `placed`. A branch that cannot
@@ -210,8 +210,8 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
                                           const FlattenOptions& o, int depth, double& placed) {
   FlattenOptions bo = o;
   bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
-  return flatten_branch_pieces(pieces, [&](const Surface& s) {
-    return flatten_surface(s, 1, std::size_t(component), lumen_sign, bo, depth + 1);
+  return flatten_branch_pieces(pieces, [&](const BranchPiece& piece) {
+    return flatten_surface(piece.surface, 1, std::size_t(component), lumen_sign, bo, depth + 1, piece.limb);
   }, placed);
 }
 
@@ -250,6 +250,7 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     piece.surface = sub_surface(w.ann, in);
     piece.neck_mm = cut.neck_mm;
     piece.tissue = cut.tissue;
+    piece.limb = cut.neck_mm >= kLimbNeck * w.seg.period;
     for (int f : in)
       for (int v : w.ann.t[std::size_t(f)])
         if (new_of_old[v] >= 0) piece.neck.push_back(new_of_old[v]);
@@ -315,9 +316,10 @@ Centreline centreline_step(SegmentWork& w, const std::vector<std::vector<int>>& 
 }
 
 // One colon segment (or side branch): the segment's work first, then its branches (parent = index
-// in the returned list; -1 for the first).
+// in the returned list; -1 for the first). A `limb`-sized branch that is a colon stretch
+// (branch_bands.h) gets the colon band's axis; other branches a pouch's.
 std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
-                                         const FlattenOptions& o, int depth) {
+                                         const FlattenOptions& o, int depth, bool limb) {
   SegmentWork w;
   w.lumen_sign = lumen_sign;
   w.branch = depth > 0;
@@ -350,7 +352,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const Centreline cl = centreline_step(w, loops);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
-  const bool pouch = depth > 0 && !colon_stretch(cl.length, w.seg.length, w.seg.period, w.ann.t.size());  // a long branch: the band's axis
+  const bool pouch = depth > 0 && !(limb && colon_stretch(cl.length, w.seg.length, w.seg.period, w.ann.t.size()));
   if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.E, p.vf, p.fixed, p.degenerate, o, pouch);
   if (o.map == "area-balanced") phase("area balance");
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
