@@ -18,6 +18,7 @@
 #include "factor_schedule.h"
 #include "metis_order.h"
 #include "threaded_factor.h"
+#include "tree_solve.h"
 
 namespace cf::flat_detail {
 
@@ -175,6 +176,8 @@ void SpdSolver::release_early() {
 
 void SpdSolver::release() {
   release_early();
+  tree_.reset();
+  group_solves_ = 0;
   early_schedule_ = early_transpose_ = rest_blocks_ = false;
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (started_) cholmod_finish(&common_);
@@ -235,6 +238,8 @@ void SpdSolver::analyze_for(const SpMat& A, const std::vector<int>* order, bool 
 }
 
 bool SpdSolver::factorize(const SpMat& A) {
+  tree_.reset();
+  group_solves_ = 0;
   if (factor_) {
     cholmod_sparse view = view_lower(A);
     ThreadedUse use;
@@ -279,6 +284,9 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
     x.middleCols(first, k) = take_dense(xg, common);
   };
   solve_calls_ += int((b.cols() + width - 1) / width);
+  if (factor_entries() >= kThreadedSolveMinEntries && b.cols() <= width && thread_count() > 1 &&
+      ++group_solves_ >= kTreeSolveFrom)
+    if (const std::shared_ptr<const TreeSolve> plan = tree_plan()) return tree_solve(*plan, b);
   if (factor_entries() < kThreadedSolveMinEntries || b.cols() <= width) {
     ThreadCommon common;
     for (Eigen::Index c = 0; c < b.cols(); c += width) solve_group(c, common.c);
@@ -291,6 +299,37 @@ Eigen::MatrixXd SpdSolver::solve(const Eigen::MatrixXd& b) const {
       solve_group(c, common.c);
     });
   parallel_tasks(groups);
+  return x;
+}
+
+// The plan of the factor as it is now, made once (null when TreeSolve cannot take it).
+std::shared_ptr<const TreeSolve> SpdSolver::tree_plan() const {
+  std::lock_guard<std::mutex> lock(tree_mutex_);
+  if (!tree_) {
+    const Stopwatch sw;
+    auto plan = std::make_shared<const TreeSolve>(factor_);
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug tree solve: %zu unknowns, entries parts %zu / %zu, rest %zu, kept %zu, plan %.3f s\n",
+                   std::size_t(factor_->n), plan->part_entries(0), plan->part_entries(1), plan->rest_entries(),
+                   plan->kept_terms(), sw.seconds());
+    tree_ = std::move(plan);
+  }
+  return tree_->usable() ? tree_ : nullptr;
+}
+
+// x = A^-1 b by the plan: b permuted into L's order in row form, solved, permuted back (as
+// cholmod_solve does: copies only).
+Eigen::MatrixXd SpdSolver::tree_solve(const TreeSolve& plan, const Eigen::MatrixXd& b) const {
+  const std::size_t n = factor_->n, k = std::size_t(b.cols());
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  std::vector<double> y(n * k);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < k; ++c) y[i * k + c] = b(perm[i], Eigen::Index(c));
+  plan.solve(y.data(), int(k));
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < k; ++c) x(perm[i], Eigen::Index(c)) = y[i * k + c];
+  ++tree_solves_;
   return x;
 }
 
@@ -314,6 +353,8 @@ Eigen::MatrixXd SpdSolver::cholmod_leading(const Eigen::MatrixXd& b, int leading
 
 bool SpdSolver::modify(const SpMat& C, bool update) {
   if (!cholmod_ok_ || C.cols() == 0) return cholmod_ok_;
+  tree_.reset();  // the update may change L's pattern
+  group_solves_ = 0;
   const int* perm = static_cast<const int*>(factor_->Perm);
   std::vector<int> place(factor_->n);  // CHOLMOD wants C's rows in the factor's order
   for (std::size_t k = 0; k < factor_->n; ++k) place[perm[k]] = int(k);

@@ -29,6 +29,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
@@ -39,6 +40,8 @@
 #include "threaded_factor.h"
 
 namespace cf::flat_detail {
+
+class TreeSolve;
 
 class SpdSolver {
  public:
@@ -77,8 +80,11 @@ class SpdSolver {
   bool compute(const SpMat& A, const std::vector<int>* order = nullptr);
   // x = A^-1 b (b: n x k), kColumnsPerSolveCall columns per CHOLMOD call: the groups on the worker
   // threads when the factor has at least kThreadedSolveMinEntries entries and there are two or more,
-  // else one after the other on the calling thread. A column's result is the same bits either way
-  // (those of its one-column solve).
+  // else one after the other on the calling thread. One group (k <= 3) of such a factor on two or
+  // more threads is solved by TreeSolve (tree_solve.h: L's elimination tree split over two threads)
+  // from the factor's kTreeSolveFrom-th such solve on (its plan, made then, costs about one solve
+  // and is kept until the factor changes). A column's result is
+  // the same bits every way (those of its one-column CHOLMOD solve).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   // Columns one CHOLMOD solve call takes: its simplicial kernels for 2 and 3 right-hand sides read L
   // once for all of them (a solve is bound by reading L, ~12 bytes an entry) and compute each column
@@ -95,6 +101,10 @@ class SpdSolver {
   // the real CT colon band's longest piece, 1 248 solves, 1.64 s -> 0.46 s wall at load 11-14
   // (docs/flatten.md, session 15).
   static constexpr std::size_t kThreadedSolveMinEntries = 1000000;
+  // The first solve of a factor is CHOLMOD's (a factor solved once, as the conformal maps' v, does
+  // not pay for a plan: 0.03 s on 1e7 entries, 0.08-0.4 s on 2.6e7 at load 10); from the second on
+  // TreeSolve's (the whole-band pass solves its factor once a step, 3-60 steps).
+  static constexpr int kTreeSolveFrom = 2;
   // Entries the numeric factor holds (0 without CHOLMOD or before factorize()).
   std::size_t factor_entries() const;
   // Columns of the factor's dense root: the last columns j of L that are full below the diagonal
@@ -129,6 +139,8 @@ class SpdSolver {
   // Whether the last factorize() computed the rows above the threaded parts in blocks (rest_blocks.h).
   bool rest_blocks() const { return rest_blocks_; }
   int threaded_transposes() const { return threaded_transposes_; }
+  // Solves of this factor that TreeSolve computed (each counted in solve_calls() too).
+  int tree_solves() const { return tree_solves_.load(); }
 
  private:
   struct Fallback;  // Eigen's SimplicialLDLT of P A P^T, P the given order (else Eigen's AMD)
@@ -141,6 +153,12 @@ class SpdSolver {
   bool early_schedule_ = false, early_transpose_ = false, rest_blocks_ = false;
   int threaded_transposes_ = 0;
   mutable std::atomic<int> solve_calls_{0};  // solve()'s CHOLMOD calls (solve() may run on two threads at once)
+  mutable std::atomic<int> tree_solves_{0};
+  mutable std::atomic<int> group_solves_{0};  // one-group solves of this factor that could take TreeSolve
+  mutable std::mutex tree_mutex_;            // the plan is made once, by the first solve() that needs it
+  mutable std::shared_ptr<const TreeSolve> tree_;  // of factor_ as it is now (null: not made yet)
+  std::shared_ptr<const TreeSolve> tree_plan() const;
+  Eigen::MatrixXd tree_solve(const TreeSolve& plan, const Eigen::MatrixXd& b) const;
 #ifdef COLONFLAT_HAVE_CHOLMOD
   mutable cholmod_common common_{};
   bool started_ = false;
