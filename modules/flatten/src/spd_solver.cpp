@@ -318,17 +318,21 @@ std::shared_ptr<const TreeSolve> SpdSolver::tree_plan() const {
 }
 
 // x = A^-1 b by the plan: b permuted into L's order in row form, solved, permuted back (as
-// cholmod_solve does: copies only).
+// cholmod_solve does: copies only, here on the worker threads).
 Eigen::MatrixXd SpdSolver::tree_solve(const TreeSolve& plan, const Eigen::MatrixXd& b) const {
   const std::size_t n = factor_->n, k = std::size_t(b.cols());
   const int* perm = static_cast<const int*>(factor_->Perm);
   std::vector<double> y(n * k);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t c = 0; c < k; ++c) y[i * k + c] = b(perm[i], Eigen::Index(c));
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t c = 0; c < k; ++c) y[i * k + c] = b(perm[i], Eigen::Index(c));
+  });
   plan.solve(y.data(), int(k));
   Eigen::MatrixXd x(b.rows(), b.cols());
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t c = 0; c < k; ++c) x(perm[i], Eigen::Index(c)) = y[i * k + c];
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t c = 0; c < k; ++c) x(perm[i], Eigen::Index(c)) = y[i * k + c];
+  });
   ++tree_solves_;
   return x;
 }
