@@ -29,6 +29,13 @@ inline FlatMap flatten_with_threads(const TriangleList& mesh, int threads) {
   return f;
 }
 
+// How many map vertices of `a` and `b` differ in u or v (bitwise; 0: the same map). Pre: same size.
+inline std::size_t uv_differences(const FlatMap& a, const FlatMap& b) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.uv.size(); ++i) differ += a.uv[i][0] != b.uv[i][0] || a.uv[i][1] != b.uv[i][1];
+  return differ;
+}
+
 inline double capsule(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
   const Eigen::Vector3d ab = b - a;
   const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
