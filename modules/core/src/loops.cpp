@@ -24,6 +24,13 @@ namespace fs = std::filesystem;
 
 namespace cf {
 
+double points_diameter(const std::vector<Vec3>& points) {
+  double d = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (std::size_t j = i + 1; j < points.size(); ++j) d = std::max(d, (points[i] - points[j]).sqrnorm());
+  return std::sqrt(d);
+}
+
 void describe_cross_section(LoopRecord* loop) {
   const auto& p = loop->points;
   if (p.empty()) return;
@@ -33,11 +40,8 @@ void describe_cross_section(LoopRecord* loop) {
   Vec3 area(0, 0, 0);  // vector area: half the sum of (p_i - c) x (p_i+1 - c)
   for (std::size_t i = 0; i < p.size(); ++i) area += OpenMesh::cross(p[i] - c, p[(i + 1) % p.size()] - c);
   area *= 0.5;
-  double diameter = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t j = i + 1; j < p.size(); ++j) diameter = std::max(diameter, (p[i] - p[j]).sqrnorm());
   loop->centroid = c;
-  loop->diameter_mm = std::sqrt(diameter);
+  loop->diameter_mm = points_diameter(p);
   loop->cross_section_area_mm2 = area.norm();
   loop->cross_section_normal = area.norm() > 0 ? area / area.norm() : Vec3(0, 0, 0);
 }

@@ -10,6 +10,7 @@
 #include <limits>
 #include <queue>
 
+#include "colonflat/core/loops.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/union_find.h"
 #include "denoise_debug.h"
@@ -222,10 +223,10 @@ std::vector<Mesh::VertexHandle> mesh_path_along(const Mesh& mesh, const CoarseSu
 }
 
 double loop_diameter(const Mesh& mesh, const std::vector<Mesh::VertexHandle>& loop) {
-  double d = 0;
-  for (std::size_t i = 0; i < loop.size(); ++i)
-    for (std::size_t j = i + 1; j < loop.size(); ++j) d = std::max(d, (mesh.point(loop[i]) - mesh.point(loop[j])).sqrnorm());
-  return std::sqrt(d);
+  std::vector<Vec3> points;
+  points.reserve(loop.size());
+  for (auto v : loop) points.push_back(mesh.point(v));
+  return points_diameter(points);
 }
 
 // ---- the exact method's hook ----

@@ -39,7 +39,11 @@ struct LoopRecord {
   Vec3 cross_section_normal{0, 0, 0};  // unit normal of that plane (direction of the cut tube or bridge)
 };
 
-// Fills centroid, diameter_mm, cross_section_area_mm2 and cross_section_normal from `points`.
+// Largest distance between two of `points` (mm; 0 for fewer than two). O(n^2).
+double points_diameter(const std::vector<Vec3>& points);
+
+// Fills centroid, diameter_mm (points_diameter), cross_section_area_mm2 and cross_section_normal
+// from `points`.
 void describe_cross_section(LoopRecord* loop);
 
 using LoopSet = std::vector<LoopRecord>;
