@@ -8,8 +8,6 @@
 #include <limits>
 #include <unordered_set>
 
-#include "colonflat/core/huge_pages.h"
-
 namespace cf {
 
 FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) { build_static(mesh, mesh.faces()); }
@@ -67,12 +65,30 @@ std::vector<int> FaceGrid::candidates(const Vec3& lo, const Vec3& hi) const {
   return cand;
 }
 
+namespace {
+// Whether the rectangle [u0, u1] x [v0, v1] of axes (u, v) lies wholly beyond one edge of triangle
+// p's projection on them (nd: p's normal along the third axis, nonzero; its sign is the
+// projection's orientation), so that the two do not meet.
+bool beyond_an_edge(const std::array<Vec3, 3>& p, int u, int v, double nd, double u0, double u1, double v0, double v1) {
+  for (int e = 0; e < 3; ++e) {
+    const Vec3 &a = p[e], &b = p[(e + 1) % 3];
+    auto inside = [&](double x, double y) {  // on p's side of edge (a, b), or on it
+      return ((b[u] - a[u]) * (y - a[v]) - (b[v] - a[v]) * (x - a[u])) * nd >= 0;
+    };
+    if (!inside(u0, v0) && !inside(u1, v0) && !inside(u0, v1) && !inside(u1, v1)) return true;
+  }
+  return false;
+}
+}  // namespace
+
 // Calls visit(cell) for the cells that the plane of triangle p crosses inside the triangle's
 // bounding box (every cell the triangle meets is one of them) until visit returns true; returns
 // whether it did. Per column of cells along the plane's dominant normal axis, the plane spans a
 // short range of that axis: a cap triangle of a long loop (tens of mm) has 10^4-10^5 cells in its
 // bounding box, and most of the surface's faces near the loop in them, but its plane crosses
-// only a sheet of cells one or two thick. A degenerate triangle visits its whole box.
+// only a sheet of cells one or two thick. Columns whose rectangle (grown by a tenth of a cell)
+// lies beyond an edge of the triangle's projection are skipped: about half the box's columns for
+// a cap triangle, none of the triangle's own. A degenerate triangle visits its whole box.
 template <class Visit>
 bool FaceGrid::triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const {
   Vec3 lo = p[0], hi = p[0];
@@ -95,6 +111,8 @@ bool FaceGrid::triangle_cells(const std::array<Vec3, 3>& p, Visit&& visit) const
       if (n[d] != 0) {  // the plane's range of axis d over the column's rectangle clamped to the box
         const double u0 = std::max(k[u] * cell_, lo[u]), u1 = std::min((k[u] + 1) * cell_, hi[u]);
         const double v0 = std::max(k[v] * cell_, lo[v]), v1 = std::min((k[v] + 1) * cell_, hi[v]);
+        const double grow = 0.1 * cell_;
+        if (beyond_an_edge(p, u, v, n[d], u0 - grow, u1 + grow, v0 - grow, v1 + grow)) continue;
         double dmin = std::numeric_limits<double>::infinity(), dmax = -dmin;
         for (double uu : {u0, u1})
           for (double vv : {v0, v1}) {
@@ -159,7 +177,7 @@ bool FaceGrid::cell_faces(const Key& k, Visit&& visit) const {
   return false;
 }
 
-// ---- the constructor's faces in compressed rows per cell ----
+// ---- the constructor's faces in compressed rows per cell (the build's part: face_grid_cells.cpp) ----
 
 std::uint64_t FaceGrid::StaticCells::code(const Key& k) {
   constexpr long long kHalf = 1LL << 20;
@@ -168,56 +186,13 @@ std::uint64_t FaceGrid::StaticCells::code(const Key& k) {
   return (std::uint64_t(k.x + kHalf) << 42) | (std::uint64_t(k.y + kHalf) << 21) | std::uint64_t(k.z + kHalf);
 }
 
-namespace {
-inline std::size_t slot_hash(std::uint64_t code, std::size_t mask) {
-  std::uint64_t h = code * 0x9E3779B97F4A7C15ull;
-  return static_cast<std::size_t>(h ^ (h >> 29)) & mask;
-}
-}  // namespace
-
 std::uint32_t FaceGrid::StaticCells::find(std::uint64_t code) const {
   if (slot_code_.empty()) return kNoRow;
   const std::size_t mask = slot_code_.size() - 1;
-  for (std::size_t s = slot_hash(code, mask);; s = (s + 1) & mask) {
+  for (std::size_t s = slot(code, mask);; s = (s + 1) & mask) {
     if (slot_code_[s] == code) return slot_row_[s];
     if (slot_code_[s] == kEmpty) return kNoRow;
   }
-}
-
-std::uint32_t FaceGrid::StaticCells::find_or_add(std::uint64_t code) {
-  if (2 * (count_.size() + 1) > slot_code_.size()) rehash(std::max<std::size_t>(4096, 2 * slot_code_.size()));
-  const std::size_t mask = slot_code_.size() - 1;
-  std::size_t s = slot_hash(code, mask);
-  for (; slot_code_[s] != kEmpty; s = (s + 1) & mask)
-    if (slot_code_[s] == code) return slot_row_[s];
-  slot_code_[s] = code;
-  slot_row_[s] = static_cast<std::uint32_t>(count_.size());
-  count_.push_back(0);
-  return slot_row_[s];
-}
-
-void FaceGrid::StaticCells::rehash(std::size_t slots) {
-  std::vector<std::uint64_t> old_code;
-  std::vector<std::uint32_t> old_row;
-  assign_huge(old_code, slots, kEmpty);
-  assign_huge(old_row, slots, kNoRow);
-  old_code.swap(slot_code_);
-  old_row.swap(slot_row_);
-  const std::size_t mask = slots - 1;
-  for (std::size_t i = 0; i < old_code.size(); ++i) {
-    if (old_code[i] == kEmpty) continue;
-    std::size_t s = slot_hash(old_code[i], mask);
-    while (slot_code_[s] != kEmpty) s = (s + 1) & mask;
-    slot_code_[s] = old_code[i];
-    slot_row_[s] = old_row[i];
-  }
-}
-
-void FaceGrid::StaticCells::finish_counts() {
-  start_.assign(count_.size() + 1, 0);
-  for (std::size_t r = 0; r < count_.size(); ++r) start_[r + 1] = start_[r] + count_[r];
-  resize_huge(faces_, start_.back());
-  cursor_.assign(start_.begin(), start_.end() - 1);
 }
 
 // One pass over the faces counts each cell's faces and lists (row, face) to fill the rows from; faces
@@ -308,9 +283,10 @@ namespace {
 // Parameter t > 1e-9 at which the ray p + t d meets triangle (a, b, c), or infinity (Moller-Trumbore).
 double ray_triangle(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
   constexpr double kNever = std::numeric_limits<double>::infinity();
+  // The near-parallel test (three square roots) last: it only turns a hit into kNever, and with
+  // det = 0 the quotients are infinite or NaN, which every test below refuses.
   const Vec3 e1 = b - a, e2 = c - a, h = OpenMesh::cross(d, e2);
   const double det = OpenMesh::dot(e1, h);
-  if (std::fabs(det) <= 1e-12 * e1.norm() * e2.norm() * d.norm()) return kNever;
   const Vec3 s = p - a;
   const double u = OpenMesh::dot(s, h) / det;
   if (u < 0 || u > 1) return kNever;
@@ -318,7 +294,8 @@ double ray_triangle(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, 
   const double v = OpenMesh::dot(d, qv) / det;
   if (v < 0 || u + v > 1) return kNever;
   const double t = OpenMesh::dot(e2, qv) / det;
-  return t > 1e-9 ? t : kNever;
+  if (!(t > 1e-9) || std::fabs(det) <= 1e-12 * e1.norm() * e2.norm() * d.norm()) return kNever;
+  return t;
 }
 
 // Segment [p, q] against triangle (a, b, c), excluding the segment's first 1e-9.

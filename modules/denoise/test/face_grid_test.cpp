@@ -106,5 +106,49 @@ TEST(DenoiseFaceGrid, FreeDistanceIsTheDistanceToTheWall) {
   EXPECT_NEAR(grid.free_distance(m, m.point(v), inward, 5.0, v.idx()), 2.0, 0.02);
 }
 
+// The grid's answers for triangles spanning many cells (its queries skip the columns of cells
+// that lie beyond an edge of the triangle's projection) are the brute-force ones: for 300
+// triangles across a sphere, free or with a corner on the sphere (the shared-vertex rule), in
+// cells of 0.05 to 0.3, hits() and count_triangles() equal a test against every face.
+TEST(DenoiseFaceGrid, WideTriangleHitsAreTheBruteForceHits) {
+  Mesh m = to_mesh(sphere(1, 32, 16));
+  const int surface_vertices = static_cast<int>(m.n_vertices());
+  std::vector<std::array<int, 3>> tris;
+  for (int i = 0; i < 300; ++i) {  // corners spread over [-1.3, 1.3]^3 by a fixed recurrence
+    std::array<int, 3> t{};
+    for (int k = 0; k < 3; ++k) {
+      const int j = 3 * i + k;
+      t[k] = m.add_vertex(Vec3(1.3 * std::sin(1.7 * j), 1.3 * std::cos(0.9 * j + 2), 1.3 * std::sin(2.3 * j))).idx();
+    }
+    if (i % 3 == 0) t[0] = (7 * i) % surface_vertices;  // a corner on the sphere
+    tris.push_back(t);
+  }
+  auto brute = [&](const std::array<int, 3>& t) {
+    std::array<Vec3, 3> p;
+    for (int k = 0; k < 3; ++k) p[k] = m.point(Mesh::VertexHandle(t[k]));
+    std::size_t n = 0;
+    for (auto f : m.faces()) {
+      std::array<int, 3> ids{};
+      std::array<Vec3, 3> q;
+      int k = 0;
+      for (auto v : m.fv_range(f)) ids[k] = v.idx(), q[k++] = m.point(v);
+      n += triangles_intersect_improperly(t, p, ids, q) ? 1 : 0;
+    }
+    return n;
+  };
+  for (double cell : {0.05, 0.12, 0.3}) {
+    const FaceGrid grid(m, cell);
+    std::size_t hits = 0;
+    for (const auto& t : tris) {
+      const std::size_t n = brute(t);
+      EXPECT_EQ(grid.count_triangles(m, {t}), n) << cell;
+      EXPECT_EQ(grid.hits(m, t), n > 0) << cell;
+      hits += n > 0;
+    }
+    EXPECT_GT(hits, 100u) << cell;  // many cross the sphere
+    EXPECT_LT(hits, 300u) << cell;  // and some do not
+  }
+}
+
 }  // namespace
 }  // namespace cf

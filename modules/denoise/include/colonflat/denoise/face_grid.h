@@ -116,6 +116,10 @@ class FaceGrid {
     const std::vector<int>& faces() const { return faces_; }
 
    private:
+    static std::size_t slot(std::uint64_t code, std::size_t mask) {  // the code's first slot
+      const std::uint64_t h = code * 0x9E3779B97F4A7C15ull;
+      return static_cast<std::size_t>(h ^ (h >> 29)) & mask;
+    }
     void rehash(std::size_t slots);
     std::vector<std::uint64_t> slot_code_;
     std::vector<std::uint32_t> slot_row_;
