@@ -19,6 +19,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/union_find.h"
+#include "conformal_area_energy.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
@@ -26,72 +27,6 @@
 
 namespace cf::flat_detail {
 namespace {
-
-double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-class ConformalAreaEnergy {
- public:
-  // `scale`: 3D / 2D area of the whole band (ratios at the area-preserving scale).
-  ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
-                      double lo, double hi, double lambda, double scale)
-      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), excess_(lo, hi), lambda_(lambda), scale_(scale) {
-    w_ = corner_weights(s, faces_);
-  }
-  const std::vector<std::array<double, 3>>& weights() const { return w_; }
-  const std::vector<int>& faces() const { return faces_; }
-
-  double energy(const std::vector<V2>& pos) const {
-    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
-      double part = 0;
-      for (std::size_t i = begin; i < end; ++i) {
-        const auto c = corners(pos, faces_[i]);
-        const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-        if (a2 <= 0) return kHuge;
-        for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
-        const int f = faces_[i];
-        const double x = excess_(scale_ * a2 / area3_[f]);
-        part += lambda_ * area3_[f] * x * x;
-      }
-      return part;
-    });
-    return e >= kHuge ? kHuge : e;
-  }
-
-  // Per face, the gradient with respect to each corner.
-  void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
-    for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const int f = faces_[i];
-        const auto c = corners(pos, f);
-        const double a2 = 0.5 * cross2(c[1] - c[0], c[2] - c[0]);
-        const double x = excess_(scale_ * a2 / area3_[f]);
-        const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
-        std::array<V2, 3>& grad = out[i];
-        grad = {V2::Zero(), V2::Zero(), V2::Zero()};
-        for (int k = 0; k < 3; ++k) {
-          const int a = (k + 1) % 3, b = (k + 2) % 3;
-          const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
-          grad[a] += e, grad[b] -= e;
-          grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
-        }
-      }
-    });
-  }
-  static constexpr double kHuge = 1e300;
-
- private:
-  std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
-    const Tri& t = s_.t[f];
-    return {pos[t[0]] + V2(0, emb_.dy[f][0]), pos[t[1]] + V2(0, emb_.dy[f][1]), pos[t[2]] + V2(0, emb_.dy[f][2])};
-  }
-  const Surface& s_;
-  const Embedding& emb_;
-  std::vector<int> faces_;
-  const std::vector<double>& area3_;
-  LogRatioExcess excess_;
-  double lambda_, scale_ = 1;
-  std::vector<std::array<double, 3>> w_;
-};
 
 // Whole-band pass: the vertices of the pockets not shown (area ratio below `below` =
 // coverage_min_ratio at the band's scale: strand stumps, pouches behind narrow necks, wide stretches
@@ -260,10 +195,28 @@ std::vector<std::vector<int>> connected_pieces(const Surface& s, const std::vect
   return pieces;
 }
 
+// Wall area (3D) of `faces` whose map area ratio at `scale` is below `ratio`.
+double area_below(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
+                  const std::vector<int>& faces, double ratio) {
+  double a = 0;
+  for (int f : faces) a += scale * emb.area2(s, f) < ratio * area3[f] ? area3[f] : 0.0;
+  return a;
+}
+
+// The wall a local piece may leave hidden (shown below coverage_min_ratio): kHiddenWallTolerance of
+// its wall, the second local pass's test of a piece with nothing to show.
+double hidden_wall_tolerance(const std::vector<double>& area3, const std::vector<int>& piece) {
+  double wall = 0;
+  for (int f : piece) wall += area3[f];
+  return kHiddenWallTolerance * wall;
+}
+
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
 // (optional): where its wall time went. A whole band (not `local`) asks `enough` beside its next
-// step's solve (proxy_descent.h).
-void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
+// step's solve (proxy_descent.h); a local piece stops once its steps stall on the same faces' cut
+// with no wall left hidden (held_steps.h). Returns the largest fold-free cut of a local piece's
+// steps (1 for a whole band: not watched).
+double minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
               const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
               AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
               const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr) {
@@ -272,13 +225,16 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
   const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
                                    scale);
   RegionSystem sys;
-  if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return;
+  if (!sys.build(s, free_vertex, energy.faces(), energy.weights(), vertex_order)) return 1.0;
   if (!local) debug_clock("whole-band system built");
   const double build_s = clock.lap();
   const int max_steps = iteration_budget(nfaces, local, o.area_correction_iterations);
   StepTimes* step_times = times ? &times->steps : nullptr;
-  const DescentResult d =
-      proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch, step_times, !local);
+  const std::vector<int>& piece = energy.faces();
+  HeldSteps held(s, emb, [&] { return area_below(s, emb, area3, scale, piece, o.coverage_min_ratio); },
+                 local ? hidden_wall_tolerance(area3, piece) : 0.0);
+  const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch,
+                                        step_times, !local, local ? &held : nullptr);
   if (times) {
     times->build_s = build_s, times->longest_s = build_s + clock.lap();
     times->longest_faces = nfaces, times->longest_steps = d.steps;
@@ -287,14 +243,7 @@ void minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const st
   res.energy_after += d.energy_after;
   res.iterations = std::max(res.iterations, d.steps);
   res.stop = d.stop;
-}
-
-// Wall area (3D) of `faces` whose map area ratio at `scale` is below `ratio`.
-double area_below(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
-                  const std::vector<int>& faces, double ratio) {
-  double a = 0;
-  for (int f : faces) a += scale * emb.area2(s, f) < ratio * area3[f] ? area3[f] : 0.0;
-  return a;
+  return local ? held.largest_cut() : 1.0;
 }
 
 // The second (grown) local pass works only on the pieces that still hide wall: a piece whose wall
@@ -306,9 +255,7 @@ double area_below(const Surface& s, const Embedding& emb, const std::vector<doub
 void keep_pieces_hiding_wall(const Surface& s, const Embedding& emb, const std::vector<double>& area3, double scale,
                              double min_ratio, std::vector<std::vector<int>>& pieces) {
   const auto shown = [&](const std::vector<int>& piece) {
-    double wall = 0;
-    for (int f : piece) wall += area3[f];
-    return !(area_below(s, emb, area3, scale, piece, min_ratio) > kHiddenWallTolerance * wall);
+    return !(area_below(s, emb, area3, scale, piece, min_ratio) > hidden_wall_tolerance(area3, piece));
   };
   pieces.erase(std::remove_if(pieces.begin(), pieces.end(), shown), pieces.end());
 }
@@ -320,7 +267,12 @@ void keep_pieces_hiding_wall(const Surface& s, const Embedding& emb, const std::
 // of its neighbours' size the piece's direction varies by far more than the spot's size), so a
 // large piece gains < min_gain per step and stops with its pockets unopened; on the spot alone the
 // same tiny steps are cheap, move only the spot, and gain until it has opened.
-constexpr double kSpotRatio = 1e-4;
+// A piece whose every step stayed below kStuckStep of the proxy's step was held by more than its
+// faces below kSpotRatio: the CT mask's window piece (pass 2: 5e-9 .. 4e-8 at each of its 62 steps)
+// holds 47 faces below 1e-4 and ~430 below 1e-3, and its re-run after the 47 went on at 1e-7 ..
+// 2e-6, held by the next ones; its spots are then the faces below kStuckSpotRatio (issue 26,
+// session 29 "tail"). Pieces that open step at 1e-5 .. 3e-2 once their ramp is over.
+constexpr double kSpotRatio = 1e-4, kStuckStep = 1e-6, kStuckSpotRatio = 1e-3;
 constexpr int kSpotRings = 2;
 struct SpotWork {
   std::size_t faces = 0;  // faces of the piece's spot regions
@@ -329,11 +281,11 @@ struct SpotWork {
 SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<int>& piece, const std::vector<char>& free_vertex,
                             const std::vector<double>& area3, double scale, const FlattenOptions& o,
-                            std::vector<V2>* scratch) {
+                            double spot_ratio, std::vector<V2>* scratch) {
   SpotWork work;
   std::vector<int> ring;
   for (int f : piece)
-    if (scale * emb.area2(s, f) < kSpotRatio * area3[f]) ring.push_back(f);
+    if (scale * emb.area2(s, f) < spot_ratio * area3[f]) ring.push_back(f);
   if (ring.empty()) return work;
   std::vector<char> mark(s.t.size(), 0);  // 1: in the piece, 2: in a spot region
   for (int f : piece) mark[f] = 1;
@@ -371,10 +323,11 @@ SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf
                        const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
                        AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
   const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
-  minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
+  const double largest_cut = minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
   if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
   Stopwatch clock;
-  const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, scratch);
+  const double spot_ratio = largest_cut < kStuckStep ? kStuckSpotRatio : kSpotRatio;
+  const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, spot_ratio, scratch);
   if (spots.faces == 0) return spots;
   AreaCorrection again;
   CorrectionTimes again_times;

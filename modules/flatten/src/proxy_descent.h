@@ -20,6 +20,7 @@
 #include "colonflat/core/threads.h"
 #include "face_blocks.h"
 #include "flatten_internal.h"
+#include "held_steps.h"
 
 namespace cf::flat_detail {
 
@@ -28,7 +29,8 @@ struct DescentResult {
   double energy_before = 0, energy_after = 0;
   // Why it stopped: "steps" (max_steps taken), "converged" (gain below min_gain), "no descent"
   // (no step lowers E, or the direction does not descend), "not injective" (E infinite at the start),
-  // "bounds met" (the caller's `enough` said so after a step).
+  // "bounds met" (the caller's `enough` said so after a step), "held" (the steps stalled on the
+  // same faces' fold-free cut once the piece was done: held_steps.h).
   const char* stop = "steps";
 };
 
@@ -99,12 +101,15 @@ class DescentTrace {
 // measured, its second part only at multiples of 8 from 16 on (U180's colon band at 24, the U's
 // 140-150 k-face branch bands at 16), where the one dropped step is the price of 11+ checks hidden
 // behind the solve before it: kept at 5.
+// `held` (optional, local pieces): computes each step's cut (the same bits) and stops the descent
+// ("held") when its steps have stalled on the same faces' cut and its `done` says so.
 constexpr int kChecksAlone = 5;
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
                             const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
                             double min_gain, const std::function<bool()>& enough = {},
-                            std::vector<V2>* scratch = nullptr, StepTimes* times = nullptr, bool check_beside = false) {
+                            std::vector<V2>* scratch = nullptr, StepTimes* times = nullptr, bool check_beside = false,
+                            HeldSteps* held = nullptr) {
   DescentResult res;
   StepTimes spent;
   double e0 = res.energy_before = res.energy_after = energy.energy(emb.pos);
@@ -150,7 +155,8 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       break;
     }
     move_to(d, 1.0);
-    double t = std::min(1.0, 0.9 * max_area_step(s, emb, trial, judged, area3, 0.0));
+    const double limit = held ? held->cut(judged, trial) : max_area_step(s, emb, trial, judged, area3, 0.0);
+    double t = std::min(1.0, 0.9 * limit);
     spent.step_limit += clock.lap();
     double e1 = Energy::kHuge;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
@@ -170,6 +176,11 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     e0 = res.energy_after = e1;
     if (!(gain > min_gain)) {
       res.stop = "converged";
+      break;
+    }
+    if (held && held->stop(limit)) {
+      ++res.steps;
+      res.stop = "held";
       break;
     }
     bool met = false;

@@ -1,0 +1,84 @@
+#pragma once
+// The area correction's energy (area_correct.cpp) over a set of faces of the band:
+//   E = sum_f sum_k w_fk |c_a - c_b|^2  +  lambda sum_f A3_f pen(log r_f)
+// (the cotangent Dirichlet energy of the map's corners plus the squared log area ratio outside
+// [lo, hi]; +infinity once a face folds), with its per-face corner gradients, in the interface
+// proxy_descent.h asks of an Energy. Every per-face loop runs in fixed blocks (face_blocks.h).
+#include <algorithm>
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "face_blocks.h"
+#include "flatten_internal.h"
+
+namespace cf::flat_detail {
+namespace area_energy_detail {
+inline double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+}  // namespace area_energy_detail
+
+class ConformalAreaEnergy {
+ public:
+  // `scale`: 3D / 2D area of the whole band (ratios at the area-preserving scale).
+  ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
+                      double lo, double hi, double lambda, double scale)
+      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), excess_(lo, hi), lambda_(lambda), scale_(scale) {
+    w_ = corner_weights(s, faces_);
+  }
+  const std::vector<std::array<double, 3>>& weights() const { return w_; }
+  const std::vector<int>& faces() const { return faces_; }
+
+  double energy(const std::vector<V2>& pos) const {
+    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      double part = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const auto c = corners(pos, faces_[i]);
+        const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
+        if (a2 <= 0) return kHuge;
+        for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
+        const int f = faces_[i];
+        const double x = excess_(scale_ * a2 / area3_[f]);
+        part += lambda_ * area3_[f] * x * x;
+      }
+      return part;
+    });
+    return e >= kHuge ? kHuge : e;
+  }
+
+  // Per face, the gradient with respect to each corner.
+  void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const int f = faces_[i];
+        const auto c = corners(pos, f);
+        const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
+        const double x = excess_(scale_ * a2 / area3_[f]);
+        const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
+        std::array<V2, 3>& grad = out[i];
+        grad = {V2::Zero(), V2::Zero(), V2::Zero()};
+        for (int k = 0; k < 3; ++k) {
+          const int a = (k + 1) % 3, b = (k + 2) % 3;
+          const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
+          grad[a] += e, grad[b] -= e;
+          grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
+        }
+      }
+    });
+  }
+  static constexpr double kHuge = 1e300;
+
+ private:
+  std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
+    const Tri& t = s_.t[f];
+    return {pos[t[0]] + V2(0, emb_.dy[f][0]), pos[t[1]] + V2(0, emb_.dy[f][1]), pos[t[2]] + V2(0, emb_.dy[f][2])};
+  }
+  const Surface& s_;
+  const Embedding& emb_;
+  std::vector<int> faces_;
+  const std::vector<double>& area3_;
+  LogRatioExcess excess_;
+  double lambda_, scale_ = 1;
+  std::vector<std::array<double, 3>> w_;
+};
+
+}  // namespace cf::flat_detail
