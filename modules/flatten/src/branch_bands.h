@@ -16,6 +16,7 @@ struct BranchPiece {
   double neck_mm = 0;
   bool tissue = false;  // holds tissue (a strand stump), not lumen
   bool limb = false;    // limb-sized: its neck at least kLimbNeck x the band's period (a fork of the lumen)
+  std::size_t loops = 1;  // open ends of `surface`: 1 (a branch, a patch that is a disk) or 2 (a patch that is an annulus)
 };
 
 // A branch whose neck is at least this fraction of its band's period (mm around) is limb-sized: the

@@ -17,6 +17,7 @@
 #include "colonflat/core/topology.h"
 #include "branch_bands.h"
 #include "factor_memory.h"
+#include "hidden_patches.h"
 #include "flatten_internal.h"
 
 namespace cf {
@@ -200,6 +201,7 @@ void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const
 }
 
 constexpr int kMaxBranchDepth = 3;  // branches of branches of branches
+constexpr int kMaxPatchDepth = kMaxBranchDepth + 2;  // patches (hidden_patches.h) of bands down to this depth
 std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
                                          const FlattenOptions& o, int depth, bool limb = false);
 
@@ -211,7 +213,7 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
   FlattenOptions bo = o;
   bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
   return flatten_branch_pieces(pieces, [&](const BranchPiece& piece) {
-    return flatten_surface(piece.surface, 1, std::size_t(component), lumen_sign, bo, depth + 1, piece.limb);
+    return flatten_surface(piece.surface, piece.loops, std::size_t(component), lumen_sign, bo, depth + 1, piece.limb);
   }, placed);
 }
 
@@ -280,6 +282,23 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
   if (depth == 0) debug_clock("branches cut off, the rest prepared");
   conformal(w, loops, p, o);
   return flattened;
+}
+
+// The wall the band's finished map still hides, cut out as patches and flattened as bands of their
+// own (hidden_patches.h; p.E and p.degenerate follow the cut, p.vf and p.fixed are stale after it);
+// `new_of_old` gets the band's vertex map (empty: nothing cut).
+std::vector<SegmentWork> flatten_patches(SegmentWork& w, Prepared& p, const FlattenOptions& o, int depth,
+                                         std::vector<int>& new_of_old) {
+  if (o.map != "area-balanced" || !(o.branch_min_area > 0) || depth >= kMaxPatchDepth) return {};
+  PatchCut cut = cut_patches(w, p.E, p.degenerate,
+                             hidden_patches(w, p.E, p.vf, p.degenerate, o.coverage_min_ratio, o.branch_min_area));
+  if (cut.pieces.empty()) return {};
+  new_of_old = std::move(cut.new_of_old);
+  double placed = 0;
+  std::vector<SegmentWork> works = flatten_branches(cut.pieces, w.seg.component, w.lumen_sign, o, depth, placed);
+  w.lost_area += cut.area_mm2 - placed;
+  if (depth == 0) debug_clock("hidden wall cut out as patches and flattened");
+  return works;
 }
 
 // Where each direct branch hangs on this segment: mean centreline position and LPS of its neck.
@@ -358,10 +377,13 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
   w.dissection_to_annulus = {};
   debug_stats("final", w, p.degenerate);
+  std::vector<int> patched;  // the band's vertex map when patches were cut out of it
+  std::vector<SegmentWork> patches = flatten_patches(w, p, o, depth, patched);
   const bool any_cut = cut.valid();
   FlattenedBranches flattened = any_cut ? cut.get() : FlattenedBranches{};
   if (any_cut) phase("side branches flattened (beside the above)");
   std::vector<SegmentWork>& branches = flattened.works;
+  join_patches(branches, patched, patches);
   w.lost_area += flattened.lost_area;
   attach_branches(w, branches);
   w.seg.faces = w.ann.t.size();
