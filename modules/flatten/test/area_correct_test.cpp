@@ -42,9 +42,11 @@ FlatMap flatten_with(const TriangleList& mesh, int iterations, double branch_min
 
 // A pedunculated polyp (6 mm head on a 1.6 mm stalk): without the correction its head is squeezed
 // through the stalk and part of the wall is not shown; the local correction (hundreds of steps on
-// a small region) shows it all, nothing folds, and the area ratios stay within bounds.
+// a small region) shows it all, nothing folds, and the area ratios stay within bounds. ("Without":
+// branches and hidden patches off too, --branch-min-area 0: a patch would show the head on its own
+// band, HiddenPatches.HiddenPolypHeadIsShownOnAPatch.)
 TEST(AreaCorrection, StalkedPolypHeadIsShown) {
-  const FlatMap before = flatten_with(test_shapes::stalked_polyp(), 0, 50);
+  const FlatMap before = flatten_with(test_shapes::stalked_polyp(), 0, 0);
   const FlatMap f = flatten_with(test_shapes::stalked_polyp(), 60, 50);
   ASSERT_EQ(f.segments.size(), 1u);
   EXPECT_LT(before.coverage.fraction, 0.99);
