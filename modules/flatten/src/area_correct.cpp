@@ -214,12 +214,14 @@ double hidden_wall_tolerance(const std::vector<double>& area3, const std::vector
 // Newton steps on one set of faces (free vertices as given); accumulates into `res`; `times`
 // (optional): where its wall time went. A whole band (not `local`) asks `enough` beside its next
 // step's solve (proxy_descent.h); a local piece stops once its steps stall on the same faces' cut
-// with no wall left hidden (held_steps.h). Returns the largest fold-free cut of a local piece's
-// steps (1 for a whole band: not watched).
+// with no wall left hidden, or with `leave_stuck` once they stall far below the proxy's step showing
+// nothing (held_steps.h). Returns the largest fold-free cut of a local piece's steps (1 for a whole
+// band: not watched).
 double minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const std::vector<char>& free_vertex,
               const std::vector<double>& area3, double scale, const FlattenOptions& o, bool local,
               AreaCorrection& res, const std::function<bool()>& enough = {}, std::vector<V2>* scratch = nullptr,
-              const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr) {
+              const std::vector<int>* vertex_order = nullptr, CorrectionTimes* times = nullptr,
+              bool leave_stuck = false) {
   const std::size_t nfaces = faces.size();
   Stopwatch clock;
   const ConformalAreaEnergy energy(s, emb, std::move(faces), area3, o.area_ratio_low, o.area_ratio_high, o.area_weight,
@@ -232,7 +234,7 @@ double minimise(const Surface& s, Embedding& emb, std::vector<int> faces, const 
   StepTimes* step_times = times ? &times->steps : nullptr;
   const std::vector<int>& piece = energy.faces();
   HeldSteps held(s, emb, [&] { return area_below(s, emb, area3, scale, piece, o.coverage_min_ratio); },
-                 local ? hidden_wall_tolerance(area3, piece) : 0.0);
+                 local ? hidden_wall_tolerance(area3, piece) : 0.0, leave_stuck);
   const DescentResult d = proxy_descent(s, emb, energy, sys, energy.faces(), area3, max_steps, 1e-5, enough, scratch,
                                         step_times, !local, local ? &held : nullptr);
   if (times) {
@@ -272,7 +274,7 @@ void keep_pieces_hiding_wall(const Surface& s, const Embedding& emb, const std::
 // holds 47 faces below 1e-4 and ~430 below 1e-3, and its re-run after the 47 went on at 1e-7 ..
 // 2e-6, held by the next ones; its spots are then the faces below kStuckSpotRatio (issue 26,
 // session 29 "tail"). Pieces that open step at 1e-5 .. 3e-2 once their ramp is over.
-constexpr double kSpotRatio = 1e-4, kStuckStep = 1e-6, kStuckSpotRatio = 1e-3;
+constexpr double kSpotRatio = 1e-4, kStuckSpotRatio = 1e-3;
 constexpr int kSpotRings = 2;
 struct SpotWork {
   std::size_t faces = 0;  // faces of the piece's spot regions
@@ -315,18 +317,20 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
 // (a piece that opens its pockets leaves a few % at most: on the real CT colon band, every piece but
 // the frozen one left <= 12 %) and the piece holds a crushed spot, the spot is opened on its own and
 // the piece runs again; in the last local pass only (`last_pass`: the grown regions, where a piece
-// has the most room; in the first pass a frozen piece is left to it). Pieces that did their job
-// are left as they are.
+// has the most room; in the first pass a frozen piece is left to it). There a piece whose first
+// descent is stuck (held_steps.h) stops it early and goes to its spots at once. Pieces that did their
+// job are left as they are.
 constexpr double kFrozen = 0.5;
 SpotWork correct_piece(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                        const std::vector<int>& piece, const std::vector<char>& free_vertex,
                        const std::vector<double>& area3, double scale, const FlattenOptions& o, bool last_pass,
                        AreaCorrection& res, std::vector<V2>* scratch, CorrectionTimes* times) {
   const double hidden = area_below(s, emb, area3, scale, piece, o.coverage_min_ratio);
-  const double largest_cut = minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times);
+  const double largest_cut =
+      minimise(s, emb, piece, free_vertex, area3, scale, o, true, res, {}, scratch, nullptr, times, last_pass);
   if (!last_pass || !(area_below(s, emb, area3, scale, piece, o.coverage_min_ratio) > kFrozen * hidden)) return {};
   Stopwatch clock;
-  const double spot_ratio = largest_cut < kStuckStep ? kStuckSpotRatio : kSpotRatio;
+  const double spot_ratio = largest_cut < HeldSteps::kStuckStep ? kStuckSpotRatio : kSpotRatio;
   const SpotWork spots = open_crushed_spots(s, vf, emb, piece, free_vertex, area3, scale, o, spot_ratio, scratch);
   if (spots.faces == 0) return spots;
   AreaCorrection again;

@@ -171,16 +171,16 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       break;
     }
     for (int v : unknowns) emb.pos[v] = trial[v];
-    const double gain = (e0 - e1) / e0;
+    const double gain = (e0 - e1) / e0, e_before = e0;
     trace.step(s, emb, judged, area3, res.steps, t, e1, gain);
     e0 = res.energy_after = e1;
     if (!(gain > min_gain)) {
       res.stop = "converged";
       break;
     }
-    if (held && held->stop(limit)) {
+    if (const char* why = held ? held->stop(limit, e_before, e1, max_steps - res.steps - 1) : nullptr) {
       ++res.steps;
-      res.stop = "held";
+      res.stop = why;
       break;
     }
     bool met = false;
