@@ -68,8 +68,10 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
 // step, but the concentric placements are only searched for a clean one (a loop's first cut,
 // undone unless clean: if no alternative is clean either, the loop is cut again with kFull);
 // kTrial, an attempt undone unless its caps are clean (concentric caps in one placement: their
-// pairs are only counted); kPlainTrial, a trial without the restricted triangulations.
-enum class CapAttempt { kFull, kFirst, kTrial, kPlainTrial };
+// pairs are only counted up to the first); kPlainTrial, a trial without the restricted
+// triangulations; kAgain, kFull without the triangulated caps, for a loop cut again after its kFirst
+// cut on the same mesh found none of them clean (the same steps on the same input fail again).
+enum class CapAttempt { kFull, kFirst, kTrial, kPlainTrial, kAgain };
 
 // Surgery plus bookkeeping; returns whether the two sides stayed connected.
 bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, const DenoiseOptions& o,

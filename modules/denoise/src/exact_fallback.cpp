@@ -22,7 +22,8 @@ namespace cf::detail {
 //     something runs through the tube, the other may: it spans the hole). Plain triangulations
 //     only: on the real CT surface the restricted ones took 7-14 s (wall, loaded machine) on
 //     such loops (235-242 vertices) and never found clean caps.
-// If none is, `loop` is cut again and its intersections are reported as before. Precondition:
+// If none is, `loop` is cut again (concentric caps only: its triangulated caps failed in its first
+// cut on this same mesh) and its intersections are reported as before. Precondition:
 // `reduced` = loop's class reduced modulo the span (nonzero). *cut_class receives the class of
 // the loop actually cut, *cut_loop (optional) the loop. Throws when a cut separates.
 SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& loop,
@@ -63,7 +64,9 @@ SurgeryResult ExactGreedy::cut_cleanly(const std::vector<Mesh::VertexHandle>& lo
       return sr;
     }
   }
-  return cut_recorded(loop, iteration);
+  // The first cut ended with pairs, so its triangulated caps all failed (they are only kept clean),
+  // and the trials were undone: the mesh is as it was, and the same steps would fail again.
+  return cut_recorded(loop, iteration, CapAttempt::kAgain);
 }
 
 // Records and cuts one loop; throws when the two sides of the cut are no longer connected.

@@ -52,6 +52,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   so.trial = attempt == CapAttempt::kTrial || attempt == CapAttempt::kPlainTrial;
   so.probe_concentric = attempt == CapAttempt::kFirst;
   so.restricted = attempt != CapAttempt::kPlainTrial;
+  so.triangulated = attempt != CapAttempt::kAgain;
   so.front = o.front_caps;
   if (st.worker)
     so.run_both = [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {

@@ -34,7 +34,7 @@ SurgeryResult Surgery::run() {
   for (std::size_t i = 0; i < k_; ++i) original_[i] = mesh_.point(loop_[i]);
   copy_loop_classes();
   Stopwatch sw;
-  const bool triangulated = try_triangulated_caps();
+  const bool triangulated = opts_.triangulated && try_triangulated_caps();
   const double t_tri = sw.seconds();
   if (!triangulated) concentric_caps();
   result_.caps = cap_kind_;

@@ -150,8 +150,9 @@ TEST(DenoiseCapIntersections, BlockedLoopIsReplacedBySameClassLoop) {
 }
 
 // The blocked torus's thinnest meridian (the exact method's first loop, cut without the cap
-// check) cut alone on a fresh copy, front caps off, with the given concentric placement rule.
-SurgeryResult cut_thinnest_meridian(bench::Blocker kind, bool trial, bool probe, Mesh* out) {
+// check) cut alone on a fresh copy, front caps off, with the given concentric placement rule
+// (and without the triangulated caps when `triangulated` is off).
+SurgeryResult cut_thinnest_meridian(bench::Blocker kind, bool trial, bool probe, Mesh* out, bool triangulated = true) {
   const Mesh m = bench::blocked_torus(kind);
   DenoiseOptions unchecked;
   unchecked.check_caps = false;
@@ -165,13 +166,26 @@ SurgeryResult cut_thinnest_meridian(bench::Blocker kind, bool trial, bool probe,
   o.front = false;
   o.trial = trial;
   o.probe_concentric = probe;
+  o.triangulated = triangulated;
   return cut_and_cap(*out, loop, o);
+}
+
+void expect_same_mesh(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  ASSERT_EQ(a.n_faces(), b.n_faces());
+  for (auto v : a.vertices()) EXPECT_EQ(a.point(v), b.point(v)) << v.idx();
+  for (auto f : a.faces()) {
+    auto ia = a.cfv_iter(f);
+    auto ib = b.cfv_iter(f);
+    for (int i = 0; i < 3; ++i, ++ia, ++ib) EXPECT_EQ(ia->idx(), ib->idx()) << f.idx();
+  }
 }
 
 // A loop's first cut only probes the concentric placements for a clean one (each count stops at
 // its first pair): where one is clean (the core blob) it gives the full search's caps, point for
 // point; where none is (a rod through every meridian's caps) the caps stay in the first
-// placement and report its pairs (as a trial does), which the full search would have lowered.
+// placement and report its pairs, which the full search would have lowered. A trial leaves the
+// same caps there but counts only up to its first pair (it is kept only when clean).
 TEST(DenoiseCapIntersections, ProbedConcentricPlacementsOnlyLookForACleanOne) {
   Mesh full_mesh, probe_mesh, trial_mesh;
   const SurgeryResult full = cut_thinnest_meridian(bench::Blocker::kCoreBlob, false, false, &full_mesh);
@@ -183,9 +197,24 @@ TEST(DenoiseCapIntersections, ProbedConcentricPlacementsOnlyLookForACleanOne) {
   const SurgeryResult rod_full = cut_thinnest_meridian(bench::Blocker::kRod, false, false, &full_mesh);
   const SurgeryResult rod_probe = cut_thinnest_meridian(bench::Blocker::kRod, false, true, &probe_mesh);
   const SurgeryResult rod_trial = cut_thinnest_meridian(bench::Blocker::kRod, true, false, &trial_mesh);
-  EXPECT_GT(rod_probe.intersections, 0u);
-  EXPECT_EQ(rod_probe.intersections, rod_trial.intersections);
+  EXPECT_GT(rod_probe.intersections, 1u);
+  EXPECT_EQ(rod_trial.intersections, 1u) << "a trial's count stops at its first pair";
+  expect_same_mesh(trial_mesh, probe_mesh);
   EXPECT_LT(rod_full.intersections, rod_probe.intersections) << "the full search must lower the first placement's pairs";
+}
+
+// A loop whose triangulated caps all fail (the rod through every meridian's caps) gets the same
+// concentric caps, vertex for vertex and face for face, when the triangulated steps are skipped
+// (CapAttempt::kAgain: the fallback's last cut of a loop whose first cut already failed them).
+TEST(DenoiseCapIntersections, SkippingFailedTriangulatedCapsGivesTheSameConcentricCaps) {
+  Mesh full_mesh, again_mesh;
+  const SurgeryResult full = cut_thinnest_meridian(bench::Blocker::kRod, false, false, &full_mesh);
+  const SurgeryResult again = cut_thinnest_meridian(bench::Blocker::kRod, false, false, &again_mesh, false);
+  ASSERT_STREQ(full.caps, "concentric");
+  ASSERT_GT(full.intersections, 0u);
+  EXPECT_STREQ(again.caps, "concentric");
+  EXPECT_EQ(again.intersections, full.intersections);
+  expect_same_mesh(again_mesh, full_mesh);
 }
 
 // A blob at the tube core (+-0.6 mm along the tube, 0.6 mm across) is crossed by every flat,

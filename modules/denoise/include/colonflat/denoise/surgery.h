@@ -32,8 +32,11 @@ struct SurgeryOptions {
   bool restricted = true;  // with a guard: also the triangulations restricted to clean triangles
   bool front = true;       // with a guard: also front caps (grown from the ring, steered off the surface)
   bool trial = false;      // with a guard: the caller keeps the result only when it intersects
-                           // nothing, so concentric caps stay in their first placement (their
-                           // pairs counted, not minimised over the placements)
+                           // nothing, so concentric caps stay in their first placement and their
+                           // pairs are counted up to the first (intersections is 0 or 1)
+  bool triangulated = true;  // with a guard: try the triangulated caps (plain, collar, front,
+                             // restricted) before the concentric ones; off when they are known to
+                             // fail (the same loop on the same mesh failed them before)
   bool probe_concentric = false;  // with a guard, not a trial: the concentric placements are only
                                   // searched for a clean one (each count stops at its first pair);
                                   // without one the caps stay in the first placement, whose pairs
