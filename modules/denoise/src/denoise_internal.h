@@ -66,7 +66,7 @@ void prepare_input(DenoiseState& st, const Mesh& input, const DenoiseOptions& o,
 
 // How hard a surgery looks for clean caps (with --check-caps): kFull, every step; kFirst, every
 // step, but the concentric placements are only searched for a clean one (a loop's first cut,
-// undone unless clean: if no alternative is clean either, the loop is cut again with kFull);
+// undone unless clean: if no alternative is clean either, the loop is cut again with kAgain);
 // kTrial, an attempt undone unless its caps are clean (concentric caps in one placement: their
 // pairs are only counted up to the first); kPlainTrial, a trial without the restricted
 // triangulations; kAgain, kFull without the triangulated caps, for a loop cut again after its kFirst

@@ -1,6 +1,7 @@
 // Cap placement of cut_and_cap(): steps 6-8 of the Surgery (surgery_steps.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <unordered_map>

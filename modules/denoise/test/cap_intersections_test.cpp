@@ -170,6 +170,7 @@ SurgeryResult cut_thinnest_meridian(bench::Blocker kind, bool trial, bool probe,
   return cut_and_cap(*out, loop, o);
 }
 
+// a and b hold the same points and the same faces (vertex ids in order).
 void expect_same_mesh(const Mesh& a, const Mesh& b) {
   ASSERT_EQ(a.n_vertices(), b.n_vertices());
   ASSERT_EQ(a.n_faces(), b.n_faces());
