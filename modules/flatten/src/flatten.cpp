@@ -296,6 +296,8 @@ std::vector<SegmentWork> flatten_patches(SegmentWork& w, Prepared& p, const Flat
   new_of_old = std::move(cut.new_of_old);
   double placed = 0;
   std::vector<SegmentWork> works = flatten_branches(cut.pieces, w.seg.component, w.lumen_sign, o, depth, placed);
+  for (SegmentWork& pw : works)
+    if (pw.parent == -1) pw.seg.holds = "wall";  // the patches themselves (not branches found inside one)
   w.lost_area += cut.area_mm2 - placed;
   if (depth == 0) debug_clock("hidden wall cut out as patches and flattened");
   return works;

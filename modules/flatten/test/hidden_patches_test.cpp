@@ -2,6 +2,7 @@
 // that wall (and a few rings around it) to a band of its own; the band keeps the map of the rest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "../src/hidden_patches.h"
@@ -106,7 +107,7 @@ TEST(HiddenPatches, CutLeavesTheRestsMapAsItWas) {
 // A stalked polyp (6 mm head on a 1.6 mm stalk) left to the conformal map (area correction and
 // balancing off) hides its head: below 99 % shown with patches off (--branch-min-area 0: nothing cut
 // out), >= 99.5 % when the hidden head is cut out as a patch and flattened on its own; nothing
-// flipped, and the same map bit for bit with 1 and 2 threads.
+// flipped, the patch band marked as wall ("holds" = "wall"), the same map bit for bit with 1 and 2 threads.
 TEST(HiddenPatches, HiddenPolypHeadIsShownOnAPatch) {
   const TriangleList mesh = test_shapes::stalked_polyp();
   FlattenOptions o;
@@ -122,6 +123,8 @@ TEST(HiddenPatches, HiddenPolypHeadIsShownOnAPatch) {
   set_thread_count(0);
   EXPECT_GE(f.coverage.fraction, 0.995);
   EXPECT_GE(f.segments.size(), 2u);
+  EXPECT_TRUE(std::any_of(f.segments.begin(), f.segments.end(),
+                          [](const FlatSegment& s) { return s.kind == "branch" && s.holds == "wall"; }));
   EXPECT_EQ(f.stats.flipped, 0u);
   ASSERT_EQ(one.uv.size(), f.uv.size());
   EXPECT_EQ(test_shapes::uv_differences(one, f), 0u);

@@ -312,7 +312,10 @@ namespace cf {
 std::string band_caption(const FlatSegment& s) {
   using detail::fmt0;
   std::string t = "segment " + std::to_string(s.id + 1) + ": ";
-  if (s.kind == "branch")
+  if (s.kind == "branch" && s.holds == "wall")
+    t += "wall patch (hidden in the map of) segment " + std::to_string(s.parent + 1) + " at " +
+         fmt0(s.attach_mm / 10) + " cm, rim " + fmt0(s.neck_mm) + " mm around; ";
+  else if (s.kind == "branch")
     t += std::string(s.holds == "tissue" ? "tissue strand (cut bridge) off" : "side branch (pouch) of") + " segment " +
          std::to_string(s.parent + 1) + " at " + fmt0(s.attach_mm / 10) + " cm, neck " + fmt0(s.neck_mm) +
          " mm around; ";

@@ -119,7 +119,8 @@ TEST(RenderImage, MissingWallIsHatched) {
 
 // A band's caption says what it shows: a side branch holding tissue (flatten's "holds", a crushed
 // strand stump: FlattenBranches.CrushedTissueStrandIsABandOfItsOwn) is a "tissue strand (cut
-// bridge)", never a pouch; one holding lumen stays "side branch (pouch)"; the colon band is neither.
+// bridge)", never a pouch; one holding lumen stays "side branch (pouch)"; a patch of wall its parent's
+// map hid ("wall") is a "wall patch", never a pouch; the colon band is none of these.
 TEST(RenderImage, BandCaptionSaysPouchOrTissueStrand) {
   FlatSegment colon, branch;
   colon.id = 0, colon.length = 200, colon.period = 75;
@@ -134,6 +135,11 @@ TEST(RenderImage, BandCaptionSaysPouchOrTissueStrand) {
   EXPECT_EQ(strand.rfind("segment 2: tissue strand (cut bridge) off segment 1 at 10 cm, neck 7 mm around; ", 0), 0u)
       << strand;
   EXPECT_EQ(strand.find("pouch"), std::string::npos) << strand;
+  branch.holds = "wall";  // a patch: wall its parent's map hid (flatten's hidden patches)
+  const std::string patch = band_caption(branch);
+  EXPECT_EQ(patch.rfind("segment 2: wall patch (hidden in the map of) segment 1 at 10 cm, rim 7 mm around; ", 0), 0u)
+      << patch;
+  EXPECT_EQ(patch.find("pouch"), std::string::npos) << patch;
   const std::string band = band_caption(colon);
   EXPECT_EQ(band.rfind("segment 1: 200 mm long x 75 mm around; end A (left) to end B (right); ", 0), 0u) << band;
   EXPECT_EQ(band.find("pouch"), std::string::npos);

@@ -101,8 +101,10 @@ struct FlatSegment {
   std::array<double, 3> attach_lps{0, 0, 0};         // branch: centre of the neck, LPS mm
   double neck_mm = 0;                                // branch: 3D length of the neck (mm)
   std::string holds = "lumen";                       // branch: what the region closed over its neck holds:
-                                                     // "lumen" (a pouch: diverticulum, blind loop) or "tissue"
+                                                     // "lumen" (a pouch: diverticulum, blind loop), "tissue"
                                                      // (a crushed strand stump: a tissue bridge cut by denoise)
+                                                     // or "wall" (a patch: wall the parent band's map hid, cut
+                                                     // out and shown on its own; its "neck" is the cut's rim)
 };
 
 // The flattened colon: a triangle mesh in the plane, cut open along one line per segment (vertices
