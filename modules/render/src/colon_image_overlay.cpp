@@ -127,11 +127,12 @@ std::vector<NotShownMark> not_shown_marks(const FlatMap& f) {
 struct NeckMark {
   int segment = 0, branch = 0;
   double x = 0, y = 0;  // flat layout position (mm)
+  std::string label;    // neck_label() of the branch's band
 };
 std::vector<NeckMark> neck_marks(const FlatMap& f) {
   std::vector<NeckMark> marks;
   for (const FlatSegment& b : f.segments) {
-    NeckMark m{b.parent, b.id, 0, 0};
+    NeckMark m{b.parent, b.id, 0, 0, neck_label(b)};
     if (b.kind == "branch" && b.parent >= 0 && nearest_flat_position(f, b.parent, b.attach_lps, m.x, m.y))
       marks.push_back(m);
   }
@@ -230,7 +231,7 @@ void ColonImagePainter::draw_branch_necks(OverlayCanvas* canvas) {
     const int cx = int(pixel[0]), cy = int(pixel[1]), r = 10;
     const int corner[5][2] = {{cx, cy - r}, {cx + r, cy}, {cx, cy + r}, {cx - r, cy}, {cx, cy - r}};
     for (int k = 0; k < 4; ++k) canvas->fill_tube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
-    labels_.push_back({"branch: segment " + std::to_string(m.branch + 1), cx + r + 2, height_ - 1 - cy - 6,
+    labels_.push_back({m.label, cx + r + 2, height_ - 1 - cy - 6,
                        {0.45, 0.9, 1}, 12, 0.55});
   }
 }
@@ -321,6 +322,10 @@ std::string band_caption(const FlatSegment& s) {
          " mm around; ";
   return t + fmt0(s.length) + " mm long x " + fmt0(s.period) + " mm around; " + s.x0_end + " (left) to " + s.x1_end +
          " (right); ";
+}
+
+std::string neck_label(const FlatSegment& s) {
+  return std::string(s.holds == "wall" ? "patch" : "branch") + ": segment " + std::to_string(s.id + 1);
 }
 
 }  // namespace cf

@@ -140,6 +140,9 @@ TEST(RenderImage, BandCaptionSaysPouchOrTissueStrand) {
   EXPECT_EQ(patch.rfind("segment 2: wall patch (hidden in the map of) segment 1 at 10 cm, rim 7 mm around; ", 0), 0u)
       << patch;
   EXPECT_EQ(patch.find("pouch"), std::string::npos) << patch;
+  EXPECT_EQ(neck_label(branch), "patch: segment 2");  // its mark on the parent band
+  branch.holds = "lumen";
+  EXPECT_EQ(neck_label(branch), "branch: segment 2");
   const std::string band = band_caption(colon);
   EXPECT_EQ(band.rfind("segment 1: 200 mm long x 75 mm around; end A (left) to end B (right); ", 0), 0u) << band;
   EXPECT_EQ(band.find("pouch"), std::string::npos);

@@ -69,6 +69,9 @@ ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, 
 // bridge) off segment P" (holds tissue: a crushed strand stump), its neck's place (cm) and length
 // (mm), then the band's size (mm) and its left / right ends, ending in "; ".
 std::string band_caption(const FlatSegment& s);
+// The label of a side band's mark on its parent band: "patch: segment N" for a patch of wall the
+// parent's map hid (holds "wall"), else "branch: segment N" (a pouch or a tissue strand's neck).
+std::string neck_label(const FlatSegment& s);
 
 // `shape_index`: per flat vertex (for color = "curvature"); may be empty.
 ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& shape_index,
