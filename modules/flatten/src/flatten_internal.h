@@ -483,8 +483,8 @@ void band_distortion(const SegmentWork& w, const std::vector<char>& degenerate, 
 std::vector<FaceFrame> band_frames(const SegmentWork& w);
 
 // Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
-// their parent and their neck's position on it, labelled "neck" -> "tip". Returns per work whether
-// its band is reversed (flatten_layout.cpp).
+// their parent and their neck's position on it, labelled "neck" -> "tip" ("rim" for a patch).
+// Returns per work whether its band is reversed (flatten_layout.cpp).
 std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x);
 
 // Lays the segments out in their order (stacked in y, `segment_gap` apart), reverses those

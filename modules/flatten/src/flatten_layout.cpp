@@ -105,7 +105,7 @@ Coverage total_coverage(const std::vector<FlatSegment>& segs) {
 }  // namespace
 
 // Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
-// their parent and their neck's position on it, labelled "neck" -> "tip".
+// their parent and their neck's position on it, labelled "neck" -> "tip" ("rim" -> "tip" for a patch).
 std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline_x) {
   std::vector<int> colon;
   std::vector<FlatSegment> segs;
@@ -125,7 +125,7 @@ std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline
     const SegmentWork& parent = work[b.parent];
     if (reversed[b.parent]) b.seg.attach_mm = parent.seg.centreline_length - b.seg.attach_mm;
     b.seg.kind = "branch";
-    b.seg.x0_end = "neck";
+    b.seg.x0_end = b.seg.holds == "wall" ? "rim" : "neck";  // a patch's x0 end is the rim it was cut along
     b.seg.x1_end = "tip";
     branch.push_back(int(i));
   }
