@@ -67,13 +67,16 @@ void grow_rings(const Surface& s, const std::vector<std::vector<int>>& vf, int r
   }
 }
 
-// Open ends of the surface made of `faces` of s: 1 for a disk, 2 for an annulus, 0 otherwise.
-std::size_t patch_loops(const Surface& s, const std::vector<int>& faces) {
-  const Surface p = sub_surface(s, faces);
+// The boundary loops and Euler characteristic of a patch's own surface.
+struct PatchShape {
+  std::size_t loops = 0;
+  long long chi = 0;
+  // Open ends: 1 for a disk, 2 for an annulus, 0 otherwise.
+  std::size_t open_ends() const { return (loops == 1 && chi == 1) ? 1 : (loops == 2 && chi == 0) ? 2 : 0; }
+};
+PatchShape patch_shape(const Surface& p) {
   const Edges e = build_edges(p.t);
-  const long long chi = (long long)p.p.size() - (long long)e.ev.size() + (long long)p.t.size();
-  const std::size_t loops = boundary_loops(p, e).size();
-  return (loops == 1 && chi == 1) ? 1 : (loops == 2 && chi == 0) ? 2 : 0;
+  return {boundary_loops(p, e).size(), (long long)p.p.size() - (long long)e.ev.size() + (long long)p.t.size()};
 }
 
 // Per vertex of s: the index of the boundary loop it lies on (-1: none).
@@ -124,12 +127,25 @@ std::vector<std::vector<int>> split_by_band_loops(const Surface& s, const Edges&
 }
 
 // COLONFLAT_FLATTEN_DEBUG=1: one line per patch (faces, area, open ends, Euler characteristic).
-void debug_patch(const Surface& s, const std::vector<int>& faces, bool kept) {
-  const Surface p = sub_surface(s, faces);
-  const Edges e = build_edges(p.t);
-  const long long chi = (long long)p.p.size() - (long long)e.ev.size() + (long long)p.t.size();
-  std::fprintf(stderr, "flatten debug hidden patch: %zu faces, %.1f mm2, %zu loops, chi %lld: %s\n", faces.size(),
-               surface_area(p), boundary_loops(p, e).size(), chi, kept ? "cut out" : "left");
+void debug_patch(const Surface& p, const PatchShape& shape, bool kept) {
+  std::fprintf(stderr, "flatten debug hidden patch: %zu faces, %.1f mm2, %zu loops, chi %lld: %s\n", p.t.size(),
+               surface_area(p), shape.loops, shape.chi, kept ? "cut out" : "left");
+}
+
+// Per edge of E between a face in a patch and a face outside it (another patch's or the rest's),
+// its length and ends added to that patch's rim (`pieces[i]`: patch i's), edges in ascending order.
+void add_rims(const Surface& s, const Edges& E, const std::vector<int>& patch_of, const std::vector<int>& new_of_old,
+              std::vector<BranchPiece>& pieces) {
+  for (std::size_t e = 0; e < E.ev.size(); ++e) {
+    const int f0 = E.ef[e][0], f1 = E.ef[e][1];
+    if (f1 < 0 || patch_of[std::size_t(f0)] == patch_of[std::size_t(f1)]) continue;
+    for (int f : {f0, f1}) {
+      const int i = patch_of[std::size_t(f)];
+      if (i < 0) continue;
+      pieces[std::size_t(i)].neck_mm += (s.p[std::size_t(E.ev[e][0])] - s.p[std::size_t(E.ev[e][1])]).norm();
+      for (int v : E.ev[e]) pieces[std::size_t(i)].neck.push_back(new_of_old[std::size_t(v)]);
+    }
+  }
 }
 
 }  // namespace
@@ -157,8 +173,10 @@ std::vector<std::vector<int>> hidden_patches(const SegmentWork& w, const Edges& 
   FaceSetScratch scratch;
   for (std::vector<int>& piece : pieces) {
     std::vector<int> clean = clean_face_set(w.ann, E, std::move(piece), &scratch);
-    const bool ok = !clean.empty() && clean.size() < w.ann.t.size() && patch_loops(w.ann, clean) > 0;
-    if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) debug_patch(w.ann, clean, ok);
+    const Surface sub = sub_surface(w.ann, clean);
+    const PatchShape shape = patch_shape(sub);
+    const bool ok = !clean.empty() && clean.size() < w.ann.t.size() && shape.open_ends() > 0;
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) debug_patch(sub, shape, ok);
     if (ok) patches.push_back(std::move(clean));
   }
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
@@ -172,24 +190,18 @@ PatchCut cut_patches(SegmentWork& w, Edges& E, std::vector<char>& degenerate, co
   if (patches.empty()) return cut;
   const std::size_t nf = w.ann.t.size();
   std::vector<char> keep(nf, 1);
-  for (const auto& patch : patches)
-    for (int f : patch) keep[std::size_t(f)] = 0;
+  std::vector<int> patch_of(nf, -1);
+  for (std::size_t i = 0; i < patches.size(); ++i)
+    for (int f : patches[i]) keep[std::size_t(f)] = 0, patch_of[std::size_t(f)] = int(i);
   Surface rest = sub_surface(w.ann, keep, &cut.new_of_old);
   for (const auto& patch : patches) {
     BranchPiece piece;
     piece.surface = sub_surface(w.ann, patch);
-    piece.loops = patch_loops(w.ann, patch);
-    std::vector<char> in(nf, 0);
-    for (int f : patch) in[std::size_t(f)] = 1;
-    for (std::size_t e = 0; e < E.ev.size(); ++e) {  // the rim: edges between the patch and the rest
-      const int f0 = E.ef[e][0], f1 = E.ef[e][1];
-      if (f1 < 0 || in[std::size_t(f0)] == in[std::size_t(f1)]) continue;
-      piece.neck_mm += (w.ann.p[std::size_t(E.ev[e][0])] - w.ann.p[std::size_t(E.ev[e][1])]).norm();
-      for (int v : E.ev[e]) piece.neck.push_back(cut.new_of_old[std::size_t(v)]);
-    }
+    piece.loops = patch_shape(piece.surface).open_ends();
     cut.area_mm2 += surface_area(piece.surface);
     cut.pieces.push_back(std::move(piece));
   }
+  add_rims(w.ann, E, patch_of, cut.new_of_old, cut.pieces);
   E = sub_edges(E, keep, cut.new_of_old);
   std::vector<V2> pos(rest.p.size());
   std::vector<double> along(w.along.empty() ? 0 : rest.p.size());
