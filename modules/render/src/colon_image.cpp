@@ -10,6 +10,7 @@ VTK_MODULE_INIT(vtkRenderingFreeType);
 #include <vtkTextRenderer.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "colonflat/core/error.h"
@@ -44,12 +45,10 @@ std::mutex& freetype_mutex() {
   return m;
 }
 
-void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int font_size, const double color[3],
-               double bg_opacity) {
-  const std::lock_guard<std::mutex> lock(freetype_mutex());
-  vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
-  if (!tr) throw Error("no FreeType text renderer in this VTK build");
-  vtkNew<vtkTextProperty> tp;
+namespace {
+
+// Bold Arial of `font_size` in `color` on a black background of `bg_opacity` (0: none).
+void set_text_property(vtkTextProperty* tp, int font_size, const double color[3], double bg_opacity) {
   tp->SetFontSize(font_size);
   tp->SetColor(color[0], color[1], color[2]);
   tp->SetFontFamilyToArial();
@@ -58,9 +57,34 @@ void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int
     tp->SetBackgroundColor(0, 0, 0);
     tp->SetBackgroundOpacity(bg_opacity);
   }
-  vtkNew<vtkImageData> t;
+}
+
+// The text rendered by FreeType into `t` (RGBA); returns its size in pixels. Pre: freetype_mutex() held.
+std::array<int, 2> render_text(vtkImageData* t, const std::string& text, int font_size, const double color[3],
+                               double bg_opacity) {
+  vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
+  if (!tr) throw Error("no FreeType text renderer in this VTK build");
+  vtkNew<vtkTextProperty> tp;
+  set_text_property(tp, font_size, color, bg_opacity);
   int dims[2];
   if (!tr->RenderString(tp, text, t, dims, 72)) throw Error("cannot render text '" + text + "'");
+  return {dims[0], dims[1]};
+}
+
+}  // namespace
+
+std::array<int, 2> text_size(const std::string& text, int font_size, double bg_opacity) {
+  const std::lock_guard<std::mutex> lock(freetype_mutex());
+  vtkNew<vtkImageData> t;
+  const double white[3] = {1, 1, 1};
+  return render_text(t, text, font_size, white, bg_opacity);
+}
+
+std::array<int, 2> draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int font_size,
+                             const double color[3], double bg_opacity) {
+  const std::lock_guard<std::mutex> lock(freetype_mutex());
+  vtkNew<vtkImageData> t;
+  const std::array<int, 2> dims = render_text(t, text, font_size, color, bg_opacity);
   int te[6], ie[6];
   t->GetExtent(te);
   rgb->GetExtent(ie);
@@ -79,6 +103,7 @@ void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int
       unsigned char* d = dst + (std::size_t(Yrow) * W + X) * 3;
       for (int k = 0; k < 3; ++k) d[k] = static_cast<unsigned char>(std::lround((1 - a) * d[k] + a * s[k]));
     }
+  return dims;
 }
 
 ColonImageGeometry colon_image_geometry(const FlatMap& flat, double pixel_size, int max_width) {
@@ -118,6 +143,7 @@ ColonImage ColonImagePainter::run() {
   write_scale_text();
   write_band_captions();
   write_legend_and_title();
+  write_labels();
   out_.image = image_;
   return out_;
 }

@@ -1,6 +1,7 @@
 // render_colon_image, steps 4-5: overlays drawn with VTK's canvas (markers, not-shown rings, scale
 // bar, axis ticks), then the text drawn with FreeType (scale, tick labels, band captions, legend,
-// title, marker labels, in that order: later text covers earlier).
+// title), then the marker labels, each placed off the text and the labels before it
+// (label_placement.h), with a leader line when away from its mark.
 #include <vtkImageCanvasSource2D.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
@@ -199,7 +200,8 @@ void ColonImagePainter::draw_marker(OverlayCanvas* canvas, ImageMarker& mk, cons
     canvas->fill_tube(int(cx + r * std::cos(a0)), int(cy + r * std::sin(a0)), int(cx + r * std::cos(a1)),
                       int(cy + r * std::sin(a1)), 1.3);
   }
-  Label l{mk.label, int(cx + r * 0.75), int(height_ - 1 - (cy + r * 0.75)) - 16, {1, 0.9, 0}, 14, 0.55};
+  Label l{mk.label, int(cx + r * 0.75), int(height_ - 1 - (cy + r * 0.75)) - 16, {1, 0.9, 0}, 14, 0.55,
+          int(cx), height_ - 1 - int(cy), int(std::ceil(r))};
   if (mk.known) l.col[0] = 0.25, l.col[1] = 0.95, l.col[2] = 0.4, l.y = int(height_ - 1 - (cy - r * 0.75)) + 2;
   labels_.push_back(l);
 }
@@ -217,7 +219,8 @@ void ColonImagePainter::draw_not_shown_rings(OverlayCanvas* canvas) {
     canvas->FillBox(cx - r, cx - r + 1, cy - r, cy + r);
     canvas->FillBox(cx + r - 1, cx + r, cy - r, cy + r);
     const std::string area = m.area_mm2 < 1000 ? fmt0(m.area_mm2) + " mm2" : fmt0(m.area_mm2 / 100.0) + " cm2";
-    labels_.push_back({area + " not shown", cx + r + 2, height_ - 1 - cy - 6, {1, 0.45, 0.45}, 12, 0.55});
+    labels_.push_back({area + " not shown", cx + r + 2, height_ - 1 - cy - 6, {1, 0.45, 0.45}, 12, 0.55, cx,
+                       height_ - 1 - cy, r});
   }
 }
 
@@ -231,8 +234,7 @@ void ColonImagePainter::draw_branch_necks(OverlayCanvas* canvas) {
     const int cx = int(pixel[0]), cy = int(pixel[1]), r = 10;
     const int corner[5][2] = {{cx, cy - r}, {cx + r, cy}, {cx, cy + r}, {cx - r, cy}, {cx, cy - r}};
     for (int k = 0; k < 4; ++k) canvas->fill_tube(corner[k][0], corner[k][1], corner[k + 1][0], corner[k + 1][1], 1.3);
-    labels_.push_back({m.label, cx + r + 2, height_ - 1 - cy - 6,
-                       {0.45, 0.9, 1}, 12, 0.55});
+    labels_.push_back({m.label, cx + r + 2, height_ - 1 - cy - 6, {0.45, 0.9, 1}, 12, 0.55, cx, height_ - 1 - cy, r});
   }
 }
 
@@ -245,6 +247,7 @@ void ColonImagePainter::draw_scale_bar(OverlayCanvas* canvas) {
   canvas->FillBox(margin, margin + bar_px_, 28, 34);
   canvas->FillBox(margin, margin + 2, 22, 40);
   canvas->FillBox(margin + bar_px_ - 2, margin + bar_px_, 22, 40);
+  text_boxes_.push_back({margin, height_ - 1 - 40, bar_px_ + 1, 19});  // labels keep off the bar too
 }
 
 void ColonImagePainter::draw_ticks(OverlayCanvas* canvas) {
@@ -259,14 +262,14 @@ void ColonImagePainter::write_scale_text() {
   const int margin = margin_;
   std::ostringstream sb;
   sb << bar_mm_ << " mm";
-  draw_text(image_, sb.str(), margin + bar_px_ + 10, height_ - 44, 16, white);
+  write_text(sb.str(), margin + bar_px_ + 10, height_ - 44, 16, white);
   std::ostringstream q;
   q.precision(2);
   q << px_;
-  draw_text(image_, "(scale at the mean, area-preserving map scale; 1 px = " + q.str() + " mm)",
+  write_text("(scale at the mean, area-preserving map scale; 1 px = " + q.str() + " mm)",
             margin + bar_px_ + 80, height_ - 42, 12, grey);
   for (const Tick& t : ticks_)
-    if (!t.text.empty()) draw_text(image_, t.text, t.col - 4 * int(t.text.size()), height_ - t.row_bottom + 2, 12, grey);
+    if (!t.text.empty()) write_text(t.text, t.col - 4 * int(t.text.size()), height_ - t.row_bottom + 2, 12, grey);
 }
 
 // Above each band: what it shows and its x axis; its two ends named at its corners.
@@ -278,23 +281,56 @@ void ColonImagePainter::write_band_captions() {
     const std::string t = band_caption(s) +
                           (along ? "x axis: cm along the centreline from the " + s.x0_end
                                  : "x axis: cm of the conformal map (not centreline length)");
-    draw_text(image_, t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
+    write_text(t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
     const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
-    draw_text(image_, s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
+    write_text(s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
     if (b.w > 10 * int(s.x0_end.size() + s.x1_end.size()) + 24)  // both names fit side by side
-      draw_text(image_, s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
+      write_text(s.x1_end, b.col0 + b.w - 10 * int(s.x1_end.size()) - 8, top_row, 16, end_col, 0.6);
   }
 }
 
-// The hatching legend (bottom), the title (top), then the marker and ring labels over everything.
+// The hatching legend (bottom) and the title (top).
 void ColonImagePainter::write_legend_and_title() {
   const double white[3] = {1, 1, 1}, grey[3] = {0.85, 0.85, 0.85};
   const int margin = margin_;
-  draw_text(image_, "hatched blue: wall compressed below " + fmt2(opts_.compressed_ratio) +
+  write_text("hatched blue: wall compressed below " + fmt2(opts_.compressed_ratio) +
                         " x its area; hatched red: wall not in the map; red squares: wall the image cannot show (its 3D area)",
             margin, height_ - 22, 12, grey);
-  draw_text(image_, opts_.title.empty() ? automatic_title() : opts_.title, margin, 12, 18, white);
-  for (const auto& l : labels_) draw_text(image_, l.text, l.x, l.y, l.size, l.col, l.bg);
+  write_text(opts_.title.empty() ? automatic_title() : opts_.title, margin, 12, 18, white);
+}
+
+void ColonImagePainter::write_text(const std::string& text, int x, int y, int size, const double col[3], double bg) {
+  const std::array<int, 2> wh = draw_text(image_, text, x, y, size, col, bg);
+  text_boxes_.push_back({x, y, wh[0], wh[1]});
+}
+
+// The marker, ring and neck labels over everything, in the order they were made (polyp markers,
+// not-shown rings, necks), each where LabelPlacer finds it a free spot; the leaders first, so no
+// leader crosses a label's text.
+void ColonImagePainter::write_labels() {
+  LabelPlacer placer(width_, height_);
+  for (const PixelBox& b : text_boxes_) placer.keep_clear(b);
+  std::vector<int> mark;
+  for (const Label& l : labels_) mark.push_back(placer.add_mark(l.mark_x, l.mark_y, l.mark_r));
+  std::vector<LabelPlacement> placed;
+  for (std::size_t i = 0; i < labels_.size(); ++i) {
+    const Label& l = labels_[i];
+    const std::array<int, 2> wh = text_size(l.text, l.size, l.bg);
+    placed.push_back(placer.place({wh[0], wh[1], l.x, l.y, l.mark_x, l.mark_y, l.mark_r}, mark[i]));
+  }
+  vtkNew<OverlayCanvas> canvas;
+  canvas->draw_on(image_);
+  for (std::size_t i = 0; i < labels_.size(); ++i) {
+    if (!placed[i].leader) continue;
+    const int* p = placed[i].line;
+    const double* c = labels_[i].col;
+    canvas->SetDrawColor(255 * c[0], 255 * c[1], 255 * c[2]);
+    canvas->fill_tube(p[0], height_ - 1 - p[1], p[2], height_ - 1 - p[3], 0.8);
+  }
+  for (std::size_t i = 0; i < labels_.size(); ++i)
+    draw_text(image_, labels_[i].text, placed[i].box.x, placed[i].box.y, labels_[i].size, labels_[i].col, labels_[i].bg);
+  out_.labels_moved = placer.moved();
+  out_.labels_crowded = placer.crowded();
 }
 
 std::string ColonImagePainter::automatic_title() const {

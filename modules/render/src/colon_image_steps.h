@@ -5,7 +5,8 @@
 //   colon_image_raster.cpp   per band: roll the segment's triangles, rasterise them on the pixel grid,
 //                            smooth the view normals, shade or hatch every pixel;
 //   colon_image_overlay.cpp  markers, not-shown rings, scale bar and ticks (VTK canvas), then the
-//                            text (scale, tick labels, band captions, legend, title, marker labels).
+//                            text (scale, tick labels, band captions, legend, title), then the
+//                            marker labels placed off that text and each other (label_placement.h).
 // Pixel rows count from the image bottom (VTK) unless a name says "from the top".
 #include <array>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include "colonflat/core/triangle_raster.h"
 #include "colonflat/render/colon_image.h"
+#include "label_placement.h"
 
 #include <vtkImageCanvasSource2D.h>
 
@@ -49,13 +51,15 @@ struct Tick {
   std::string text;
 };
 
-// A text drawn last, over everything (marker ids, not-shown areas).
+// A text drawn last, over everything (marker ids, not-shown areas, branch necks), beside its mark;
+// write_labels() moves it off the other labels and text (label_placement.h).
 struct Label {
   std::string text;
-  int x, y;  // top-left, row from the top
+  int x, y;  // top-left of its old place, row from the top
   double col[3];
   int size;
   double bg;
+  int mark_x = 0, mark_y = 0, mark_r = 0;  // its mark: centre (row from the top) and radius, px
 };
 
 // A band's rolled triangles sampled at its pixel centres (pixel id = row * w + column): the
@@ -128,6 +132,9 @@ class ColonImagePainter {
   void write_scale_text();
   void write_band_captions();
   void write_legend_and_title();
+  void write_labels();
+  // draw_text, the text's box kept for write_labels (row from the top).
+  void write_text(const std::string& text, int x, int y, int size, const double col[3], double bg = 0.0);
   std::string automatic_title() const;
 
   const FlatMap& flat_;
@@ -144,6 +151,7 @@ class ColonImagePainter {
   unsigned char* pixels_ = nullptr;
   std::vector<Tick> ticks_;
   std::vector<Label> labels_;
+  std::vector<PixelBox> text_boxes_;  // the scale, tick, caption, legend and title text (labels keep off)
   double bar_mm_ = 0;
   int bar_px_ = 0;
 };

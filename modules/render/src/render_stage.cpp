@@ -123,12 +123,18 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
   Stopwatch sw;
   RenderResult r = render_flat(flat, opts_);
   phase_done("colon image and candidates");
-  ctx.report["colon_image"] = {{"width", r.colon.width}, {"height", r.colon.height}, {"pixel_size_mm", r.colon.pixel_size}};
+  ctx.report["colon_image"] = {{"width", r.colon.width},
+                               {"height", r.colon.height},
+                               {"pixel_size_mm", r.colon.pixel_size},
+                               {"labels_moved", r.colon.labels_moved},
+                               {"labels_crowded", r.colon.labels_crowded}};
   ctx.report["candidates"] = r.candidates.size();
   if (r.candidates_json.contains("score_vs_known")) ctx.report["score_vs_known"] = r.candidates_json["score_vs_known"];
   ctx.report["image_time_s"] = sw.seconds();
   ctx.progress("render: colon image " + std::to_string(r.colon.width) + " x " + std::to_string(r.colon.height) +
-               " px, " + std::to_string(r.candidates.size()) + " polyp candidates");
+               " px, " + std::to_string(r.candidates.size()) + " polyp candidates; labels: " +
+               std::to_string(r.colon.labels_moved) + " moved off other text, " + std::to_string(r.colon.labels_crowded) +
+               " with no free spot");
   bag.put("colon_image", r.colon.image);
   bag.put("candidates", r.candidates_json);
   if (opts_.snapshots) finish_snapshots(snapshots, r.candidates.size(), bag, ctx);

@@ -9,6 +9,7 @@
 // end, hatching where the wall is strongly compressed (blue) or missing from the map (red), and
 // a scale bar in mm (valid at the mean, area-preserving scale). Each band is rolled around the colon so that
 // its cut runs as far as possible from every marker.
+#include <array>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -46,6 +47,8 @@ struct ColonImage {
   std::vector<double> roll; // per segment: y offset of the cut (mm, in [y0, y0 + period))
   std::size_t missing_pixels = 0;     // band pixels with no wall (hatched red)
   std::size_t compressed_pixels = 0;  // wall pixels below compressed_ratio (hatched blue)
+  int labels_moved = 0;    // marker labels not at their old place (beside the mark) to keep off other text
+  int labels_crowded = 0;  // marker labels with no free spot: drawn over other text or marks where they cover least
 };
 
 // Where each segment's band lies in the image: one band per segment, stacked from the image bottom
@@ -79,13 +82,16 @@ ColonImage render_colon_image(const FlatMap& flat, const std::vector<double>& sh
 
 // VTK's FreeType text rendering (vtkTextRenderer, vtkFreeTypeTools and its font cache) is one
 // process-wide instance and not thread-safe; the snapshots are rendered on a second thread while
-// the colon image draws its labels. Only draw_text uses FreeType (a snapshot's caption is drawn
-// with it onto the grabbed image, its scene has no text actor), and it holds this lock.
+// the colon image draws its labels. Only draw_text and text_size use FreeType (a snapshot's caption is drawn
+// with it onto the grabbed image, its scene has no text actor), and they hold this lock.
 std::mutex& freetype_mutex();
 
 // Draws `text` into an RGB image at column x, row-from-top y (top-left corner), with FreeType
-// (under freetype_mutex()).
-void draw_text(vtkImageData* rgb, const std::string& text, int x, int y_from_top, int font_size,
-               const double color[3], double background_opacity = 0.0);
+// (under freetype_mutex()); returns the text's width and height in pixels (clipped or not).
+std::array<int, 2> draw_text(vtkImageData* rgb, const std::string& text, int x, int y_from_top, int font_size,
+                             const double color[3], double background_opacity = 0.0);
+// The width and height in pixels draw_text gives `text` at `font_size` (the same font, bold Arial;
+// a background pads the text by 2 px on each side).
+std::array<int, 2> text_size(const std::string& text, int font_size, double background_opacity = 0.0);
 
 }  // namespace cf
