@@ -327,8 +327,12 @@ void ColonImagePainter::write_labels() {
     canvas->SetDrawColor(255 * c[0], 255 * c[1], 255 * c[2]);
     canvas->fill_tube(p[0], height_ - 1 - p[1], p[2], height_ - 1 - p[3], 0.8);
   }
-  for (std::size_t i = 0; i < labels_.size(); ++i)
-    draw_text(image_, labels_[i].text, placed[i].box.x, placed[i].box.y, labels_[i].size, labels_[i].col, labels_[i].bg);
+  for (std::size_t i = 0; i < labels_.size(); ++i) {
+    const PixelBox& b = placed[i].box;
+    draw_text(image_, labels_[i].text, b.x, b.y, labels_[i].size, labels_[i].col, labels_[i].bg);
+    if (placed[i].crowded)
+      out_.crowded_labels.push_back(labels_[i].text + " at (" + std::to_string(b.x) + ", " + std::to_string(b.y) + ")");
+  }
   out_.labels_moved = placer.moved();
   out_.labels_crowded = placer.crowded();
 }

@@ -127,7 +127,8 @@ void RenderStage::run(ArtifactBag& bag, RunContext& ctx) {
                                {"height", r.colon.height},
                                {"pixel_size_mm", r.colon.pixel_size},
                                {"labels_moved", r.colon.labels_moved},
-                               {"labels_crowded", r.colon.labels_crowded}};
+                               {"labels_crowded", r.colon.labels_crowded},
+                               {"crowded_labels", r.colon.crowded_labels}};
   ctx.report["candidates"] = r.candidates.size();
   if (r.candidates_json.contains("score_vs_known")) ctx.report["score_vs_known"] = r.candidates_json["score_vs_known"];
   ctx.report["image_time_s"] = sw.seconds();

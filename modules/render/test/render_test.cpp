@@ -231,6 +231,26 @@ TEST(RenderImage, KnownPolypsAreOverlaidAndScored) {
   EXPECT_EQ(r.candidates_json["score_vs_known"]["false_positives"], 0);
 }
 
+// One marker keeps its label's old place (none moved, none crowded); 60 markers at one place with
+// long labels cannot all find a free spot: every one is still drawn, the crowded ones are counted
+// and listed with their text, and the rest moved.
+TEST(RenderImage, CrowdedMarkerLabelsAreCountedAndListed) {
+  const FlatMap f = flatten_colon(test_colon().mesh);
+  ColonImageOptions o;
+  std::vector<ImageMarker> one(1);
+  one[0].x = f.segments[0].x0 + 0.5 * f.segments[0].length, one[0].y = f.segments[0].y0, one[0].label = "P1 8 mm";
+  const ColonImage lone = render_colon_image(f, {}, one, o);
+  EXPECT_EQ(lone.labels_moved, 0);
+  EXPECT_EQ(lone.labels_crowded, 0);
+  std::vector<ImageMarker> many(60, one[0]);
+  for (std::size_t i = 0; i < many.size(); ++i) many[i].label = "P" + std::to_string(i + 1) + " a long candidate label here";
+  const ColonImage pile = render_colon_image(f, {}, many, o);
+  EXPECT_GT(pile.labels_crowded, 0);
+  ASSERT_EQ(pile.crowded_labels.size(), std::size_t(pile.labels_crowded));
+  EXPECT_EQ(pile.crowded_labels[0].rfind("P", 0), 0u) << pile.crowded_labels[0];
+  EXPECT_GE(pile.labels_moved, 59);
+}
+
 // Off-screen VTK rendering works without a display (a private Xvfb is started): the sphere is
 // drawn over the background and a loop polyline is visible in red.
 TEST(RenderSnapshot, OffScreenWithoutDisplay) {

@@ -49,6 +49,7 @@ struct ColonImage {
   std::size_t compressed_pixels = 0;  // wall pixels below compressed_ratio (hatched blue)
   int labels_moved = 0;    // marker labels not at their old place (beside the mark) to keep off other text
   int labels_crowded = 0;  // marker labels with no free spot: drawn over other text or marks where they cover least
+  std::vector<std::string> crowded_labels;  // their text and place, "TEXT at (column, row from the top)"
 };
 
 // Where each segment's band lies in the image: one band per segment, stacked from the image bottom
