@@ -15,6 +15,7 @@
 #include "colonflat/core/threads.h"
 #include "flatten_internal.h"
 #include "conformal_factor.h"
+#include "face_blocks.h"
 #include "factor_schedule.h"
 #include "metis_order.h"
 #include "spd_solver.h"
@@ -391,27 +392,36 @@ SegmentOrder small_segment_vertex_order(const Edges& E, int nv, bool measure) {
   return out;
 }
 
+// Each face on its own (blocks of faces on the worker threads, face_blocks.h): the same bits for any
+// thread count.
 void normalise_corner_offsets(const Surface& s, Embedding& emb) {
   const double P = emb.period;
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    const auto c = emb.corners(s, int(f));
-    const double shift = std::floor((c[0].y() + c[1].y() + c[2].y()) / 3 / P) * P;
-    for (int k = 0; k < 3; ++k) emb.dy[f][k] -= shift;
-  }
+  for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const auto c = emb.corners(s, int(f));
+      const double shift = std::floor((c[0].y() + c[1].y() + c[2].y()) / 3 / P) * P;
+      for (int k = 0; k < 3; ++k) emb.dy[f][k] -= shift;
+    }
+  });
 }
 
+// Each vertex and each face on its own, in blocks on the worker threads (as above).
 Embedding embed_conformal(const Surface& s, const Edges& E, const Harmonic& h, double sign, double scale) {
   Embedding emb;
   emb.period = h.period * scale;
   const double ys = sign * emb.period;
   emb.pos.resize(s.p.size());
-  for (std::size_t v = 0; v < s.p.size(); ++v) emb.pos[v] = V2(h.u[v] * scale, h.v[v] * ys);
+  for_each_block(s.p.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) emb.pos[v] = V2(h.u[Eigen::Index(v)] * scale, h.v[Eigen::Index(v)] * ys);
+  });
   emb.dy.resize(s.t.size());
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    const Tri& t = s.t[f];
-    // corner k (k = 1, 2) reached from corner 0 along the edge opposite corner 3 - k
-    emb.dy[f] = {0.0, ys * eta_dir(h.eta, E, E.fe[f][2], t[0]), ys * eta_dir(h.eta, E, E.fe[f][1], t[0])};
-  }
+  for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const Tri& t = s.t[f];
+      // corner k (k = 1, 2) reached from corner 0 along the edge opposite corner 3 - k
+      emb.dy[f] = {0.0, ys * eta_dir(h.eta, E, E.fe[f][2], t[0]), ys * eta_dir(h.eta, E, E.fe[f][1], t[0])};
+    }
+  });
   normalise_corner_offsets(s, emb);
   return emb;
 }

@@ -804,3 +804,37 @@ TEST(FlattenSolver, RestInBlocksIsCholmodsFactorToRounding) {
   EXPECT_LT(diff, 1e-10);
 }
 #endif
+
+// The conformal embedding (its vertex and face loops in blocks on the worker threads) is the same
+// bits with 1 and 2 threads, on a tube of several blocks of faces: each vertex at (u, sign v P) x
+// scale, each face's corner offsets whole periods with the face's centroid y in [0, P).
+TEST(FlattenSolver, ConformalEmbeddingIsTheSameBitsOnOneAndTwoThreads) {
+  using namespace cf::flat_detail;
+  const Surface tube = bumpy_tube(48, 120);
+  ASSERT_GT(tube.t.size(), 8192u);
+  const Edges E = build_edges(tube.t);
+  auto loops = boundary_loops(tube, E);
+  ASSERT_EQ(loops.size(), 2u);
+  const Harmonic h = solve_harmonic(tube, E, loops[0], loops[1], false);
+  cf::set_thread_count(1);
+  const Embedding one = embed_conformal(tube, E, h, -1.0, 1.7);
+  cf::set_thread_count(2);
+  const Embedding two = embed_conformal(tube, E, h, -1.0, 1.7);
+  cf::set_thread_count(0);
+  const double P = h.period * 1.7;
+  ASSERT_EQ(one.pos.size(), two.pos.size());
+  int differ = 0, off = 0;
+  for (std::size_t v = 0; v < one.pos.size(); ++v) {
+    differ += one.pos[v] != two.pos[v];
+    off += one.pos[v] != cf::flat_detail::V2(h.u[Eigen::Index(v)] * 1.7, h.v[Eigen::Index(v)] * -P);
+  }
+  for (std::size_t f = 0; f < tube.t.size(); ++f) {
+    differ += one.dy[f] != two.dy[f];
+    const auto c = one.corners(tube, int(f));
+    const double y = (c[0].y() + c[1].y() + c[2].y()) / 3;
+    off += !(y >= 0 && y < P) || std::fmod(std::abs(one.dy[f][1]) / P + 0.5, 1.0) > 0.5 + 1e-9;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(off, 0);
+  EXPECT_EQ(one.period, P);
+}
