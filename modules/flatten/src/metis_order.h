@@ -31,13 +31,10 @@ bool metis_direct_available();
 // A side of the top separator with at least this many vertices is split again at its own METIS
 // vertex separator and its two halves are ordered by METIS_NodeND: on a colon band four parts of
 // about a quarter each instead of two of about half, which two threads end at about the same time
-// (the real CT colon's sides, 457 k and 603 k vertices, took 2.24 and 3.02 CPU s; its four parts
-// 1.66 / 1.18 / 1.08 / 0.81: the first map's system waited 1.56 s for the order, one core idle for
-// 1.0 s of it; issue 26, session 31). From 420 000 on: the bands of about 2 M faces (the real CT's
-// and its mask's rows, flatten 21-24 s against the 20 s goal); the real mask's rows (sides of at
-// most 0.41 M vertices, flatten 8-10 s) keep their order and their maps bit for bit (with 200 000
-// their maps moved by rounding: the grown real mask's 99.683 % shown became 99.669 %).
-constexpr int kSplitSidesMinVertices = 420000;
+// (the real CT colon's sides, 457 k and 603 k vertices, took 2.36 and 3.18 CPU s: one thread idled
+// 0.8 s while the first map's system waited for the order; issue 26, session 31). A graph whose
+// sides are both smaller (any segment below about twice this size) is ordered as before.
+constexpr int kSplitSidesMinVertices = 200000;
 
 // The order before its postorder: side 0's vertices, then side 1's, then the `separator` vertices
 // of METIS_ComputeVertexSeparator (ascending ids). A side is ordered by METIS_NodeND of its
