@@ -36,9 +36,10 @@ SurgeryResult Surgery::run() {
   Stopwatch sw;
   const bool triangulated = opts_.triangulated && try_triangulated_caps();
   const double t_tri = sw.seconds();
-  if (!triangulated) concentric_caps();
+  const bool mincut = !triangulated && try_mincut_caps();
+  if (!triangulated && !mincut) concentric_caps();
   result_.caps = cap_kind_;
-  if (detail::denoise_debug() && (sw.seconds() > 0.2 || !triangulated))
+  if (detail::denoise_debug() && (sw.seconds() > 0.2 || !triangulated))  // "concentric": mincut caps included
     std::fprintf(stderr, "denoise debug: surgery of %zu vertices: caps %s, %zu pairs; triangulated %.2f s, concentric %.2f s\n",
                  k_, cap_kind_, result_.intersections, t_tri, sw.seconds() - t_tri);
   return result_;

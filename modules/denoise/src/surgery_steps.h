@@ -4,10 +4,12 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <unordered_map>
 #include <vector>
 
 #include "colonflat/denoise/cap_triangulation.h"
+#include "colonflat/denoise/free_space_cut.h"
 #include "colonflat/denoise/homology.h"
 #include "colonflat/denoise/surgery.h"
 
@@ -132,6 +134,22 @@ class Surgery {
                                               double step, std::vector<std::array<int, 3>>* tris);
   bool clean_from(const std::vector<std::array<int, 3>>& tris, std::size_t from,
                   const std::vector<std::array<int, 3>>& others) const;
+  // Minimum-cut caps (surgery_mincut.cpp).
+  bool try_mincut_caps();
+  FreeSpaceBox mincut_box() const;
+  std::vector<SidedTriangle> sided_faces(const FreeSpaceBox& box) const;
+  void flood_sides(const std::vector<int>& local, std::deque<Mesh::FaceHandle>* queue,
+                   std::vector<SidedTriangle>* out) const;
+  const CutDisk* ring_disk(const std::vector<CutDisk>& disks, double cell) const;
+  bool disk_runs_with_loop(const CutDisk& disk) const;
+  void mincut_strip(const std::vector<Mesh::VertexHandle>& ring, const std::vector<int>& inner,
+                    std::vector<std::array<int, 3>>* tris) const;
+  FrontCap mincut_cap(const CutDisk& disk, double shift, int rim_passes, bool flip);
+  FrontCap mincut_mirror(const CutDisk& disk, const FrontCap& right, double shift, int rim_passes, bool flip);
+  bool close_hole(const std::vector<int>& rim, const std::vector<int>& id, bool flip,
+                  std::vector<std::array<int, 3>>* tris) const;
+  bool mincut_caps(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell);
+  void add_ordered(const std::vector<std::array<int, 3>>& tris);
   ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void shape_concentric_cap(ConcentricCap& cap, double dome);

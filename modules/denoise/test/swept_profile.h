@@ -1,5 +1,5 @@
 #pragma once
-// Closed bands for the surgery tests: a closed 2D profile swept around the z axis; mean edge length.
+// Closed bands for the surgery tests: a closed 2D profile swept around the z axis; boxes; mean edge length.
 #include <array>
 #include <cmath>
 #include <vector>
@@ -29,6 +29,18 @@ inline TriangleList swept_profile(const std::vector<std::array<double, 2>>& prof
       t.triangles.push_back({a, b, c});
       t.triangles.push_back({a, c, d});
     }
+  return t;
+}
+
+// A closed axis-aligned box from corner lo to corner hi (outward faces, 12 triangles).
+inline TriangleList axis_box(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  TriangleList t;
+  for (int c = 0; c < 8; ++c) t.points.push_back({c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]});
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    t.triangles.push_back({q[0], q[1], q[2]});
+    t.triangles.push_back({q[0], q[2], q[3]});
+  }
   return t;
 }
 

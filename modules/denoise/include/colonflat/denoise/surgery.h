@@ -37,6 +37,9 @@ struct SurgeryOptions {
   bool triangulated = true;  // with a guard: try the triangulated caps (plain, collar, front,
                              // restricted) before the concentric ones; off when they are known to
                              // fail (the same loop on the same mesh failed them before)
+  bool mincut = false;  // with a guard, not a trial: before the concentric caps, caps from the
+                        // minimum cut of free space around the loop (free_space_cut.h; kept when clean)
+  double mincut_cell = 0.25;  // mm: cell edge of that cut's graph
   bool probe_concentric = false;  // with a guard, not a trial: the concentric placements are only
                                   // searched for a clean one (each count stops at its first pair);
                                   // without one the caps stay in the first placement, whose pairs
@@ -64,7 +67,7 @@ struct SurgeryResult {
   std::vector<Mesh::VertexHandle> left_ring, right_ring;  // copies, in loop order
   Mesh::VertexHandle left_cap, right_cap;                 // cap centres
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
-  const char* caps = "concentric";  // which step made the caps: plain, collar, front, restricted or concentric
+  const char* caps = "concentric";  // which step made the caps: plain, collar, front, restricted, mincut or concentric
   int placement = -1;  // index of the ring placement the triangulated caps were made in (0 = the first); -1: concentric
   int left_caps_ahead = 0;  // left-ring restricted triangulations taken from the helper thread's (run_both)
   SurgeryUndo undo;
