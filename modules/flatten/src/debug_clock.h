@@ -1,5 +1,7 @@
 #pragma once
 // The flatten stage's debug timeline (COLONFLAT_FLATTEN_DEBUG=1).
+#include <cstddef>
+#include <vector>
 
 namespace cf::flat_detail {
 
@@ -17,6 +19,24 @@ struct DebugClockScope {
   DebugClockScope(const DebugClockScope&) = delete;
   DebugClockScope& operator=(const DebugClockScope&) = delete;
   bool was;
+};
+
+// COLONFLAT_FLATTEN_DEBUG=1: one line per band flattened (a colon segment, a side branch or a patch),
+// when it is done: its depth, faces, and the calling thread's CPU seconds (wall in brackets) of each
+// stretch marked (`mark(what)`: the stretch since the previous mark, or since the timer's start).
+class BandTimer {
+ public:
+  BandTimer();
+  void mark(const char* what);
+  void report(int depth, std::size_t faces_in, std::size_t band_faces, std::size_t patches, std::size_t branches) const;
+
+ private:
+  struct Stretch {
+    const char* what;
+    double wall, cpu;
+  };
+  double wall0_ = 0, cpu0_ = 0;
+  std::vector<Stretch> stretches_;
 };
 
 }  // namespace cf::flat_detail

@@ -351,6 +351,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
     if (depth == 0) phase_done(what), debug_clock(what);
   };
   const DebugClockScope clock_scope(depth == 0);
+  BandTimer timer;
   Edges edges;
   auto loops = open_annulus(s, nloops, o, c, w, edges);
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
@@ -359,6 +360,7 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   Prepared p = prepare(w, std::move(edges));
   w.cap_area = surface_area(s) - w.seg.area_3d;  // (prepare: the annulus' area)
   phase("ends opened");
+  timer.mark("opened");
   const bool may_cut = o.map == "area-balanced" && o.branch_min_area > 0 && depth < kMaxBranchDepth;
   // A colon map that side branches may replace is untangled only if it stays (branch detection
   // reads the collapse, which untangling cannot lift).
@@ -370,19 +372,23 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   if (may_cut) cut = cut_branches(w, loops, p, o, depth);
   w.prior = PriorSolve{};  // the last factorisation's memory back
   if (cut.valid()) phase("side branches cut, conformal map again");
+  timer.mark("conformal");
   const Centreline cl = centreline_step(w, loops);
   phase("centreline");
   debug_stats("conformal", w, p.degenerate);
   const bool pouch = depth > 0 && !(limb && colon_stretch(cl.length, w.seg.length, w.seg.period, w.ann.t.size()));
   if (o.map == "area-balanced") area_balanced_step(w, cl, loops, p.E, p.vf, p.fixed, p.degenerate, o, pouch);
   if (o.map == "area-balanced") phase("area balance");
+  timer.mark("balance");
   w.dissection = {};  // the order's memory back (it is not needed after the balance)
   w.dissection_to_annulus = {};
   debug_stats("final", w, p.degenerate);
   std::vector<int> patched;  // the band's vertex map when patches were cut out of it
   std::vector<SegmentWork> patches = flatten_patches(w, p, o, depth, patched);
+  timer.mark("patches");
   const bool any_cut = cut.valid();
   FlattenedBranches flattened = any_cut ? cut.get() : FlattenedBranches{};
+  timer.mark("branches waited");
   if (any_cut) phase("side branches flattened (beside the above)");
   std::vector<SegmentWork>& branches = flattened.works;
   join_patches(branches, patched, patches);
@@ -392,6 +398,8 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   w.seg.vertices = w.ann.p.size();
   measure(w, p.E, p.degenerate, o);
   phase("distortion and coverage");
+  timer.mark("measured");
+  timer.report(depth, s.t.size(), w.ann.t.size(), patches.size(), branches.size());
   std::vector<SegmentWork> out;
   out.push_back(std::move(w));
   for (auto& b : branches) {
