@@ -21,6 +21,7 @@
 #include "colonflat/core/union_find.h"
 #include "conformal_area_energy.h"
 #include "face_blocks.h"
+#include "face_rings.h"
 #include "flatten_internal.h"
 #include "proxy_descent.h"
 #include "whole_band_stop.h"
@@ -47,24 +48,6 @@ void hold_crushed(const Surface& s, const std::vector<double>& area2, const std:
                                return !free_vertex[t[0]] && !free_vertex[t[1]] && !free_vertex[t[2]];
                              }),
               faces.end());
-}
-
-// Grows a face set by `rings` vertex rings. `ring` holds the set's newest faces; each step adds the
-// faces that share a vertex with the previous step's and that `take(g)` accepts (take marks g as
-// in the set). On return `ring` holds the last step's faces; `added` (optional) gets every added
-// face in the order added.
-template <class Take>
-void grow_face_rings(const Surface& s, const std::vector<std::vector<int>>& vf, int rings, std::vector<int>& ring,
-                     Take&& take, std::vector<int>* added = nullptr) {
-  for (int k = 0; k < rings; ++k) {
-    std::vector<int> next;
-    for (int f : ring)
-      for (int v : s.t[f])
-        for (int g : vf[v])
-          if (take(g)) next.push_back(g);
-    if (added) added->insert(added->end(), next.begin(), next.end());
-    ring.swap(next);
-  }
 }
 
 // A region's rim stays: a free vertex with a face outside the region (`inside(g)` false) is fixed.

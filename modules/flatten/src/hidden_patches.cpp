@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "face_rings.h"
+
 namespace cf::flat_detail {
 namespace {
 
@@ -54,17 +56,17 @@ std::vector<std::vector<int>> face_pieces(const Edges& E, const std::vector<char
   return pieces;
 }
 
-// `in` grown by `rings` vertex rings (every face touching a vertex of a marked face).
+// `in` grown by `rings` vertex rings (every face touching a vertex of a marked face), from its faces
+// in ascending order (grow_face_rings).
 void grow_rings(const Surface& s, const std::vector<std::vector<int>>& vf, int rings, std::vector<char>& in) {
-  for (int r = 0; r < rings; ++r) {
-    std::vector<char> vin(s.p.size(), 0);
-    for (std::size_t f = 0; f < s.t.size(); ++f)
-      if (in[f])
-        for (int v : s.t[f]) vin[std::size_t(v)] = 1;
-    for (std::size_t v = 0; v < s.p.size(); ++v)
-      if (vin[v])
-        for (int f : vf[v]) in[std::size_t(f)] = 1;
-  }
+  std::vector<int> ring;
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (in[f]) ring.push_back(int(f));
+  grow_face_rings(s, vf, rings, ring, [&](int g) {
+    if (in[std::size_t(g)]) return false;
+    in[std::size_t(g)] = 1;
+    return true;
+  });
 }
 
 // The boundary loops and Euler characteristic of a patch's own surface.
