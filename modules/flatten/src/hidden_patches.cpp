@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "face_rings.h"
+#include "patch_slit.h"
 
 namespace cf::flat_detail {
 namespace {
@@ -201,6 +202,10 @@ PatchCut cut_patches(SegmentWork& w, Edges& E, std::vector<char>& degenerate, co
     piece.surface = sub_surface(w.ann, patch);
     piece.loops = patch_shape(piece.surface).open_ends();
     cut.area_mm2 += surface_area(piece.surface);
+    if (piece.loops == 1) {  // a disk: opened along its ridge (patch_slit.h), else at a tip cap
+      Surface slit = slit_disk(piece.surface);
+      if (!slit.t.empty()) piece.surface = std::move(slit), piece.loops = 2;
+    }
     cut.pieces.push_back(std::move(piece));
   }
   add_rims(w.ann, E, patch_of, cut.new_of_old, cut.pieces);

@@ -90,7 +90,7 @@ TEST(HiddenPatches, CutLeavesTheRestsMapAsItWas) {
   ASSERT_EQ(patches.size(), 1u);
   const flat_detail::PatchCut cut = flat_detail::cut_patches(g.w, g.E, g.degenerate, patches);
   ASSERT_EQ(cut.pieces.size(), 1u);
-  EXPECT_EQ(cut.pieces[0].loops, 1u);
+  EXPECT_EQ(cut.pieces[0].loops, 2u);  // a disk, opened along its ridge (patch_slit.h) into an annulus
   EXPECT_EQ(g.w.ann.t.size() + cut.pieces[0].surface.t.size(), before.ann.t.size());
   EXPECT_EQ(g.degenerate.size(), g.w.ann.t.size());
   EXPECT_EQ(g.w.emb.dy.size(), g.w.ann.t.size());

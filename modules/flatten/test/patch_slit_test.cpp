@@ -1,0 +1,97 @@
+// A disk-shaped patch opened along its ridge (src/patch_slit.cpp): the strip of wall a band hides
+// becomes an annulus whose second loop runs along the strip's middle, with every face kept.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "../src/branch_bands.h"
+#include "../src/patch_slit.h"
+#include "colonflat/core/threads.h"
+#include "colonflat/flatten/flatten.h"
+#include "squeezed_grid.h"
+
+namespace cf {
+namespace {
+
+using flat_detail::V3;
+
+// A flat strip of nx x ny vertices, 1 mm apart (a disk: one boundary loop), vertex j * nx + i at (i, j, 0).
+flat_detail::Surface strip(int nx, int ny) {
+  flat_detail::Surface s;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) s.p.emplace_back(i, j, 0.0), s.src.push_back(j * nx + i);
+  test_shapes::grid_triangles(nx, ny, s.t);
+  return s;
+}
+
+// A stadium: the faces of strip(nx, 13) whose centroid lies within 6 mm of the segment y = 6,
+// x in [6, nx - 7] (round ends), cleaned into a disk.
+flat_detail::Surface stadium(int nx) {
+  const flat_detail::Surface s = strip(nx, 13);
+  std::vector<char> keep(s.t.size(), 0);
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    const V3 c = (s.p[std::size_t(s.t[f][0])] + s.p[std::size_t(s.t[f][1])] + s.p[std::size_t(s.t[f][2])]) / 3.0;
+    const double x = std::clamp(c.x(), 6.0, nx - 7.0);
+    keep[f] = std::hypot(c.x() - x, c.y() - 6.0) <= 6.0;
+  }
+  flat_detail::clean_selection(s, flat_detail::build_edges(s.t), keep);
+  return flat_detail::sub_surface(s, keep);
+}
+
+// The strip as a TriangleList (flatten_colon's input).
+TriangleList as_mesh(const flat_detail::Surface& s) {
+  TriangleList m;
+  for (const V3& p : s.p) m.points.push_back({p.x(), p.y(), p.z()});
+  for (const auto& t : s.t) m.triangles.push_back({t[0], t[1], t[2]});
+  return m;
+}
+
+// A 61 x 13 mm strip: its slit runs along the middle line y = 6 over the ridge (distance to the rim
+// >= 3 mm: x in [3, 57]), the cut is an annulus with the same faces (same area), and only the slit's
+// inner vertices are doubled.
+TEST(PatchSlit, StripIsCutAlongItsMiddleLine) {
+  const flat_detail::Surface s = strip(61, 13);
+  const flat_detail::Surface cut = flat_detail::slit_disk(s);
+  ASSERT_EQ(cut.t.size(), s.t.size());
+  const flat_detail::Edges E = flat_detail::build_edges(cut.t);
+  const auto loops = flat_detail::boundary_loops(cut, E);
+  ASSERT_EQ(loops.size(), 2u);
+  EXPECT_EQ((long long)cut.p.size() - (long long)E.ev.size() + (long long)cut.t.size(), 0);
+  EXPECT_NEAR(flat_detail::surface_area(cut), 60.0 * 12.0, 1e-9);
+  const auto& inner = loops[0].size() < loops[1].size() ? loops[0] : loops[1];
+  double xmin = 1e9, xmax = -1e9;
+  for (int v : inner) {
+    EXPECT_NEAR(cut.p[std::size_t(v)].y(), 6.0, 3.0 + 1e-9);  // on the ridge
+    xmin = std::min(xmin, cut.p[std::size_t(v)].x()), xmax = std::max(xmax, cut.p[std::size_t(v)].x());
+  }
+  EXPECT_LE(xmin, 4.0);  // from near x = 3 ...
+  EXPECT_GE(xmax, 56.0);  // ... to near x = 57
+  EXPECT_EQ(cut.p.size() - s.p.size(), inner.size() / 2 - 1);  // the slit's inner vertices, once each
+  for (std::size_t v = s.p.size(); v < cut.p.size(); ++v) EXPECT_EQ(cut.p[v], s.p[std::size_t(cut.src[v])]);
+}
+
+// A 3 x 3 grid has one vertex off the rim: its ridge is that vertex, no slit of two edges: no cut.
+TEST(PatchSlit, DiskWithOneRidgeVertexIsNotCut) {
+  EXPECT_TRUE(flat_detail::slit_disk(strip(3, 3)).t.empty());
+}
+
+// A 12 x 120 mm stadium flattened as a band from its rim: from a tip cap at its middle (a pouch's
+// map) the harmonic u falls off exponentially along it and its ends are crushed (most of it hidden);
+// cut along its slit (a tube from the rim to the slit) nearly all of it is shown, none folded.
+TEST(PatchSlit, SlitStripIsShownWhereTheTipCapMapCrushesIt) {
+  set_thread_count(1);
+  const flat_detail::Surface s = stadium(121);
+  FlattenOptions o;
+  o.end_cut_radius = 5;  // a branch's tip cap
+  o.branch_min_area = 0;  // the strip itself, no branches or patches
+  const FlatMap capped = flatten_colon(as_mesh(s), o);
+  const FlatMap slit = flatten_colon(as_mesh(flat_detail::slit_disk(s)), o);
+  EXPECT_LT(capped.coverage.fraction, 0.5);  // 0.146 measured
+  EXPECT_GE(slit.coverage.fraction, 0.99);  // 0.995 measured (the staircase rim's corners)
+  EXPECT_EQ(slit.stats.flipped, 0u);
+  set_thread_count(0);
+}
+
+}  // namespace
+}  // namespace cf
