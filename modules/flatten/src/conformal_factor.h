@@ -31,4 +31,9 @@ struct ConformalFactor {
 bool restrict_factor(ConformalFactor& f, const Edges& E, const std::vector<double>& w, const std::vector<char>& mark,
                      const std::vector<int>& new_of_old);
 
+// Whether restrict_factor updates a factorisation of `factorisation_flops` (CHOLMOD's count) with
+// terms whose modify_flops() estimate is `estimated_update_flops`, rather than leaving it to a new
+// factorisation: the update is the cheaper in wall time on two threads, with a margin.
+bool update_is_cheaper(double estimated_update_flops, double factorisation_flops);
+
 }  // namespace cf::flat_detail

@@ -11,6 +11,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/union_find.h"
 #include "conformal_factor.h"
+#include "factor_schedule.h"  // thread_cpu_seconds
 
 namespace cf::flat_detail {
 namespace {
@@ -87,36 +88,56 @@ bool same_loops(const ConformalFactor& f, const std::vector<char>& mark, const s
 
 }  // namespace
 
-// The update is used while its estimated operations stay below this share of a new
-// factorisation's: both run at about the same rate, and the estimate counts every column on each
-// term's path, though terms processed together (CHOLMOD takes up to 8 at a time) share them.
-constexpr double kUpdateShareOfFactorisation = 0.5;
+// The update is used while its estimated operations stay below this share of the first
+// factorisation's (session 31 "update", docs/history/flatten.md): the update runs on one thread
+// at ~0.45 x a factorisation's time per counted flop (the estimate counts every column on each
+// term's path; CHOLMOD takes up to 8 terms at a time along shared paths), a new factorisation on
+// two threads and on the smaller remaining surface (0.4-1 x the first's flops). Measured on the
+// stress rows (estimate / first factorisation -> wall of the update / of the new factorisation):
+// 0.07 -> 0.05, 0.39 -> 0.14, 0.49 -> 0.11, 0.74 -> 0.54, 0.95 -> 0.44, 1.10 -> 0.47;
+// 1.27 -> 1.42, 1.50 -> 1.31, 1.83 -> 1.07, 3.46 -> 3.4. At 1 every update taken was >= 1.8 x
+// cheaper; of those refused only 1.10 (an 80 k-unknown band, 0.5 s) would have been cheaper.
+constexpr double kUpdateShareOfFactorisation = 1.0;
+
+bool update_is_cheaper(double estimated_update_flops, double factorisation_flops) {
+  return estimated_update_flops <= kUpdateShareOfFactorisation * factorisation_flops;
+}
+
+namespace {
+
+// COLONFLAT_FLATTEN_DEBUG: why the update is not tried.
+bool refuse(const char* why) {
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG")) std::fprintf(stderr, "flatten debug factor update refused: %s\n", why);
+  return false;
+}
+
+}  // namespace
 
 bool restrict_factor(ConformalFactor& f, const Edges& E, const std::vector<double>& w, const std::vector<char>& mark,
                      const std::vector<int>& new_of_old) {
-  if (new_of_old.size() != f.unknown_of.size() || !same_loops(f, mark, new_of_old)) return false;
+  if (new_of_old.size() != f.unknown_of.size() || !same_loops(f, mark, new_of_old)) return refuse("not the same loops");
   std::vector<int> old_of(mark.size(), -1);
   for (std::size_t v = 0; v < new_of_old.size(); ++v)
     if (new_of_old[v] >= 0) old_of[new_of_old[v]] = int(v);
-  if (std::count(old_of.begin(), old_of.end(), -1) > 0) return false;
+  if (std::count(old_of.begin(), old_of.end(), -1) > 0) return refuse("vertices that are not the factor's");
   std::vector<double> change;
-  if (!weight_changes(f, E, w, old_of, change)) return false;
+  if (!weight_changes(f, E, w, old_of, change)) return refuse("edges that are not the factor's");
   RankOneColumns grow, shrink;
   rank_one_terms(f, change, new_of_old, grow, shrink);
-  // When the terms would cost more than a share of a new factorisation (many of them, or paths
-  // through the dense columns of the loops, ordered last), a new factorisation is cheaper.
+  // Many terms, or paths through the dense columns of the loops (ordered last): a new factorisation.
   const int n = int(f.unknown_of.size()) - 1;
   const SpdSolver::SpMat up = grow.matrix(n), down = shrink.matrix(n);
-  const double budget = kUpdateShareOfFactorisation * f.solver.factor_flops();
-  const double cost = f.solver.modify_flops({&up, &down}, budget);
-  const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
+  const double factor_flops = f.solver.factor_flops();
+  const double cost = f.solver.modify_flops({&up, &down}, kUpdateShareOfFactorisation * factor_flops);
+  const bool cheaper = update_is_cheaper(cost, factor_flops), debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
   if (debug)
-    std::fprintf(stderr, "flatten debug factor update: %d rank-one terms, about %.3g flops against %.3g for a new factorisation\n",
-                 grow.columns + shrink.columns, cost, f.solver.factor_flops());
-  if (cost > budget) return false;
+    std::fprintf(stderr, "flatten debug factor update: %d rank-one terms, about %.3g flops against %.3g for a new factorisation (%.3f): %s\n",
+                 grow.columns + shrink.columns, cost, factor_flops, cost / factor_flops, cheaper ? "updated" : "refused, too dear");
+  if (!cheaper) return false;
   const Stopwatch sw;
+  const double cpu = thread_cpu_seconds();
   const bool ok = f.solver.modify(up, true) && f.solver.modify(down, false);
-  if (debug) std::fprintf(stderr, "flatten debug factor update done: %.2f s\n", sw.seconds());
+  if (debug) std::fprintf(stderr, "flatten debug factor update done: %.2f s, %.2f CPU s\n", sw.seconds(), thread_cpu_seconds() - cpu);
   return ok;
 }
 

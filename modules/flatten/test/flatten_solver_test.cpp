@@ -13,6 +13,7 @@
 #include <cstring>
 #include <utility>
 
+#include "../src/conformal_factor.h"
 #include "../src/factor_schedule.h"
 #include "../src/flatten_internal.h"
 #include "../src/spd_solver.h"
@@ -235,6 +236,23 @@ TEST(FlattenSolver, UpdatedFactorisationSolvesTheSurfaceThatRemains) {
   for (std::size_t v = 0; v < whole.p.size(); ++v)
     if (new_of_old[v] >= 0) moved = std::max(moved, std::abs(first.v[Eigen::Index(v)] - fresh.v[new_of_old[v]]));
   EXPECT_GT(moved, 1e-3);
+}
+
+// The update-or-refactorise rule on the stress rows' measured numbers (estimated update flops,
+// first factorisation's flops; session 31): updates where the update took 0.05-0.54 of a new
+// factorisation's wall time (real CT, CT mask and its raw row, the real mask's bands), new
+// factorisations where it took 1.07-3.4 (the generated U's, the grown masks), and the CT mask row
+// accepted with room (the four-part order's 3.44e9 against 10 % fewer flops).
+TEST(FlattenSolver, FactorUpdateIsChosenWhereItWasMeasuredCheaper) {
+  using cf::flat_detail::update_is_cheaper;
+  EXPECT_TRUE(update_is_cheaper(2.76e9, 7.05e9));        // real CT: 0.14
+  EXPECT_TRUE(update_is_cheaper(3.44e9, 6.88e9 * 0.9));  // CT mask, four-part order, 10 % fewer flops
+  EXPECT_TRUE(update_is_cheaper(5.00e9, 6.80e9));        // CT mask raw: 0.54
+  EXPECT_TRUE(update_is_cheaper(7.92e8, 8.38e8));        // real mask, 80 k-unknown band: 0.44
+  EXPECT_FALSE(update_is_cheaper(8.08e9, 6.37e9));       // U60: 1.42
+  EXPECT_FALSE(update_is_cheaper(5.52e9, 3.67e9));       // real mask grown: 1.31
+  EXPECT_FALSE(update_is_cheaper(1.52e10, 8.31e9));      // U120: 1.07
+  EXPECT_FALSE(update_is_cheaper(1.0, 0.0));             // no factorisation to compare with
 }
 
 // A first solve whose elimination order is still being computed on another thread (as beside the
