@@ -300,6 +300,18 @@ ConcentricCap Surgery::make_concentric_cap(const std::vector<Mesh::HalfedgeHandl
   return cap;
 }
 
+// Both caps, already added with interior vertices (front caps, minimum-cut caps): their new edges'
+// classes (the left ring in the left cap's order, along the new opposite halfedges) and the result's caps.
+void Surgery::finish_caps_with_interior(const std::vector<Mesh::VertexHandle>& right_inner,
+                                        const std::vector<Mesh::VertexHandle>& left_inner) {
+  set_cap_classes(result_.right_ring, loop_halfedges_, right_inner);
+  set_cap_classes(left_cap_order(result_.left_ring),
+                  std::vector<Mesh::HalfedgeHandle>(new_opposites_.rbegin(), new_opposites_.rend()), left_inner);
+  result_.right_cap = result_.right_ring[0];
+  result_.left_cap = result_.left_ring[0];
+  result_.intersections = 0;
+}
+
 // Classes of a cap's new edges: ring vertex i gets the potential P_i (prefix XOR of the ring's
 // edge classes), interior vertices 0, and each new edge (a, b) the class P(a) ^ P(b), so every
 // cap triangle sums to zero (the closing one to the loop's class, which the caller quotients

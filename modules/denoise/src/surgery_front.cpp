@@ -348,12 +348,7 @@ bool Surgery::front_caps(double sign) {
   }
   add_cap(mesh_, right.tris, opts_.guard, "surgery (front)");
   add_cap(mesh_, left.tris, opts_.guard, "surgery (front)");
-  set_cap_classes(result_.right_ring, loop_halfedges_, right.inner);
-  set_cap_classes(left_cap_order(result_.left_ring),
-                  std::vector<Mesh::HalfedgeHandle>(new_opposites_.rbegin(), new_opposites_.rend()), left.inner);
-  result_.right_cap = result_.right_ring[0];
-  result_.left_cap = result_.left_ring[0];
-  result_.intersections = 0;
+  finish_caps_with_interior(right.inner, left.inner);
   return true;
 }
 

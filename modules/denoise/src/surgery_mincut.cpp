@@ -360,12 +360,7 @@ bool Surgery::mincut_caps(const CutDisk& disk, double shift, double left_shift, 
   }
   add_ordered(right.tris);
   add_ordered(left.tris);
-  set_cap_classes(result_.right_ring, loop_halfedges_, right.inner);
-  set_cap_classes(left_cap_order(result_.left_ring),
-                  std::vector<Mesh::HalfedgeHandle>(new_opposites_.rbegin(), new_opposites_.rend()), left.inner);
-  result_.right_cap = result_.right_ring[0];
-  result_.left_cap = result_.left_ring[0];
-  result_.intersections = 0;
+  finish_caps_with_interior(right.inner, left.inner);
   return true;
 }
 

@@ -78,6 +78,9 @@ class Surgery {
   void add_triangulated_caps(const std::vector<std::array<int, 3>>& right, const std::vector<std::array<int, 3>>& left);
   void set_cap_classes(const std::vector<Mesh::VertexHandle>& ring, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges,
                        const std::vector<Mesh::VertexHandle>& inner);
+  // Both caps added with interior vertices (front and minimum-cut caps): their edge classes and the result's caps.
+  void finish_caps_with_interior(const std::vector<Mesh::VertexHandle>& right_inner,
+                                 const std::vector<Mesh::VertexHandle>& left_inner);
   // Restricted caps (surgery_restricted.cpp).
   struct LeftAhead {  // left_first()'s first triangulation, made on the helper thread (run_both)
     std::vector<std::array<int, 3>> tris;

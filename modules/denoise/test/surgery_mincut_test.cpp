@@ -120,21 +120,32 @@ TEST(DenoiseMincutCaps, TrialsDoNotMakeMincutCaps) {
   EXPECT_GT(c.result.intersections, 0u);
 }
 
-// Two parallel walls across a 2 mm box (x = 0.1: source side, x = 1.9: sink side): the minimum
-// cut is one flat disk across the box, 8 x 8 cells of 0.25 mm, so the flow is 64 and the disk
-// has 64 squares, 81 points, a boundary of 32 and normals along +x (towards the sink).
-TEST(FreeSpaceCut, TwoWallsGiveAFlatDiskOfTheCrossSection) {
+// Two square walls across the x axis, at x = 0.1 (side 1, the source's) and x = 1.9 (side 2).
+std::vector<SidedTriangle> two_walls() {
   std::vector<SidedTriangle> tris;
   for (const auto& [x, side] : {std::pair{0.1, 1}, std::pair{1.9, 2}}) {
     tris.push_back({{Vec3(x, -1, -1), Vec3(x, 3, -1), Vec3(x, 3, 3)}, side});
     tris.push_back({{Vec3(x, -1, -1), Vec3(x, 3, 3), Vec3(x, -1, 3)}, side});
   }
+  return tris;
+}
+
+// The minimum cut of a 2 mm cube at the origin, 8 x 8 x 8 cells of 0.25 mm, among `tris`.
+std::vector<CutDisk> cut_two_mm_cube(const std::vector<SidedTriangle>& tris, FreeSpaceCutStats* st) {
   FreeSpaceBox box;
   box.lo = Vec3(0, 0, 0);
   box.cell = 0.25;
   box.n = {8, 8, 8};
+  return free_space_cut(box, tris, st);
+}
+
+// Two parallel walls across a 2 mm box (x = 0.1: source side, x = 1.9: sink side): the minimum
+// cut is one flat disk across the box, 8 x 8 cells of 0.25 mm, so the flow is 64 and the disk
+// has 64 squares, 81 points, a boundary of 32 and normals along +x (towards the sink).
+TEST(FreeSpaceCut, TwoWallsGiveAFlatDiskOfTheCrossSection) {
+  std::vector<SidedTriangle> tris = two_walls();
   FreeSpaceCutStats st;
-  const std::vector<CutDisk> disks = free_space_cut(box, tris, &st);
+  const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
   EXPECT_EQ(st.flow, 64);
   ASSERT_EQ(disks.size(), 1u);
   EXPECT_EQ(disks[0].quads.size(), 64u);
@@ -147,22 +158,15 @@ TEST(FreeSpaceCut, TwoWallsGiveAFlatDiskOfTheCrossSection) {
 // cut: the cut is a whole flat disk beside it (64 squares, flow 64), not the cheaper plane through
 // it with a hole where it is (60 squares: an annulus, no disk).
 TEST(FreeSpaceCut, AnObstacleLiesOnOneSideOfTheDisk) {
-  std::vector<SidedTriangle> tris;
-  for (const auto& [x, side] : {std::pair{0.1, 1}, std::pair{1.9, 2}}) {
-    tris.push_back({{Vec3(x, -1, -1), Vec3(x, 3, -1), Vec3(x, 3, 3)}, side});
-    tris.push_back({{Vec3(x, -1, -1), Vec3(x, 3, 3), Vec3(x, -1, 3)}, side});
-  }
+  std::vector<SidedTriangle> tris = two_walls();
   const TriangleList b = testing::axis_box({0.8, 0.8, 0.8}, {1.2, 1.2, 1.2});
   for (const auto& t : b.triangles) {
     std::array<Vec3, 3> p;
     for (int i = 0; i < 3; ++i) p[i] = Vec3(b.points[t[i]][0], b.points[t[i]][1], b.points[t[i]][2]);
     tris.push_back({p, 3});
   }
-  FreeSpaceBox box;
-  box.cell = 0.25;
-  box.n = {8, 8, 8};
   FreeSpaceCutStats st;
-  const std::vector<CutDisk> disks = free_space_cut(box, tris, &st);
+  const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
   EXPECT_EQ(st.flow, 64);
   ASSERT_EQ(disks.size(), 1u);
   EXPECT_EQ(disks[0].quads.size(), 64u);
