@@ -73,11 +73,17 @@ std::array<int, 2> render_text(vtkImageData* t, const std::string& text, int fon
 
 }  // namespace
 
+// Measured with FreeType's bounding box (no glyphs rendered): the extent RenderString fills.
 std::array<int, 2> text_size(const std::string& text, int font_size, double bg_opacity) {
   const std::lock_guard<std::mutex> lock(freetype_mutex());
-  vtkNew<vtkImageData> t;
+  vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
+  if (!tr) throw Error("no FreeType text renderer in this VTK build");
+  vtkNew<vtkTextProperty> tp;
   const double white[3] = {1, 1, 1};
-  return render_text(t, text, font_size, white, bg_opacity);
+  set_text_property(tp, font_size, white, bg_opacity);
+  int bbox[4];
+  if (!tr->GetBoundingBox(tp, text, bbox, 72)) throw Error("cannot measure text '" + text + "'");
+  return {bbox[1] - bbox[0] + 1, bbox[3] - bbox[2] + 1};
 }
 
 std::array<int, 2> draw_text(vtkImageData* rgb, const std::string& text, int x, int y_top, int font_size,
