@@ -11,14 +11,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The vertices of the disk's rim (its boundary edges' ends, with repeats).
-std::vector<int> rim_vertices(const Edges& E) {
-  std::vector<int> rim;
-  for (std::size_t e = 0; e < E.ev.size(); ++e)
-    if (E.ef[e][1] < 0) rim.push_back(E.ev[e][0]), rim.push_back(E.ev[e][1]);
-  return rim;
-}
-
 // The shortest path in g from `to` back to the source of `d` (d: dijkstra from that one source),
 // each step to the neighbour u with the least d[u] + edge length among those with d[u] < d[v]
 // (the first in g's order on a tie): to, ..., source.
@@ -43,7 +35,8 @@ std::vector<int> path_back(const Csr& g, const std::vector<double>& d, int to) {
 // the rim, the ridge vertex farthest from it, then the one farthest from that). Empty: no ridge.
 std::vector<int> ridge_path(const Surface& s, const Edges& E) {
   Csr g = build_csr(s, E);
-  const std::vector<int> rim = rim_vertices(E);
+  std::vector<int> rim;  // the disk's rim: its boundary loops' vertices
+  for (const std::vector<int>& loop : boundary_loops(s, E)) rim.insert(rim.end(), loop.begin(), loop.end());
   if (rim.empty()) return {};
   const std::vector<double> d = dijkstra(g, rim);
   const int top = argmax_finite(d);
