@@ -136,7 +136,11 @@ void debug_patch(const Surface& p, const PatchShape& shape, bool kept) {
 }
 
 // Per edge of E between a face in a patch and a face outside it (another patch's or the rest's),
-// its length and ends added to that patch's rim (`pieces[i]`: patch i's), edges in ascending order.
+// its length added to that patch's rim length (`pieces[i]`: patch i's), edges in ascending order,
+// and its ends that the rest keeps to the patch's neck (where it hangs on the band). The ends of an
+// edge between two patches alone are in no face of the rest (new_of_old -1): they are not on the
+// band, so they stay out of the neck (they were read as vertex -1 of the band, a read before its
+// arrays that made the patch's attach point change from run to run; issue 26, session 32).
 void add_rims(const Surface& s, const Edges& E, const std::vector<int>& patch_of, const std::vector<int>& new_of_old,
               std::vector<BranchPiece>& pieces) {
   for (std::size_t e = 0; e < E.ev.size(); ++e) {
@@ -146,7 +150,8 @@ void add_rims(const Surface& s, const Edges& E, const std::vector<int>& patch_of
       const int i = patch_of[std::size_t(f)];
       if (i < 0) continue;
       pieces[std::size_t(i)].neck_mm += (s.p[std::size_t(E.ev[e][0])] - s.p[std::size_t(E.ev[e][1])]).norm();
-      for (int v : E.ev[e]) pieces[std::size_t(i)].neck.push_back(new_of_old[std::size_t(v)]);
+      for (int v : E.ev[e])
+        if (new_of_old[std::size_t(v)] >= 0) pieces[std::size_t(i)].neck.push_back(new_of_old[std::size_t(v)]);
     }
   }
 }

@@ -104,6 +104,32 @@ TEST(HiddenPatches, CutLeavesTheRestsMapAsItWas) {
   for (int v : cut.pieces[0].neck) EXPECT_GE(v, 0);
 }
 
+// Two patches side by side (the crushed disk's left and right halves, r < 8 mm) share a rim edge
+// whose ends lie in no face of the rest: each patch's neck holds only vertices the rest keeps (valid
+// band vertices, off the shared edge's inner ends), on its own side of the disk.
+TEST(HiddenPatches, NeckOfPatchesSideBySideHoldsOnlyTheBandsVertices) {
+  CrushedDisk g(0.2);
+  std::vector<std::vector<int>> halves(2);
+  for (std::size_t f = 0; f < g.w.ann.t.size(); ++f) {
+    if (!(g.centre_distance(int(f)) < 8)) continue;
+    const auto& t = g.w.ann.t[f];
+    const double x = (g.w.ann.p[std::size_t(t[0])].x() + g.w.ann.p[std::size_t(t[1])].x() + g.w.ann.p[std::size_t(t[2])].x()) / 3;
+    halves[x < 20 ? 0 : 1].push_back(int(f));
+  }
+  const flat_detail::PatchCut cut = flat_detail::cut_patches(g.w, g.E, g.degenerate, halves);
+  ASSERT_EQ(cut.pieces.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    ASSERT_FALSE(cut.pieces[i].neck.empty());
+    double mean_x = 0;
+    for (int v : cut.pieces[i].neck) {
+      ASSERT_GE(v, 0);
+      ASSERT_LT(std::size_t(v), g.w.ann.p.size());
+      mean_x += g.w.ann.p[std::size_t(v)].x() / double(cut.pieces[i].neck.size());
+    }
+    EXPECT_EQ(mean_x < 20, i == 0) << "patch " << i << " mean x " << mean_x;
+  }
+}
+
 // A stalked polyp (6 mm head on a 1.6 mm stalk) left to the conformal map (area correction and
 // balancing off) hides its head: below 99 % shown with patches off (--branch-min-area 0: nothing cut
 // out), >= 99.5 % when the hidden head is cut out as a patch and flattened on its own; nothing
