@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <queue>
 #include <unordered_map>
 
 #include "colonflat/core/bucket_slots.h"
@@ -118,19 +117,67 @@ Csr build_csr(const Surface& s, const Edges& E) {
   return g;
 }
 
+namespace {
+
+// The unsettled vertices that hold a finite distance, in a 4-ary min-heap on d (ties in any order:
+// the distances do not depend on it) with each vertex's place in it, so that a shorter distance
+// moves its vertex up instead of adding a second entry (std::priority_queue's lazy deletion kept
+// every stale entry: about a quarter more time on a colon's million vertices).
+class DistanceHeap {
+ public:
+  explicit DistanceHeap(const std::vector<double>& d) : d_(d), place_(d.size(), -1) {}
+  bool empty() const { return heap_.empty(); }
+  int top() const { return heap_[0]; }
+  void lowered(int v) {  // d[v] was set or lowered
+    if (place_[std::size_t(v)] < 0) place_[std::size_t(v)] = int(heap_.size()), heap_.push_back(v);
+    up(place_[std::size_t(v)]);
+  }
+  void pop() {
+    place_[std::size_t(heap_[0])] = -1;
+    heap_[0] = heap_.back();
+    heap_.pop_back();
+    if (!heap_.empty()) down(0);
+  }
+
+ private:
+  void put(int i, int v) { heap_[std::size_t(i)] = v, place_[std::size_t(v)] = i; }
+  void up(int i) {
+    const int v = heap_[std::size_t(i)];
+    for (int p; i > 0 && d_[std::size_t(v)] < d_[std::size_t(heap_[std::size_t(p = (i - 1) / 4)])]; i = p) put(i, heap_[std::size_t(p)]);
+    put(i, v);
+  }
+  void down(int i) {
+    const int v = heap_[std::size_t(i)], n = int(heap_.size());
+    for (int c; (c = 4 * i + 1) < n;) {
+      int best = c;
+      for (int k = c + 1; k < std::min(c + 4, n); ++k)
+        if (d_[std::size_t(heap_[std::size_t(k)])] < d_[std::size_t(heap_[std::size_t(best)])]) best = k;
+      if (!(d_[std::size_t(heap_[std::size_t(best)])] < d_[std::size_t(v)])) break;
+      put(i, heap_[std::size_t(best)]), i = best;
+    }
+    put(i, v);
+  }
+  const std::vector<double>& d_;
+  std::vector<int> heap_, place_;
+};
+
+}  // namespace
+
+// Each vertex is settled once, in ascending distance; a vertex's distance is the least of its
+// settled neighbours' distance + edge length, whatever the order among equal distances: the result
+// does not depend on the heap (the same bits as the lazy-deletion search this replaced).
 std::vector<double> dijkstra(const Csr& g, const std::vector<int>& sources, double settle_up_to) {
   std::vector<double> d(g.start.size() - 1, kInf);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-  for (int s : sources) d[s] = 0, q.push({0.0, s});
+  DistanceHeap q(d);
+  for (int s : sources) d[std::size_t(s)] = 0, q.lowered(s);
   while (!q.empty()) {
-    auto [dv, v] = q.top();
-    q.pop();
-    if (dv > d[v]) continue;
+    const int v = q.top();
+    const double dv = d[std::size_t(v)];
     if (dv > settle_up_to) break;
-    for (int k = g.start[v]; k < g.start[v + 1]; ++k) {
-      const double nd = dv + g.len[k];
-      if (nd < d[g.nbr[k]]) d[g.nbr[k]] = nd, q.push({nd, g.nbr[k]});
+    q.pop();
+    for (int k = g.start[std::size_t(v)]; k < g.start[std::size_t(v) + 1]; ++k) {
+      const double nd = dv + g.len[std::size_t(k)];
+      if (nd < d[std::size_t(g.nbr[std::size_t(k)])]) d[std::size_t(g.nbr[std::size_t(k)])] = nd, q.lowered(g.nbr[std::size_t(k)]);
     }
   }
   return d;
