@@ -112,12 +112,15 @@ std::size_t count_bad(const Surface& s, const Embedding& emb, const std::vector<
 // the faces are bad (conformal map), or if any is (a side branch's band: its pouch folds where the
 // cotangent weights of its steep walls are negative and untangle cannot repair it; the clamped
 // solve costs little on a branch).
+// `faces_ready` returns once vf, fixed, degenerate and w.seg.area_3d are set (the solve needs only E).
 Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& loops,
                          const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
-                         const std::vector<char>& degenerate, const FlattenOptions& o) {
+                         const std::vector<char>& degenerate, const FlattenOptions& o,
+                         const std::function<void()>& faces_ready) {
   const Surface& s = w.ann;
   auto attempt = [&](bool clamp, std::size_t& bad) {
     Harmonic h = solve_harmonic(s, E, loops[0], loops[1], clamp, &w.prior);
+    faces_ready();
     w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}, {}};
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
     double signed_area = 0;
@@ -177,10 +180,9 @@ struct Prepared {
   std::vector<std::vector<int>> vf;
 };
 
-Prepared prepare(SegmentWork& w, Edges edges) {
-  Prepared p;
+// Everything but the edges (p.E, set): what the map needs after its solve.
+void prepare_faces(SegmentWork& w, Prepared& p) {
   const Surface& ann = w.ann;
-  p.E = std::move(edges);
   std::vector<double> area(ann.t.size());  // w.seg.area_3d: summed as surface_area sums
   w.seg.area_3d = 0;
   for (std::size_t f = 0; f < ann.t.size(); ++f) area[f] = face_area_3d(ann, int(f)), w.seg.area_3d += area[f];
@@ -191,11 +193,18 @@ Prepared prepare(SegmentWork& w, Edges edges) {
   for (std::size_t e = 0; e < p.E.ev.size(); ++e)
     if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
   p.vf = vertex_faces(ann);
+}
+
+Prepared prepare(SegmentWork& w, Edges edges) {
+  Prepared p;
+  p.E = std::move(edges);
+  prepare_faces(w, p);
   return p;
 }
 
-void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const Prepared& p, const FlattenOptions& o) {
-  w.emb = conformal_step(w, p.E, loops, p.vf, p.fixed, p.degenerate, o);
+void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const Prepared& p, const FlattenOptions& o,
+               const std::function<void()>& faces_ready = [] {}) {
+  w.emb = conformal_step(w, p.E, loops, p.vf, p.fixed, p.degenerate, o, faces_ready);
   w.seg.length = w.seg.area_3d / w.emb.period;  // the conformal rectangle: length x period = area
   w.seg.period = w.emb.period;
 }
@@ -278,9 +287,13 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     b.lost_area = cut_area - placed;
     return b;
   });
-  p = prepare(w, std::move(rest_edges));  // (an exception here waits for the branches: the future's destructor joins)
-  if (depth == 0) debug_clock("branches cut off, the rest prepared");
-  conformal(w, loops, p, o);
+  p = Prepared{};  // (an exception below waits for the branches: the future's destructor joins)
+  p.E = std::move(rest_edges);
+  if (depth == 0) debug_clock("branches cut off");
+  // The rest's faces prepared beside its solve (the factor update runs on one thread): prepare_faces
+  // writes p's other members and w.seg.area_3d, which the solve does not read.
+  auto faces = std::async(side_launch(), [&w, &p] { prepare_faces(w, p); });
+  conformal(w, loops, p, o, [&faces] { faces.wait(); });
   return flattened;
 }
 

@@ -54,6 +54,24 @@ TEST(FlattenThreads, OneAndTwoThreadsGiveTheSameMap) {
   EXPECT_EQ(one.stats.flipped, 0u);
 }
 
+// The band left once its side branch is cut has its faces prepared (wall area, degenerate and
+// fixed vertices, vertex faces) beside its re-solve on 2 threads, before it on 1: its wall area,
+// length and period (conformal rectangle: length x period = wall area) are the same bits either way.
+TEST(FlattenThreads, RestPreparedBesideItsResolveGivesTheSameBand) {
+  const TriangleList mesh = test_shapes::pouch_behind_neck(3.0);
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
+  const FlatMap two = test_shapes::flatten_with_threads(mesh, 2);
+  ASSERT_GE(one.segments.size(), 2u);  // the colon and its cut-off branch
+  ASSERT_EQ(one.segments.size(), two.segments.size());
+  for (std::size_t k = 0; k < one.segments.size(); ++k) {
+    EXPECT_GT(one.segments[k].area_3d, 0.0);
+    EXPECT_EQ(one.segments[k].area_3d, two.segments[k].area_3d);
+    EXPECT_EQ(one.segments[k].length, two.segments[k].length);
+    EXPECT_EQ(one.segments[k].period, two.segments[k].period);
+  }
+  EXPECT_EQ(one.uv, two.uv);
+}
+
 // A colon segment large enough to get its nested dissection order (computed beside its first
 // conformal map, used by the re-solve after its side branch is cut and by the whole-band area
 // correction its wide pouch needs): a tube with a wide pouch and a pouch behind a 3 mm neck, at 0.42 mm.
