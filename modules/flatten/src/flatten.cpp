@@ -111,8 +111,7 @@ std::size_t count_bad(const Surface& s, const Embedding& emb, const std::vector<
 // weights, retried with clamped weights (no negative weight: folds are rare) if more than 1 % of
 // the faces are bad (conformal map), or if any is (a side branch's band: its pouch folds where the
 // cotangent weights of its steep walls are negative and untangle cannot repair it; the clamped
-// solve costs little on a branch).
-// `faces_ready` returns once vf, fixed, degenerate and w.seg.area_3d are set (the solve needs only E).
+// solve costs little on a branch). The solve needs only E; then `faces_ready` waits for the rest.
 Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& loops,
                          const std::vector<std::vector<int>>& vf, const std::vector<char>& fixed,
                          const std::vector<char>& degenerate, const FlattenOptions& o,
@@ -172,15 +171,14 @@ void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate
   c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
 }
 
-// What every step on an annulus needs: its edges (`edges`: those of w.ann, moved in),
-// degenerate faces, fixed (boundary) vertices and vertex -> faces; also sets the annulus' 3D area.
+// What every step on an annulus needs: its edges (w.ann's), degenerate faces, fixed (boundary)
+// vertices and vertex -> faces (prepare_faces, which also sets the annulus' 3D area).
 struct Prepared {
   Edges E;
   std::vector<char> degenerate, fixed;
   std::vector<std::vector<int>> vf;
 };
 
-// Everything but the edges (p.E, set): what the map needs after its solve.
 void prepare_faces(SegmentWork& w, Prepared& p) {
   const Surface& ann = w.ann;
   std::vector<double> area(ann.t.size());  // w.seg.area_3d: summed as surface_area sums
@@ -193,13 +191,6 @@ void prepare_faces(SegmentWork& w, Prepared& p) {
   for (std::size_t e = 0; e < p.E.ev.size(); ++e)
     if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
   p.vf = vertex_faces(ann);
-}
-
-Prepared prepare(SegmentWork& w, Edges edges) {
-  Prepared p;
-  p.E = std::move(edges);
-  prepare_faces(w, p);
-  return p;
 }
 
 void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const Prepared& p, const FlattenOptions& o,
@@ -287,11 +278,9 @@ std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vec
     b.lost_area = cut_area - placed;
     return b;
   });
-  p = Prepared{};  // (an exception below waits for the branches: the future's destructor joins)
-  p.E = std::move(rest_edges);
+  p = Prepared{std::move(rest_edges), {}, {}, {}};  // (an exception below joins the branches' future)
   if (depth == 0) debug_clock("branches cut off");
-  // The rest's faces prepared beside its solve (the factor update runs on one thread): prepare_faces
-  // writes p's other members and w.seg.area_3d, which the solve does not read.
+  // The rest's faces beside its solve (which reads neither them nor w.seg.area_3d; one-thread update).
   auto faces = std::async(side_launch(), [&w, &p] { prepare_faces(w, p); });
   conformal(w, loops, p, o, [&faces] { faces.wait(); });
   return flattened;
@@ -370,7 +359,8 @@ std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, s
   const V3 ca = loop_centre(w.ann, loops[0]), cb = loop_centre(w.ann, loops[1]);
   w.seg.end_a = {ca.x(), ca.y(), ca.z()};
   w.seg.end_b = {cb.x(), cb.y(), cb.z()};
-  Prepared p = prepare(w, std::move(edges));
+  Prepared p{std::move(edges), {}, {}, {}};
+  prepare_faces(w, p);
   w.cap_area = surface_area(s) - w.seg.area_3d;  // (prepare: the annulus' area)
   phase("ends opened");
   timer.mark("opened");
