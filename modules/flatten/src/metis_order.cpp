@@ -15,7 +15,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
-#include <string>
 
 #if defined(COLONFLAT_HAVE_METIS) && defined(COLONFLAT_HAVE_CHOLMOD)
 #include <cholmod.h>
@@ -162,68 +161,22 @@ bool node_nd(Graph& g, std::vector<idx_t>& perm) {
   return METIS_NodeND(&n, g.xadj.data(), g.adjncy.data(), nullptr, options, perm.data(), iperm.data()) == METIS_OK;
 }
 
-// One part of the graph ordered by METIS_NodeND: its vertices (global ids, ascending), its subgraph
-// and its order in global ids (empty and `ok` false on failure).
-struct PartOrder {
+// The order of one side in global ids (empty and `ok` false on failure).
+struct SideOrder {
   std::vector<int> global, order;
-  Graph g;
   bool ok = false;
   double cpu = 0;  // thread CPU s (COLONFLAT_FLATTEN_DEBUG)
 };
 
-void order_part(PartOrder& p) {
+void order_side(const Graph& g, const std::vector<idx_t>& part, idx_t side, SideOrder& out) {
   const double start = thread_cpu_seconds();
+  Graph s = side_graph(g, part, side, out.global);
   std::vector<idx_t> perm;
-  p.ok = node_nd(p.g, perm);
-  if (p.ok) {
-    p.order.reserve(perm.size());
-    for (idx_t k : perm) p.order.push_back(p.global[std::size_t(k)]);
-  }
-  p.g = Graph{};  // its memory back
-  p.cpu = thread_cpu_seconds() - start;
-}
-
-// A side of the top separator: one part, or (from split_from vertices on) two parts and the
-// separator between them (global ids, ascending), split by its own METIS vertex separator.
-struct Side {
-  std::vector<PartOrder> parts;
-  std::vector<int> separator;
-  std::size_t vertices = 0;
-};
-
-// Side `side` of `part` (top_separator's) in global ids.
-void make_side(const Graph& g, const std::vector<idx_t>& part, idx_t side, int split_from, Side& out) {
-  PartOrder whole;
-  whole.g = side_graph(g, part, side, whole.global);
-  out.vertices = whole.global.size();
-  std::vector<idx_t> halves;
-  if (whole.g.size() >= split_from) halves = top_separator(whole.g);
-  if (halves.empty()) {
-    out.parts.push_back(std::move(whole));
-    return;
-  }
-  for (idx_t h = 0; h < 2; ++h) {
-    PartOrder p;
-    std::vector<int> local;
-    p.g = side_graph(whole.g, halves, h, local);
-    for (int v : local) p.global.push_back(whole.global[std::size_t(v)]);
-    out.parts.push_back(std::move(p));
-  }
-  for (std::size_t v = 0; v < halves.size(); ++v)
-    if (halves[v] == 2) out.separator.push_back(whole.global[v]);
-}
-
-// Every part of both sides ordered on the worker threads, the largest first (the threads take them
-// in that order, so the last to finish is a small one).
-void order_parts(Side (&sides)[2]) {
-  std::vector<PartOrder*> parts;
-  for (Side& side : sides)
-    for (PartOrder& p : side.parts) parts.push_back(&p);
-  std::stable_sort(parts.begin(), parts.end(),
-                   [](const PartOrder* a, const PartOrder* b) { return a->global.size() > b->global.size(); });
-  std::vector<std::function<void()>> tasks;
-  for (PartOrder* p : parts) tasks.push_back([p] { order_part(*p); });
-  cf::parallel_tasks(tasks);
+  out.ok = node_nd(s, perm);
+  if (!out.ok) return;
+  out.order.reserve(perm.size());
+  for (idx_t p : perm) out.order.push_back(out.global[std::size_t(p)]);
+  out.cpu = thread_cpu_seconds() - start;
 }
 
 // order followed by the postorder of the elimination tree of the symmetric matrix whose lower
@@ -262,43 +215,28 @@ cholmod_sparse lower_pattern(const Graph& g, std::vector<int>& p, std::vector<in
 }
 
 // COLONFLAT_FLATTEN_DEBUG: what the split order's parts cost.
-void print_split_debug(double separator_s, const Side (&sides)[2], double sides_s) {
-  if (!std::getenv("COLONFLAT_FLATTEN_DEBUG")) return;
-  std::string parts;
-  double cpu = 0;
-  for (const Side& side : sides)
-    for (const PartOrder& p : side.parts) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%s%zu (%.2f)", parts.empty() ? "" : " / ", p.global.size(), p.cpu);
-      parts += buf, cpu += p.cpu;
-    }
-  std::fprintf(stderr,
-               "flatten debug split order: separator %.2f s, sides %zu / %zu vertices, parts %s vertices (CPU s), "
-               "%.2f CPU s, wall %.2f s\n",
-               separator_s, sides[0].vertices, sides[1].vertices, parts.c_str(), cpu, sides_s);
+void print_split_debug(double separator_s, const SideOrder (&sides)[2], double sides_s) {
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr,
+                 "flatten debug split order: separator %.2f s, sides %zu / %zu vertices (CPU %.2f / %.2f s, "
+                 "wall %.2f s)\n",
+                 separator_s, sides[0].global.size(), sides[1].global.size(), sides[0].cpu, sides[1].cpu, sides_s);
 }
 
 // metis_split_order of the graph g.
-SplitOrder split_order(Graph& g, int split_from) {
+SplitOrder split_order(Graph& g) {
   const Stopwatch sw;
   const std::vector<idx_t> part = top_separator(g);
   if (part.empty()) return {};
   const double separator_s = sw.seconds();
-  Side sides[2];
-  cf::parallel_tasks({[&] { make_side(g, part, 0, split_from, sides[0]); },
-                      [&] { make_side(g, part, 1, split_from, sides[1]); }});
-  order_parts(sides);
+  SideOrder sides[2];
+  cf::parallel_tasks({[&] { order_side(g, part, 0, sides[0]); }, [&] { order_side(g, part, 1, sides[1]); }});
   print_split_debug(separator_s, sides, sw.seconds() - separator_s);
+  if (!sides[0].ok || !sides[1].ok) return {};
   SplitOrder out;
-  for (const Side& side : sides) {
-    for (const PartOrder& p : side.parts) {
-      if (!p.ok) return {};
-      out.parts.push_back({int(out.order.size()), int(out.order.size() + p.order.size())});
-      out.order.insert(out.order.end(), p.order.begin(), p.order.end());
-    }
-    out.order.insert(out.order.end(), side.separator.begin(), side.separator.end());
-    if (&side == &sides[0]) out.first_side = int(out.order.size());
-  }
+  out.order = sides[0].order;
+  out.first_side = int(out.order.size());
+  out.order.insert(out.order.end(), sides[1].order.begin(), sides[1].order.end());
   const std::size_t sides_size = out.order.size();
   for (std::size_t v = 0; v < part.size(); ++v)
     if (part[v] == 2) out.order.push_back(int(v));
@@ -310,22 +248,22 @@ SplitOrder split_order(Graph& g, int split_from) {
 
 bool metis_direct_available() { return true; }
 
-SplitOrder metis_split_order(const MetisSpMat& A, int split_sides_from) {
+SplitOrder metis_split_order(const MetisSpMat& A) {
   if (A.rows() != A.cols() || A.rows() == 0 || !A.isCompressed()) return {};
   Graph g = graph_of(A);
-  return split_order(g, split_sides_from);
+  return split_order(g);
 }
 
-std::vector<int> metis_split_dissection_order(const MetisSpMat& A, int split_sides_from) {
-  std::vector<int> order = metis_split_order(A, split_sides_from).order;
+std::vector<int> metis_split_dissection_order(const MetisSpMat& A) {
+  std::vector<int> order = metis_split_order(A).order;
   cholmod_sparse view = view_lower(A);
   if (order.empty() || !postorder(view, order)) return {};
   return order;
 }
 
-std::vector<int> metis_split_dissection_order(VertexGraph g, int split_sides_from) {
+std::vector<int> metis_split_dissection_order(VertexGraph g) {
   if (g.size() <= 0) return {};
-  std::vector<int> order = split_order(g, split_sides_from).order;
+  std::vector<int> order = split_order(g).order;
   std::vector<int> p, i;
   cholmod_sparse lower = lower_pattern(g, p, i);
   if (order.empty() || !postorder(lower, order)) return {};
@@ -339,9 +277,9 @@ std::vector<int> metis_split_dissection_order(VertexGraph g, int split_sides_fro
 namespace cf::flat_detail {
 
 bool metis_direct_available() { return false; }
-SplitOrder metis_split_order(const MetisSpMat&, int) { return {}; }
-std::vector<int> metis_split_dissection_order(const MetisSpMat&, int) { return {}; }
-std::vector<int> metis_split_dissection_order(VertexGraph, int) { return {}; }
+SplitOrder metis_split_order(const MetisSpMat&) { return {}; }
+std::vector<int> metis_split_dissection_order(const MetisSpMat&) { return {}; }
+std::vector<int> metis_split_dissection_order(VertexGraph) { return {}; }
 
 }  // namespace cf::flat_detail
 

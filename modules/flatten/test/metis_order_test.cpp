@@ -85,57 +85,6 @@ TEST(MetisOrder, SplitOrderIsSideSideSeparatorAndTheSeparatorSeparates) {
   for (auto [a, b] : t.edges) EXPECT_FALSE(side[std::size_t(a)] + side[std::size_t(b)] == 1) << a << "-" << b;
 }
 
-// A side of at least split_sides_from vertices is split again: four parts (two per side) that no
-// edge joins, every other vertex a separator vertex (the sides' own separators, then the top one),
-// the top separator and the sides the same as without the second split; below the size, two parts.
-TEST(MetisOrder, LargeSidesAreSplitAgainIntoPartsNoEdgeJoins) {
-  if (!cf::flat_detail::metis_direct_available()) GTEST_SKIP() << "built without libmetis-dev";
-  const Tube t = tube(40, 240);
-  const int n = t.around * t.along;
-  const MetisSpMat A = tube_system(t);
-  const cf::flat_detail::SplitOrder once = cf::flat_detail::metis_split_order(A, n);
-  const cf::flat_detail::SplitOrder twice = cf::flat_detail::metis_split_order(A, 1000);
-  ASSERT_TRUE(is_permutation(twice.order, n));
-  EXPECT_EQ(once.parts.size(), 2u);
-  ASSERT_EQ(twice.parts.size(), 4u);
-  EXPECT_EQ(twice.first_side, once.first_side);
-  EXPECT_EQ(twice.separator, once.separator);
-  EXPECT_TRUE(std::equal(once.order.end() - once.separator, once.order.end(), twice.order.end() - twice.separator));
-  std::vector<int> part_of(static_cast<std::size_t>(n), -1);
-  int in_parts = 0;
-  for (std::size_t p = 0; p < twice.parts.size(); ++p) {
-    EXPECT_GT(twice.parts[p][1] - twice.parts[p][0], n / 8) << "part " << p;
-    for (int k = twice.parts[p][0]; k < twice.parts[p][1]; ++k) part_of[std::size_t(twice.order[std::size_t(k)])] = int(p), ++in_parts;
-  }
-  EXPECT_LT(n - in_parts, 4 * 2 * t.around);  // three separators, each about one ring
-  for (auto [a, b] : t.edges) {
-    const int pa = part_of[std::size_t(a)], pb = part_of[std::size_t(b)];
-    EXPECT_FALSE(pa >= 0 && pb >= 0 && pa != pb) << a << "-" << b;
-  }
-}
-
-// The order with the sides split again is the same for one and two threads, and its factorisation
-// costs at most 1.1 x the flops of the order with the sides whole.
-TEST(MetisOrder, SidesSplitAgainOrderTheSameOnAnyThreadCountWithAboutTheSameFill) {
-  if (!cf::flat_detail::metis_direct_available()) GTEST_SKIP() << "built without libmetis-dev";
-  const Tube t = tube(60, 300);
-  const MetisSpMat A = tube_system(t);
-  cf::set_thread_count(1);
-  const std::vector<int> one = cf::flat_detail::metis_split_dissection_order(A, 2000);
-  cf::set_thread_count(2);
-  const std::vector<int> two = cf::flat_detail::metis_split_dissection_order(A, 2000);
-  cf::set_thread_count(0);
-  ASSERT_TRUE(is_permutation(one, int(A.rows())));
-  EXPECT_EQ(one, two);
-#ifdef COLONFLAT_HAVE_CHOLMOD
-  MetisSpMat lower = A.triangularView<Eigen::Lower>();
-  lower.makeCompressed();
-  const std::vector<int> whole = cf::flat_detail::metis_split_dissection_order(A, int(A.rows()));
-  EXPECT_NE(whole, one);
-  EXPECT_LE(SpdSolver::order_flops(lower, one), 1.1 * SpdSolver::order_flops(lower, whole));
-#endif
-}
-
 // Two split orders computed at once on two threads are each the order computed alone, with one or
 // two worker threads per order; METIS's rand() calls reach the per-thread generator (counted, so
 // that the comparison is not of orders that never drew a random number).
