@@ -35,10 +35,7 @@ class ConformalAreaEnergy {
         const auto c = corners(pos, faces_[i]);
         const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
         if (a2 <= 0) return kHuge;
-        for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
-        const int f = faces_[i];
-        const double x = excess_(scale_ * a2 / area3_[f]);
-        part += lambda_ * area3_[f] * x * x;
+        add_face_energy(i, c, excess(i, a2), part);
       }
       return part;
     });
@@ -49,25 +46,53 @@ class ConformalAreaEnergy {
   void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
     for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        const int f = faces_[i];
-        const auto c = corners(pos, f);
+        const auto c = corners(pos, faces_[i]);
         const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
-        const double x = excess_(scale_ * a2 / area3_[f]);
-        const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
-        std::array<V2, 3>& grad = out[i];
-        grad = {V2::Zero(), V2::Zero(), V2::Zero()};
-        for (int k = 0; k < 3; ++k) {
-          const int a = (k + 1) % 3, b = (k + 2) % 3;
-          const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
-          grad[a] += e, grad[b] -= e;
-          grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
-        }
+        face_gradient(i, c, a2, excess(i, a2), out[i]);
       }
     });
+  }
+
+  // energy(pos) and, when it is below kHuge, face_gradients(pos, out) (the same bits as each alone),
+  // from one read of each face's corners: the descent's line search asks it at each trial, so the
+  // step it takes comes with the next step's gradients (proxy_descent.h).
+  double energy_and_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
+      double part = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const auto c = corners(pos, faces_[i]);
+        const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
+        if (a2 <= 0) return kHuge;
+        const double x = excess(i, a2);
+        add_face_energy(i, c, x, part);
+        face_gradient(i, c, a2, x, out[i]);
+      }
+      return part;
+    });
+    return e >= kHuge ? kHuge : e;
   }
   static constexpr double kHuge = 1e300;
 
  private:
+  // Face i's log area ratio outside [lo, hi] (a2: its signed map area).
+  double excess(std::size_t i, double a2) const { return excess_(scale_ * a2 / area3_[std::size_t(faces_[i])]); }
+  // Face i's terms added to `part` one by one (the order energy() has always summed them in); x: excess().
+  void add_face_energy(std::size_t i, const std::array<V2, 3>& c, double x, double& part) const {
+    for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
+    part += lambda_ * area3_[std::size_t(faces_[i])] * x * x;
+  }
+  // Face i's corner gradients at corners c (a2: its signed map area, x: excess()).
+  void face_gradient(std::size_t i, const std::array<V2, 3>& c, double a2, double x, std::array<V2, 3>& grad) const {
+    const int f = faces_[i];
+    const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
+    grad = {V2::Zero(), V2::Zero(), V2::Zero()};
+    for (int k = 0; k < 3; ++k) {
+      const int a = (k + 1) % 3, b = (k + 2) % 3;
+      const V2 e = 2 * w_[i][k] * (c[a] - c[b]);
+      grad[a] += e, grad[b] -= e;
+      grad[k] += dpen * 0.5 * V2(c[a].y() - c[b].y(), c[b].x() - c[a].x());  // d(a2)/d(c_k)
+    }
+  }
   std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
     const Tri& t = s_.t[f];
     return {pos[t[0]] + V2(0, emb_.dy[f][0]), pos[t[1]] + V2(0, emb_.dy[f][1]), pos[t[2]] + V2(0, emb_.dy[f][2])};

@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <type_traits>
+#include <utility>
 
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
@@ -104,6 +106,18 @@ class DescentTrace {
 // `held` (optional, local pieces): computes each step's cut (the same bits) and stops the descent
 // ("held") when its steps have stalled on the same faces' cut and its `done` says so.
 constexpr int kChecksAlone = 5;
+
+// Whether an Energy also offers double energy_and_gradients(pos, g) const: energy(pos) and, when it
+// is below kHuge, face_gradients(pos, g), the same bits as each alone. The line search then asks it at
+// each trial, and the step it takes needs no gradient pass of its own (one read of the faces' corners
+// a step instead of two).
+template <class Energy, class = void>
+struct FusedGradients : std::false_type {};
+template <class Energy>
+struct FusedGradients<Energy, std::void_t<decltype(std::declval<const Energy&>().energy_and_gradients(
+                                  std::declval<const std::vector<V2>&>(), std::declval<std::vector<std::array<V2, 3>>&>()))>>
+    : std::true_type {};
+
 template <class Energy>
 DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& energy, const RegionSystem& sys,
                             const std::vector<int>& judged, const std::vector<double>& area3, int max_steps,
@@ -120,6 +134,9 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   const std::vector<int>& unknowns = sys.unknowns();
   const CornerGather gather(s, energy.faces(), sys);
   std::vector<std::array<V2, 3>> face_gradients(energy.faces().size());
+  constexpr bool fused = FusedGradients<Energy>::value;
+  std::vector<std::array<V2, 3>> trial_gradients(fused ? face_gradients.size() : 0);  // at the line search's trial
+  bool have_gradients = false;  // face_gradients are emb.pos's (from the step's accepted trial)
   // emb.pos with the unknowns moved, filled only where the region reads it (its faces' corners):
   // regions far apart may run side by side on one embedding, each reading and writing its own.
   std::vector<V2> own;
@@ -137,7 +154,8 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
   Eigen::MatrixXd g, d;  // the step's gradient (n x 2) and direction
   auto direction = [&] {  // of the step from emb.pos
     Stopwatch clock;
-    energy.face_gradients(emb.pos, face_gradients);
+    if (!have_gradients) energy.face_gradients(emb.pos, face_gradients);
+    have_gradients = false;
     g = gather.sum(face_gradients);
     spent.gradient += clock.lap();
     d = -sys.solve_raw(g) / 2;
@@ -161,7 +179,8 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
     double e1 = Energy::kHuge;
     for (int half = 0; half < 30; ++half, t *= 0.5) {
       move_to(d, t);
-      e1 = energy.energy(trial);
+      if constexpr (fused) e1 = energy.energy_and_gradients(trial, trial_gradients);
+      else e1 = energy.energy(trial);
       ++spent.energy_evals;
       if (e1 <= e0 + 1e-4 * t * slope) break;
     }
@@ -171,6 +190,7 @@ DescentResult proxy_descent(const Surface& s, Embedding& emb, const Energy& ener
       break;
     }
     for (int v : unknowns) emb.pos[v] = trial[v];
+    if constexpr (fused) face_gradients.swap(trial_gradients), have_gradients = true;
     const double gain = (e0 - e1) / e0, e_before = e0;
     trace.step(s, emb, judged, area3, res.steps, t, e1, gain);
     e0 = res.energy_after = e1;

@@ -413,5 +413,82 @@ TEST(AreaCorrection, PieceHeldByTheSameFacesStopsOnceItsWallIsShown) {
   }
 }
 
+// The area energy of the grid with its middle squeezed and its vertices moved by a fixed pattern (some
+// faces far outside the bounds), a piece of the local pass over all its faces.
+struct WavyGrid {
+  test_shapes::SqueezedGrid g{0.05, 2};
+  std::vector<int> faces;
+  std::vector<double> area3;
+  std::vector<char> free_vertex;
+  WavyGrid() {
+    for (std::size_t f = 0; f < g.s.t.size(); ++f) faces.push_back(int(f)), area3.push_back(flat_detail::face_area_3d(g.s, int(f)));
+    for (std::size_t u = 0; u < g.s.p.size(); ++u) free_vertex.push_back(!g.fixed[u]);
+  }
+  flat_detail::ConformalAreaEnergy energy() const {
+    return flat_detail::ConformalAreaEnergy(g.s, g.emb, faces, area3, 0.4, 3.0, 10.0, 1.0);
+  }
+  std::vector<flat_detail::V2> moved(double amount) const {
+    std::vector<flat_detail::V2> p = g.emb.pos;
+    for (std::size_t v = 0; v < p.size(); ++v)
+      if (free_vertex[v]) p[v] += amount * flat_detail::V2(std::sin(1.3 * double(v)), std::cos(0.7 * double(v)));
+    return p;
+  }
+};
+
+// The same energy without energy_and_gradients(): proxy_descent then asks energy() and face_gradients()
+// apart, as before the fused line search.
+struct SeparateGradients {
+  const flat_detail::ConformalAreaEnergy& e;
+  static constexpr double kHuge = flat_detail::ConformalAreaEnergy::kHuge;
+  const std::vector<int>& faces() const { return e.faces(); }
+  double energy(const std::vector<flat_detail::V2>& pos) const { return e.energy(pos); }
+  void face_gradients(const std::vector<flat_detail::V2>& pos, std::vector<std::array<flat_detail::V2, 3>>& g) const {
+    e.face_gradients(pos, g);
+  }
+};
+
+// energy_and_gradients() is energy() and face_gradients() to the bit, on an unfolded map (faces inside
+// and far outside the area bounds); on a folded one it says kHuge, as energy() does.
+TEST(AreaCorrection, FusedEnergyAndGradientsAreEachAlonesBits) {
+  const WavyGrid w;
+  const flat_detail::ConformalAreaEnergy energy = w.energy();
+  const std::vector<flat_detail::V2> pos = w.moved(0.01);
+  std::vector<std::array<flat_detail::V2, 3>> alone(w.faces.size()), fused(w.faces.size());
+  energy.face_gradients(pos, alone);
+  const double e = energy.energy_and_gradients(pos, fused);
+  ASSERT_LT(e, flat_detail::ConformalAreaEnergy::kHuge);
+  EXPECT_EQ(e, energy.energy(pos));
+  for (std::size_t i = 0; i < alone.size(); ++i)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(fused[i][std::size_t(k)], alone[i][std::size_t(k)]) << i << " " << k;
+  EXPECT_EQ(energy.energy_and_gradients(w.moved(3.0), fused), flat_detail::ConformalAreaEnergy::kHuge);
+  EXPECT_EQ(energy.energy(w.moved(3.0)), flat_detail::ConformalAreaEnergy::kHuge);
+}
+
+// The descent whose line search brings the next step's gradients along (energy_and_gradients) takes
+// the same steps as the one asking energy() and face_gradients() apart: the same step count, stop
+// and energy, and the same map to the bit, over tens of steps (trials rejected by the line search
+// among them).
+TEST(AreaCorrection, DescentWithFusedGradientsTakesTheSameSteps) {
+  WavyGrid fused, apart;
+  const flat_detail::ConformalAreaEnergy e1 = fused.energy(), e2 = apart.energy();
+  flat_detail::RegionSystem s1, s2;
+  ASSERT_TRUE(s1.build(fused.g.s, fused.free_vertex, e1.faces(), e1.weights()));
+  ASSERT_TRUE(s2.build(apart.g.s, apart.free_vertex, e2.faces(), e2.weights()));
+  static_assert(flat_detail::FusedGradients<flat_detail::ConformalAreaEnergy>::value);
+  static_assert(!flat_detail::FusedGradients<SeparateGradients>::value);
+  flat_detail::StepTimes t1, t2;
+  const flat_detail::DescentResult a =
+      flat_detail::proxy_descent(fused.g.s, fused.g.emb, e1, s1, e1.faces(), fused.area3, 200, 1e-7, {}, nullptr, &t1);
+  const SeparateGradients plain{e2};
+  const flat_detail::DescentResult b =
+      flat_detail::proxy_descent(apart.g.s, apart.g.emb, plain, s2, e2.faces(), apart.area3, 200, 1e-7, {}, nullptr, &t2);
+  EXPECT_GT(a.steps, 10);
+  EXPECT_GT(t2.energy_evals, b.steps);  // some trials were rejected
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_STREQ(a.stop, b.stop);
+  EXPECT_EQ(a.energy_after, b.energy_after);
+  EXPECT_EQ(fused.g.emb.pos, apart.g.emb.pos);
+}
+
 }  // namespace
 }  // namespace cf
