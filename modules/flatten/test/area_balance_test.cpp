@@ -54,6 +54,29 @@ TEST(AreaBalance, SecondPassOnTheSameRegionReusesItsSystem) {
   EXPECT_EQ(g.emb.pos, before);
 }
 
+// The region is a list of faces by index whatever seeds it grew from: the whole grid squeezed to ~0.35
+// across, unevenly (the seeds nearly every face), one step moves some faces, the second pass's seeds
+// differ but grow into the same region (all faces), and it reuses the first pass's system (one
+// factorised for the two passes, where a list in growing order, seeds first, made two).
+TEST(AreaBalance, RegionGrownFromOtherSeedsReusesItsSystem) {
+  FlattenOptions o;
+  o.balance_iterations = 1;
+  Grid g(1.0);
+  for (std::size_t v = 0; v < g.emb.pos.size(); ++v)
+    g.emb.pos[v].x() = 0.35 * g.emb.pos[v].x() + (g.fixed[v] ? 0.0 : 0.05 * std::sin(1.7 * double(v)));
+  const auto seeds = [&] {
+    std::vector<char> seed(g.s.t.size());
+    for (std::size_t f = 0; f < seed.size(); ++f) seed[f] = g.emb.area2(g.s, int(f)) < 0.4 * face_area_3d(g.s, int(f));
+    return seed;
+  };
+  const std::vector<char> before = seeds();
+  const BalanceResult r = balance_area(g.s, g.vf, g.emb, g.fixed, g.degenerate, o);
+  EXPECT_GE(r.iterations, 1u);
+  EXPECT_EQ(r.faces, g.s.t.size() - 2);  // all but the two corner faces (no free vertex)
+  EXPECT_NE(seeds(), before);  // the step moved faces across a bound
+  EXPECT_EQ(r.systems_built, 1u);
+}
+
 // The largest fold-free step reads each face's corners once: it is, to the bit, the smallest of
 // face_step_limit() over the faces with a positive area, each with keep = min(0.5, floor x its 3D
 // area / its 2D area), for moves that crush some faces and fold others (floor 0 and 0.3).
