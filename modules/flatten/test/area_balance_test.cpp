@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "squeezed_grid.h"
+#include "../src/proxy_descent.h"
+#include "../src/symmetric_dirichlet_energy.h"
 
 namespace cf::flat_detail {
 namespace {
@@ -75,6 +77,48 @@ TEST(AreaBalance, RegionGrownFromOtherSeedsReusesItsSystem) {
   EXPECT_EQ(r.faces, g.s.t.size() - 2);  // all but the two corner faces (no free vertex)
   EXPECT_NE(seeds(), before);  // the step moved faces across a bound
   EXPECT_EQ(r.systems_built, 1u);
+}
+
+// The balancing's energy without energy_and_gradients(): proxy_descent asks energy() and
+// face_gradients() apart, as before the fused line search.
+struct SeparateGradients {
+  const SymmetricDirichlet& e;
+  static constexpr double kHuge = SymmetricDirichlet::kHuge;
+  const std::vector<int>& faces() const { return e.faces(); }
+  double energy(const std::vector<V2>& pos) const { return e.energy(pos); }
+  void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& g) const { e.face_gradients(pos, g); }
+};
+
+// The symmetric Dirichlet energy's energy_and_gradients() is energy() and face_gradients() to the bit
+// (kHuge on a folded map), and the balancing's descent with it takes the same steps as without: same
+// count and stop, same map to the bit.
+TEST(AreaBalance, FusedSymmetricDirichletGradientsTakeTheSameSteps) {
+  Grid fused(0.2), apart(0.2);
+  std::vector<int> faces(fused.s.t.size());
+  std::vector<double> area3(faces.size());
+  std::vector<char> free_vertex(fused.s.p.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) faces[f] = int(f), area3[f] = face_area_3d(fused.s, int(f));
+  for (std::size_t v = 0; v < free_vertex.size(); ++v) free_vertex[v] = !fused.fixed[v];
+  const SymmetricDirichlet e1 = make_energy(fused.s, fused.emb, faces), e2 = make_energy(apart.s, apart.emb, faces);
+  std::vector<std::array<V2, 3>> alone(faces.size()), both(faces.size());
+  e1.face_gradients(fused.emb.pos, alone);
+  EXPECT_EQ(e1.energy_and_gradients(fused.emb.pos, both), e1.energy(fused.emb.pos));
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(both[i][std::size_t(k)], alone[i][std::size_t(k)]) << i;
+  std::vector<V2> folded = fused.emb.pos;
+  folded[std::size_t(5 * fused.nx + 12)].x() += 3.0;
+  EXPECT_EQ(e1.energy_and_gradients(folded, both), SymmetricDirichlet::kHuge);
+  RegionSystem s1, s2;
+  const std::vector<std::array<double, 3>> w = corner_weights(fused.s, faces);
+  ASSERT_TRUE(s1.build(fused.s, free_vertex, faces, w));
+  ASSERT_TRUE(s2.build(apart.s, free_vertex, faces, w));
+  static_assert(FusedGradients<SymmetricDirichlet>::value && !FusedGradients<SeparateGradients>::value);
+  const DescentResult a = proxy_descent(fused.s, fused.emb, e1, s1, faces, area3, 50, 1e-9);
+  const DescentResult b = proxy_descent(apart.s, apart.emb, SeparateGradients{e2}, s2, faces, area3, 50, 1e-9);
+  EXPECT_GT(a.steps, 5);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_STREQ(a.stop, b.stop);
+  EXPECT_EQ(fused.emb.pos, apart.emb.pos);
 }
 
 // The largest fold-free step reads each face's corners once: it is, to the bit, the smallest of
