@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/free_space_cut.h"
@@ -171,6 +172,36 @@ TEST(FreeSpaceCut, AnObstacleLiesOnOneSideOfTheDisk) {
   ASSERT_EQ(disks.size(), 1u);
   EXPECT_EQ(disks[0].quads.size(), 64u);
   EXPECT_EQ(disks[0].boundary.size(), 32u);
+}
+
+// Two pegs between those walls, one standing on each (side 1 from the source wall up to x = 0.95,
+// side 2 from the sink wall down to x = 1.05, both over y, z in [0.8, 1.2]), meet within 0.1 mm:
+// less than a cell, so every cell of their four columns is blocked and the cut ends round them
+// for free. The disk has a hole there (a rim of 8 lattice vertices round 2 x 2 cells): 60 squares,
+// flow 60, outer boundary 32 (the raw CT mask's loop 91 has three such holes, session 31).
+TEST(FreeSpaceCut, PegsMeetingWithinACellLeaveAHoleInTheDisk) {
+  std::vector<SidedTriangle> tris = two_walls();
+  for (const auto& [lo, hi, side] : {std::tuple{0.1, 0.95, 1}, std::tuple{1.05, 1.9, 2}}) {
+    const TriangleList b = testing::axis_box({lo, 0.8, 0.8}, {hi, 1.2, 1.2});
+    for (const auto& t : b.triangles) {
+      std::array<Vec3, 3> p;
+      for (int i = 0; i < 3; ++i) p[i] = Vec3(b.points[t[i]][0], b.points[t[i]][1], b.points[t[i]][2]);
+      tris.push_back({p, side});
+    }
+  }
+  FreeSpaceCutStats st;
+  const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
+  EXPECT_EQ(st.flow, 60);
+  ASSERT_EQ(disks.size(), 1u);
+  EXPECT_EQ(disks[0].quads.size(), 60u);
+  EXPECT_EQ(disks[0].boundary.size(), 32u);
+  ASSERT_EQ(disks[0].holes.size(), 1u);
+  EXPECT_EQ(disks[0].holes[0].size(), 8u);
+  for (int v : disks[0].holes[0]) {  // the rim runs round the pegs' square, y, z in {0.75, 1, 1.25}
+    EXPECT_GT(std::fabs(disks[0].points[v][1] - 1.0) + std::fabs(disks[0].points[v][2] - 1.0), 0.2);
+    EXPECT_LE(std::fabs(disks[0].points[v][1] - 1.0), 0.25 + 1e-9);
+    EXPECT_LE(std::fabs(disks[0].points[v][2] - 1.0), 0.25 + 1e-9);
+  }
 }
 
 // The triangle-box test against sampling: a triangle with a sampled point (fine barycentric grid)
