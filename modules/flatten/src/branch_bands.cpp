@@ -55,8 +55,10 @@ std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& p
       try {
         subs[i] = band(pieces[i]);
         done[i] = 1;
-      } catch (const std::exception&) {
-        // not flattenable as a band: its wall counts as not shown
+      } catch (const std::exception& e) {  // not flattenable as a band: its wall counts as not shown
+        if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+          std::fprintf(stderr, "flatten debug branch of %zu faces (%zu open ends) not flattened: %s\n",
+                       pieces[i].surface.t.size(), pieces[i].loops, e.what());
       }
     });
   parallel_tasks(tasks);

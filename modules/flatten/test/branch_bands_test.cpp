@@ -3,6 +3,10 @@
 // band's axis and band length, the branches are flattened side by side with the same bits.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
 #include "../src/branch_bands.h"
 #include "colonflat/flatten/flatten.h"
 #include "flatten_shapes.h"
@@ -43,6 +47,28 @@ TEST(BranchBands, SeveredColonsLongBranchIsFlattenedAsABand) {
   ASSERT_EQ(one.uv.size(), f.uv.size());
   EXPECT_EQ(test_shapes::uv_differences(one, f), 0u);
   EXPECT_EQ(one.triangles, f.triangles);
+}
+
+// A piece its band cannot flatten (the band throws) is left out, its area not counted as placed,
+// and with COLONFLAT_FLATTEN_DEBUG set one line says which piece and why (a patch's slit that the
+// band's boundary clean-up unzipped was lost this way without a word, session 32 "grown").
+TEST(BranchBands, PieceThatCannotBeFlattenedIsLeftOutAndReported) {
+  flat_detail::BranchPiece piece;
+  piece.surface.p = {flat_detail::V3(0, 0, 0), flat_detail::V3(1, 0, 0), flat_detail::V3(0, 1, 0)};
+  piece.surface.t = {{0, 1, 2}};
+  piece.loops = 2;
+  const flat_detail::FlattenBand band = [](const flat_detail::BranchPiece&) -> std::vector<flat_detail::SegmentWork> {
+    throw std::runtime_error("not tube-like");
+  };
+  double placed = 0;
+  ::setenv("COLONFLAT_FLATTEN_DEBUG", "1", 1);
+  testing::internal::CaptureStderr();
+  const auto works = flat_detail::flatten_branch_pieces({piece}, band, placed);
+  const std::string err = testing::internal::GetCapturedStderr();
+  ::unsetenv("COLONFLAT_FLATTEN_DEBUG");
+  EXPECT_TRUE(works.empty());
+  EXPECT_EQ(placed, 0.0);
+  EXPECT_NE(err.find("branch of 1 faces (2 open ends) not flattened: not tube-like"), std::string::npos) << err;
 }
 
 }  // namespace
