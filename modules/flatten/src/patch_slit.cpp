@@ -77,6 +77,31 @@ std::vector<int> left_fan(const Surface& s, const std::vector<std::vector<int>>&
   return fan;
 }
 
+// Two boundary loops and Euler characteristic 0 (false also when an edge is not manifold).
+bool two_loops(const Surface& s) {
+  try {
+    const Edges E = build_edges(s.t);
+    const long long chi = (long long)s.p.size() - (long long)E.ev.size() + (long long)s.t.size();
+    return boundary_loops(s, E).size() == 2 && chi == 0;
+  } catch (const PreconditionError&) {
+    return false;  // not a manifold after the cut
+  }
+}
+
+// An annulus that stays one after the band's boundary clean-up (clean_face_set: faces with three
+// corners on the boundary and pinches dropped, again and again): a slit that runs one face from the
+// rim is unzipped into it there, and the band would be no tube.
+bool is_annulus(const Surface& s) {
+  if (!two_loops(s)) return false;
+  std::vector<int> all(s.t.size());
+  for (std::size_t f = 0; f < all.size(); ++f) all[f] = int(f);
+  const std::vector<int> kept = clean_face_set(s, build_edges(s.t), std::move(all));
+  if (kept.size() == s.t.size()) return true;
+  std::vector<char> keep(s.t.size(), 0);
+  for (int f : kept) keep[std::size_t(f)] = 1;
+  return two_loops(sub_surface(s, keep));
+}
+
 }  // namespace
 
 Surface slit_disk(const Surface& disk) {
@@ -95,14 +120,12 @@ Surface slit_disk(const Surface& disk) {
       for (int& c : out.t[std::size_t(f)])
         if (c == v) c = copy;
   }
-  try {
-    const Edges cut = build_edges(out.t);
-    const long long chi = (long long)out.p.size() - (long long)cut.ev.size() + (long long)out.t.size();
-    if (boundary_loops(out, cut).size() == 2 && chi == 0) return out;
-  } catch (const PreconditionError&) {
-    // not a manifold after the cut: no slit
-  }
-  return {};
+  std::vector<char> keep(out.t.size(), 1);  // the slit's two ends rounded: the faces around each end vertex dropped
+  for (int end : {path.front(), path.back()})
+    for (int f : vf[std::size_t(end)]) keep[std::size_t(f)] = 0;
+  Surface rounded = sub_surface(out, keep);
+  if (is_annulus(rounded)) return rounded;
+  return is_annulus(out) ? out : Surface{};  // the ends as they are, where rounding them reaches the rim
 }
 
 }  // namespace cf::flat_detail

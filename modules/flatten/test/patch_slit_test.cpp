@@ -47,28 +47,53 @@ TriangleList as_mesh(const flat_detail::Surface& s) {
   return m;
 }
 
-// A 61 x 13 mm strip: its slit runs along the middle line y = 6 over the ridge (distance to the rim
-// >= 3 mm: x in [3, 57]), the cut is an annulus with the same faces (same area), and only the slit's
-// inner vertices are doubled.
+// A 61 x 13 mm strip: its slit runs along the middle over the ridge (distance to the rim >= 3 mm:
+// x in [3, 57], y in [3, 9]), rounded at both ends (the six faces around each end vertex dropped); the
+// cut is an annulus, the slit's inner vertices doubled, every vertex at its source's position.
 TEST(PatchSlit, StripIsCutAlongItsMiddleLine) {
   const flat_detail::Surface s = strip(61, 13);
   const flat_detail::Surface cut = flat_detail::slit_disk(s);
-  ASSERT_EQ(cut.t.size(), s.t.size());
+  ASSERT_EQ(cut.t.size() + 12, s.t.size());
   const flat_detail::Edges E = flat_detail::build_edges(cut.t);
   const auto loops = flat_detail::boundary_loops(cut, E);
   ASSERT_EQ(loops.size(), 2u);
   EXPECT_EQ((long long)cut.p.size() - (long long)E.ev.size() + (long long)cut.t.size(), 0);
-  EXPECT_NEAR(flat_detail::surface_area(cut), 60.0 * 12.0, 1e-9);
+  EXPECT_NEAR(flat_detail::surface_area(cut), 60.0 * 12.0 - 12 * 0.5, 1e-9);
+  std::vector<int> uses(s.p.size(), 0);
+  for (std::size_t v = 0; v < cut.p.size(); ++v) {
+    EXPECT_EQ(cut.p[v], s.p[std::size_t(cut.src[v])]);
+    ++uses[std::size_t(cut.src[v])];
+  }
   const auto& inner = loops[0].size() < loops[1].size() ? loops[0] : loops[1];
   double xmin = 1e9, xmax = -1e9;
   for (int v : inner) {
-    EXPECT_NEAR(cut.p[std::size_t(v)].y(), 6.0, 3.0 + 1e-9);  // on the ridge
+    EXPECT_NEAR(cut.p[std::size_t(v)].y(), 6.0, 4.0 + 1e-9);  // on the ridge, or one edge beyond it around an end
     xmin = std::min(xmin, cut.p[std::size_t(v)].x()), xmax = std::max(xmax, cut.p[std::size_t(v)].x());
   }
   EXPECT_LE(xmin, 4.0);  // from near x = 3 ...
   EXPECT_GE(xmax, 56.0);  // ... to near x = 57
-  EXPECT_EQ(cut.p.size() - s.p.size(), inner.size() / 2 - 1);  // the slit's inner vertices, once each
-  for (std::size_t v = s.p.size(); v < cut.p.size(); ++v) EXPECT_EQ(cut.p[v], s.p[std::size_t(cut.src[v])]);
+  const long long doubled = std::count(uses.begin(), uses.end(), 2), gone = std::count(uses.begin(), uses.end(), 0);
+  EXPECT_EQ(gone, 2);  // the two end vertices
+  EXPECT_EQ(std::count(uses.begin(), uses.end(), 1) + 2 * doubled, (long long)cut.p.size());
+  EXPECT_EQ(inner.size(), std::size_t(2 * doubled + 10));  // both sides of the slit, and 5 + 5 around the ends' fans
+}
+
+// A slit one face from the rim would be unzipped into it by the band's boundary clean-up (faces
+// with three corners on the boundary dropped one after the other, clean_face_set): on a 61 x 5 mm
+// strip (ridge 1 mm from the rim) there is no slit; on a 61 x 7 mm one the slit is cut and the
+// clean-up drops no more than it drops of the uncut strip (its corner faces).
+TEST(PatchSlit, SlitIsNeverOneFaceFromTheRim) {
+  EXPECT_TRUE(flat_detail::slit_disk(strip(61, 5)).t.empty());
+  const flat_detail::Surface s = strip(61, 7), cut = flat_detail::slit_disk(s);
+  ASSERT_FALSE(cut.t.empty());
+  const flat_detail::Edges E = flat_detail::build_edges(cut.t);
+  EXPECT_EQ(flat_detail::boundary_loops(cut, E).size(), 2u);
+  auto dropped = [](const flat_detail::Surface& x, const flat_detail::Edges& e) {  // faces the clean-up drops
+    std::vector<int> all(x.t.size());
+    for (std::size_t f = 0; f < all.size(); ++f) all[f] = int(f);
+    return x.t.size() - flat_detail::clean_face_set(x, e, all).size();
+  };
+  EXPECT_EQ(dropped(cut, E), dropped(s, flat_detail::build_edges(s.t)));  // only the strip's own corners
 }
 
 // A 3 x 3 grid has one vertex off the rim: its ridge is that vertex, no slit of two edges: no cut.
