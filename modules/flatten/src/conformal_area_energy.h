@@ -28,19 +28,7 @@ class ConformalAreaEnergy {
   const std::vector<std::array<double, 3>>& weights() const { return w_; }
   const std::vector<int>& faces() const { return faces_; }
 
-  double energy(const std::vector<V2>& pos) const {
-    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
-      double part = 0;
-      for (std::size_t i = begin; i < end; ++i) {
-        const auto c = corners(pos, faces_[i]);
-        const double a2 = 0.5 * area_energy_detail::cross2(c[1] - c[0], c[2] - c[0]);
-        if (a2 <= 0) return kHuge;
-        add_face_energy(i, c, excess(i, a2), part);
-      }
-      return part;
-    });
-    return e >= kHuge ? kHuge : e;
-  }
+  double energy(const std::vector<V2>& pos) const { return energy_with(pos, nullptr); }
 
   // Per face, the gradient with respect to each corner.
   void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
@@ -57,6 +45,10 @@ class ConformalAreaEnergy {
   // from one read of each face's corners: the descent's line search asks it at each trial, so the
   // step it takes comes with the next step's gradients (proxy_descent.h).
   double energy_and_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    return energy_with(pos, &out);
+  }
+  // The energy, and each face's corner gradients into *out when out is given (one corner read a face).
+  double energy_with(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>* out) const {
     const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
       double part = 0;
       for (std::size_t i = begin; i < end; ++i) {
@@ -65,7 +57,7 @@ class ConformalAreaEnergy {
         if (a2 <= 0) return kHuge;
         const double x = excess(i, a2);
         add_face_energy(i, c, x, part);
-        face_gradient(i, c, a2, x, out[i]);
+        if (out) face_gradient(i, c, a2, x, (*out)[i]);
       }
       return part;
     });

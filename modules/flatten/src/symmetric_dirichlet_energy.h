@@ -46,19 +46,7 @@ struct SymmetricDirichlet {
     D.col(1) = pos[t[2]] + V2(0, emb.dy[f][2]) - c0;
     return D * x_inv[i];
   }
-  double energy(const std::vector<V2>& pos) const {
-    const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
-      double part = 0;
-      for (std::size_t i = begin; i < end; ++i) {
-        const Eigen::Matrix2d J = jacobian(pos, i);
-        const double det = J.determinant();
-        if (det <= 0) return kHuge;
-        part += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
-      }
-      return part;
-    });
-    return e >= kHuge ? kHuge : e;
-  }
+  double energy(const std::vector<V2>& pos) const { return energy_with(pos, nullptr); }
   // Per face, the gradient with respect to each corner.
   void face_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
     for_each_block(faces_.size(), [&](std::size_t begin, std::size_t end) {
@@ -68,6 +56,10 @@ struct SymmetricDirichlet {
   // energy(pos) and, when it is below kHuge, face_gradients(pos, out), the same bits as each alone,
   // from one Jacobian a face (proxy_descent.h's fused line search).
   double energy_and_gradients(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>& out) const {
+    return energy_with(pos, &out);
+  }
+  // The energy, and each face's corner gradients into *out when out is given (one Jacobian a face).
+  double energy_with(const std::vector<V2>& pos, std::vector<std::array<V2, 3>>* out) const {
     const double e = block_sum(faces_.size(), [&](std::size_t begin, std::size_t end) {
       double part = 0;
       for (std::size_t i = begin; i < end; ++i) {
@@ -75,7 +67,7 @@ struct SymmetricDirichlet {
         const double det = J.determinant();
         if (det <= 0) return kHuge;
         part += area3[i] * J.squaredNorm() * (1 + 1 / (det * det));
-        face_gradient(i, J, out[i]);
+        if (out) face_gradient(i, J, (*out)[i]);
       }
       return part;
     });
