@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <tuple>
 
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/free_space_cut.h"
@@ -131,6 +130,16 @@ std::vector<SidedTriangle> two_walls() {
   return tris;
 }
 
+// The 12 triangles of the axis box [lo, hi] added to `tris` on side `side`.
+void add_box(std::vector<SidedTriangle>& tris, const std::array<double, 3>& lo, const std::array<double, 3>& hi, int side) {
+  const TriangleList b = testing::axis_box(lo, hi);
+  for (const auto& t : b.triangles) {
+    std::array<Vec3, 3> p;
+    for (int i = 0; i < 3; ++i) p[i] = Vec3(b.points[t[i]][0], b.points[t[i]][1], b.points[t[i]][2]);
+    tris.push_back({p, side});
+  }
+}
+
 // The minimum cut of a 2 mm cube at the origin, 8 x 8 x 8 cells of 0.25 mm, among `tris`.
 std::vector<CutDisk> cut_two_mm_cube(const std::vector<SidedTriangle>& tris, FreeSpaceCutStats* st) {
   FreeSpaceBox box;
@@ -160,12 +169,7 @@ TEST(FreeSpaceCut, TwoWallsGiveAFlatDiskOfTheCrossSection) {
 // it with a hole where it is (60 squares: an annulus, no disk).
 TEST(FreeSpaceCut, AnObstacleLiesOnOneSideOfTheDisk) {
   std::vector<SidedTriangle> tris = two_walls();
-  const TriangleList b = testing::axis_box({0.8, 0.8, 0.8}, {1.2, 1.2, 1.2});
-  for (const auto& t : b.triangles) {
-    std::array<Vec3, 3> p;
-    for (int i = 0; i < 3; ++i) p[i] = Vec3(b.points[t[i]][0], b.points[t[i]][1], b.points[t[i]][2]);
-    tris.push_back({p, 3});
-  }
+  add_box(tris, {0.8, 0.8, 0.8}, {1.2, 1.2, 1.2}, 3);
   FreeSpaceCutStats st;
   const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
   EXPECT_EQ(st.flow, 64);
@@ -181,14 +185,8 @@ TEST(FreeSpaceCut, AnObstacleLiesOnOneSideOfTheDisk) {
 // flow 60, outer boundary 32 (the raw CT mask's loop 91 has three such holes, session 31).
 TEST(FreeSpaceCut, PegsMeetingWithinACellLeaveAHoleInTheDisk) {
   std::vector<SidedTriangle> tris = two_walls();
-  for (const auto& [lo, hi, side] : {std::tuple{0.1, 0.95, 1}, std::tuple{1.05, 1.9, 2}}) {
-    const TriangleList b = testing::axis_box({lo, 0.8, 0.8}, {hi, 1.2, 1.2});
-    for (const auto& t : b.triangles) {
-      std::array<Vec3, 3> p;
-      for (int i = 0; i < 3; ++i) p[i] = Vec3(b.points[t[i]][0], b.points[t[i]][1], b.points[t[i]][2]);
-      tris.push_back({p, side});
-    }
-  }
+  add_box(tris, {0.1, 0.8, 0.8}, {0.95, 1.2, 1.2}, 1);
+  add_box(tris, {1.05, 0.8, 0.8}, {1.9, 1.2, 1.2}, 2);
   FreeSpaceCutStats st;
   const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
   EXPECT_EQ(st.flow, 60);
