@@ -50,10 +50,7 @@ Mesh rippled_washer_under_a_plate(double ripple, double gap, int nu) {
 }
 
 std::vector<Mesh::VertexHandle> top_loop(int nu) {
-  const int n = static_cast<int>(washer_profile(0).size());
-  std::vector<Mesh::VertexHandle> loop;
-  for (int i = 0; i < nu; ++i) loop.push_back(Mesh::VertexHandle(i * n + kLoopPoint));
-  return loop;
+  return testing::swept_point_loop(nu, static_cast<int>(washer_profile(0).size()), kLoopPoint);
 }
 
 struct Cut {

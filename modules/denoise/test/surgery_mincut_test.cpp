@@ -52,10 +52,7 @@ Mesh washer_with_stepped_gap() {
 }
 
 std::vector<Mesh::VertexHandle> hole_loop() {
-  const int n = static_cast<int>(washer_profile().size());
-  std::vector<Mesh::VertexHandle> loop;
-  for (int i = 0; i < kSections; ++i) loop.push_back(Mesh::VertexHandle(i * n + kLoopPoint));
-  return loop;
+  return testing::swept_point_loop(kSections, static_cast<int>(washer_profile().size()), kLoopPoint);
 }
 
 struct Cut {
@@ -149,6 +146,15 @@ std::vector<CutDisk> cut_two_mm_cube(const std::vector<SidedTriangle>& tris, Fre
   return free_space_cut(box, tris, st);
 }
 
+// The cut holds one disk of `squares` cell squares whose outer boundary has `boundary` lattice
+// vertices, and its flow is `squares` (one unit per cell square cut).
+void expect_one_disk(const std::vector<CutDisk>& disks, const FreeSpaceCutStats& st, int squares, std::size_t boundary) {
+  EXPECT_EQ(st.flow, squares);
+  ASSERT_EQ(disks.size(), 1u);
+  EXPECT_EQ(disks[0].quads.size(), static_cast<std::size_t>(squares));
+  EXPECT_EQ(disks[0].boundary.size(), boundary);
+}
+
 // Two parallel walls across a 2 mm box (x = 0.1: source side, x = 1.9: sink side): the minimum
 // cut is one flat disk across the box, 8 x 8 cells of 0.25 mm, so the flow is 64 and the disk
 // has 64 squares, 81 points, a boundary of 32 and normals along +x (towards the sink).
@@ -156,11 +162,8 @@ TEST(FreeSpaceCut, TwoWallsGiveAFlatDiskOfTheCrossSection) {
   std::vector<SidedTriangle> tris = two_walls();
   FreeSpaceCutStats st;
   const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
-  EXPECT_EQ(st.flow, 64);
-  ASSERT_EQ(disks.size(), 1u);
-  EXPECT_EQ(disks[0].quads.size(), 64u);
+  ASSERT_NO_FATAL_FAILURE(expect_one_disk(disks, st, 64, 32));
   EXPECT_EQ(disks[0].points.size(), 81u);
-  EXPECT_EQ(disks[0].boundary.size(), 32u);
   for (const auto& n : disks[0].normals) EXPECT_NEAR(n[0], 1.0, 1e-12);
 }
 
@@ -172,10 +175,7 @@ TEST(FreeSpaceCut, AnObstacleLiesOnOneSideOfTheDisk) {
   add_box(tris, {0.8, 0.8, 0.8}, {1.2, 1.2, 1.2}, 3);
   FreeSpaceCutStats st;
   const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
-  EXPECT_EQ(st.flow, 64);
-  ASSERT_EQ(disks.size(), 1u);
-  EXPECT_EQ(disks[0].quads.size(), 64u);
-  EXPECT_EQ(disks[0].boundary.size(), 32u);
+  ASSERT_NO_FATAL_FAILURE(expect_one_disk(disks, st, 64, 32));
 }
 
 // Two pegs between those walls, one standing on each (side 1 from the source wall up to x = 0.95,
@@ -189,10 +189,7 @@ TEST(FreeSpaceCut, PegsMeetingWithinACellLeaveAHoleInTheDisk) {
   add_box(tris, {1.05, 0.8, 0.8}, {1.9, 1.2, 1.2}, 2);
   FreeSpaceCutStats st;
   const std::vector<CutDisk> disks = cut_two_mm_cube(tris, &st);
-  EXPECT_EQ(st.flow, 60);
-  ASSERT_EQ(disks.size(), 1u);
-  EXPECT_EQ(disks[0].quads.size(), 60u);
-  EXPECT_EQ(disks[0].boundary.size(), 32u);
+  ASSERT_NO_FATAL_FAILURE(expect_one_disk(disks, st, 60, 32));
   ASSERT_EQ(disks[0].holes.size(), 1u);
   EXPECT_EQ(disks[0].holes[0].size(), 8u);
   for (int v : disks[0].holes[0]) {  // the rim runs round the pegs' square, y, z in {0.75, 1, 1.25}

@@ -44,6 +44,14 @@ inline TriangleList axis_box(const std::array<double, 3>& lo, const std::array<d
   return t;
 }
 
+// The loop of profile point `point` round a profile of n points swept in nu sections (the
+// sweep's direction): vertex i * n + point of each section i.
+inline std::vector<Mesh::VertexHandle> swept_point_loop(int nu, int n, int point) {
+  std::vector<Mesh::VertexHandle> loop;
+  for (int i = 0; i < nu; ++i) loop.push_back(Mesh::VertexHandle(i * n + point));
+  return loop;
+}
+
 inline double mean_edge(const Mesh& m) {
   double s = 0;
   for (auto e : m.edges()) s += m.calc_edge_length(e);
