@@ -365,21 +365,30 @@ TEST(AreaCorrection, LogRatioExcessIsTheFullFormulaToTheBit) {
 namespace cf {
 namespace {
 
-// The unsqueezed grid (3 x as many vertices each way) with one needle: its middle vertex raised 30 mm
-// in 3D (its six faces at map / 3D area ~0.03, hidden) and drawn in the map to 1e-6 of its distance
-// from the far edge of one of them (that face nearly degenerate). The whole grid is one local piece.
-struct NeedleGrid {
-  test_shapes::SqueezedGrid g{1.0, 3};
+// A squeezed grid whose faces are all one local piece: their 3D areas, every vertex free but the
+// grid's fixed ones (take_whole_grid, once the grid has its final shape).
+struct GridPiece {
+  test_shapes::SqueezedGrid g;
   std::vector<int> faces;
   std::vector<double> area3;
   std::vector<char> free_vertex;
-  NeedleGrid() {
+  GridPiece(double squeeze, int size) : g(squeeze, size) {}
+  void take_whole_grid() {
+    for (std::size_t f = 0; f < g.s.t.size(); ++f) faces.push_back(int(f)), area3.push_back(flat_detail::face_area_3d(g.s, int(f)));
+    for (std::size_t u = 0; u < g.s.p.size(); ++u) free_vertex.push_back(!g.fixed[u]);
+  }
+};
+
+// The unsqueezed grid (3 x as many vertices each way) with one needle: its middle vertex raised 30 mm
+// in 3D (its six faces at map / 3D area ~0.03, hidden) and drawn in the map to 1e-6 of its distance
+// from the far edge of one of them (that face nearly degenerate). The whole grid is one local piece.
+struct NeedleGrid : GridPiece {
+  NeedleGrid() : GridPiece(1.0, 3) {
     const int v = (g.ny / 2) * g.nx + g.nx / 2;
     g.s.p[v].z() = 30.0;
     const flat_detail::V2 mid = 0.5 * (g.emb.pos[v + 1] + g.emb.pos[v + g.nx + 1]);
     g.emb.pos[v] = mid + 1e-6 * (g.emb.pos[v] - mid);
-    for (std::size_t f = 0; f < g.s.t.size(); ++f) faces.push_back(int(f)), area3.push_back(flat_detail::face_area_3d(g.s, int(f)));
-    for (std::size_t u = 0; u < g.s.p.size(); ++u) free_vertex.push_back(!g.fixed[u]);
+    take_whole_grid();
   }
   double wall() const { return std::accumulate(area3.begin(), area3.end(), 0.0); }
   // The local pass's descent on the grid (band scale 1; area weight 100: the needle's penalty steep
@@ -415,15 +424,8 @@ TEST(AreaCorrection, PieceHeldByTheSameFacesStopsOnceItsWallIsShown) {
 
 // The area energy of the grid with its middle squeezed and its vertices moved by a fixed pattern (some
 // faces far outside the bounds), a piece of the local pass over all its faces.
-struct WavyGrid {
-  test_shapes::SqueezedGrid g{0.05, 2};
-  std::vector<int> faces;
-  std::vector<double> area3;
-  std::vector<char> free_vertex;
-  WavyGrid() {
-    for (std::size_t f = 0; f < g.s.t.size(); ++f) faces.push_back(int(f)), area3.push_back(flat_detail::face_area_3d(g.s, int(f)));
-    for (std::size_t u = 0; u < g.s.p.size(); ++u) free_vertex.push_back(!g.fixed[u]);
-  }
+struct WavyGrid : GridPiece {
+  WavyGrid() : GridPiece(0.05, 2) { take_whole_grid(); }
   flat_detail::ConformalAreaEnergy energy() const {
     return flat_detail::ConformalAreaEnergy(g.s, g.emb, faces, area3, 0.4, 3.0, 10.0, 1.0);
   }
