@@ -22,7 +22,9 @@
 #include "colonflat/denoise/face_grid.h"
 #include "colonflat/denoise/free_space_cut.h"
 #include "denoise_debug.h"
+#include "free_space_disks.h"
 #include "surgery_steps.h"
+#include "triangle_hash.h"
 
 namespace cf::detail {
 
@@ -35,6 +37,16 @@ constexpr double kMaxCells = 4.0e6;
 // A disk's boundary must stay this close to the loop: 2 cells (the free cells next to the faces
 // at the loop) plus 2 mean loop edges (how far the staircase walls there can lie from the loop).
 constexpr double kGapCells = 2.0, kGapEdges = 2.0;
+// Rounds of taking the squares a strip crosses off the disk (mincut_caps()), over all placements
+// of one loop: on the real CT surface, with these caps tried in a loop's first cut (not kept), a
+// loop whose strips never came clean ran 16 rounds in each of the 36 placements (90 s, load 10).
+constexpr int kPeelRounds = 16;
+// Wall widening at a disk's holes (surgery_mincut_widen.cpp): rounds of moves and cuts, and the
+// moves tried in a round (fractions of SurgeryOptions::mincut_widen), largest first.
+constexpr int kWidenRounds = 3;
+constexpr double kWidenShifts[] = {1.0, 2.0 / 3.0, 1.0 / 3.0};
+// Crossing pairs among the caps' triangles gathered per round (their squares are peeled).
+constexpr std::size_t kMaxPairs = 64;
 // The placements tried, in order: ring pull, right cap's offset and left cap's (cells, along the
 // normals), rim smoothing passes. The first passed the stepped-gap washer (test), the later ones
 // the folds seen on the raw CT mask's loop 91 (a smoothed concave rim corner folding over a square,
@@ -67,36 +79,19 @@ Bounds bounds(const std::array<Vec3, 3>& p) {
   return b;
 }
 
-std::array<Vec3, 3> triangle_points(const Mesh& mesh, const std::array<int, 3>& t) {
-  return {mesh.point(Mesh::VertexHandle(t[0])), mesh.point(Mesh::VertexHandle(t[1])), mesh.point(Mesh::VertexHandle(t[2]))};
-}
-
-// True when two of `tris` (mesh vertex ids, not in the mesh) intersect improperly: a hash of
-// their bounding boxes in cells of `cell` mm, each pair tested once.
-bool any_crossing(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris, double cell, std::pair<int, int>* pair) {
-  std::unordered_map<long long, std::vector<int>> grid;
-  std::vector<int> stamp(tris.size(), -1);
-  auto key = [cell](const Vec3& p, int a) { return static_cast<long long>(std::floor(p[a] / cell)); };
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    const auto p = triangle_points(mesh, tris[t]);
-    const Bounds b = bounds(p);
-    for (long long z = key(b.lo, 2); z <= key(b.hi, 2); ++z)
-      for (long long y = key(b.lo, 1); y <= key(b.hi, 1); ++y)
-        for (long long x = key(b.lo, 0); x <= key(b.hi, 0); ++x) {
-          auto& cellfaces = grid[(x * 73856093LL) ^ (y * 19349663LL) ^ (z * 83492791LL)];
-          for (int u : cellfaces) {
-            if (stamp[u] == int(t)) continue;
-            stamp[u] = int(t);
-            const auto q = triangle_points(mesh, tris[u]);
-            if (bounds(q).meets(b) && triangles_intersect_improperly(tris[t], p, tris[u], q)) {
-              *pair = {u, int(t)};
-              return true;
-            }
-          }
-          cellfaces.push_back(int(t));
-        }
+// Up to `most` pairs of `tris` (mesh vertex ids, not in the mesh) that intersect improperly (one
+// per later triangle; hash cells of `cell` mm).
+std::vector<std::pair<int, int>> crossings(const Mesh& mesh, const std::vector<std::array<int, 3>>& tris, double cell,
+                                           std::size_t most) {
+  TriangleHash hash(mesh, cell);
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& t : tris) {
+    const int u = hash.crossing(t);
+    if (u >= 0) pairs.emplace_back(u, static_cast<int>(hash.size()));
+    if (pairs.size() >= most) break;
+    hash.insert(t);
   }
-  return false;
+  return pairs;
 }
 }  // namespace
 
@@ -119,7 +114,7 @@ FreeSpaceBox Surgery::mincut_box() const {
 // The faces whose bounding boxes meet the box, each with the side it is reached from first by a
 // breadth-first flood over faces inside the box: 2 from the right ring, 1 from the left (0: not
 // reached). Both rings must be where the loop was.
-std::vector<SidedTriangle> Surgery::sided_faces(const FreeSpaceBox& box) const {
+std::vector<SidedTriangle> Surgery::sided_faces(const FreeSpaceBox& box, std::vector<int>* ids) const {
   const Bounds region{box.lo, box.lo + box.cell * Vec3(box.n[0], box.n[1], box.n[2])};
   std::vector<int> local(mesh_.n_faces(), -1);
   std::vector<SidedTriangle> out;
@@ -130,6 +125,7 @@ std::vector<SidedTriangle> Surgery::sided_faces(const FreeSpaceBox& box) const {
     if (!bounds(p).meets(region)) continue;
     local[f.idx()] = static_cast<int>(out.size());
     out.push_back({p, 0});
+    if (ids) ids->push_back(f.idx());
   }
   std::deque<Mesh::FaceHandle> queue;
   for (const auto& [ring, side] : {std::pair{&result_.right_ring, 2}, std::pair{&result_.left_ring, 1}})
@@ -176,14 +172,15 @@ const CutDisk* Surgery::ring_disk(const std::vector<CutDisk>& disks, double cell
   const CutDisk* best = nullptr;
   for (const auto& d : disks) {
     double gap = 0;
+    Vec3 far(0, 0, 0);
     for (int v : d.boundary) {
       double near = 1e300;
       for (const auto& p : original_) near = std::min(near, (d.points[v] - p).norm());
-      gap = std::max(gap, near);
+      if (near > gap) gap = near, far = d.points[v];
     }
     if (denoise_debug())
-      std::fprintf(stderr, "denoise debug: mincut k=%zu: disk of %zu squares, boundary %zu vertices up to %.2f mm off the loop\n",
-                   k_, d.quads.size(), d.boundary.size(), gap);
+      std::fprintf(stderr, "denoise debug: mincut k=%zu: disk of %zu squares, %zu holes, boundary %zu vertices up to %.2f mm off the loop "
+                   "(at %.2f, %.2f, %.2f)\n", k_, d.quads.size(), d.holes.size(), d.boundary.size(), gap, far[0], far[1], far[2]);
     if (gap <= limit && (!best || d.quads.size() < best->quads.size())) best = &d;
   }
   return best;
@@ -209,44 +206,6 @@ bool Surgery::disk_runs_with_loop(const CutDisk& disk) const {
   return turn > 0;
 }
 
-// The strip between `ring` (mesh vertices, loop order) and `inner` (the disk's boundary, loop
-// direction), oriented like the ring: the least-area one that joins ring[0] to the inner vertex
-// nearest it and advances along one side per triangle (contour tiling by dynamic programming; a
-// greedy shorter-diagonal rule folded where the lattice boundary zigzags).
-void Surgery::mincut_strip(const std::vector<Mesh::VertexHandle>& ring, const std::vector<int>& inner,
-                           std::vector<std::array<int, 3>>* tris) const {
-  const std::size_t k = ring.size(), m = inner.size();
-  auto at = [this](int v) { return mesh_.point(Mesh::VertexHandle(v)); };
-  std::size_t j0 = 0;
-  for (std::size_t j = 1; j < m; ++j)
-    if ((at(inner[j]) - mesh_.point(ring[0])).sqrnorm() < (at(inner[j0]) - mesh_.point(ring[0])).sqrnorm()) j0 = j;
-  auto r = [&](std::size_t i) { return ring[i % k].idx(); };
-  auto b = [&](std::size_t j) { return inner[(j0 + j) % m]; };
-  auto area = [&](int x, int y, int z) { return OpenMesh::cross(at(y) - at(x), at(z) - at(x)).norm(); };
-  const std::size_t w = m + 1;
-  std::vector<double> cost((k + 1) * w, 1e300);
-  std::vector<char> along_ring((k + 1) * w, 0);
-  cost[0] = 0;
-  for (std::size_t i = 0; i <= k; ++i)
-    for (std::size_t j = 0; j <= m; ++j) {
-      double& c = cost[i * w + j];
-      if (i > 0 && cost[(i - 1) * w + j] + area(r(i - 1), r(i), b(j)) < c) {
-        c = cost[(i - 1) * w + j] + area(r(i - 1), r(i), b(j));
-        along_ring[i * w + j] = 1;
-      }
-      if (j > 0 && cost[i * w + j - 1] + area(r(i), b(j), b(j - 1)) < c) {
-        c = cost[i * w + j - 1] + area(r(i), b(j), b(j - 1));
-        along_ring[i * w + j] = 0;
-      }
-    }
-  std::vector<std::array<int, 3>> back;
-  for (std::size_t i = k, j = m; i > 0 || j > 0;) {
-    if (along_ring[i * w + j]) back.push_back({r(i - 1), r(i), b(j)}), --i;
-    else back.push_back({r(i), b(j), b(j - 1)}), --j;
-  }
-  tris->insert(tris->end(), back.rbegin(), back.rend());
-}
-
 // The disk's points with its boundary's staircase smoothed (`passes` passes of a (1, 2, 1) / 4
 // average along the boundary; inner points unchanged): the strips then join a rim without the
 // lattice's one-cell bays, over which a strip would pass the other cap's squares.
@@ -262,9 +221,9 @@ static std::vector<Vec3> smoothed_rim(const CutDisk& disk, int passes) {
   return p;
 }
 
-// The right cap from the disk: its points moved `shift` mm along their normals and added to the
-// mesh, the strip to the right ring, then the disk's squares as two triangles each, oriented like
-// the ring's hole.
+// The right cap's disk: its points moved `shift` mm along their normals and added to the mesh
+// (inner[i]: point i), the squares as two triangles each, oriented like the ring's hole, then the
+// holes' fills (the strip to the ring is added by join_mincut_rims()).
 Surgery::FrontCap Surgery::mincut_cap(const CutDisk& disk, double shift, int rim_passes, bool flip) {
   FrontCap cap;
   std::vector<int> id(disk.points.size());
@@ -273,72 +232,115 @@ Surgery::FrontCap Surgery::mincut_cap(const CutDisk& disk, double shift, int rim
     cap.inner.push_back(mesh_.add_vertex(points[i] + shift * disk.normals[i]));
     id[i] = cap.inner.back().idx();
   }
-  std::vector<int> inner;
-  for (int v : disk.boundary) inner.push_back(id[v]);
-  if (flip) std::reverse(inner.begin(), inner.end());
-  mincut_strip(result_.right_ring, inner, &cap.tris);
   for (const auto& q : disk.quads)
     for (std::array<int, 3> t : {std::array<int, 3>{id[q[0]], id[q[1]], id[q[2]]}, std::array<int, 3>{id[q[0]], id[q[2]], id[q[3]]}}) {
       if (flip) std::swap(t[1], t[2]);
       cap.tris.push_back(t);
     }
-  for (const auto& rim : disk.holes)
-    if (!close_hole(rim, id, flip, &cap.tris)) return FrontCap{};
   return cap;
 }
 
-// Closes a hole of the disk (rim: disk point ids in the squares' direction; id: their mesh ids)
-// with the least-area triangulation of its rim whose triangles meet no grid face (cap_triangulation.h);
-// false when there is none.
-bool Surgery::close_hole(const std::vector<int>& rim, const std::vector<int>& id, bool flip,
-                         std::vector<std::array<int, 3>>* tris) const {
-  std::vector<Mesh::VertexHandle> ring;  // the hole's boundary as the fill sees it: against the squares
-  for (auto it = rim.rbegin(); it != rim.rend(); ++it) ring.push_back(Mesh::VertexHandle(id[*it]));
-  if (flip) std::reverse(ring.begin(), ring.end());
-  auto none = [](Mesh::VertexHandle, Mesh::VertexHandle) { return false; };
-  const std::vector<std::array<int, 3>> fill = triangulate_ring(mesh_, ring, none, opts_.guard);
-  tris->insert(tris->end(), fill.begin(), fill.end());
-  return !fill.empty();
-}
-
-// The left cap as the right one's mirror (the same strip and squares on the left ring and on
-// copies of the disk's points moved `shift` mm along their normals, reversed), so the two strips
-// and disks run side by side; its holes are closed on its own points (a mirrored fill met the
-// surface where the right one did not). Empty when a hole has no clean fill.
+// The left cap's disk as the right one's mirror (the same squares on copies of the disk's points
+// moved `shift` mm along their normals, reversed), so the two disks run side by side; its holes
+// are closed on its own points (a mirrored fill met the surface where the right one did not).
+// Empty when a hole has no clean fill.
 Surgery::FrontCap Surgery::mincut_mirror(const CutDisk& disk, const FrontCap& right, double shift, int rim_passes,
                                          bool flip) {
   FrontCap cap;
   const std::vector<Vec3> points = smoothed_rim(disk, rim_passes);
   std::unordered_map<int, int> mirror;
   std::vector<int> id(disk.points.size());
-  for (std::size_t i = 0; i < k_; ++i) mirror[result_.right_ring[i].idx()] = result_.left_ring[i].idx();
   for (std::size_t i = 0; i < right.inner.size(); ++i) {
     cap.inner.push_back(mesh_.add_vertex(points[i] + shift * disk.normals[i]));
     mirror[right.inner[i].idx()] = id[i] = cap.inner.back().idx();
   }
-  std::size_t fills = 0;
-  for (const auto& rim : disk.holes) fills += rim.size() - 2;
-  for (std::size_t t = 0; t + fills < right.tris.size(); ++t)
+  for (std::size_t t = 0; t < 2 * disk.quads.size(); ++t)
     cap.tris.push_back({mirror.at(right.tris[t][0]), mirror.at(right.tris[t][2]), mirror.at(right.tris[t][1])});
-  for (const auto& rim : disk.holes)
-    if (!close_hole(rim, id, !flip, &cap.tris)) return FrontCap{};
   return cap;
+}
+
+// Puts each ring's strip (mincut_strips()) in front of its cap's disk triangles; false when no
+// strip pair is clean.
+bool Surgery::join_mincut_rims(const CutDisk& disk, bool flip, double cell, FrontCap* right, FrontCap* left,
+                               std::vector<int>* disk_hits) const {
+  std::unordered_map<int, int> mirror;
+  for (std::size_t i = 0; i < k_; ++i) mirror[result_.right_ring[i].idx()] = result_.left_ring[i].idx();
+  for (std::size_t i = 0; i < right->inner.size(); ++i) mirror[right->inner[i].idx()] = left->inner[i].idx();
+  std::vector<int> inner;
+  for (int v : disk.boundary) inner.push_back(right->inner[v].idx());
+  if (flip) std::reverse(inner.begin(), inner.end());
+  TriangleHash disks(mesh_, 2 * cell);
+  for (const auto* cap : {right, left})
+    for (const auto& t : cap->tris) disks.insert(t);
+  std::vector<std::array<int, 3>> right_strip, left_strip;
+  if (!mincut_strips(inner, mirror, disks, cell, &right_strip, &left_strip, disk_hits)) return false;
+  right->tris.insert(right->tris.begin(), right_strip.begin(), right_strip.end());
+  left->tris.insert(left->tris.begin(), left_strip.begin(), left_strip.end());
+  return true;
+}
+
+// The triangles that close the disk's holes (a triangulation of a hole's rim has two fewer).
+static std::size_t fill_count(const CutDisk& disk) {
+  std::size_t n = 0;
+  for (const auto& rim : disk.holes) n += rim.size() - 2;
+  return n;
+}
+
+// The disk without the squares `hits` names (indices in the right cap's triangles then the left's,
+// `right_tris` of them the right's: squares first, two triangles each), as the largest disk its
+// other squares form; false when they form none.
+static bool peeled(const CutDisk& disk, const std::vector<int>& hits, std::size_t right_tris, CutDisk* out) {
+  std::vector<char> drop(disk.quads.size(), 0);
+  for (int u : hits) {
+    const std::size_t t = std::size_t(u) < right_tris ? std::size_t(u) : std::size_t(u) - right_tris;
+    if (t < 2 * disk.quads.size()) drop[t / 2] = 1;
+  }
+  std::vector<std::array<long long, 4>> squares;
+  for (std::size_t q = 0; q < disk.quads.size(); ++q)
+    if (!drop[q]) squares.push_back({disk.quads[q][0], disk.quads[q][1], disk.quads[q][2], disk.quads[q][3]});
+  if (squares.size() == disk.quads.size()) return false;
+  std::size_t pieces = 0;
+  std::vector<CutDisk> disks = cut_disks(squares, [&disk](long long v) { return disk.points[v]; }, &pieces);
+  if (disks.empty()) return false;
+  *out = *std::max_element(disks.begin(), disks.end(), [](const CutDisk& a, const CutDisk& b) { return a.quads.size() < b.quads.size(); });
+  return true;
+}
+
+// Both caps (mincut_caps_once()); where a strip or a hole's fill crosses a square of the disk, the
+// disk loses those squares (near the rim: its rim lay beyond a ring, which is then on the other
+// cap's side) and the caps are made again, while the loop's peel_rounds_left_ last.
+bool Surgery::mincut_caps(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell) {
+  CutDisk d = disk;
+  for (;;) {
+    std::vector<int> hits;
+    if (mincut_caps_once(d, shift, left_shift, rim_passes, cell, &hits)) return true;
+    if (hits.empty() || peel_rounds_left_ <= 0) return false;
+    if (denoise_debug())
+      std::fprintf(stderr, "denoise debug: mincut k=%zu: peel (%d left): %zu squares, %zu crossed\n", k_, peel_rounds_left_,
+                   d.quads.size(), hits.size());
+    --peel_rounds_left_;
+    CutDisk next;
+    if (!peeled(d, hits, 2 * d.quads.size() + fill_count(d), &next)) return false;
+    d = std::move(next);
+  }
 }
 
 // Both caps `shift` mm off the cut (the right one towards the right side); kept when neither
 // meets a grid face nor the other cap nor itself, otherwise the vertices they added are removed.
-bool Surgery::mincut_caps(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell) {
+bool Surgery::mincut_caps_once(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell,
+                               std::vector<int>* disk_hits) {
   const std::size_t n_vertices = mesh_.n_vertices(), n_edges = mesh_.n_edges(), n_faces = mesh_.n_faces();
   const bool flip = !disk_runs_with_loop(disk);
-  const FrontCap right = mincut_cap(disk, shift, rim_passes, flip);
-  if (right.tris.empty()) {  // a hole without a clean fill
+  FrontCap right = mincut_cap(disk, shift, rim_passes, flip);
+  FrontCap left = mincut_mirror(disk, right, left_shift, rim_passes, flip);
+  if (!close_mincut_holes(disk, flip, cell, &right, &left)) {
     if (denoise_debug()) std::fprintf(stderr, "denoise debug: mincut k=%zu: offset %.3f mm: a hole has no clean fill\n", k_, shift);
     mesh_.resize(n_vertices, n_edges, n_faces);
     return false;
   }
-  const FrontCap left = mincut_mirror(disk, right, left_shift, rim_passes, flip);
-  if (left.tris.empty()) {
-    if (denoise_debug()) std::fprintf(stderr, "denoise debug: mincut k=%zu: offset %.3f mm: a left hole has no clean fill\n", k_, shift);
+  const std::size_t right_disk = right.tris.size();
+  if (!join_mincut_rims(disk, flip, cell, &right, &left, disk_hits)) {
+    if (denoise_debug()) std::fprintf(stderr, "denoise debug: mincut k=%zu: offset %.3f / %.3f mm, rim %d: no clean strip\n", k_, shift, left_shift, rim_passes);
     mesh_.resize(n_vertices, n_edges, n_faces);
     return false;
   }
@@ -347,13 +349,24 @@ bool Surgery::mincut_caps(const CutDisk& disk, double shift, double left_shift, 
   bool clean = true;
   std::size_t t = 0;
   for (; t < all.size() && clean; ++t) clean = !opts_.guard->hits(mesh_, all[t]);
-  std::pair<int, int> pair{-1, -1};
-  const bool crossing = clean && any_crossing(mesh_, all, 2 * cell, &pair);
-  if (denoise_debug() && (!clean || crossing))
-    std::fprintf(stderr, "denoise debug: mincut k=%zu: offset %.3f / %.3f mm, rim %d: %s (triangle %zu, pair %d %d of %zu + %zu)\n",
-                 k_, shift, left_shift, rim_passes, crossing ? "the caps cross" : "a cap triangle hits the surface", t - 1,
-                 pair.first, pair.second, right.tris.size(), left.tris.size());
-  clean = clean && !crossing;
+  const auto pairs = clean ? crossings(mesh_, all, 2 * cell, kMaxPairs) : std::vector<std::pair<int, int>>{};
+  if (denoise_debug() && (!clean || !pairs.empty()))
+    std::fprintf(stderr, "denoise debug: mincut k=%zu: offset %.3f / %.3f mm, rim %d: %s (triangle %zu, %zu pairs, first %d %d of %zu + %zu)\n",
+                 k_, shift, left_shift, rim_passes, clean ? "the caps cross" : "a cap triangle hits the surface", t - 1, pairs.size(),
+                 pairs.empty() ? -1 : pairs[0].first, pairs.empty() ? -1 : pairs[0].second, right.tris.size(), left.tris.size());
+  if (denoise_debug() && !clean) {
+    Vec3 c(0, 0, 0);
+    for (int v : all[t - 1]) c += mesh_.point(Mesh::VertexHandle(v)) / 3.0;
+    std::fprintf(stderr, "denoise debug: mincut k=%zu: the triangle hitting the surface is at (%.2f, %.2f, %.2f)\n", k_, c[0], c[1], c[2]);
+  }
+  const std::size_t strip = right.tris.size() - right_disk;
+  for (const auto& [a, b] : pairs)
+    for (int x : {a, b}) {  // the squares among the crossing triangles, as peeled() counts them
+      const long i = x - long(strip), j = x - long(right.tris.size() + strip);
+      if (i >= 0 && i < long(2 * disk.quads.size())) disk_hits->push_back(int(i));
+      if (j >= 0 && j < long(2 * disk.quads.size())) disk_hits->push_back(int(right_disk + j));
+    }
+  clean = clean && pairs.empty();
   if (!clean) {
     mesh_.resize(n_vertices, n_edges, n_faces);
     return false;
@@ -390,22 +403,14 @@ bool Surgery::try_mincut_caps() {
   place_rings(0.0, target_left_, target_right_);
   const FreeSpaceBox box = mincut_box();
   FreeSpaceCutStats st;
-  const std::vector<CutDisk> disks = free_space_cut(box, sided_faces(box), &st);
+  std::vector<int> ids;
+  std::vector<SidedTriangle> sided = sided_faces(box, &ids);
+  const std::vector<CutDisk> disks = free_space_cut(box, sided, &st);
   const CutDisk* disk = ring_disk(disks, box.cell);
   const double t_cut = sw.seconds();
   double used = 0;
-  double placed_pull = -1;
-  for (const MincutPlacement& pl : mincut_placements(opts_.ring_pull)) {
-    if (!disk || used > 0) break;
-    if (pl.pull != placed_pull) {
-      place_rings(pl.pull, target_left_, target_right_);
-      placed_pull = pl.pull;
-      const std::vector<Mesh::FaceHandle> around = faces_around_rings();
-      for (auto f : around) opts_.guard->insert(mesh_, f);
-      if (new_pairs(around, 1) > 0) continue;
-    }
-    if (mincut_caps(*disk, pl.right * box.cell, pl.left * box.cell, pl.rim, box.cell)) used = pl.right;
-  }
+  if (disk && !disk->holes.empty() && opts_.mincut_widen > 0) used = widened_mincut_caps(*disk, box, sided, ids);
+  if (used == 0 && disk) used = place_mincut_caps(*disk, box);
   if (denoise_debug())
     std::fprintf(stderr, "denoise debug: mincut k=%zu: %d x %d x %d cells of %.3f mm, %zu free (%zu source, %zu sink), flow %lld, "
                  "%zu squares in %zu pieces, %zu disks: %s (offset %.3f cell); cut %.2f s, caps %.2f s\n", k_, box.n[0], box.n[1],
@@ -413,6 +418,57 @@ bool Surgery::try_mincut_caps() {
                  used > 0 ? "clean" : disk ? "failed" : "no disk", used, t_cut, sw.seconds() - t_cut);
   if (used > 0) cap_kind_ = "mincut";
   return used > 0;
+}
+
+// The placements (mincut_placements) of caps from `disk`, in order, until one is clean; the right
+// cap's offset (cells) of the one kept, 0 when none was.
+double Surgery::place_mincut_caps(const CutDisk& disk, const FreeSpaceBox& box) {
+  double placed_pull = -1;
+  peel_rounds_left_ = kPeelRounds;
+  for (const MincutPlacement& pl : mincut_placements(opts_.ring_pull)) {
+    if (pl.pull != placed_pull) {
+      place_rings(pl.pull, target_left_, target_right_);
+      placed_pull = pl.pull;
+      const std::vector<Mesh::FaceHandle> around = faces_around_rings();
+      for (auto f : around) opts_.guard->insert(mesh_, f);
+      if (new_pairs(around, 1) > 0) continue;
+    }
+    if (mincut_caps(disk, pl.right * box.cell, pl.left * box.cell, pl.rim, box.cell)) return pl.right;
+  }
+  return 0;
+}
+
+// A disk with holes: the walls moved apart at its holes (surgery_mincut_widen.cpp) by the first of
+// kWidenShifts that moves them cleanly, the cut made again, up to kWidenRounds times while the
+// disk keeps holes; then its placements. Without clean caps every move is put back (0 returned).
+double Surgery::widened_mincut_caps(const CutDisk& first, const FreeSpaceBox& box, std::vector<SidedTriangle> sided,
+                                    std::vector<int> ids) {
+  std::vector<std::pair<Mesh::VertexHandle, Vec3>> before;
+  double largest = 0;
+  std::vector<CutDisk> disks{first};
+  const CutDisk* disk = &disks[0];
+  for (int round = 0; round < kWidenRounds && disk && !disk->holes.empty(); ++round) {
+    bool moved = false;
+    for (double shift : kWidenShifts)
+      if (!moved) moved = widen_at_holes(*disk, sided, ids, shift * opts_.mincut_widen * box.cell, &before, &largest);
+    if (!moved) break;
+    FreeSpaceCutStats st;
+    sided = sided_faces(box, &ids);
+    disks = free_space_cut(box, sided, &st);
+    disk = ring_disk(disks, box.cell);
+    if (denoise_debug())
+      std::fprintf(stderr, "denoise debug: mincut k=%zu: walls moved apart at the holes (%zu vertices, up to %.3f mm): flow %lld, "
+                   "%s with %zu holes\n", k_, before.size(), largest, st.flow, disk ? "a disk" : "no disk",
+                   disk ? disk->holes.size() : std::size_t{0});
+  }
+  const double used = disk && disk->holes.empty() ? place_mincut_caps(*disk, box) : 0;
+  if (used == 0) {
+    set_points(before);
+    return 0;
+  }
+  result_.widened = largest;
+  result_.undo.positions.insert(result_.undo.positions.end(), before.begin(), before.end());
+  return used;
 }
 
 }  // namespace cf::detail

@@ -15,6 +15,8 @@
 
 namespace cf::detail {
 
+class TriangleHash;  // triangle_hash.h
+
 // A disk of concentric rings around a centre vertex spanning one cut ring (the fallback cap).
 struct ConcentricCap {
   std::vector<std::vector<Mesh::VertexHandle>> rings;  // rings[0] = the cut ring, boundary order
@@ -140,18 +142,44 @@ class Surgery {
   // Minimum-cut caps (surgery_mincut.cpp).
   bool try_mincut_caps();
   FreeSpaceBox mincut_box() const;
-  std::vector<SidedTriangle> sided_faces(const FreeSpaceBox& box) const;
+  std::vector<SidedTriangle> sided_faces(const FreeSpaceBox& box, std::vector<int>* ids = nullptr) const;
+  double place_mincut_caps(const CutDisk& disk, const FreeSpaceBox& box);
+  double widened_mincut_caps(const CutDisk& first, const FreeSpaceBox& box, std::vector<SidedTriangle> sided,
+                             std::vector<int> ids);
+  // Wall widening at a disk's holes (surgery_mincut_widen.cpp).
+  std::unordered_map<int, int> vertex_sides(const std::vector<SidedTriangle>& sided, const std::vector<int>& ids) const;
+  std::vector<std::pair<Mesh::VertexHandle, Vec3>> widening_moves(const CutDisk& disk, const std::unordered_map<int, int>& side,
+                                                                  double shift) const;
+  std::vector<Mesh::FaceHandle> set_points(const std::vector<std::pair<Mesh::VertexHandle, Vec3>>& points);
+  bool widen_at_holes(const CutDisk& disk, const std::vector<SidedTriangle>& sided, const std::vector<int>& ids, double shift,
+                      std::vector<std::pair<Mesh::VertexHandle, Vec3>>* before, double* largest);
   void flood_sides(const std::vector<int>& local, std::deque<Mesh::FaceHandle>* queue,
                    std::vector<SidedTriangle>* out) const;
   const CutDisk* ring_disk(const std::vector<CutDisk>& disks, double cell) const;
   bool disk_runs_with_loop(const CutDisk& disk) const;
-  void mincut_strip(const std::vector<Mesh::VertexHandle>& ring, const std::vector<int>& inner,
-                    std::vector<std::array<int, 3>>* tris) const;
+  // Strips (surgery_mincut_strip.cpp).
+  bool mincut_strip(const std::vector<Mesh::VertexHandle>& ring, const std::vector<int>& inner,
+                    const std::vector<char>& forbidden, std::vector<std::array<int, 3>>* tris,
+                    std::vector<std::size_t>* keys) const;
+  bool mincut_strips(const std::vector<int>& inner, const std::unordered_map<int, int>& mirror, const TriangleHash& disks,
+                     double cell, std::vector<std::array<int, 3>>* right, std::vector<std::array<int, 3>>* left,
+                     std::vector<int>* disk_hits) const;
+  std::vector<std::size_t> failed_strip_triangles(const std::vector<std::array<int, 3>>& right,
+                                                  const std::vector<std::array<int, 3>>& left, const TriangleHash& disks,
+                                                  double cell, std::vector<int>* disk_hits) const;
   FrontCap mincut_cap(const CutDisk& disk, double shift, int rim_passes, bool flip);
   FrontCap mincut_mirror(const CutDisk& disk, const FrontCap& right, double shift, int rim_passes, bool flip);
   bool close_hole(const std::vector<int>& rim, const std::vector<int>& id, bool flip,
-                  std::vector<std::array<int, 3>>* tris) const;
+                  const std::vector<std::array<int, 3>>& others, std::vector<std::array<int, 3>>* tris) const;
+  bool close_mincut_holes(const CutDisk& disk, bool flip, double cell, FrontCap* right, FrontCap* left) const;
+  bool mirrored_fill(const std::vector<int>& rim, const std::vector<int>& from, const std::vector<int>& to, bool flip,
+                     const std::vector<std::array<int, 3>>& own, const std::vector<std::array<int, 3>>& all,
+                     std::vector<std::array<int, 3>>* fill, std::vector<std::array<int, 3>>* mirrored) const;
+  bool join_mincut_rims(const CutDisk& disk, bool flip, double cell, FrontCap* right, FrontCap* left,
+                        std::vector<int>* disk_hits) const;
   bool mincut_caps(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell);
+  bool mincut_caps_once(const CutDisk& disk, double shift, double left_shift, int rim_passes, double cell,
+                        std::vector<int>* disk_hits);
   void add_ordered(const std::vector<std::array<int, 3>>& tris);
   ConcentricCap make_concentric_cap(const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
   void set_concentric_classes(const ConcentricCap& cap, const std::vector<Mesh::HalfedgeHandle>& ring_halfedges);
@@ -182,6 +210,7 @@ class Surgery {
   RingQueryCache right_cache_, left_cache_;  // grid answers of each ring's restricted triangulations, this placement
   bool gave_up_ = false;                // no more restricted triangulations (budget spent, or the right ring has none)
   long long query_budget_ = 0;          // grid queries left for them (kMaxGridQueries per surgery)
+  int peel_rounds_left_ = 0;            // minimum-cut caps: disk peelings left for this loop (surgery_mincut.cpp)
   const char* cap_kind_ = "concentric";  // which step made the caps (COLONFLAT_DENOISE_DEBUG)
 };
 

@@ -40,6 +40,10 @@ struct SurgeryOptions {
   bool mincut = false;  // with a guard, not a trial: before the concentric caps, caps from the
                         // minimum cut of free space around the loop (free_space_cut.h; kept when clean)
   double mincut_cell = 0.25;  // mm: cell edge of that cut's graph
+  double mincut_widen = 1.5;  // cells: when that cut's disk has holes (a left and a right wall within a
+                              // cell), the surface's walls there are moved apart by up to this much
+                              // each (then 2/3 and 1/3 of it) and the cut made again; 0 = never
+                              // (surgery_mincut_widen.cpp; kept only with clean caps)
   bool probe_concentric = false;  // with a guard, not a trial: the concentric placements are only
                                   // searched for a clean one (each count stops at its first pair);
                                   // without one the caps stay in the first placement, whose pairs
@@ -69,6 +73,8 @@ struct SurgeryResult {
   std::size_t intersections = 0;  // triangle pairs the chosen placement still intersects (guard only)
   const char* caps = "concentric";  // which step made the caps: plain, collar, front, restricted, mincut or concentric
   int placement = -1;  // index of the ring placement the triangulated caps were made in (0 = the first); -1: concentric
+  double widened = 0;  // mm: the largest move of a surface vertex the minimum-cut caps kept (walls moved
+                       // apart at the cut's holes, surgery_mincut_widen.cpp); 0: the surface was not moved
   int left_caps_ahead = 0;  // left-ring restricted triangulations taken from the helper thread's (run_both)
   SurgeryUndo undo;
 };
