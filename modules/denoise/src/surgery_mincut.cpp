@@ -409,8 +409,9 @@ bool Surgery::try_mincut_caps() {
   const CutDisk* disk = ring_disk(disks, box.cell);
   const double t_cut = sw.seconds();
   double used = 0;
-  if (disk && !disk->holes.empty() && opts_.mincut_widen > 0) used = widened_mincut_caps(*disk, box, sided, ids);
-  if (used == 0 && disk) used = place_mincut_caps(*disk, box);
+  bool hole_free = false;  // widening gave a disk without holes (its placements were tried)
+  if (disk && !disk->holes.empty() && opts_.mincut_widen > 0) used = widened_mincut_caps(*disk, box, sided, ids, &hole_free);
+  if (used == 0 && disk && !hole_free) used = place_mincut_caps(*disk, box);
   if (denoise_debug())
     std::fprintf(stderr, "denoise debug: mincut k=%zu: %d x %d x %d cells of %.3f mm, %zu free (%zu source, %zu sink), flow %lld, "
                  "%zu squares in %zu pieces, %zu disks: %s (offset %.3f cell); cut %.2f s, caps %.2f s\n", k_, box.n[0], box.n[1],
@@ -440,9 +441,11 @@ double Surgery::place_mincut_caps(const CutDisk& disk, const FreeSpaceBox& box) 
 
 // A disk with holes: the walls moved apart at its holes (surgery_mincut_widen.cpp) by the first of
 // kWidenShifts that moves them cleanly, the cut made again, up to kWidenRounds times while the
-// disk keeps holes; then its placements. Without clean caps every move is put back (0 returned).
+// disk keeps holes; then, when it has none (*hole_free), its placements. Without clean caps every
+// move is put back (0 returned); the caller then tries the first disk only when no hole-free one
+// was tried (on the raw CT mask's loop 91 both fail, and trying both doubled the caps' time).
 double Surgery::widened_mincut_caps(const CutDisk& first, const FreeSpaceBox& box, std::vector<SidedTriangle> sided,
-                                    std::vector<int> ids) {
+                                    std::vector<int> ids, bool* hole_free) {
   std::vector<std::pair<Mesh::VertexHandle, Vec3>> before;
   double largest = 0;
   std::vector<CutDisk> disks{first};
@@ -461,7 +464,8 @@ double Surgery::widened_mincut_caps(const CutDisk& first, const FreeSpaceBox& bo
                    "%s with %zu holes\n", k_, before.size(), largest, st.flow, disk ? "a disk" : "no disk",
                    disk ? disk->holes.size() : std::size_t{0});
   }
-  const double used = disk && disk->holes.empty() ? place_mincut_caps(*disk, box) : 0;
+  *hole_free = disk && disk->holes.empty();
+  const double used = *hole_free ? place_mincut_caps(*disk, box) : 0;
   if (used == 0) {
     set_points(before);
     return 0;

@@ -145,7 +145,7 @@ class Surgery {
   std::vector<SidedTriangle> sided_faces(const FreeSpaceBox& box, std::vector<int>* ids = nullptr) const;
   double place_mincut_caps(const CutDisk& disk, const FreeSpaceBox& box);
   double widened_mincut_caps(const CutDisk& first, const FreeSpaceBox& box, std::vector<SidedTriangle> sided,
-                             std::vector<int> ids);
+                             std::vector<int> ids, bool* hole_free);
   // Wall widening at a disk's holes (surgery_mincut_widen.cpp).
   std::unordered_map<int, int> vertex_sides(const std::vector<SidedTriangle>& sided, const std::vector<int>& ids) const;
   std::vector<std::pair<Mesh::VertexHandle, Vec3>> widening_moves(const CutDisk& disk, const std::unordered_map<int, int>& side,
