@@ -113,11 +113,12 @@ FreeSpaceBox Surgery::mincut_box() const {
 
 // The faces whose bounding boxes meet the box, each with the side it is reached from first by a
 // breadth-first flood over faces inside the box: 2 from the right ring, 1 from the left (0: not
-// reached). Both rings must be where the loop was.
+// reached). Both rings must be where the loop was. *ids (when given) receives each one's mesh face id.
 std::vector<SidedTriangle> Surgery::sided_faces(const FreeSpaceBox& box, std::vector<int>* ids) const {
   const Bounds region{box.lo, box.lo + box.cell * Vec3(box.n[0], box.n[1], box.n[2])};
   std::vector<int> local(mesh_.n_faces(), -1);
   std::vector<SidedTriangle> out;
+  if (ids) ids->clear();
   for (auto f : mesh_.faces()) {
     std::array<Vec3, 3> p;
     int i = 0;
