@@ -72,7 +72,7 @@ std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& p
     sub[0].seg.neck_mm = piece.neck_mm;
     sub[0].seg.holds = piece.tissue ? "tissue" : "lumen";
     sub[0].neck = piece.neck;
-    placed += surface_area(piece.surface);
+    placed += surface_area(sub[0].seg.map == "disk" ? *piece.as_disk() : piece.surface);  // (a disk band holds the unslit disk)
     append_branch(sub, out);
   }
   return out;

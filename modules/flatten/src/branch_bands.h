@@ -17,6 +17,9 @@ struct BranchPiece {
   bool tissue = false;  // holds tissue (a strand stump), not lumen
   bool limb = false;    // limb-sized: its neck at least kLimbNeck x the band's period (a fork of the lumen)
   std::size_t loops = 1;  // open ends of `surface`: 1 (a branch, a patch that is a disk) or 2 (a patch that is an annulus)
+  Surface disk;           // a disk patch before its slit (patch_slit.h); empty: none, or `surface` itself when loops == 1
+  // The piece as a disk (disk_map.h): `disk`, else `surface` when it has one open end; null: not a disk.
+  const Surface* as_disk() const { return !disk.t.empty() ? &disk : loops == 1 ? &surface : nullptr; }
 };
 
 // A branch whose neck is at least this fraction of its band's period (mm around) is limb-sized: the

@@ -127,6 +127,7 @@ std::vector<char> label_and_order(std::vector<SegmentWork>& work, double midline
     b.seg.kind = "branch";
     b.seg.x0_end = b.seg.holds == "wall" ? "rim" : "neck";  // a patch's x0 end is the rim it was cut along
     b.seg.x1_end = "tip";
+    if (b.seg.map == "disk") b.seg.x0_end = b.seg.x1_end = "rim";  // a disk band: x between two rim points
     branch.push_back(int(i));
   }
   std::stable_sort(branch.begin(), branch.end(), [&](int a, int b) {

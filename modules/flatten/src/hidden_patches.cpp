@@ -209,7 +209,7 @@ PatchCut cut_patches(SegmentWork& w, Edges& E, std::vector<char>& degenerate, co
     cut.area_mm2 += surface_area(piece.surface);
     if (piece.loops == 1) {  // a disk: opened along its ridge (patch_slit.h), else at a tip cap
       Surface slit = slit_disk(piece.surface);
-      if (!slit.t.empty()) piece.surface = std::move(slit), piece.loops = 2;
+      if (!slit.t.empty()) piece.disk = std::move(piece.surface), piece.surface = std::move(slit), piece.loops = 2;
     }
     cut.pieces.push_back(std::move(piece));
   }

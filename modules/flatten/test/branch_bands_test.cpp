@@ -71,5 +71,27 @@ TEST(BranchBands, PieceThatCannotBeFlattenedIsLeftOutAndReported) {
   EXPECT_NE(err.find("branch of 1 faces (2 open ends) not flattened: not tube-like"), std::string::npos) << err;
 }
 
+// A slit patch (its unslit disk kept) whose band is a disk band places the disk's whole area (the
+// faces its slit's rounded ends dropped included: the disk band shows them); a tube band places only
+// the slit surface's area (those faces are wall not shown).
+TEST(BranchBands, DiskBandPlacesTheUnslitDisksArea) {
+  flat_detail::BranchPiece piece;
+  piece.disk.p = {flat_detail::V3(0, 0, 0), flat_detail::V3(2, 0, 0), flat_detail::V3(0, 2, 0), flat_detail::V3(2, 2, 0)};
+  piece.disk.t = {{0, 1, 2}, {1, 3, 2}};  // 4 mm2
+  piece.surface.p = piece.disk.p;
+  piece.surface.t = {{0, 1, 2}};  // 2 mm2
+  piece.loops = 2;
+  for (const char* map : {"disk", "area-balanced"}) {
+    const flat_detail::FlattenBand band = [map](const flat_detail::BranchPiece&) {
+      std::vector<flat_detail::SegmentWork> w(1);
+      w[0].seg.map = map;
+      return w;
+    };
+    double placed = 0;
+    flat_detail::flatten_branch_pieces({piece}, band, placed);
+    EXPECT_DOUBLE_EQ(placed, std::string(map) == "disk" ? 4.0 : 2.0) << map;
+  }
+}
+
 }  // namespace
 }  // namespace cf

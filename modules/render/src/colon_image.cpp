@@ -25,6 +25,7 @@ constexpr int kMargin = 30, kTop = 70, kGap = 64, kBottom = 90, kMinWidth = 400;
 
 // Picks the cut position of a segment: middle of the largest circular gap between markers.
 double choose_roll(const FlatSegment& s, const std::vector<ImageMarker>& markers) {
+  if (s.map == "disk") return s.y0;  // a disk band (flatten's disk_map.h) does not wrap around: never rolled
   std::vector<double> ys;
   for (const auto& m : markers)
     if (m.segment == s.id) ys.push_back(std::fmod(std::fmod(m.y - s.y0, s.period) + s.period, s.period));

@@ -277,10 +277,11 @@ void ColonImagePainter::write_band_captions() {
   const double grey[3] = {0.85, 0.85, 0.85}, end_col[3] = {1, 0.85, 0.35};
   for (const Band& b : bands_) {
     const FlatSegment& s = flat_.segments[b.seg];
-    const bool along = !s.map.empty() && s.map != "conformal";
+    const bool along = !s.map.empty() && s.map != "conformal" && s.map != "disk";
     const std::string t = band_caption(s) +
-                          (along ? "x axis: cm along the centreline from the " + s.x0_end
-                                 : "x axis: cm of the conformal map (not centreline length)");
+                          (along             ? "x axis: cm along the centreline from the " + s.x0_end
+                           : s.map == "disk" ? "x axis: cm of the disk's own map (rim to rim, not centreline length)"
+                                             : "x axis: cm of the conformal map (not centreline length)");
     write_text(t, b.col0, height_ - 1 - (b.row0 + b.h) - 24, 15, grey);
     const int top_row = height_ - 1 - (b.row0 + b.h) + 4;
     write_text(s.x0_end, b.col0 + 4, top_row, 16, end_col, 0.6);
