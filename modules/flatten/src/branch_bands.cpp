@@ -28,7 +28,35 @@ void append_branch(std::vector<SegmentWork>& sub, std::vector<SegmentWork>& out)
   out[base].parent = -1;
 }
 
+// The wall (end caps aside), the wall shown and the lowest band area p05 of a piece's works.
+struct WorksShown {
+  double wall = 0, shown = 0, p05 = 1e300;
+};
+WorksShown works_shown(const std::vector<SegmentWork>& works) {
+  WorksShown r;
+  for (const SegmentWork& w : works)
+    r.wall += w.seg.coverage.wall_area_mm2, r.shown += w.seg.coverage.shown_area_mm2,
+        r.p05 = std::min(r.p05, w.seg.stats.area_p05);
+  return r;
+}
+
 }  // namespace
+
+std::vector<SegmentWork> tube_or_disk(const BranchPiece& piece, std::vector<SegmentWork> tube, const FlattenDisk& disk,
+                                      int depth) {
+  const Surface* d = piece.as_disk();
+  const WorksShown t = works_shown(tube);
+  if (!d || !(t.wall - t.shown > kDiskMapTrigger * t.wall)) return tube;
+  std::vector<SegmentWork> flat = disk(*d);
+  const double shown = flat.empty() ? 0.0 : flat[0].seg.coverage.shown_area_mm2;
+  const bool better = shown > t.shown && flat[0].seg.stats.area_p05 >= t.p05;
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+    std::fprintf(stderr, "flatten debug disk piece of %zu faces (depth %d): tube map shows %.1f of %.1f mm2 (%zu bands), "
+                 "disk map %.1f of %.1f (p05 %.3f, tube's lowest p05 %.3f): %s\n", d->t.size(), depth, t.shown, t.wall,
+                 tube.size(), shown, flat.empty() ? 0.0 : flat[0].seg.coverage.wall_area_mm2,
+                 flat.empty() ? 0.0 : flat[0].seg.stats.area_p05, t.p05, better ? "disk" : "tube");
+  return better ? flat : tube;
+}
 
 bool colon_stretch(double centreline_mm, double conformal_mm, double period_mm, std::size_t faces) {
   const bool stretch = period_mm > 0 && conformal_mm >= kColonStretchAspect * period_mm &&

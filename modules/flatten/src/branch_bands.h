@@ -57,4 +57,19 @@ using FlattenBand = std::function<std::vector<SegmentWork>(const BranchPiece&)>;
 std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& pieces, const FlattenBand& band,
                                                double& placed);
 
+// A piece's map misses the coverage target (issue 26: 99.5 % shown) when it leaves more than this share
+// of its wall not shown: then its disk map is tried (tube_or_disk).
+constexpr double kDiskMapTrigger = 2 * kHiddenWallTolerance;
+
+// Maps a disk as one band (disk_map.h flatten_disk; empty: refused).
+using FlattenDisk = std::function<std::vector<SegmentWork>(const Surface&)>;
+
+// A cut-off piece's works: `tube` (its tube map and the bands below it: flatten_surface's, from its
+// rim to a tip cap or a slit) or, for a disk piece (piece.as_disk()) whose tube map misses the
+// coverage target (kDiskMapTrigger), its disk map `disk` instead when that shows more wall with an
+// area p05 no lower than the tube map's lowest band p05 (issue 26, session 33 "patchmap").
+// COLONFLAT_FLATTEN_DEBUG: one line per disk map tried (`depth`: the piece's band depth).
+std::vector<SegmentWork> tube_or_disk(const BranchPiece& piece, std::vector<SegmentWork> tube, const FlattenDisk& disk,
+                                      int depth);
+
 }  // namespace cf::flat_detail

@@ -264,4 +264,29 @@ DiskMapResult disk_band(SegmentWork& w, const Edges& E, const std::vector<std::v
   return res;
 }
 
+std::vector<SegmentWork> flatten_disk(const Surface& disk, int component, double lumen_sign, const FlattenOptions& o) {
+  SegmentWork w;
+  w.lumen_sign = lumen_sign;
+  w.branch = true;
+  w.seg.component = component;
+  w.seg.input_kind = "one open end";
+  w.seg.weights = "cotan";
+  w.ann = disk;
+  const Edges E = build_edges(disk.t);
+  std::vector<double> area(disk.t.size());  // as flatten's prepare_faces: area_3d, degenerate faces
+  for (std::size_t f = 0; f < disk.t.size(); ++f) area[f] = face_area_3d(disk, int(f)), w.seg.area_3d += area[f];
+  std::vector<char> degenerate(disk.t.size(), 0);
+  for (std::size_t f = 0; f < disk.t.size(); ++f) degenerate[f] = area[f] <= 1e-6 * w.seg.area_3d / double(disk.t.size());
+  const DiskMapResult r = disk_band(w, E, vertex_faces(disk), degenerate, o);
+  if (std::getenv("COLONFLAT_FLATTEN_DEBUG") && !r.ok)
+    std::fprintf(stderr, "flatten debug disk map of %zu faces refused: %s\n", disk.t.size(), r.why);
+  if (!r.ok) return {};
+  w.seg.faces = w.ann.t.size();
+  w.seg.vertices = w.ann.p.size();
+  measure(w, E, degenerate, o);
+  std::vector<SegmentWork> out;
+  out.push_back(std::move(w));
+  return out;
+}
+
 }  // namespace cf::flat_detail

@@ -51,4 +51,9 @@ struct DiskMapResult {
 DiskMapResult disk_band(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
                         const std::vector<char>& degenerate, const FlattenOptions& o);
 
+// A disk piece as one band: disk_band on `disk` (its faces prepared as a band's), measured; the band a
+// branch's (`branch`, no branches or patches of its own). Empty when the map is refused
+// (COLONFLAT_FLATTEN_DEBUG: a line saying why).
+std::vector<SegmentWork> flatten_disk(const Surface& disk, int component, double lumen_sign, const FlattenOptions& o);
+
 }  // namespace cf::flat_detail

@@ -370,3 +370,33 @@ nlohmann::json flat_report(const FlatMap& f) {
 }
 
 }  // namespace cf
+
+namespace cf::flat_detail {
+
+// Distortion, faces left out (zero or negative area) and coverage of a segment.
+void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o) {
+  const Surface& s = w.ann;
+  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
+  w.in_map.assign(s.t.size(), 1);
+  std::vector<FaceDistortion> kept;
+  kept.reserve(fd.size());
+  double a2 = 0;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) {
+      w.in_map[f] = 0, ++w.seg.crowded_faces;
+      w.seg.inverted_faces += fd[f].area2 < 0;
+    } else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
+  }
+  w.seg.stats = stats_of(kept);
+  const double scale = a2 > 0 ? w.seg.area_3d / a2 : 1.0;
+  std::vector<double> ratio(s.t.size(), 1.0);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (!degenerate[f] && fd[f].area3 > 0) ratio[f] = fd[f].area2 * scale / fd[f].area3;
+  Coverage& c = w.seg.coverage;
+  c = coverage_of(s, E, w.in_map, ratio, o.coverage_min_ratio, w.cap_area);
+  c.wall_area_mm2 += w.lost_area;  // faces dropped at a branch's neck, a branch tip's cap
+  c.missing_area_mm2 += w.lost_area;
+  c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
+}
+
+}  // namespace cf::flat_detail

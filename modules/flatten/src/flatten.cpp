@@ -13,7 +13,6 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/progress.h"
-#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
 #include "branch_bands.h"
@@ -147,32 +146,6 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
   return emb;
 }
 
-// Distortion, faces left out (zero or negative area) and coverage of a segment.
-void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o) {
-  const Surface& s = w.ann;
-  const std::vector<FaceDistortion> fd = band_distortion(w, degenerate);
-  w.in_map.assign(s.t.size(), 1);
-  std::vector<FaceDistortion> kept;
-  kept.reserve(fd.size());
-  double a2 = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!degenerate[f] && too_small_in_map(fd[f].area2, fd[f].area3)) {
-      w.in_map[f] = 0, ++w.seg.crowded_faces;
-      w.seg.inverted_faces += fd[f].area2 < 0;
-    } else kept.push_back(fd[f]), a2 += std::abs(fd[f].area2);
-  }
-  w.seg.stats = stats_of(kept);
-  const double scale = a2 > 0 ? w.seg.area_3d / a2 : 1.0;
-  std::vector<double> ratio(s.t.size(), 1.0);
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f] && fd[f].area3 > 0) ratio[f] = fd[f].area2 * scale / fd[f].area3;
-  Coverage& c = w.seg.coverage;
-  c = coverage_of(s, E, w.in_map, ratio, o.coverage_min_ratio, w.cap_area);
-  c.wall_area_mm2 += w.lost_area;  // faces dropped at a branch's neck, a branch tip's cap
-  c.missing_area_mm2 += w.lost_area;
-  c.fraction = c.wall_area_mm2 > 0 ? c.shown_area_mm2 / c.wall_area_mm2 : 1.0;
-}
-
 // What every step on an annulus needs: its edges (w.ann's), degenerate faces, fixed (boundary)
 // vertices and vertex -> faces (prepare_faces, which also sets the annulus' 3D area).
 struct Prepared {
@@ -207,73 +180,6 @@ constexpr int kMaxPatchDepth = kMaxBranchDepth + 2;  // patches (hidden_patches.
 std::vector<SegmentWork> flatten_surface(const Surface& s, std::size_t nloops, std::size_t c, double lumen_sign,
                                          const FlattenOptions& o, int depth, bool limb = false);
 
-// A disk piece mapped as one band by the free-boundary disk map (disk_map.h), with no branches or
-// patches of its own, measured; empty when the map is refused (COLONFLAT_FLATTEN_DEBUG: a line).
-std::vector<SegmentWork> flatten_disk(const Surface& disk, int component, double lumen_sign, const FlattenOptions& o) {
-  SegmentWork w;
-  w.lumen_sign = lumen_sign;
-  w.branch = true;
-  w.seg.component = component;
-  w.seg.input_kind = "one open end";
-  w.seg.weights = "cotan";
-  w.ann = disk;
-  Prepared p{build_edges(disk.t), {}, {}, {}};
-  prepare_faces(w, p);
-  const DiskMapResult r = disk_band(w, p.E, p.vf, p.degenerate, o);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG") && !r.ok)
-    std::fprintf(stderr, "flatten debug disk map of %zu faces refused: %s\n", disk.t.size(), r.why);
-  if (!r.ok) return {};
-  w.seg.faces = w.ann.t.size();
-  w.seg.vertices = w.ann.p.size();
-  measure(w, p.E, p.degenerate, o);
-  std::vector<SegmentWork> out;
-  out.push_back(std::move(w));
-  return out;
-}
-
-// The wall (end caps aside), the wall shown and the lowest band area p05 of a piece's works (its band
-// and those below it).
-struct WorksShown {
-  double wall = 0, shown = 0, p05 = 1e300;
-};
-WorksShown works_shown(const std::vector<SegmentWork>& works) {
-  WorksShown r;
-  for (const SegmentWork& w : works)
-    r.wall += w.seg.coverage.wall_area_mm2, r.shown += w.seg.coverage.shown_area_mm2,
-        r.p05 = std::min(r.p05, w.seg.stats.area_p05);
-  return r;
-}
-
-// A piece's map misses the coverage target (issue 26: 99.5 % shown) when it leaves more than this share
-// of its wall not shown: then its disk map is tried.
-constexpr double kDiskMapTrigger = 2 * kHiddenWallTolerance;
-
-// A cut-off piece's works: its tube map (flatten_surface: from its rim to a tip cap or a slit) and,
-// for a disk piece whose tube map misses the coverage target (kDiskMapTrigger), its disk map
-// (disk_map.h) instead when that shows more wall with an area p05 no lower than the tube map's
-// lowest band p05 (issue 26, session 33 "patchmap").
-std::vector<SegmentWork> flatten_piece(const BranchPiece& piece, int component, double lumen_sign,
-                                       const FlattenOptions& o, int depth) {
-  std::vector<SegmentWork> tube =
-      flatten_surface(piece.surface, piece.loops, std::size_t(component), lumen_sign, o, depth + 1, piece.limb);
-  const Surface* disk = piece.as_disk();
-  const WorksShown t = works_shown(tube);
-  const double wall = t.wall, shown = t.shown;
-  if (!disk || o.map != "area-balanced" || !(wall - shown > kDiskMapTrigger * wall)) return tube;
-  const Stopwatch disk_clock;
-  std::vector<SegmentWork> flat = flatten_disk(*disk, component, lumen_sign, o);
-  const double disk_s = disk_clock.seconds();
-  const double disk_shown = flat.empty() ? 0.0 : flat[0].seg.coverage.shown_area_mm2;
-  const bool better = disk_shown > shown && flat[0].seg.stats.area_p05 >= t.p05;
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug disk piece of %zu faces (depth %d): tube map shows %.1f of %.1f mm2 (%zu bands), "
-                 "disk map %.1f of %.1f (p05 %.3f p95 %.3f, tube's lowest p05 %.3f): %s; disk map %.2f s wall\n", disk->t.size(), depth + 1, shown,
-                 wall, tube.size(), disk_shown, flat.empty() ? 0.0 : flat[0].seg.coverage.wall_area_mm2,
-                 flat.empty() ? 0.0 : flat[0].seg.stats.area_p05, flat.empty() ? 0.0 : flat[0].seg.stats.area_p95,
-                 t.p05, better ? "disk" : "tube", disk_s);
-  return better ? flat : tube;
-}
-
 // Flattens the cut-off branches (each as a band of its own, recursively, side by side:
 // branch_bands.h); returns their works and adds their wall area to `placed`. A branch that cannot
 // be flattened counts as wall not shown.
@@ -282,7 +188,9 @@ std::vector<SegmentWork> flatten_branches(const std::vector<BranchPiece>& pieces
   FlattenOptions bo = o;
   bo.end_cut_radius = std::min(o.end_cut_radius, 5.0);  // the tip of a pouch is wall, not an end
   return flatten_branch_pieces(pieces, [&](const BranchPiece& piece) {
-    return flatten_piece(piece, component, lumen_sign, bo, depth);
+    return tube_or_disk(piece, flatten_surface(piece.surface, piece.loops, std::size_t(component), lumen_sign, bo,
+                                               depth + 1, piece.limb),
+                        [&](const Surface& d) { return flatten_disk(d, component, lumen_sign, bo); }, depth + 1);
   }, placed);
 }
 

@@ -481,6 +481,9 @@ void band_distortion(const SegmentWork& w, const std::vector<char>& degenerate, 
                      std::vector<FaceDistortion>& fd);
 // face_frame() of every face of the segment's annulus (on the worker threads).
 std::vector<FaceFrame> band_frames(const SegmentWork& w);
+// Distortion, faces left out (zero or negative area) and coverage of a segment (distortion.cpp): w.in_map,
+// w.seg's stats, crowded and inverted faces and coverage (its caps w.cap_area aside, w.lost_area not shown).
+void measure(SegmentWork& w, const Edges& E, const std::vector<char>& degenerate, const FlattenOptions& o);
 
 // Labels and orders the colon segments (rectum -> cecum); side branches follow, by the order of
 // their parent and their neck's position on it, labelled "neck" -> "tip" ("rim" for a patch).
