@@ -87,7 +87,7 @@ void ColonImagePainter::paint_rows(const Band& b, const ProbedBand& probed, cons
       unsigned char* d = pixels_ + (std::size_t(b.row0 + j) * width_ + b.col0 + i) * 3;
       const bool stripe = ((i + j) / 4) % 2 == 0;  // diagonal hatching, 4 px stripes
       const bool past_edge = (i + 0.5) * px_ > s.length || (j + 0.5) * px_ > s.period;  // the last column / row (rounding)
-      if (!probed.valid[id] && past_edge) continue;
+      if (!probed.valid[id] && (past_edge || s.map == "disk")) continue;  // a disk band's box outside the disk: no wall
       if (!probed.valid[id]) {
         hatch_missing(stripe, d);
         ++counts[1];

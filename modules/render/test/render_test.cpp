@@ -117,6 +117,22 @@ TEST(RenderImage, MissingWallIsHatched) {
   EXPECT_NEAR(double(holed.missing_pixels) * px_area, removed, 0.15 * removed);
 }
 
+// A disk band (flatten's disk_map.h: the disk's own outline inside its bounding box) leaves the box
+// outside the disk unpainted, not hatched as missing wall: the same holed map as above, its band marked
+// "disk", has no missing pixels.
+TEST(RenderImage, DiskBandsEmptyBoxIsNotMissingWall) {
+  auto c = test_colon();
+  FlatMap f = flatten_colon(c.mesh);
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& t : f.triangles)
+    if (!(f.uv[t[0]][0] > 100 && f.uv[t[0]][0] < 120)) kept.push_back(t);
+  f.triangles = kept;
+  std::vector<ImageMarker> none;
+  ASSERT_GT(render_colon_image(f, {}, none, ColonImageOptions{}).missing_pixels, 0u);
+  for (FlatSegment& s : f.segments) s.map = "disk";
+  EXPECT_EQ(render_colon_image(f, {}, none, ColonImageOptions{}).missing_pixels, 0u);
+}
+
 // A band's caption says what it shows: a side branch holding tissue (flatten's "holds", a crushed
 // strand stump: FlattenBranches.CrushedTissueStrandIsABandOfItsOwn) is a "tissue strand (cut
 // bridge)", never a pouch; one holding lumen stays "side branch (pouch)"; a patch of wall its parent's
