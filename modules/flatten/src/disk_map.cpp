@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "band_faces.h"
 #include "whole_band_stop.h"
 
 namespace cf::flat_detail {
@@ -165,9 +166,9 @@ void correct_disk(SegmentWork& w, const std::vector<std::vector<int>>& vf, const
 }
 
 // The disk's conformal map (the cotangent LSCM; where it folds faces, the clamped one; folds left
-// re-embedded by untangle with the boundary held); false when the map is not injective then.
+// re-embedded by untangle with the boundary `rim` held); false when the map is not injective then.
 bool conformal_disk(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
-                    const std::vector<char>& degenerate, const std::array<int, 2>& pins) {
+                    const std::vector<char>& degenerate, const std::vector<char>& rim, const std::array<int, 2>& pins) {
   auto folded = [&] {
     std::size_t n = 0;
     for (std::size_t f = 0; f < w.ann.t.size(); ++f) n += !degenerate[f] && w.emb.area2(w.ann, int(f)) < 0;
@@ -176,9 +177,6 @@ bool conformal_disk(SegmentWork& w, const Edges& E, const std::vector<std::vecto
   if (!lscm_embedding(w, E, degenerate, pins, false)) return false;
   std::size_t folds = folded();
   if (folds > 0 && lscm_embedding(w, E, degenerate, pins, true)) folds = folded();
-  std::vector<char> rim(w.ann.p.size(), 0);
-  for (std::size_t e = 0; e < E.ev.size(); ++e)
-    if (E.ef[e][1] < 0) rim[std::size_t(E.ev[e][0])] = rim[std::size_t(E.ev[e][1])] = 1;
   if (folds > 0) untangle(w.ann, vf, w.emb, rim, degenerate);
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug disk map, %zu faces: %zu folded (clamped), %zu after untangle, boundary crosses %d\n",
@@ -239,12 +237,14 @@ bool injective_disk_map(const Surface& s, const Edges& E, const Embedding& emb, 
   return !boundary_crosses(s, E, emb);
 }
 
-DiskMapResult disk_band(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
-                        const std::vector<char>& degenerate, const FlattenOptions& o) {
+DiskMapResult disk_band(SegmentWork& w, const Prepared& p, const FlattenOptions& o) {
+  const Edges& E = p.E;
+  const std::vector<std::vector<int>>& vf = p.vf;
+  const std::vector<char>& degenerate = p.degenerate;
   DiskMapResult res;
   const std::array<int, 2> pins = far_boundary_pair(w.ann, E);
   if (pins[0] < 0 || pins[0] == pins[1]) return res.why = "no two boundary vertices", res;
-  if (!conformal_disk(w, E, vf, degenerate, pins)) return res.why = "the conformal map overlaps itself", res;
+  if (!conformal_disk(w, E, vf, degenerate, p.fixed, pins)) return res.why = "the conformal map overlaps itself", res;
   const Embedding conformal = w.emb;
   std::vector<char> held(w.ann.p.size(), 0);
   held[std::size_t(pins[0])] = 1;
@@ -272,18 +272,15 @@ std::vector<SegmentWork> flatten_disk(const Surface& disk, int component, double
   w.seg.input_kind = "one open end";
   w.seg.weights = "cotan";
   w.ann = disk;
-  const Edges E = build_edges(disk.t);
-  std::vector<double> area(disk.t.size());  // as flatten's prepare_faces: area_3d, degenerate faces
-  for (std::size_t f = 0; f < disk.t.size(); ++f) area[f] = face_area_3d(disk, int(f)), w.seg.area_3d += area[f];
-  std::vector<char> degenerate(disk.t.size(), 0);
-  for (std::size_t f = 0; f < disk.t.size(); ++f) degenerate[f] = area[f] <= 1e-6 * w.seg.area_3d / double(disk.t.size());
-  const DiskMapResult r = disk_band(w, E, vertex_faces(disk), degenerate, o);
+  Prepared p{build_edges(disk.t), {}, {}, {}};
+  prepare_faces(w, p);
+  const DiskMapResult r = disk_band(w, p, o);
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG") && !r.ok)
     std::fprintf(stderr, "flatten debug disk map of %zu faces refused: %s\n", disk.t.size(), r.why);
   if (!r.ok) return {};
   w.seg.faces = w.ann.t.size();
   w.seg.vertices = w.ann.p.size();
-  measure(w, E, degenerate, o);
+  measure(w, p.E, p.degenerate, o);
   std::vector<SegmentWork> out;
   out.push_back(std::move(w));
   return out;

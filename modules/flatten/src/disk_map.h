@@ -17,6 +17,7 @@
 // (docs/flatten.md "Disk bands"). The map does not wrap in y (every corner offset 0).
 #include <vector>
 
+#include "band_faces.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -45,11 +46,11 @@ struct DiskMapResult {
   std::size_t balanced_vertices = 0;
 };
 
-// Maps band w (w.ann a disk with edges E, vertex -> faces vf, `degenerate` faces; w.seg.area_3d set)
-// as above: sets w.emb (corner offsets 0, period = the box's height), w.along (= x, mm), w.seg.length
-// and period (the box), map "disk" and its correction figures. On failure w.emb is unspecified.
-DiskMapResult disk_band(SegmentWork& w, const Edges& E, const std::vector<std::vector<int>>& vf,
-                        const std::vector<char>& degenerate, const FlattenOptions& o);
+// Maps band w (w.ann a disk; p: prepare_faces() of it, which set w.seg.area_3d; its `fixed` vertices,
+// the rim, are held while the conformal map's folds are untangled) as above: sets w.emb (corner
+// offsets 0, period = the box's height), w.along (= x, mm), w.seg.length and period (the box), map
+// "disk" and its correction figures. On failure w.emb is unspecified.
+DiskMapResult disk_band(SegmentWork& w, const Prepared& p, const FlattenOptions& o);
 
 // A disk piece as one band: disk_band on `disk` (its faces prepared as a band's), measured; the band a
 // branch's (`branch`, no branches or patches of its own). Empty when the map is refused

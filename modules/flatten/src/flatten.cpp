@@ -15,6 +15,7 @@
 #include "colonflat/core/progress.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
+#include "band_faces.h"
 #include "branch_bands.h"
 #include "disk_map.h"
 #include "factor_memory.h"
@@ -144,28 +145,6 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
     w.seg = keep;
   }
   return emb;
-}
-
-// What every step on an annulus needs: its edges (w.ann's), degenerate faces, fixed (boundary)
-// vertices and vertex -> faces (prepare_faces, which also sets the annulus' 3D area).
-struct Prepared {
-  Edges E;
-  std::vector<char> degenerate, fixed;
-  std::vector<std::vector<int>> vf;
-};
-
-void prepare_faces(SegmentWork& w, Prepared& p) {
-  const Surface& ann = w.ann;
-  std::vector<double> area(ann.t.size());  // w.seg.area_3d: summed as surface_area sums
-  w.seg.area_3d = 0;
-  for (std::size_t f = 0; f < ann.t.size(); ++f) area[f] = face_area_3d(ann, int(f)), w.seg.area_3d += area[f];
-  p.degenerate.assign(ann.t.size(), 0);
-  const double mean_area = w.seg.area_3d / double(ann.t.size());
-  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = area[f] <= 1e-6 * mean_area;
-  p.fixed.assign(ann.p.size(), 0);  // the ends and the rims of cut-off branches
-  for (std::size_t e = 0; e < p.E.ev.size(); ++e)
-    if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
-  p.vf = vertex_faces(ann);
 }
 
 void conformal(SegmentWork& w, const std::vector<std::vector<int>>& loops, const Prepared& p, const FlattenOptions& o,
@@ -475,3 +454,22 @@ TriangleList flat_to_surface(const FlatMap& flat, std::vector<int>* flat_to_3d) 
 }
 
 }  // namespace cf
+
+namespace cf::flat_detail {
+
+// (flatten_internal.h)
+void prepare_faces(SegmentWork& w, Prepared& p) {
+  const Surface& ann = w.ann;
+  std::vector<double> area(ann.t.size());  // w.seg.area_3d: summed as surface_area sums
+  w.seg.area_3d = 0;
+  for (std::size_t f = 0; f < ann.t.size(); ++f) area[f] = face_area_3d(ann, int(f)), w.seg.area_3d += area[f];
+  p.degenerate.assign(ann.t.size(), 0);
+  const double mean_area = w.seg.area_3d / double(ann.t.size());
+  for (std::size_t f = 0; f < ann.t.size(); ++f) p.degenerate[f] = area[f] <= 1e-6 * mean_area;
+  p.fixed.assign(ann.p.size(), 0);  // the ends and the rims of cut-off branches
+  for (std::size_t e = 0; e < p.E.ev.size(); ++e)
+    if (p.E.ef[e][1] < 0) p.fixed[p.E.ev[e][0]] = p.fixed[p.E.ev[e][1]] = 1;
+  p.vf = vertex_faces(ann);
+}
+
+}  // namespace cf::flat_detail

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../src/band_faces.h"
 #include "../src/disk_map.h"
 #include "colonflat/core/threads.h"
 #include "squeezed_grid.h"
@@ -51,20 +52,17 @@ flat_detail::Surface finger() {
   });
 }
 
-// What disk_band made of a surface: the band, its edges and the result.
+// What disk_band made of a surface: the band and the result.
 struct DiskRun {
   flat_detail::SegmentWork w;
-  flat_detail::Edges E;
-  std::vector<char> degenerate;
   flat_detail::DiskMapResult r;
 };
 DiskRun run_disk(const flat_detail::Surface& s, const FlattenOptions& o = {}) {
   DiskRun d;
   d.w.ann = s;
-  d.E = flat_detail::build_edges(s.t);
-  d.degenerate.assign(s.t.size(), 0);
-  for (std::size_t f = 0; f < s.t.size(); ++f) d.w.seg.area_3d += flat_detail::face_area_3d(s, int(f));
-  d.r = flat_detail::disk_band(d.w, d.E, flat_detail::vertex_faces(s), d.degenerate, o);
+  flat_detail::Prepared p{flat_detail::build_edges(s.t), {}, {}, {}};
+  flat_detail::prepare_faces(d.w, p);
+  d.r = flat_detail::disk_band(d.w, p, o);
   return d;
 }
 
