@@ -361,6 +361,8 @@ std::string band_caption(const FlatSegment& s) {
     t += std::string(s.holds == "tissue" ? "tissue strand (cut bridge) off" : "side branch (pouch) of") + " segment " +
          std::to_string(s.parent + 1) + " at " + fmt0(s.attach_mm / 10) + " cm, neck " + fmt0(s.neck_mm) +
          " mm around; ";
+  if (s.map == "disk")  // flatten's disk map: no ends, no wrap; its box is the bounding box of the disk's outline
+    return t + "mapped as a disk in a " + fmt0(s.length) + " x " + fmt0(s.period) + " mm box, its rim the outline; ";
   return t + fmt0(s.length) + " mm long x " + fmt0(s.period) + " mm around; " + s.x0_end + " (left) to " + s.x1_end +
          " (right); ";
 }

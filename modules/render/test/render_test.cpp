@@ -165,6 +165,19 @@ TEST(RenderImage, BandCaptionSaysPouchOrTissueStrand) {
   EXPECT_EQ(band.find("tissue"), std::string::npos);
 }
 
+// A disk band's caption (flatten's disk map: a wall patch mapped as itself) names its box, not a
+// length "around" a tube it is not, and no ends: its rim is the outline.
+TEST(RenderImage, DiskBandCaptionNamesItsBoxNotATube) {
+  FlatSegment patch;
+  patch.id = 4, patch.kind = "branch", patch.parent = 0, patch.attach_mm = 1520, patch.neck_mm = 41;
+  patch.holds = "wall", patch.map = "disk", patch.length = 70, patch.period = 49, patch.x0_end = "rim", patch.x1_end = "rim";
+  const std::string caption = band_caption(patch);
+  EXPECT_EQ(caption, "segment 5: wall patch (hidden in the map of) segment 1 at 152 cm, rim 41 mm around; "
+                     "mapped as a disk in a 70 x 49 mm box, its rim the outline; ");
+  patch.map = "conformal";  // the same patch mapped as a tube keeps the tube's wording
+  EXPECT_NE(band_caption(patch).find("70 mm long x 49 mm around; rim (left) to rim (right); "), std::string::npos);
+}
+
 // The colon image is the same, pixel for pixel and in its counts, for 1 and 2 threads (a hole
 // in the map makes hatched pixels count too).
 TEST(RenderImage, SameImageForAnyThreadCount) {

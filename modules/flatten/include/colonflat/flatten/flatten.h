@@ -83,11 +83,12 @@ struct FlatSegment {
   std::size_t inverted_faces = 0;        // of those: folded over (negative 2D area), however small
   DistortionStats stats;
   // area-balanced map (empty / 0 for older files and the conformal map)
-  std::string map;                                   // "area-balanced" or "conformal"
+  std::string map;                                   // "area-balanced", "conformal" or "disk" (disk_map.h: x, y in
+                                                     // the disk's own mm, length x period its bounding box)
   std::vector<std::array<double, 3>> centreline;     // LPS mm, from the x0 end to the x1 end
   double centreline_length = 0;                      // mm
   std::vector<std::array<double, 2>> centreline_x;   // (centreline mm from the x0 end, band x mm), increasing
-  std::string x0_end = "end A", x1_end = "end B";    // "rectum", "cecum", "end A", "end B"
+  std::string x0_end = "end A", x1_end = "end B";    // "rectum", "cecum", "end A", "end B", "neck", "tip", "rim"
   int order = 0;                                     // position rectum -> cecum among segments
   double centreline_offset = 0;                      // mm of centreline of the segments before it
   std::size_t balanced_vertices = 0;                 // vertices moved by the local symmetric-Dirichlet balancing
