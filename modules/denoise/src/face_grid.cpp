@@ -8,6 +8,8 @@
 #include <limits>
 #include <unordered_set>
 
+#include "colonflat/core/vertex_stamps.h"
+
 namespace cf {
 
 FaceGrid::FaceGrid(const Mesh& mesh, double cell_size) : cell_(cell_size) { build_static(mesh, mesh.faces()); }
@@ -22,6 +24,23 @@ FaceGrid::Key FaceGrid::key(const Vec3& p) const {
 }
 
 namespace {
+// The faces the calling thread's current query has tested: a face lies in every cell its bounding
+// box meets (about two on a surface whose edges are a third of a cell), and a query that walks a
+// triangle's or a segment's cells would read and test it once per cell. One array per thread
+// (the restricted caps query from two threads at once); a call costs only the faces it reaches.
+VertexStamps& tested_faces(const Mesh& mesh) {
+  thread_local VertexStamps stamps;
+  stamps.start(mesh.n_faces());
+  return stamps;
+}
+
+// True the first time face f comes in the current query.
+bool first_visit(VertexStamps& seen, int f) {
+  if (seen.marked(f)) return false;
+  seen.mark(f);
+  return true;
+}
+
 void face_box(const Mesh& mesh, Mesh::FaceHandle f, Vec3& lo, Vec3& hi, std::array<int, 3>& ids,
               std::array<Vec3, 3>& pts) {
   // The face's halfedge cycle read directly (the order of fv_range): this runs for every
@@ -335,7 +354,9 @@ bool triangles_intersect_improperly(const std::array<int, 3>& ids, const std::ar
 
 bool FaceGrid::segment_hits(const Mesh& mesh, int a, int b) const {
   const Vec3 p = mesh.point(Mesh::VertexHandle(a)), q = mesh.point(Mesh::VertexHandle(b));
+  VertexStamps& seen = tested_faces(mesh);
   auto pierces = [&](int gi) {
+    if (!first_visit(seen, gi)) return false;
     Vec3 lo, hi;
     std::array<int, 3> ids;
     std::array<Vec3, 3> t;
@@ -352,7 +373,9 @@ bool FaceGrid::segment_hits(const Mesh& mesh, int a, int b) const {
 double FaceGrid::free_distance(const Mesh& mesh, const Vec3& origin, const Vec3& dir, double max_dist,
                                int skip_vertex) const {
   double best = max_dist;
+  VertexStamps& seen = tested_faces(mesh);
   auto meet = [&](int gi) {
+    if (!first_visit(seen, gi)) return false;
     Vec3 lo, hi;
     std::array<int, 3> ids;
     std::array<Vec3, 3> q;
@@ -435,8 +458,10 @@ std::size_t FaceGrid::grid_hits(const Mesh& mesh, const std::array<int, 3>& ids,
     return triangles_intersect_improperly(ids, p, gids, q);
   };
   if (first_only) {
-    if (std::any_of(big_.begin(), big_.end(), hit)) return 1;
-    return triangle_cells(p, [&](const Key& k) { return cell_faces(k, hit); }) ? 1 : 0;
+    VertexStamps& seen = tested_faces(mesh);
+    auto first_hit = [&](int gi) { return first_visit(seen, gi) && hit(gi); };
+    if (std::any_of(big_.begin(), big_.end(), first_hit)) return 1;
+    return triangle_cells(p, [&](const Key& k) { return cell_faces(k, first_hit); }) ? 1 : 0;
   }
   std::vector<int> cand(big_.begin(), big_.end());
   triangle_cells(p, [&](const Key& k) { return cell_faces(k, [&](int f) { return cand.push_back(f), false; }); });

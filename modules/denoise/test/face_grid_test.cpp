@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
 
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/face_grid.h"
@@ -148,6 +149,77 @@ TEST(DenoiseFaceGrid, WideTriangleHitsAreTheBruteForceHits) {
     EXPECT_GT(hits, 100u) << cell;  // many cross the sphere
     EXPECT_LT(hits, 300u) << cell;  // and some do not
   }
+}
+
+// Each query tests a face once however many of its cells it walks (per-thread marks, cleared by
+// the next query): on a sphere whose faces span up to dozens of cells of 0.04, the answers of 200
+// segments and 200 rays asked one after the other equal a test of every face, and two threads
+// asking the same queries at once (as the restricted caps do) get the same answers.
+TEST(DenoiseFaceGrid, SegmentAndRayAnswersAreTheBruteForceOnesOnAnyThread) {
+  Mesh m = to_mesh(sphere(1, 20, 10));
+  std::vector<std::pair<int, int>> segments;
+  for (int i = 0; i < 200; ++i) {  // ends spread over [-1.4, 1.4]^3 by a fixed recurrence
+    const auto a = m.add_vertex(Vec3(1.4 * std::sin(1.1 * i), 1.4 * std::cos(0.7 * i + 1), 1.4 * std::sin(2.9 * i)));
+    const auto b = m.add_vertex(Vec3(1.4 * std::cos(1.9 * i), 1.4 * std::sin(0.3 * i + 2), 1.4 * std::cos(1.3 * i)));
+    segments.push_back({a.idx(), b.idx()});
+  }
+  auto face_points = [&](Mesh::FaceHandle f) {
+    std::array<Vec3, 3> q;
+    int k = 0;
+    for (auto v : m.fv_range(f)) q[k++] = m.point(v);
+    return q;
+  };
+  auto brute_pierces = [&](int a, int b) {  // a proper crossing of the segment with a face
+    const Vec3 p = m.point(Mesh::VertexHandle(a)), d = m.point(Mesh::VertexHandle(b)) - p;
+    for (auto f : m.faces()) {
+      const auto q = face_points(f);
+      const Vec3 n = OpenMesh::cross(q[1] - q[0], q[2] - q[0]);
+      const double t = OpenMesh::dot(q[0] - p, n) / OpenMesh::dot(d, n);
+      if (!(t > 1e-6 && t < 1 - 1e-6)) continue;
+      const Vec3 x = p + t * d;
+      bool inside = true;
+      for (int e = 0; e < 3; ++e) inside = inside && OpenMesh::dot(OpenMesh::cross(q[(e + 1) % 3] - q[e], x - q[e]), n) > 0;
+      if (inside) return true;
+    }
+    return false;
+  };
+  const FaceGrid grid(m, 0.04);
+  auto answers = [&](std::vector<int>* out) {
+    for (const auto& [a, b] : segments) {
+      out->push_back(grid.segment_hits(m, a, b) ? 1 : 0);
+      const Vec3 p = m.point(Mesh::VertexHandle(a)), d = m.point(Mesh::VertexHandle(b)) - p;
+      out->push_back(static_cast<int>(std::lround(1e6 * grid.free_distance(m, p, d / d.norm(), 3.0, -1))));
+    }
+  };
+  std::vector<int> one, two_a, two_b;
+  answers(&one);
+  std::thread helper([&] { answers(&two_b); });
+  answers(&two_a);
+  helper.join();
+  EXPECT_EQ(one, two_a);
+  EXPECT_EQ(one, two_b);
+  int pierced = 0;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const bool brute = brute_pierces(segments[i].first, segments[i].second);
+    EXPECT_EQ(one[2 * i] == 1, brute) << i;
+    pierced += brute;
+    const Vec3 p = m.point(Mesh::VertexHandle(segments[i].first));
+    const Vec3 d = m.point(Mesh::VertexHandle(segments[i].second)) - p;
+    double nearest = 3.0;  // the ray's first face, brute force (Moller-Trumbore as a plane + inside test)
+    for (auto f : m.faces()) {
+      const auto q = face_points(f);
+      const Vec3 n = OpenMesh::cross(q[1] - q[0], q[2] - q[0]), u = d / d.norm();
+      const double t = OpenMesh::dot(q[0] - p, n) / OpenMesh::dot(u, n);
+      if (!(t > 1e-9 && t < nearest)) continue;
+      const Vec3 x = p + t * u;
+      bool inside = true;
+      for (int e = 0; e < 3; ++e) inside = inside && OpenMesh::dot(OpenMesh::cross(q[(e + 1) % 3] - q[e], x - q[e]), n) >= 0;
+      if (inside) nearest = t;
+    }
+    EXPECT_NEAR(one[2 * i + 1] * 1e-6, nearest, 2e-6) << i;
+  }
+  EXPECT_GT(pierced, 50);   // many segments cross the sphere
+  EXPECT_LT(pierced, 200);  // and some do not
 }
 
 }  // namespace
