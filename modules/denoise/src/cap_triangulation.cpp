@@ -44,6 +44,7 @@ class LazyMinArea {
   double area(int i, int m, int j) const { return 0.5 * OpenMesh::cross(p_[m] - p_[i], p_[j] - p_[i]).norm(); }
   void solve(int i, int j);
   void solve_lightest_first(int i, int j);
+  void lighter_than_refused(int i, int j, int refused, double* best, int* best_m);
   void solve_around(int i_hi, int j_lo);
   std::vector<std::array<int, 3>> extract() const;
   bool refuse_failing(const std::vector<std::array<int, 3>>& tris, int* i_hi, int* j_lo);
@@ -92,32 +93,49 @@ void LazyMinArea::solve(int i, int j) {
 
 // With side_ok (restricted caps, whose queries are grid queries and refuse most candidates on a
 // ring that runs along a wall): the candidates (w, m) over sides with a triangulation are taken
-// from a min-heap, lightest first (smallest m on ties), until `allowed` passes one; none is asked
-// when side (i, j) is refused (then so would be every triangle on it). Lazy rounds cost more here
-// (real CT surface, issue 26 session 19: 100-940 rounds per ring of 87-173 vertices, 2.6 s of CPU
-// for its 16 restricted triangulations against 1.5 s lightest first).
+// lightest first (smallest m on ties) until `allowed` passes one; none is asked when side (i, j)
+// is refused (then so would be every triangle on it). Lazy rounds cost more here (real CT
+// surface, issue 26 session 19: 100-940 rounds per ring of 87-173 vertices, 2.6 s of CPU for its
+// 16 restricted triangulations against 1.5 s lightest first). The lightest comes from a scan
+// that skips the candidates whose sides alone weigh as much (as solve() does); only when it is
+// refused are all candidates formed and taken from a min-heap (session 34: most subproblems
+// stop at their lightest, and forming every candidate's area was most of the programme's time).
 void LazyMinArea::solve_lightest_first(int i, int j) {
-  order_.clear();
-  for (int m = i + 1; m < j; ++m) {
-    const double w = W_[at(i, m)] + W_[at(m, j)] + area(i, m, j);
-    if (w < kNone) order_.push_back({w, m});
-  }
   double best = kNone;
   int best_m = -1;
-  if (!order_.empty() && !side_refused(i, j)) {
-    const auto later = std::greater<std::pair<double, int>>();
-    std::make_heap(order_.begin(), order_.end(), later);
-    for (auto end = order_.end(); end != order_.begin(); --end) {
-      std::pop_heap(order_.begin(), end, later);
-      const auto [w, m] = *(end - 1);
-      if (allowed_(i, m, j)) {
-        best = w, best_m = m;
-        break;
-      }
-    }
+  for (int m = i + 1; m < j; ++m) {
+    const double sides = W_[at(i, m)] + W_[at(m, j)];
+    if (!(sides < best)) continue;  // area >= 0: w = sides + area cannot be lighter
+    const double w = sides + area(i, m, j);
+    if (w < best) best = w, best_m = m;
+  }
+  if (best_m >= 0 && (side_refused(i, j) || !allowed_(i, best_m, j))) {
+    const int refused = side_refused(i, j) ? -1 : best_m;
+    best = kNone, best_m = -1;
+    if (refused >= 0) lighter_than_refused(i, j, refused, &best, &best_m);
   }
   W_[at(i, j)] = best;
   arg_[at(i, j)] = best_m;
+}
+
+// The next candidates of subproblem (i, j) after its lightest, `refused`, was refused: every
+// finite (w, m) but that one from a min-heap, lightest first, until `allowed` passes one.
+void LazyMinArea::lighter_than_refused(int i, int j, int refused, double* best, int* best_m) {
+  order_.clear();
+  for (int m = i + 1; m < j; ++m) {
+    const double w = W_[at(i, m)] + W_[at(m, j)] + area(i, m, j);
+    if (w < kNone && m != refused) order_.push_back({w, m});
+  }
+  const auto later = std::greater<std::pair<double, int>>();
+  std::make_heap(order_.begin(), order_.end(), later);
+  for (auto end = order_.end(); end != order_.begin(); --end) {
+    std::pop_heap(order_.begin(), end, later);
+    const auto [w, m] = *(end - 1);
+    if (allowed_(i, m, j)) {
+      *best = w, *best_m = m;
+      return;
+    }
+  }
 }
 
 // Solves again the subproblems (i, j) with i <= i_hi and j >= j_lo (those that contain a refusal),

@@ -245,5 +245,44 @@ TEST(DenoiseCapTriangulation, QueryCacheGivesTheSameTriangulations) {
   EXPECT_EQ(spent, spent_blocked);
 }
 
+// Lightest first with side_ok (the restricted caps' programme, which now forms a subproblem's
+// other candidates only once its lightest is refused): the same questions, sides and triangles in
+// the same order, and the same triangles as the old programme (written out here: per subproblem,
+// the side unless a ring edge, then every candidate sorted by (weight, apex) until one passes),
+// with a fifth of the sides and a third of the triangles refused.
+TEST(DenoiseCapTriangulation, LightestFirstAsksWhatTheOldProgrammeAsked) {
+  const std::vector<Vec3> ring = bumpy_ring(40);
+  const int n = static_cast<int>(ring.size());
+  std::vector<std::array<int, 3>> asked, expected;
+  auto third = [&](int i, int m, int j) { return asked.push_back({i, m, j}), !refused(i, m, j, 33); };
+  auto side_ok = [&](int a, int b) { return asked.push_back({a, b, -1}), !refused(a, b, -1, 20); };
+  const auto tris = min_area_triangulation(ring, third, {}, side_ok);
+  const double none = std::numeric_limits<double>::infinity();
+  std::vector<double> W(std::size_t(n) * n, 0.0);
+  std::vector<int> arg(std::size_t(n) * n, -1);
+  for (int len = 2; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      std::vector<std::pair<double, int>> order;
+      for (int m = i + 1; m < j; ++m) {
+        const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] +
+                         0.5 * OpenMesh::cross(ring[m] - ring[i], ring[j] - ring[i]).norm();
+        if (w < none) order.push_back({w, m});
+      }
+      std::sort(order.begin(), order.end());
+      W[std::size_t(i) * n + j] = none;
+      const bool edge = i == 0 && j == n - 1;
+      if (order.empty() || (!edge && (expected.push_back({i, j, -1}), refused(i, j, -1, 20)))) continue;
+      for (const auto& [w, m] : order)
+        if (expected.push_back({i, m, j}), !refused(i, m, j, 33)) {
+          W[std::size_t(i) * n + j] = w, arg[std::size_t(i) * n + j] = m;
+          break;
+        }
+    }
+  EXPECT_EQ(asked, expected);
+  ASSERT_EQ(tris.size(), ring.size() - 2);
+  for (const auto& t : tris) EXPECT_EQ(arg[std::size_t(t[0]) * n + t[2]], t[1]);
+}
+
 }  // namespace
 }  // namespace cf
