@@ -24,18 +24,15 @@ FaceGrid::Key FaceGrid::key(const Vec3& p) const {
 }
 
 namespace {
-// The faces the calling thread's current query has tested: a face lies in every cell its bounding
-// box meets (about two on a surface whose edges are a third of a cell), and a query that walks a
-// triangle's or a segment's cells would read and test it once per cell. One array per thread
-// (the restricted caps query from two threads at once); a call costs only the faces it reaches.
+// Faces the thread's current query tested (a face lies in every cell its box meets, and a query
+// walking cells would test it once per cell); one array per thread: the restricted caps query from two.
 VertexStamps& tested_faces(const Mesh& mesh) {
   thread_local VertexStamps stamps;
   stamps.start(mesh.n_faces());
   return stamps;
 }
 
-// True the first time face f comes in the current query.
-bool first_visit(VertexStamps& seen, int f) {
+bool first_visit(VertexStamps& seen, int f) {  // true the first time face f comes in the query
   if (seen.marked(f)) return false;
   seen.mark(f);
   return true;
