@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <numeric>
+
+#include <time.h>
 
 #include "colonflat/core/threads.h"
 
@@ -15,7 +18,31 @@ double surface_area(const Surface& s) {
   return a;
 }
 
+double DiskShape::isoperimetric() const {
+  return rim_mm > 0 ? 4 * 3.14159265358979323846 * area_mm2 / (rim_mm * rim_mm) : std::numeric_limits<double>::infinity();
+}
+
+DiskShape disk_shape(const Surface& s) {
+  DiskShape d;
+  d.area_mm2 = surface_area(s);
+  const Edges E = build_edges(s.t);
+  std::vector<int> rim;
+  for (std::size_t e = 0; e < E.ev.size(); ++e)
+    if (E.ef[e][1] < 0)
+      d.rim_mm += (s.p[std::size_t(E.ev[e][0])] - s.p[std::size_t(E.ev[e][1])]).norm(), rim.push_back(E.ev[e][0]);
+  if (rim.empty()) return d;
+  const std::vector<double> dist = dijkstra(build_csr(s, E), rim);
+  d.depth_mm = dist[std::size_t(argmax_finite(dist))];
+  return d;
+}
+
 namespace {
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 // Appends the works of a flattened branch (its own first, parents relative to the list) to `out`,
 // the branch hanging from the work at index -1 (the caller's segment).
@@ -47,14 +74,27 @@ std::vector<SegmentWork> tube_or_disk(const BranchPiece& piece, std::vector<Segm
   const Surface* d = piece.as_disk();
   const WorksShown t = works_shown(tube);
   if (!d || !(t.wall - t.shown > kDiskMapTrigger * t.wall)) return tube;
+  const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
+  if (d->t.size() > kDiskMapMaxFaces) {
+    if (debug)
+      std::fprintf(stderr, "flatten debug disk piece of %zu faces (depth %d): tube map shows %.1f of %.1f mm2 (%zu bands), "
+                   "disk map not tried (more than %zu faces)\n", d->t.size(), depth, t.shown, t.wall, tube.size(),
+                   kDiskMapMaxFaces);
+    return tube;
+  }
+  const DiskShape shape = debug ? disk_shape(*d) : DiskShape{};
+  const double cpu0 = thread_cpu_seconds();
   std::vector<SegmentWork> flat = disk(*d);
+  const double cpu = thread_cpu_seconds() - cpu0;
   const double shown = flat.empty() ? 0.0 : flat[0].seg.coverage.shown_area_mm2;
   const bool better = shown > t.shown && flat[0].seg.stats.area_p05 >= t.p05;
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+  if (debug)
     std::fprintf(stderr, "flatten debug disk piece of %zu faces (depth %d): tube map shows %.1f of %.1f mm2 (%zu bands), "
-                 "disk map %.1f of %.1f (p05 %.3f, tube's lowest p05 %.3f): %s\n", d->t.size(), depth, t.shown, t.wall,
+                 "disk map %.1f of %.1f (p05 %.3f, tube's lowest p05 %.3f): %s; shape: area %.1f mm2, rim %.1f mm, "
+                 "depth %.2f mm, isoperimetric %.3f; disk map thread CPU %.3f s\n", d->t.size(), depth, t.shown, t.wall,
                  tube.size(), shown, flat.empty() ? 0.0 : flat[0].seg.coverage.wall_area_mm2,
-                 flat.empty() ? 0.0 : flat[0].seg.stats.area_p05, t.p05, better ? "disk" : "tube");
+                 flat.empty() ? 0.0 : flat[0].seg.stats.area_p05, t.p05, better ? "disk" : "tube", shape.area_mm2,
+                 shape.rim_mm, shape.depth_mm, shape.isoperimetric(), cpu);
   return better ? flat : tube;
 }
 

@@ -61,14 +61,32 @@ std::vector<SegmentWork> flatten_branch_pieces(const std::vector<BranchPiece>& p
 // of its wall not shown: then its disk map is tried (tube_or_disk).
 constexpr double kDiskMapTrigger = 2 * kHiddenWallTolerance;
 
+// A disk piece's shape, known before it is mapped: its wall (mm^2), its rim's length (mm, the
+// boundary edges summed) and the largest distance along edges from the rim (mm).
+struct DiskShape {
+  double area_mm2 = 0, rim_mm = 0, depth_mm = 0;
+  // 4 pi area / rim^2: 1 for a flat round disk, < 1 for a flat strip, 2 for a hemisphere, about
+  // 2 h / r + 2 for a pouch of length h and radius r (infinity without a rim).
+  double isoperimetric() const;
+};
+DiskShape disk_shape(const Surface& s);
+
+// A disk piece of more faces than this keeps its tube map: its disk map is not tried. Measured
+// (docs/history/flatten.md session 34 "grown"): on the grown CT mask, grown real mask and raw CT mask
+// rows the disk map won on pieces of 270-8 532 faces and on none above: every one of 10 291-285 943
+// faces (7, all on the grown CT mask) was refused or showed less (the 285 943-face one 54 % of its
+// wall, against its tube map's 99.47 %), and they took 19 of the 26 thread-CPU s its disk maps cost.
+constexpr std::size_t kDiskMapMaxFaces = 20000;
+
 // Maps a disk as one band (disk_map.h flatten_disk; empty: refused).
 using FlattenDisk = std::function<std::vector<SegmentWork>(const Surface&)>;
 
 // A cut-off piece's works: `tube` (its tube map and the bands below it: flatten_surface's, from its
 // rim to a tip cap or a slit) or, for a disk piece (piece.as_disk()) whose tube map misses the
-// coverage target (kDiskMapTrigger), its disk map `disk` instead when that shows more wall with an
-// area p05 no lower than the tube map's lowest band p05 (issue 26, session 33 "patchmap").
-// COLONFLAT_FLATTEN_DEBUG: one line per disk map tried (`depth`: the piece's band depth).
+// coverage target (kDiskMapTrigger) and has at most kDiskMapMaxFaces faces, its disk map `disk`
+// instead when that shows more wall with an area p05 no lower than the tube map's lowest band p05
+// (issue 26, session 33 "patchmap"). COLONFLAT_FLATTEN_DEBUG: one line per disk map tried (`depth`:
+// the piece's band depth; its shape and the disk map's thread CPU) or skipped for its size.
 std::vector<SegmentWork> tube_or_disk(const BranchPiece& piece, std::vector<SegmentWork> tube, const FlattenDisk& disk,
                                       int depth);
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "../src/band_faces.h"
+#include "../src/branch_bands.h"
 #include "../src/disk_map.h"
 #include "colonflat/core/threads.h"
 #include "squeezed_grid.h"
@@ -167,6 +168,41 @@ TEST(DiskMap, SameMapForOneAndTwoThreads) {
   ASSERT_EQ(one.w.emb.pos.size(), two.w.emb.pos.size());
   for (std::size_t v = 0; v < one.w.emb.pos.size(); ++v) EXPECT_EQ(one.w.emb.pos[v], two.w.emb.pos[v]) << v;
   EXPECT_GT(one.r.corrected_iterations + int(one.r.balanced_vertices), 0);  // the correction ran
+}
+
+// A tube map (one band) that shows `shown` of the piece's wall `wall` (mm^2), area p05 0.
+std::vector<flat_detail::SegmentWork> tube_showing(double shown, double wall) {
+  std::vector<flat_detail::SegmentWork> tube(1);
+  tube[0].seg.coverage.wall_area_mm2 = wall;
+  tube[0].seg.coverage.shown_area_mm2 = shown;
+  tube[0].seg.stats.area_p05 = 0.0;
+  tube[0].seg.map = "area-balanced";
+  return tube;
+}
+
+// tube_or_disk tries a disk piece's disk map only up to kDiskMapMaxFaces faces: the 12 x 120 mm
+// stadium (2 8xx faces) whose tube map shows half of it gets its disk map (made, and kept: it shows
+// >= 99.5 %); a 12 x 1 800 mm stadium (over 40 000 faces) with the same tube map keeps the tube map
+// and its disk map is never made (measured: no piece above 8 532 faces won on the three patched
+// rows, the 285 943-face one took 14.8 CPU s to show 54 %).
+TEST(DiskMap, OnlyPiecesUpToTheSizeLimitAreDiskMapped) {
+  for (int nx : {121, 1801}) {
+    flat_detail::BranchPiece piece;
+    piece.surface = stadium(nx);
+    const bool small = piece.surface.t.size() <= flat_detail::kDiskMapMaxFaces;
+    ASSERT_EQ(small, nx == 121) << piece.surface.t.size();
+    const double wall = flat_detail::surface_area(piece.surface);
+    int made = 0;
+    const flat_detail::FlattenDisk disk = [&](const flat_detail::Surface& d) {
+      ++made;
+      return flat_detail::flatten_disk(d, 0, 1.0, FlattenOptions{});
+    };
+    const auto works = flat_detail::tube_or_disk(piece, tube_showing(0.5 * wall, wall), disk, 1);
+    ASSERT_EQ(works.size(), 1u);
+    EXPECT_EQ(made, small ? 1 : 0) << nx;
+    EXPECT_EQ(works[0].seg.map, small ? "disk" : "area-balanced") << nx;
+    if (small) EXPECT_GE(works[0].seg.coverage.shown_area_mm2, 0.995 * wall);
+  }
 }
 
 }  // namespace
