@@ -245,17 +245,20 @@ std::function<bool()> whole_band_done(const SegmentWork& w, const std::vector<ch
   }
   const std::size_t moved_faces = std::size_t(std::count(moved->begin(), moved->end(), 1));
   const bool debug = std::getenv("COLONFLAT_FLATTEN_DEBUG") != nullptr;
-  return [&w, &degenerate, &o, frames, scratch, moved, moved_faces, debug, rule = WholeBandStop(), step = 0]() mutable {
-    const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get(), scratch.get());
-    if (rule.all_done(now.all)) return true;
+  auto all = std::make_shared<AllFacesCheck>(w.ann, *frames, degenerate);  // rule (a), after every step
+  return [&w, &degenerate, &o, frames, scratch, moved, moved_faces, debug, all, rule = WholeBandStop(), step = 0]() mutable {
+    if (all->all_done(w.emb)) return true;
     if (!WholeBandStop::judges_free(++step)) return false;
     std::vector<FaceDistortion>& fd = scratch->fd;  // the held faces left out, as degenerate ones are
+    band_distortion(w, degenerate, frames.get(), fd);
     for (std::size_t f = 0; f < fd.size(); ++f) fd[f].degenerate = !(*moved)[f];
     const BoundStats free = bound_stats_in_map(fd, &scratch->ratio);
-    if (debug)
+    if (debug) {
+      const CorrectionNeed now = needs_correction(w, degenerate, o, frames.get());
       std::fprintf(stderr, "flatten debug whole-band check %d: all p05 %.4f p95 %.4f qc %.4f hidden %.6f; "
                    "free (%zu of %zu faces) p05 %.4f p95 %.4f qc %.4f\n", step, now.all.area_p05, now.all.area_p95,
                    now.all.qc_mean, now.hidden, moved_faces, fd.size(), free.area_p05, free.area_p95, free.qc_mean);
+    }
     return rule.free_done(free);
   };
 }

@@ -62,10 +62,12 @@ class WholeBandStop {
   }
   // (a), after each step; the caller measures the free faces only when this says go on.
   bool all_done(const BoundStats& all) {
-    const bool angles = all.qc_mean <= kWholeBandQcMean || all.qc_mean >= last_qc_;
+    const bool angles = angles_settled(all.qc_mean, last_qc_);
     last_qc_ = all.qc_mean;
     return within_area(all) && angles;
   }
+  // (a)'s angle part: qc mean `qc` after a step, `before` after the step before (infinity before the first).
+  static bool angles_settled(double qc, double before) { return qc <= kWholeBandQcMean || qc >= before; }
   // Whether (b) is judged after step `step` (1, 2, ...; the caller measures the free faces then).
   static bool judges_free(int step) { return step % kStallSteps == 0; }
   // (b), after each step judges_free() names, when all_done() said go on.
@@ -83,6 +85,41 @@ class WholeBandStop {
   double last_qc_ = std::numeric_limits<double>::infinity();
   BoundStats before_;    // the free faces' measures kStallSteps steps before
   bool judged_ = false;  // before_ is set
+};
+
+// Rule (a) of WholeBandStop measured after each step as cheaply as its verdict allows (issue 26, session
+// 34 "idle"): the same verdicts, step by step, as WholeBandStop::all_done() on bound_stats_in_map() of
+// the band's distortion (the same area ratio and qc bits, summed in the same face order). Whether the
+// area ratios are within the margins needs no percentile: the 5th is >= kWholeBandAreaLow exactly when
+// at most k05 ratios are below it (the 95th likewise), so a step costs each face's map area and two
+// counts. The qc mean is needed only when the areas are within the margins (then for this step and
+// the one before, whose positions are kept): on U120's colon band (held faces keep its p05 at 0.04)
+// never, on the CT rows' bands at their last 2 steps. A ratio that is NaN falls back to the percentiles.
+class AllFacesCheck {
+ public:
+  // `frames`: band_frames() of the band's faces (kept by reference, as s and degenerate are).
+  AllFacesCheck(const Surface& s, const std::vector<FaceFrame>& frames, const std::vector<char>& degenerate)
+      : s_(s), frames_(frames), degenerate_(degenerate) {
+    area3_.reserve(frames.size());
+    for (const FaceFrame& fr : frames) area3_.push_back(fr.area3);
+  }
+  // Rule (a) on the map `emb` after the next step.
+  bool all_done(const Embedding& emb);
+  // The qc mean over the faces in the map at positions `pos` (corner offsets emb.dy): bound_stats_in_map()'s.
+  double qc_mean(const std::vector<V2>& pos, const Embedding& emb);
+  // Whether every face's area ratio is within the area margins (WholeBandStop::within_area of the faces in the map).
+  bool within_area(const Embedding& emb);
+
+ private:
+  bool in_map(std::size_t f, double area2) const { return !degenerate_[f] && !too_small_in_map(area2, area3_[f]); }
+  const Surface& s_;
+  const std::vector<FaceFrame>& frames_;
+  const std::vector<char>& degenerate_;
+  std::vector<double> area3_;       // per face, frames_[f].area3 (the sums read them in face order)
+  std::vector<double> area2_, qc_;  // per face, the last measure's
+  std::vector<V2> before_;          // the positions after the step before, when its qc mean is not known
+  double qc_before_ = std::numeric_limits<double>::infinity();
+  bool known_ = true;               // qc_before_ is the qc mean after the step before
 };
 
 // The whole-band pass's stop check for band `w` as it is now (asked after each step; band_axis.cpp):

@@ -4,6 +4,8 @@
 // (all faces within the margins, angles settled) still stops a band at once.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -88,6 +90,66 @@ TEST(WholeBandStop, BandWithHeldFacesStopsOnceItsFreeFacesAreDone) {
   set_thread_count(0);
   ASSERT_EQ(final_pos[0].size(), final_pos[1].size());
   EXPECT_EQ(std::memcmp(final_pos[0].data(), final_pos[1].data(), final_pos[0].size() * sizeof(flat_detail::V2)), 0);
+}
+
+// The squeezed grid (24 x 12 x size 8: 36 290 faces, 5 blocks of face_blocks.h) mapped at step k with
+// its middle columns squeezed to squeeze[k] of their width, the whole map sheared by shear[k]
+// (x += shear y: areas kept, angles not), every vertex moved by a fixed jitter of 1e-3 and its last
+// column crushed to 1e-9 of its width.
+flat_detail::Embedding squeezed_step(const test_shapes::SqueezedGrid& g, double squeeze, double shear) {
+  flat_detail::Embedding emb = g.emb;
+  const int a = 8 * g.nx / 24, b = 16 * g.nx / 24;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const double x = i < a ? i : i < b ? a + squeeze * (i - a) : a + (b - a) * squeeze + (i - b);
+      const std::size_t v = std::size_t(j * g.nx + i);
+      emb.pos[v] = flat_detail::V2(x + shear * j + 1e-3 * std::sin(7.0 * double(v)), j + 1e-3 * std::cos(5.0 * double(v)));
+    }
+  for (int j = 0; j < g.ny; ++j)  // the last column crushed out of the map
+    emb.pos[std::size_t(j * g.nx + g.nx - 1)] = emb.pos[std::size_t(j * g.nx + g.nx - 2)] + flat_detail::V2(1e-9, 0);
+  return emb;
+}
+
+// AllFacesCheck (rule (a) from counts, its qc means only when the areas are within the margins, the
+// step before's from its kept positions) says stop at exactly the steps WholeBandStop::all_done says so
+// on the full statistics (bound_stats_in_map of the band's distortion), on 1, 2 and 3 threads, over steps
+// that go in and out of the area margins with the qc mean rising and falling; one face is degenerate
+// and one column crushed out of the map. The sequence holds a stop right after a step out of the margins
+// (the kept positions decide it) and a step within the margins that does not stop (angles unsettled).
+TEST(WholeBandStop, CheckFromCountsSaysWhatTheFullStatisticsSay) {
+  const std::vector<double> squeeze = {0.1, 0.3, 0.3, 0.32, 0.12, 0.35, 0.35, 0.15, 0.35, 0.45, 0.9, 0.05, 0.6};
+  const std::vector<double> shear = {0.0, 0.8, 0.9, 0.7, 0.0, 0.1, 0.2, 0.0, 1.5, 0.4, 0.0, 0.0, 0.3};
+  test_shapes::SqueezedGrid g(0.3, 8);
+  g.degenerate[100] = 1;
+  std::vector<char> expected, within;
+  {  // the full statistics
+    WholeBandStop rule;
+    for (std::size_t k = 0; k < squeeze.size(); ++k) {
+      flat_detail::SegmentWork w;
+      w.ann = g.s, w.emb = squeezed_step(g, squeeze[k], shear[k]);
+      const BoundStats all = flat_detail::bound_stats_in_map(flat_detail::band_distortion(w, g.degenerate));
+      within.push_back(WholeBandStop::within_area(all));
+      expected.push_back(rule.all_done(all));
+    }
+  }
+  for (int threads : {1, 2, 3}) {
+    set_thread_count(threads);
+    flat_detail::SegmentWork w;
+    w.ann = g.s;
+    const std::vector<flat_detail::FaceFrame> frames = flat_detail::band_frames(w);
+    flat_detail::AllFacesCheck check(w.ann, frames, g.degenerate);
+    for (std::size_t k = 0; k < squeeze.size(); ++k) {
+      w.emb = squeezed_step(g, squeeze[k], shear[k]);
+      EXPECT_EQ(check.all_done(w.emb), expected[k] != 0) << "step " << k << ", " << threads << " threads";
+    }
+  }
+  set_thread_count(0);
+  bool stop_after_out = false, within_going_on = false;
+  for (std::size_t k = 1; k < expected.size(); ++k)
+    stop_after_out |= expected[k] && !within[k - 1], within_going_on |= within[k] && !expected[k];
+  EXPECT_TRUE(stop_after_out);
+  EXPECT_TRUE(within_going_on);
+  EXPECT_FALSE(std::all_of(within.begin(), within.end(), [](char c) { return c != 0; }));
 }
 
 }  // namespace
