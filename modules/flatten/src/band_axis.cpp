@@ -283,8 +283,11 @@ static int correct_pass(SegmentWork& w, const std::vector<std::vector<int>>& vf,
                  local ? "local" : "whole band", local ? "longest piece" : "band", times.longest_faces, times.longest_steps,
                  times.longest_s, times.build_s, t.gradient, t.solve, t.step_limit, t.line_search, t.energy_evals, t.check,
                  times.pieces, times.pieces_s, times.longest_place + 1);
+    const Stopwatch measures;  // debug only, inside the pass's debug clock stretch (mostly one thread)
     debug_stats(local ? "local area correction" : "area correction", w, degenerate);
     debug_pockets(local ? "local area correction" : "area correction", w, degenerate, fixed);
+    std::fprintf(stderr, "flatten debug area correction (%s) measures (debug only): %.2f s wall\n",
+                 local ? "local" : "whole band", measures.seconds());
   }
   return corr.iterations;
 }
