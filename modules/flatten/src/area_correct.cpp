@@ -260,8 +260,11 @@ void keep_pieces_hiding_wall(const Surface& s, const Embedding& emb, const std::
 constexpr double kSpotRatio = 1e-4, kStuckSpotRatio = 1e-3;
 constexpr int kSpotRings = 2;
 struct SpotWork {
-  std::size_t faces = 0;  // faces of the piece's spot regions
-  int steps = 0;          // most steps a spot region took
+  std::size_t faces = 0;    // faces of the piece's spot regions
+  int steps = 0;            // most steps a spot region took
+  std::size_t regions = 0;  // spot regions (vertex-connected)
+  long summed_steps = 0;    // steps of all regions
+  double seconds = 0;       // wall time of the regions' descents
 };
 SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>>& vf, Embedding& emb,
                             const std::vector<int>& piece, const std::vector<char>& free_vertex,
@@ -288,11 +291,13 @@ SpotWork open_crushed_spots(const Surface& s, const std::vector<std::vector<int>
     for (int v : s.t[f]) spot_free[v] = free_vertex[v];
   fix_region_rim(vf, [&](int g) { return mark[g] == 2; }, spot_free);
   work.faces = faces.size();
+  const Stopwatch clock;
   for (std::vector<int>& spot : connected_pieces(s, faces)) {
     AreaCorrection res;
     minimise(s, emb, std::move(spot), spot_free, area3, scale, o, true, res, {}, scratch);
-    work.steps = std::max(work.steps, res.iterations);
+    work.steps = std::max(work.steps, res.iterations), work.summed_steps += res.iterations, ++work.regions;
   }
+  work.seconds = clock.seconds();
   return work;
 }
 
@@ -358,11 +363,11 @@ class PieceLog {
              const std::vector<std::size_t>& place, const std::vector<SpotWork>& spots) const {
     for (std::size_t i = 0; i < part.size(); ++i)
       std::fprintf(stderr, "flatten debug local piece %zu (started %zu-th): %zu faces, %d steps of %d, %s, %.3f s; "
-                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps; room %.3f\n",
+                   "shown below %.2g: %.1f -> %.1f mm2; below %.2g: %.1f mm2; crushed spots first: %zu faces, %d steps (%zu regions, %ld steps summed, %.3f s); room %.3f\n",
                    i, place[i] + 1, pieces_[i].size(), part[i].iterations,
                    iteration_budget(pieces_[i].size(), true, o_.area_correction_iterations), part[i].stop,
                    times[i].longest_s, o_.coverage_min_ratio, hidden_before_[i], area_below(pieces_[i], o_.coverage_min_ratio),
-                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps, room_[i]);
+                   o_.area_ratio_low, area_below(pieces_[i], o_.area_ratio_low), spots[i].faces, spots[i].steps, spots[i].regions, spots[i].summed_steps, spots[i].seconds, room_[i]);
   }
 
  private:
