@@ -99,8 +99,10 @@ class SpdSolver {
   // idle; on a loaded machine the new thread also waits for a core). The local area-correction
   // pieces (a few thousand unknowns, 10^4-10^5 entries) solve hundreds to thousands of times each:
   // the real CT colon band's longest piece, 1 248 solves, 1.64 s -> 0.46 s wall at load 11-14
-  // (docs/flatten.md, session 15).
-  static constexpr std::size_t kThreadedSolveMinEntries = 1000000;
+  // (docs/flatten.md, session 15). 2 x 10^5 since session 34 ("idle"): the CT mask's lone window piece
+  // of the last local pass (30 k unknowns, below 10^6 entries) solved on one thread, 196 steps, the other
+  // core idle (its pass 1.78 -> 1.59 s wall, piece 1.47 -> 1.27 s at load 3; same bits: TreeSolve's).
+  static constexpr std::size_t kThreadedSolveMinEntries = 200000;
   // The first solve of a factor is CHOLMOD's (a factor solved once, as the conformal maps' v, does
   // not pay for a plan: 0.03 s on 1e7 entries, 0.08-0.4 s on 2.6e7 at load 10); from the second on
   // TreeSolve's (the whole-band pass solves its factor once a step, 3-60 steps).
