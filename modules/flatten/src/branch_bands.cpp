@@ -7,9 +7,8 @@
 #include <limits>
 #include <numeric>
 
-#include <time.h>
-
 #include "colonflat/core/threads.h"
+#include "factor_schedule.h"  // thread_cpu_seconds
 
 namespace cf::flat_detail {
 double surface_area(const Surface& s) {
@@ -37,12 +36,6 @@ DiskShape disk_shape(const Surface& s) {
 }
 
 namespace {
-
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
 
 // Appends the works of a flattened branch (its own first, parents relative to the list) to `out`,
 // the branch hanging from the work at index -1 (the caller's segment).
