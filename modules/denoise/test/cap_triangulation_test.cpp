@@ -85,9 +85,11 @@ std::vector<Vec3> bumpy_ring(int n) {
 }
 
 // The old programme, written out as the reference: every subproblem's candidates sorted by
-// (weight, apex) and `allowed` asked lightest first until one passes.
-std::vector<std::array<int, 3>> lightest_first_reference(const std::vector<Vec3>& p,
-                                                         const std::function<bool(int, int, int)>& allowed) {
+// (weight, apex) and `allowed` asked lightest first until one passes; with `side_ok`, each
+// subproblem's side (i, j) but the ring edge is asked first and a refused side leaves it without a
+// triangle. Per subproblem (i, j): its apex (arg[i n + j], -1: none).
+std::vector<int> lightest_first_apexes(const std::vector<Vec3>& p, const std::function<bool(int, int, int)>& allowed,
+                                       const std::function<bool(int, int)>& side_ok = {}) {
   const int n = static_cast<int>(p.size());
   const double none = std::numeric_limits<double>::infinity();
   std::vector<double> W(std::size_t(n) * n, 0.0);
@@ -103,12 +105,22 @@ std::vector<std::array<int, 3>> lightest_first_reference(const std::vector<Vec3>
       }
       std::sort(order.begin(), order.end());
       W[std::size_t(i) * n + j] = none;
+      const bool edge = i == 0 && j == n - 1;
+      if (side_ok && (order.empty() || (!edge && !side_ok(i, j)))) continue;
       for (const auto& [w, m] : order)
         if (allowed(i, m, j)) {
           W[std::size_t(i) * n + j] = w, arg[std::size_t(i) * n + j] = m;
           break;
         }
     }
+  return arg;
+}
+
+// The reference's triangles (empty when the whole ring has none).
+std::vector<std::array<int, 3>> lightest_first_reference(const std::vector<Vec3>& p,
+                                                         const std::function<bool(int, int, int)>& allowed) {
+  const int n = static_cast<int>(p.size());
+  const std::vector<int> arg = lightest_first_apexes(p, allowed);
   std::vector<std::array<int, 3>> tris;
   std::vector<std::pair<int, int>> stack{{0, n - 1}};
   while (!stack.empty()) {
@@ -257,28 +269,9 @@ TEST(DenoiseCapTriangulation, LightestFirstAsksWhatTheOldProgrammeAsked) {
   auto third = [&](int i, int m, int j) { return asked.push_back({i, m, j}), !refused(i, m, j, 33); };
   auto side_ok = [&](int a, int b) { return asked.push_back({a, b, -1}), !refused(a, b, -1, 20); };
   const auto tris = min_area_triangulation(ring, third, {}, side_ok);
-  const double none = std::numeric_limits<double>::infinity();
-  std::vector<double> W(std::size_t(n) * n, 0.0);
-  std::vector<int> arg(std::size_t(n) * n, -1);
-  for (int len = 2; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
-      std::vector<std::pair<double, int>> order;
-      for (int m = i + 1; m < j; ++m) {
-        const double w = W[std::size_t(i) * n + m] + W[std::size_t(m) * n + j] +
-                         0.5 * OpenMesh::cross(ring[m] - ring[i], ring[j] - ring[i]).norm();
-        if (w < none) order.push_back({w, m});
-      }
-      std::sort(order.begin(), order.end());
-      W[std::size_t(i) * n + j] = none;
-      const bool edge = i == 0 && j == n - 1;
-      if (order.empty() || (!edge && (expected.push_back({i, j, -1}), refused(i, j, -1, 20)))) continue;
-      for (const auto& [w, m] : order)
-        if (expected.push_back({i, m, j}), !refused(i, m, j, 33)) {
-          W[std::size_t(i) * n + j] = w, arg[std::size_t(i) * n + j] = m;
-          break;
-        }
-    }
+  const std::vector<int> arg = lightest_first_apexes(
+      ring, [&](int i, int m, int j) { return expected.push_back({i, m, j}), !refused(i, m, j, 33); },
+      [&](int i, int j) { return expected.push_back({i, j, -1}), !refused(i, j, -1, 20); });
   EXPECT_EQ(asked, expected);
   ASSERT_EQ(tris.size(), ring.size() - 2);
   for (const auto& t : tris) EXPECT_EQ(arg[std::size_t(t[0]) * n + t[2]], t[1]);
