@@ -13,6 +13,7 @@
 #include "colonflat/denoise/homology.h"
 #include "colonflat/denoise/surgery.h"
 #include "self_intersections.h"
+#include "guarded_cut.h"
 #include "swept_profile.h"
 
 namespace cf {
@@ -53,10 +54,7 @@ std::vector<Mesh::VertexHandle> top_loop(int nu) {
   return testing::swept_point_loop(nu, static_cast<int>(washer_profile(0).size()), kLoopPoint);
 }
 
-struct Cut {
-  Mesh mesh;
-  SurgeryResult result;
-};
+using Cut = testing::GuardedCut;
 
 // The steep ripple: a crest 0.175 mm above the loop half a millimetre inside it, higher than a
 // collar may rise there (a third of the 0.45 mm between the loop and the plate).
@@ -64,14 +62,7 @@ constexpr double kGentleRipple = 0.02, kSteepRipple = 0.1;
 double plate_gap(double ripple) { return ripple == kSteepRipple ? 0.15 : 0.3; }
 
 Cut cut_top_loop(int nu, HomologyBasis* homology = nullptr, double ripple = kGentleRipple) {
-  Cut c;
-  c.mesh = rippled_washer_under_a_plate(ripple, plate_gap(ripple), nu);
-  if (homology) homology->build(c.mesh);
-  FaceGrid grid(c.mesh, 3 * testing::mean_edge(c.mesh));
-  SurgeryOptions o;
-  o.guard = &grid;
-  c.result = cut_and_cap(c.mesh, top_loop(nu), o, homology);
-  return c;
+  return testing::guarded_cut(rippled_washer_under_a_plate(ripple, plate_gap(ripple), nu), top_loop(nu), {}, homology);
 }
 
 // The test surface is what it claims: two embedded washers, genus 1 each, and the top loop at

@@ -11,6 +11,7 @@
 #include "colonflat/denoise/free_space_cut.h"
 #include "colonflat/denoise/surgery.h"
 #include "self_intersections.h"
+#include "guarded_cut.h"
 #include "swept_profile.h"
 
 namespace cf {
@@ -55,22 +56,14 @@ std::vector<Mesh::VertexHandle> hole_loop() {
   return testing::swept_point_loop(kSections, static_cast<int>(washer_profile().size()), kLoopPoint);
 }
 
-struct Cut {
-  Mesh mesh;
-  SurgeryResult result;
-};
+using Cut = testing::GuardedCut;
 
 // The hole loop cut with a guard, as in a loop's last cut (every cap kind), mincut caps on or off.
 Cut cut_hole_loop(bool mincut, bool trial = false) {
-  Cut c;
-  c.mesh = washer_with_stepped_gap();
-  FaceGrid grid(c.mesh, 3 * testing::mean_edge(c.mesh));
   SurgeryOptions o;
-  o.guard = &grid;
   o.mincut = mincut;
   o.trial = trial;
-  c.result = cut_and_cap(c.mesh, hole_loop(), o);
-  return c;
+  return testing::guarded_cut(washer_with_stepped_gap(), hole_loop(), o);
 }
 
 // The input is what it claims: a genus-1 washer and 12 boxes, closed, embedded, and the loop is

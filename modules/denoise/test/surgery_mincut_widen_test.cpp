@@ -11,6 +11,7 @@
 #include "colonflat/core/topology.h"
 #include "colonflat/denoise/surgery.h"
 #include "self_intersections.h"
+#include "guarded_cut.h"
 #include "swept_profile.h"
 
 namespace cf {
@@ -79,24 +80,16 @@ std::vector<Mesh::VertexHandle> hole_loop() {
   return testing::swept_point_loop(kSections, static_cast<int>(tongue_profile(0).size()), kLoopPoint);
 }
 
-struct Cut {
-  Mesh mesh;
-  SurgeryResult result;
-};
+using Cut = testing::GuardedCut;
 
 // The hole loop cut as in a loop's last cut after its triangulated caps failed: minimum-cut caps,
 // then concentric ones; walls widened by up to `widen` cells (0: never).
 Cut cut_hole_loop(double widen) {
-  Cut c;
-  c.mesh = tongued_washer();
-  FaceGrid grid(c.mesh, 3 * testing::mean_edge(c.mesh));
   SurgeryOptions o;
-  o.guard = &grid;
   o.mincut = true;
   o.triangulated = false;
   o.mincut_widen = widen;
-  c.result = cut_and_cap(c.mesh, hole_loop(), o);
-  return c;
+  return testing::guarded_cut(tongued_washer(), hole_loop(), o);
 }
 
 // The input is what it claims: a closed, embedded genus-1 surface whose loop is the hole's circle
