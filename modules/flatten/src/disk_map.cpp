@@ -74,7 +74,7 @@ bool segments_cross(const V2& p0, const V2& p1, const V2& q0, const V2& q1) {
 }
 
 // Whether two boundary edges that share no vertex cross: the edges swept in order of their lowest x.
-bool boundary_crosses(const Surface& s, const Edges& E, const Embedding& emb) {
+bool boundary_crosses(const Edges& E, const Embedding& emb) {
   std::vector<int> be;
   for (std::size_t e = 0; e < E.ev.size(); ++e)
     if (E.ef[e][1] < 0) be.push_back(int(e));
@@ -91,7 +91,6 @@ bool boundary_crosses(const Surface& s, const Edges& E, const Embedding& emb) {
         return true;
     }
   }
-  (void)s;
   return false;
 }
 
@@ -180,7 +179,7 @@ bool conformal_disk(SegmentWork& w, const Edges& E, const std::vector<std::vecto
   if (folds > 0) untangle(w.ann, vf, w.emb, rim, degenerate);
   if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
     std::fprintf(stderr, "flatten debug disk map, %zu faces: %zu folded (clamped), %zu after untangle, boundary crosses %d\n",
-                 w.ann.t.size(), folds, folded(), int(boundary_crosses(w.ann, E, w.emb)));
+                 w.ann.t.size(), folds, folded(), int(boundary_crosses(E, w.emb)));
   return injective_disk_map(w.ann, E, w.emb, degenerate);
 }
 
@@ -234,7 +233,7 @@ std::vector<V2> lscm_positions(const Surface& s, const Edges& E, const std::vect
 bool injective_disk_map(const Surface& s, const Edges& E, const Embedding& emb, const std::vector<char>& degenerate) {
   for (std::size_t f = 0; f < s.t.size(); ++f)
     if (!degenerate[f] && emb.area2(s, int(f)) < 0) return false;
-  return !boundary_crosses(s, E, emb);
+  return !boundary_crosses(E, emb);
 }
 
 DiskMapResult disk_band(SegmentWork& w, const Prepared& p, const FlattenOptions& o) {
