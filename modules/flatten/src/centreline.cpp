@@ -2,7 +2,9 @@
 // anatomical labelling (rectum / cecum) and order of the segments' ends.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "face_blocks.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -17,8 +19,39 @@ struct FaceSample {
   V3 centroid;
 };
 
+// The used faces' samples in face order, each computed on its own in blocks of faces on the worker
+// threads (the same bits for any thread count; the array is first written there too, not zeroed
+// on the calling thread first).
+class FaceSamples {
+ public:
+  FaceSamples(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face) {
+    const std::size_t nb = face_blocks(s.t.size());
+    std::vector<std::size_t> first(nb + 1, 0);  // per block: its first sample
+    for (std::size_t f = 0; f < s.t.size(); ++f) first[f / kFaceBlock + 1] += use_face[f] != 0;
+    for (std::size_t b = 0; b < nb; ++b) first[b + 1] += first[b];
+    size_ = first[nb];
+    data_.reset(new FaceSample[size_]);  // (default-initialised: not written here)
+    for_each_block(s.t.size(), [&](std::size_t begin, std::size_t end) {
+      std::size_t k = first[begin / kFaceBlock];
+      for (std::size_t f = begin; f < end; ++f) {
+        if (!use_face[f]) continue;
+        const Tri& t = s.t[f];
+        const double uf = (u[t[0]] + u[t[1]] + u[t[2]]) / 3;
+        data_[k++] = {uf, uf, face_area_3d(s, int(f)), (s.p[t[0]] + s.p[t[1]] + s.p[t[2]]) / 3};
+      }
+    });
+  }
+  std::size_t size() const { return size_; }
+  FaceSample* begin() const { return data_.get(); }
+  FaceSample* end() const { return data_.get() + size_; }
+
+ private:
+  std::unique_ptr<FaceSample[]> data_;
+  std::size_t size_ = 0;
+};
+
 // Area-weighted centroid and mean u of the faces in each of `bins` equal bins of key in [0, kmax].
-void slice_centroids(const std::vector<FaceSample>& faces, int bins, double kmax, std::vector<V3>& centre,
+void slice_centroids(const FaceSamples& faces, int bins, double kmax, std::vector<V3>& centre,
                      std::vector<double>& mean_u) {
   std::vector<V3> sum(bins, V3::Zero());
   std::vector<double> su(bins, 0.0), sa(bins, 0.0);
@@ -112,14 +145,7 @@ double Centreline::s_of_u(double u) const {
 
 Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, const std::vector<char>& use_face,
                              const V3& end_a, const V3& end_b) {
-  std::vector<FaceSample> faces;
-  faces.reserve(s.t.size());
-  for (std::size_t f = 0; f < s.t.size(); ++f) {
-    if (!use_face[f]) continue;
-    const Tri& t = s.t[f];
-    const double uf = (u[t[0]] + u[t[1]] + u[t[2]]) / 3;
-    faces.push_back({uf, uf, face_area_3d(s, int(f)), (s.p[t[0]] + s.p[t[1]] + s.p[t[2]]) / 3});
-  }
+  const FaceSamples faces(s, u, use_face);
   // Pass 1: 256 slices equal in u give a coarse arc length s1(u).
   std::vector<V3> centre;
   std::vector<double> mean_u;
@@ -127,7 +153,9 @@ Centreline centreline_from_u(const Surface& s, const std::vector<double>& u, con
   const Centreline coarse = polyline(centre, mean_u, end_a, end_b, 2);
   // Pass 2: slices about 8 mm apart in s1 (equal in length, not in u), smoothed across.
   const int bins = std::clamp(int(coarse.length / 8.0), 8, 2000);
-  for (auto& fs : faces) fs.key = coarse.s_of_u(fs.u);
+  for_each_block(faces.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) faces.begin()[k].key = coarse.s_of_u(faces.begin()[k].u);
+  });
   slice_centroids(faces, bins, coarse.length, centre, mean_u);
   Centreline c = polyline(centre, mean_u, end_a, end_b, 8);
   // Cumulative wall area as a function of u (4096 bins), made strictly increasing.

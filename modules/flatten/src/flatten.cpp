@@ -19,6 +19,7 @@
 #include "band_faces.h"
 #include "branch_bands.h"
 #include "disk_map.h"
+#include "face_blocks.h"
 #include "factor_memory.h"
 #include "hidden_patches.h"
 #include "flatten_internal.h"
@@ -107,11 +108,14 @@ V3 loop_centre(const Surface& s, const std::vector<int>& l) {
   return m / double(l.size());
 }
 
+// (Counted in blocks of faces on the worker threads: an integer, the same for any thread count.)
 std::size_t count_bad(const Surface& s, const Embedding& emb, const std::vector<char>& degenerate) {
-  std::size_t n = 0;
-  for (std::size_t f = 0; f < s.t.size(); ++f)
-    if (!degenerate[f] && too_small_in_map(emb.area2(s, int(f)), face_area_3d(s, int(f)))) ++n;
-  return n;
+  return std::size_t(block_sum(s.t.size(), [&](std::size_t begin, std::size_t end) {
+    double n = 0;
+    for (std::size_t f = begin; f < end; ++f)
+      n += !degenerate[f] && too_small_in_map(emb.area2(s, int(f)), face_area_3d(s, int(f)));
+    return n;
+  }));
 }
 
 // Conformal map scaled to the area-preserving rectangle, fold-overs untangled. With "auto"
@@ -129,8 +133,12 @@ Embedding conformal_step(SegmentWork& w, const Edges& E, const std::vector<std::
     faces_ready();
     w.prior = PriorSolve{h.vertex_order, std::move(h.factor), {}, {}};
     Embedding emb = embed_conformal(s, E, h, 1.0, 1.0);
+    std::vector<double> area2(s.t.size());  // each face's in blocks on the worker threads, summed in face order
+    for_each_block(s.t.size(), [&](std::size_t b, std::size_t e) {
+      for (; b < e; ++b) area2[b] = emb.area2(s, int(b));
+    });
     double signed_area = 0;
-    for (std::size_t f = 0; f < s.t.size(); ++f) signed_area += emb.area2(s, int(f));
+    for (double a : area2) signed_area += a;
     const double scale = std::sqrt(w.seg.area_3d / h.period);
     emb = embed_conformal(s, E, h, signed_area >= 0 ? 1.0 : -1.0, scale);
     w.seg.untangled_vertices = w.folds_pending ? 0 : untangle(s, vf, emb, fixed, degenerate);
@@ -284,18 +292,24 @@ void attach_branches(const SegmentWork& w, std::vector<SegmentWork>& branches) {
 // Centreline from the level sets of u (crowded faces left out) and each vertex's arc length.
 Centreline centreline_step(SegmentWork& w, const std::vector<std::vector<int>>& loops) {
   const Surface& ann = w.ann;
-  std::vector<double> u(ann.p.size());
-  for (std::size_t v = 0; v < ann.p.size(); ++v) u[v] = std::clamp(w.emb.pos[v].x() / w.seg.length, 0.0, 1.0);
+  std::vector<double> u(ann.p.size());  // (each vertex and face on its own, in blocks on the worker threads)
+  for_each_block(ann.p.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) u[v] = std::clamp(w.emb.pos[v].x() / w.seg.length, 0.0, 1.0);
+  });
   std::vector<char> use_face(ann.t.size(), 1);
   const double conformal_scale = w.seg.area_3d / (w.seg.length * w.seg.period);
-  for (std::size_t f = 0; f < ann.t.size(); ++f)
-    use_face[f] = w.emb.area2(ann, int(f)) * conformal_scale >= 0.05 * face_area_3d(ann, int(f));
+  for_each_block(ann.t.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f)
+      use_face[f] = w.emb.area2(ann, int(f)) * conformal_scale >= 0.05 * face_area_3d(ann, int(f));
+  });
   const V3 ca = loop_centre(ann, loops[0]), cb = loop_centre(ann, loops[1]);
   Centreline cl = centreline_from_u(ann, u, use_face, ca, cb);
   w.seg.centreline = cl.points;
   w.seg.centreline_length = cl.length;
   w.along.resize(ann.p.size());
-  for (std::size_t v = 0; v < ann.p.size(); ++v) w.along[v] = cl.s_of_u(u[v]);
+  for_each_block(ann.p.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) w.along[v] = cl.s_of_u(u[v]);
+  });
   return cl;
 }
 

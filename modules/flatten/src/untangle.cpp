@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "face_blocks.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {
@@ -42,10 +43,15 @@ class Untangler {
     if (!in_[v]) in_[v] = 1, region_.push_back(v);
   }
 
-  // The vertices of the folded faces.
+  // The vertices of the folded faces (in face order; which faces are folded is asked in blocks of
+  // faces on the worker threads).
   void seed() {
+    std::vector<char> fold(s_.t.size());
+    for_each_block(s_.t.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t f = begin; f < end; ++f) fold[f] = folded(int(f));
+    });
     for (std::size_t f = 0; f < s_.t.size(); ++f)
-      if (folded(int(f)))
+      if (fold[f])
         for (int v : s_.t[f]) add(v);
   }
 

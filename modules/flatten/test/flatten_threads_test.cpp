@@ -3,9 +3,12 @@
 // by column.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "colonflat/core/synthetic.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/flatten/flatten.h"
+#include "../src/face_blocks.h"
 #include "../src/factor_memory.h"
 #include "../src/flatten_internal.h"
 #include "flatten_shapes.h"
@@ -52,6 +55,74 @@ TEST(FlattenThreads, OneAndTwoThreadsGiveTheSameMap) {
     EXPECT_EQ(one.segments[k].corrected_iterations, two.segments[k].corrected_iterations);
   }
   EXPECT_EQ(one.stats.flipped, 0u);
+}
+
+// An open cylinder along x (radius 10 mm, 200 mm long, 400 rings of 64 vertices: 51 200 faces, seven
+// blocks), u = x / 200.
+flat_detail::Surface cylinder_band() {
+  flat_detail::Surface s;
+  constexpr int kRings = 401, kAround = 64;
+  for (int i = 0; i < kRings; ++i)
+    for (int j = 0; j < kAround; ++j) {
+      const double a = 2 * M_PI * j / kAround;
+      s.p.emplace_back(200.0 * i / (kRings - 1), 10 * std::cos(a), 10 * std::sin(a));
+    }
+  for (int i = 0; i + 1 < kRings; ++i)
+    for (int j = 0; j < kAround; ++j) {
+      const int a = i * kAround + j, b = i * kAround + (j + 1) % kAround;
+      s.t.push_back({a, b, b + kAround});
+      s.t.push_back({a, b + kAround, a + kAround});
+    }
+  return s;
+}
+
+flat_detail::Centreline centreline_on_threads(const flat_detail::Surface& s, const std::vector<char>& use, int threads) {
+  std::vector<double> u(s.p.size());
+  for (std::size_t v = 0; v < s.p.size(); ++v) u[v] = s.p[v].x() / 200.0;
+  set_thread_count(threads);
+  flat_detail::Centreline c = centreline_from_u(s, u, use, {0, 0, 0}, {200, 0, 0});
+  set_thread_count(0);
+  return c;
+}
+
+// The centreline's face samples and arc lengths (computed in blocks of faces on the worker threads)
+// give the same bits on 1, 2 and 3 threads, with some faces left out; with all faces in, it is the
+// cylinder's axis (the ring centroids), 200 mm long, with the wall area spread evenly over u.
+TEST(FlattenThreads, CentrelineIsTheSameOnOneTwoThreeThreadsAndFollowsTheAxis) {
+  const flat_detail::Surface s = cylinder_band();
+  ASSERT_GT(s.t.size(), 6 * flat_detail::kFaceBlock);
+  std::vector<char> some(s.t.size(), 1);
+  for (std::size_t f = 3; f < s.t.size(); f += 7) some[f] = 0;
+  const flat_detail::Centreline one = centreline_on_threads(s, some, 1);
+  for (int threads : {2, 3}) {
+    const flat_detail::Centreline c = centreline_on_threads(s, some, threads);
+    EXPECT_EQ(c.points, one.points) << threads;
+    EXPECT_EQ(c.knot_u, one.knot_u) << threads;
+    EXPECT_EQ(c.knot_s, one.knot_s) << threads;
+    EXPECT_EQ(c.area_cdf, one.area_cdf) << threads;
+    EXPECT_EQ(c.length, one.length) << threads;
+  }
+  const flat_detail::Centreline axis = centreline_on_threads(s, std::vector<char>(s.t.size(), 1), 2);
+  EXPECT_NEAR(axis.length, 200.0, 1e-3);
+  ASSERT_GT(axis.points.size(), 20u);
+  for (const auto& p : axis.points) EXPECT_LT(std::hypot(p[1], p[2]), 1e-9);
+  for (std::size_t k = 0; k < axis.area_cdf.size(); k += 256)
+    EXPECT_NEAR(axis.area_cdf[k], double(k) / double(axis.area_cdf.size() - 1), 3e-3) << k;
+  for (double x : {25.0, 100.0, 180.0}) EXPECT_NEAR(axis.s_of_u(x / 200), x, 0.5) << x;
+}
+
+// The two-segment case with 3 threads (blocks of faces split unevenly over the threads: the
+// conformal maps' signed areas and bad-face counts, the centrelines, the untangling's folds) lands
+// every flat vertex where 1 thread does.
+TEST(FlattenThreads, ThreeThreadsGiveTheOneThreadMap) {
+  const TriangleList mesh = two_segments_with_a_branch();
+  const FlatMap one = test_shapes::flatten_with_threads(mesh, 1);
+  const FlatMap three = test_shapes::flatten_with_threads(mesh, 3);
+  ASSERT_GE(one.segments.size(), 3u);
+  EXPECT_EQ(one.uv, three.uv);
+  EXPECT_EQ(one.source_vertex, three.source_vertex);
+  EXPECT_EQ(one.triangles, three.triangles);
+  EXPECT_EQ(one.coverage.fraction, three.coverage.fraction);
 }
 
 // The band left once its side branch is cut has its faces prepared (wall area, degenerate and
