@@ -68,7 +68,8 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     const int nv = int(s.p.size());
     const bool dissect = uses_dissection(s.p.size(), o.map), balanced = o.map == "area-balanced";
     std::shared_future<SegmentOrder> order;
-    if (dissect) order = std::async(side_launch(), [t = s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(t, nv), true}; });
+    // (s outlives the order: flatten_surface waits for it, or an exception's unwinding of w does)
+    if (dissect) order = std::async(side_launch(), [t = &s.t, nv] { return SegmentOrder{nested_dissection_vertex_order(*t, nv), true}; });
     auto E0 = std::make_shared<const Edges>(build_edges(s.t));
     if (!dissect) order = std::async(side_launch(), [E0, nv, balanced] { return small_segment_vertex_order(*E0, nv, balanced); });
     Opened op = open_ends(s, *E0, nloops, o.end_cut_radius);

@@ -20,8 +20,9 @@ std::atomic<std::size_t> edge_graphs_built{0};
 std::size_t build_edges_count() { return edge_graphs_built.load(); }
 
 // The face corners bucketed by the lower vertex of the edge opposite them (a counting sort), each
-// bucket sorted by the higher vertex (stable, so corners of one edge stay in face order): edges
-// come out sorted by (lo, hi) in O(faces), with the same numbering as a global sort of the keys.
+// bucket sorted by (higher vertex, corner): a bucket is filled in corner order, so this is the stable
+// sort by the higher vertex (corners of one edge stay in face order) without stable_sort's buffer;
+// edges come out sorted by (lo, hi) in O(faces), with the same numbering as a global sort of the keys.
 Edges build_edges(const std::vector<Tri>& t) {
   ++edge_graphs_built;
   int nv = 0;
@@ -43,7 +44,7 @@ Edges build_edges(const std::vector<Tri>& t) {
   E.ef.reserve(3 * t.size() / 2 + 1);
   for (int lo = 0; lo < nv; ++lo) {
     const auto first = corner.begin() + start[lo], last = corner.begin() + start[lo + 1];
-    std::stable_sort(first, last, [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::sort(first, last);
     for (auto i = first; i != last;) {
       auto j = i;
       while (j != last && j->first == i->first) ++j;
@@ -334,6 +335,8 @@ Surface sub_surface(const Surface& s, const std::vector<int>& faces, std::vector
   std::vector<int>& map = new_of_old ? *new_of_old : local;
   map.assign(s.p.size(), -1);
   r.t.reserve(faces.size());
+  r.p.reserve(std::min(s.p.size(), 3 * faces.size()));  // (at most three new vertices a face)
+  r.src.reserve(r.p.capacity());
   for (int f : faces) {
     Tri t;
     for (int k = 0; k < 3; ++k) {

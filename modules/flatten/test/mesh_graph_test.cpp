@@ -47,6 +47,36 @@ TEST(FlattenMeshGraph, SubEdgesEqualTheSubSurfacesOwnEdges) {
   expect_same_edges(sub_edges(E, keep, new_of_old), build_edges(sub.t));
 }
 
+// build_edges (corners bucketed by the edge's lower vertex, each bucket sorted by higher vertex and
+// corner) numbers the edges as a stable global sort of every corner's (lo, hi) key does: edges by
+// (lo, hi), an edge's faces in face order, each face's edge opposite each corner; on a closed colon
+// whose faces are shuffled (so that buckets fill out of vertex order and an edge's faces far apart).
+TEST(FlattenMeshGraph, EdgesAreNumberedAsAStableGlobalSortOfTheCornersKeys) {
+  Surface s = surface_of(synthetic::colon(synthetic::colon_options(120, 12, 1.5, {})).mesh);
+  std::mt19937 rng(11);
+  std::shuffle(s.t.begin(), s.t.end(), rng);
+  struct Corner {
+    int lo, hi, f, k;
+  };
+  std::vector<Corner> corners;
+  for (int f = 0; f < int(s.t.size()); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = s.t[std::size_t(f)][(k + 1) % 3], b = s.t[std::size_t(f)][(k + 2) % 3];
+      corners.push_back({std::min(a, b), std::max(a, b), f, k});
+    }
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const Corner& x, const Corner& y) { return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi; });
+  Edges ref;
+  ref.fe.assign(s.t.size(), {-1, -1, -1});
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    const bool same = i > 0 && corners[i].lo == corners[i - 1].lo && corners[i].hi == corners[i - 1].hi;
+    if (same) ref.ef.back()[1] = corners[i].f;
+    else ref.ev.push_back({corners[i].lo, corners[i].hi}), ref.ef.push_back({corners[i].f, -1});
+    ref.fe[std::size_t(corners[i].f)][std::size_t(corners[i].k)] = int(ref.ev.size()) - 1;
+  }
+  expect_same_edges(build_edges(s.t), ref);
+}
+
 // The annulus open_ends returns carries its own edges (both caps cut off a closed colon), and
 // opening builds no edge graph: the edges are walked once, on the closed surface.
 TEST(FlattenMeshGraph, OpenedAnnulusCarriesItsEdgesWithoutBuildingThem) {
