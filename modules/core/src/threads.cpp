@@ -13,32 +13,19 @@
 #include <vtkMultiThreader.h>
 #include <vtkSMPTools.h>
 
+#include "worker_pool.h"
+
 namespace cf {
 
 namespace {
 
 std::atomic<int> g_threads{0};  // 0: the default
 
-// Runs work(i) for every i in [0, count) on `threads` threads (the caller is one of them), each
-// thread taking the next unclaimed index; rethrows the exception of the lowest index that threw.
+// Runs work(i) for every i in [0, count) on `threads` threads (the caller is one of them and runs
+// index 0) of the process's persistent pool (worker_pool.h), sized thread_count() - 1; rethrows the
+// exception of the lowest index that threw.
 void run_indexed(std::size_t count, int threads, const std::function<void(std::size_t)>& work) {
-  std::vector<std::exception_ptr> errors(count);
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i = next++; i < count; i = next++) {
-      try {
-        work(i);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  core_detail::WorkerPool::instance().run_indexed(count, threads, std::size_t(thread_count() - 1), work);
 }
 
 }  // namespace
@@ -78,6 +65,7 @@ void set_thread_count(int n) {
   g_threads.store(n > 0 ? n : 0);
   const int now = thread_count();
   vtk_follows(now);
+  core_detail::WorkerPool::instance().resize(std::size_t(now - 1));
   std::lock_guard<std::mutex> lock(g_listeners_mutex);
   for (ThreadCountListener l : listeners()) l(now);
 }

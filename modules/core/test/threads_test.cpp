@@ -4,10 +4,14 @@
 #include <vtkSMPTools.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
+
+#include "../src/worker_pool.h"
 
 namespace {
 
@@ -124,6 +128,134 @@ TEST_F(CoreThreads, LibraryPoolsAndListenersFollowTheCount) {
   cf::add_thread_count_listener(hear);  // registered once: no second call per change
   cf::set_thread_count(0);
   EXPECT_EQ(g_heard, cf::default_thread_count());
+}
+
+}  // namespace
+
+namespace {
+
+using Bounds = std::vector<std::pair<std::size_t, std::size_t>>;
+
+// Every chunk's bounds, by chunk index, from one parallel_for call (each chunk must come once).
+Bounds chunks_of(std::size_t n) {
+  const std::size_t t = std::min<std::size_t>(std::size_t(cf::thread_count()), n);
+  Bounds got(t, {0, 0});
+  std::vector<std::atomic<int>> calls(t);
+  std::atomic<bool> caller_ran_first{false};
+  const auto caller = std::this_thread::get_id();
+  cf::parallel_for(n, [&](std::size_t b, std::size_t e) {
+    std::size_t c = 0;
+    while (c < t && n * c / t != b) ++c;  // the chunk whose documented start is b
+    if (c == t) return;
+    ++calls[c];
+    got[c] = {b, e};
+    if (c == 0 && std::this_thread::get_id() == caller) caller_ran_first = true;
+  });
+  for (std::size_t c = 0; c < t; ++c) EXPECT_EQ(calls[c].load(), 1) << "chunk " << c;
+  EXPECT_TRUE(n == 0 || caller_ran_first.load());
+  return got;
+}
+
+// The pool runs every chunk exactly once, with the documented bounds [n c/T, n (c+1)/T), chunk 0
+// on the calling thread, on 1, 2, 3 and 8 threads.
+TEST_F(CoreThreads, PoolRunsEveryChunkOnceWithTheDocumentedBounds) {
+  for (int t : {1, 2, 3, 8}) {
+    cf::set_thread_count(t);
+    for (std::size_t n : {1u, 2u, 5u, 8u, 9u, 1000u}) {
+      const Bounds got = chunks_of(n);
+      const std::size_t T = std::min<std::size_t>(std::size_t(t), n);
+      ASSERT_EQ(got.size(), T);
+      for (std::size_t c = 0; c < T; ++c)
+        EXPECT_EQ(got[c], std::make_pair(n * c / T, n * (c + 1) / T)) << "t=" << t << " n=" << n << " c=" << c;
+    }
+  }
+}
+
+// A parallel_for inside a parallel_for chunk, and inside parallel_tasks, completes (no deadlock)
+// and covers its indices once, with as many threads as chunks or fewer.
+TEST_F(CoreThreads, NestedCallsComplete) {
+  for (int t : {2, 3, 8}) {
+    cf::set_thread_count(t);
+    std::vector<std::atomic<int>> seen(64 * 100);
+    cf::parallel_for(64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t o = b; o < e; ++o)
+        cf::parallel_for(100, [&](std::size_t ib, std::size_t ie) {
+          for (std::size_t i = ib; i < ie; ++i) ++seen[o * 100 + i];
+        });
+    });
+    for (auto& s : seen) EXPECT_EQ(s.load(), 1);
+    std::atomic<int> inner{0};
+    std::vector<std::function<void()>> tasks(5, [&] {
+      cf::parallel_for(7, [&](std::size_t b, std::size_t e) {
+        cf::parallel_tasks({[&] { inner += int(e - b); }});
+      });
+    });
+    cf::parallel_tasks(tasks);
+    EXPECT_EQ(inner.load(), 35);
+  }
+}
+
+// set_thread_count(n) leaves n - 1 pool workers (none for 1), and calls in a row start no new
+// thread: the pool's workers persist between calls.
+TEST_F(CoreThreads, SetThreadCountResizesThePersistentPool) {
+  auto& pool = cf::core_detail::WorkerPool::instance();
+  for (int t : {3, 5, 2, 1, 4}) {
+    cf::set_thread_count(t);
+    EXPECT_EQ(pool.workers(), std::size_t(t - 1)) << "t=" << t;
+    const std::size_t started = pool.threads_started();
+    for (int k = 0; k < 200; ++k) cf::parallel_for(100, [](std::size_t, std::size_t) {});
+    EXPECT_EQ(pool.threads_started(), started) << "t=" << t;
+    EXPECT_EQ(pool.workers(), std::size_t(t - 1));
+  }
+  ::setenv("COLONFLAT_THREADS", "3", 1);  // a default changed without set_thread_count: the next call resizes
+  cf::set_thread_count(0);
+  ::setenv("COLONFLAT_THREADS", "6", 1);
+  cf::parallel_for(100, [](std::size_t, std::size_t) {});
+  EXPECT_EQ(pool.workers(), 5u);
+  ::unsetenv("COLONFLAT_THREADS");
+}
+
+// An exception in chunk 0 (the caller's) reaches the caller only after the other chunks, still
+// running, finished; on 2, 3 and 8 threads.
+TEST_F(CoreThreads, ExceptionIsRethrownAfterEveryChunkFinished) {
+  for (int t : {2, 3, 8}) {
+    cf::set_thread_count(t);
+    std::atomic<int> finished{0};
+    try {
+      cf::parallel_for(std::size_t(t), [&](std::size_t b, std::size_t) {
+        if (b == 0) throw std::runtime_error("chunk 0");
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        ++finished;
+      });
+      FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "chunk 0");
+    }
+    EXPECT_EQ(finished.load(), t - 1) << "t=" << t;
+  }
+}
+
+// Many tiny calls in a row, from two threads at once, stay correct: every sum is the brute-force one.
+TEST_F(CoreThreads, ManyTinyCallsStayCorrect) {
+  cf::set_thread_count(3);
+  auto calls = [](std::size_t first) {
+    for (std::size_t k = 0; k < 20000; ++k) {
+      const std::size_t n = 1 + (first + k) % 9;
+      std::vector<std::size_t> part(n, 0);
+      cf::parallel_for(n, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) part[i] = i + k;
+      });
+      std::size_t sum = 0;
+      for (std::size_t p : part) sum += p;
+      if (sum != n * (n - 1) / 2 + n * k) return false;
+    }
+    return true;
+  };
+  bool other_ok = false;
+  std::thread other([&] { other_ok = calls(4); });
+  EXPECT_TRUE(calls(0));
+  other.join();
+  EXPECT_TRUE(other_ok);
 }
 
 }  // namespace
