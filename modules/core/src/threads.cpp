@@ -87,6 +87,11 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t, std::size
   run_indexed(t, int(t), [&](std::size_t c) { body(n * c / t, n * (c + 1) / t); });
 }
 
+void parallel_indices(std::size_t n, const std::function<void(std::size_t)>& body, int max_threads) {
+  const std::size_t t = std::min<std::size_t>({std::size_t(thread_count()), std::size_t(std::max(1, max_threads)), n});
+  run_indexed(n, int(std::max<std::size_t>(1, t)), body);
+}
+
 void parallel_tasks(const std::vector<std::function<void()>>& tasks) {
   const int t = int(std::min<std::size_t>(std::size_t(thread_count()), tasks.size()));
   run_indexed(tasks.size(), std::max(1, t), [&](std::size_t i) { tasks[i](); });

@@ -259,3 +259,48 @@ TEST_F(CoreThreads, ManyTinyCallsStayCorrect) {
 }
 
 }  // namespace
+
+namespace {
+
+// parallel_indices runs every index once, the caller taking index 0, on 1, 2, 3 and 8 threads; and
+// with max_threads 1 all on the caller.
+TEST_F(CoreThreads, IndicesRunOnceWithIndexZeroOnTheCaller) {
+  for (int t : {1, 2, 3, 8}) {
+    cf::set_thread_count(t);
+    for (std::size_t n : {1u, 2u, 7u, 64u}) {
+      std::vector<std::atomic<int>> seen(n);
+      std::atomic<bool> zero_on_caller{false};
+      const auto caller = std::this_thread::get_id();
+      cf::parallel_indices(n, [&](std::size_t i) {
+        ++seen[i];
+        if (i == 0) zero_on_caller = std::this_thread::get_id() == caller;
+      });
+      for (auto& s : seen) EXPECT_EQ(s.load(), 1) << "t=" << t << " n=" << n;
+      EXPECT_TRUE(zero_on_caller.load());
+    }
+    std::atomic<int> elsewhere{0};
+    const auto caller = std::this_thread::get_id();
+    cf::parallel_indices(50, [&](std::size_t) { elsewhere += std::this_thread::get_id() != caller; }, 1);
+    EXPECT_EQ(elsewhere.load(), 0);
+  }
+}
+
+// A helper that stalls in its first index does not hold the others: the caller takes every other
+// index meanwhile (fixed halves, as parallel_for's chunks, would leave 8 of 16 to the stalled helper).
+TEST_F(CoreThreads, IndicesGoToTheThreadThatIsFree) {
+  cf::set_thread_count(2);
+  const auto caller = std::this_thread::get_id();
+  std::atomic<bool> stalled{false};
+  std::atomic<int> on_caller{0};
+  cf::parallel_indices(16, [&](std::size_t) {
+    if (std::this_thread::get_id() == caller) {
+      ++on_caller;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    } else if (!stalled.exchange(true)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+  });
+  EXPECT_GE(on_caller.load(), 15);
+}
+
+}  // namespace

@@ -19,8 +19,10 @@ constexpr std::size_t kFaceBlock = 8192;
 
 inline std::size_t face_blocks(std::size_t n) { return (n + kFaceBlock - 1) / kFaceBlock; }
 
-// Calls body(begin, end) on every block [b kFaceBlock, min(n, (b + 1) kFaceBlock)), blocks spread
-// over the threads. body must write only what its own items own.
+// Calls body(begin, end) on every block [b kFaceBlock, min(n, (b + 1) kFaceBlock)), each thread
+// taking the next block (parallel_indices: a late thread takes fewer blocks; the CT mask's window
+// piece, 8 blocks on 2 threads, had its caller doing 58 % of the face loops in fixed halves).
+// body must write only what its own items own.
 template <class Body>
 void for_each_block(std::size_t n, Body&& body) {
   const std::size_t nb = face_blocks(n);
@@ -28,9 +30,7 @@ void for_each_block(std::size_t n, Body&& body) {
     if (n > 0) body(std::size_t(0), n);
     return;
   }
-  parallel_for(nb, [&](std::size_t b0, std::size_t b1) {
-    for (std::size_t b = b0; b < b1; ++b) body(b * kFaceBlock, std::min(n, (b + 1) * kFaceBlock));
-  });
+  parallel_indices(nb, [&](std::size_t b) { body(b * kFaceBlock, std::min(n, (b + 1) * kFaceBlock)); });
 }
 
 // Sum of part(begin, end) over the blocks, added in block order.

@@ -34,6 +34,13 @@ int default_thread_count();
 void parallel_for(std::size_t n, const std::function<void(std::size_t begin, std::size_t end)>& body,
                   int max_threads = 1 << 30);
 
+// Calls body(i) for every i in [0, n) on up to min(thread_count(), max_threads, n) threads, each
+// taking the next unclaimed index (the calling thread takes index 0 first). For work cut into more
+// pieces than threads whose results do not depend on who computes them (face_blocks.h's fixed
+// blocks): a thread that starts late (its core busy) takes fewer pieces instead of leaving the
+// caller waiting for a fixed share. Exceptions as in parallel_for (the first by index).
+void parallel_indices(std::size_t n, const std::function<void(std::size_t i)>& body, int max_threads = 1 << 30);
+
 // Runs every task, on up to thread_count() threads (tasks are taken in index order; the caller
 // runs some of them). Exceptions as in parallel_for (the first by task index).
 void parallel_tasks(const std::vector<std::function<void()>>& tasks);
