@@ -116,6 +116,17 @@ class ExactGreedy {
   void finish_group(const GroupRun& g, double best);
   int next_seed(const std::vector<GroupRun>& batch, double best, std::uint32_t taken);
   bool near_group(int seed, const GroupRun& g) const;
+  // exact_speculation.cpp: while a batch holds one group, the group the next batch will most
+  // likely search is searched beside it on the helper thread, and taken only if the next batch
+  // forms exactly that group (same seed, roots, tree, radius and limit on the same mesh): the same
+  // searches and results as without it, for any thread count.
+  bool can_speculate() const;
+  GroupRun guess_next_group(const GroupRun& alone, double best);
+  void run_alone_with_guess(GroupRun& alone, double best);
+  bool take_speculation(GroupRun& g);
+  GroupRun spec_;            // the group searched ahead, valid while spec_ready_
+  bool spec_ready_ = false;  // cleared by every step that may change what the next batch forms
+  long long spec_runs_ = 0, spec_hits_ = 0;
   static constexpr std::size_t kMaxSkipped = 64;  // far-first entries set aside per batch, at most
   static constexpr double kGroupRadius = 0.5;  // first group radius, times the best known loop
   // Groups are searched in batches of kBatchLanes lanes of about kBatchWork settled vertices

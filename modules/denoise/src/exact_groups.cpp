@@ -83,7 +83,11 @@ void ExactGreedy::search_group(int seed, double best) {
     std::push_heap(far_order_.begin(), far_order_.end());
   }
   far_skipped_.clear();
-  run_groups(runs);
+  const bool taken = runs.size() == 1 && take_speculation(runs[0]);
+  spec_ready_ = false;
+  if (taken) settled_alone_ += static_cast<long long>(runs[0].settled);  // searched alone, ahead
+  else if (runs.size() == 1 && can_speculate()) run_alone_with_guess(runs[0], best);
+  else run_groups(runs);
   mixed_batches_ += std::any_of(runs.begin(), runs.end(),
                                 [&](const GroupRun& g) { return slots_[g.seed].family != slots_[seed].family; });
   std::size_t settled = 0;

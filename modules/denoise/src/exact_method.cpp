@@ -114,6 +114,7 @@ double ExactGreedy::search_limit(int slot) {
 
 CycleCandidate ExactGreedy::search_from(int slot, double limit) {
   Stopwatch sw;
+  spec_ready_ = false;
   const int family = slots_[slot].family;
   search_->set_cochain(family == 0 ? nullptr : &families_[family].cochain);
   const int v = slots_[slot].vertex;
@@ -187,6 +188,7 @@ std::string ExactGreedy::run(int needed, const DenoiseProgress& progress) {
 }
 
 void ExactGreedy::cut(int slot, const CycleCandidate& c, int iteration) {
+  spec_ready_ = false;
   set_bound(slot, SourceBound{0, false, -1, 0});  // searched again after the surgery
   last_cut_value_ = c.value;
   const std::vector<Mesh::VertexHandle> pick = search_->extract(c);
@@ -263,6 +265,8 @@ void ExactGreedy::write_stats(nlohmann::json& stats) const {
   stats["shortcut_tests"] = shortcut_tests_;
   stats["shortcut_loops_replaced"] = shortcut_replaced_;
   stats["shortcut_seconds"] = shortcut_s_;
+  stats["group_searches_ahead"] = spec_runs_;
+  stats["group_searches_ahead_taken"] = spec_hits_;
   stats["schedule"] = "per-source limits, bounds shared within each search ball; crossing families at genus 1";
 }
 

@@ -21,6 +21,7 @@ namespace cf::detail {
 // quantity whatever the annotations.
 void ExactGreedy::build_homology() {
   Stopwatch sw;
+  spec_ready_ = false;
   std::vector<std::pair<int, SourceBound>> old;  // (vertex, bound) of the span family's active sources
   for (int s : active_)
     if (slots_[s].active && slots_[s].family == 0) old.push_back({slots_[s].vertex, slots_[s].bound});
@@ -150,6 +151,7 @@ void ExactGreedy::enter_crossing_mode() {
     for (int s : active_)
       if (slots_[s].active) carried_[slots_[s].vertex] = slots_[s].bound.value;
   }
+  spec_ready_ = false;
   deactivate_all_slots();
   queue_ = {};
   exact_queue_ = {};
@@ -206,6 +208,7 @@ void ExactGreedy::add_crossing_family(const std::vector<Mesh::VertexHandle>& loo
 
 // Back to the span family on a fresh homology (after a cut, or if no crossing cycle exists).
 void ExactGreedy::leave_crossing_mode() {
+  spec_ready_ = false;
   crossing_ = false;
   search_->set_cochain(nullptr);
   deactivate_all_slots();

@@ -179,6 +179,22 @@ TEST(DenoiseThreads, ColonLikeSurfaceIsTheSameForAnyThreadCount) {
   }
 }
 
+// The colon-like surface's last handles leave batches of one group search: with 2 threads the
+// group the next batch forms is searched ahead beside it (some taken), and the searches, settled
+// vertices, loops and mesh are those of the 1-thread run, which searches nothing ahead.
+TEST(DenoiseThreads, GroupsSearchedAheadChangeNoSearchLoopOrMesh) {
+  const Mesh m = bench::colon_like_surface({1.0, 60, true, true, true});
+  const DenoiseResult a = denoise_with_threads(m, 1), b = denoise_with_threads(m, 2);
+  const auto& sa = a.report["search"];
+  const auto& sb = b.report["search"];
+  EXPECT_EQ(sa["group_searches_ahead"].get<long long>(), 0);
+  EXPECT_GT(sb["group_searches_ahead_taken"].get<long long>(), 0);
+  EXPECT_LE(sb["group_searches_ahead_taken"].get<long long>(), sb["group_searches_ahead"].get<long long>());
+  for (const char* key : {"searches", "settled_vertices", "settled_vertices_alone", "group_searches", "bounds_spread"})
+    EXPECT_EQ(sa[key], sb[key]) << key;
+  expect_same_result(a, b);
+}
+
 // A handle removed through the crossing-loop fallback (no meridian of the blocked torus can be
 // capped cleanly, the longitude is cut): identical loops and mesh with 1 and 2 threads.
 TEST(DenoiseThreads, CrossingLoopFallbackIsTheSameForAnyThreadCount) {
