@@ -5,14 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
 
 #include "colonflat/core/huge_pages.h"
-#include "colonflat/core/malloc_tunables.h"
-#include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 
 #ifdef COLONFLAT_HAVE_CHOLMOD
@@ -160,51 +157,6 @@ BlockCache::Stats BlockCache::stats() const {
   s.kept = kept_.size();
   for (const auto& k : kept_) s.kept_bytes += k.second;
   return s;
-}
-
-namespace {
-
-// The value of tunable `name` in a GLIBC_TUNABLES string ("name=value:name=value"), 0 when unset.
-unsigned long long tunable_value(const std::string& tunables, const std::string& name) {
-  std::size_t at = 0;
-  while ((at = tunables.find(name + "=", at)) != std::string::npos) {
-    if (at == 0 || tunables[at - 1] == ':') return std::strtoull(tunables.c_str() + at + name.size() + 1, nullptr, 0);
-    at += name.size();
-  }
-  return 0;
-}
-
-}  // namespace
-
-bool heap_keeps_freed(const std::string& tunables, std::size_t bytes) {
-  return tunable_value(tunables, "glibc.malloc.mmap_threshold") > bytes &&
-         tunable_value(tunables, "glibc.malloc.trim_threshold") > bytes;
-}
-
-std::size_t prefault_heap(std::size_t bytes, const std::function<bool()>& done) {
-  void* p = std::malloc(bytes);
-  if (!p) return 0;
-  advised(p, bytes);
-  const std::size_t page = page_bytes();
-  volatile char* c = static_cast<volatile char*>(p);
-  std::size_t written = 0;
-  while (written < bytes && !done()) {
-    const std::size_t end = std::min(bytes, written + kPrefaultStepBytes);
-    for (std::size_t k = written; k < end; k += page) c[k] = 0;
-    written = end;
-  }
-  std::free(p);
-  return written;
-}
-
-std::size_t prefault_heap_if_kept(std::size_t bytes, const std::function<bool()>& done) {
-  if (getpid() != gettid() || !heap_keeps_freed(malloc_tunables(), bytes)) return 0;
-  const Stopwatch sw;
-  const std::size_t written = prefault_heap(bytes, done);
-  if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
-    std::fprintf(stderr, "flatten debug heap faulted in ahead of the factorisation: %zu of %zu MiB, %.2f s\n",
-                 written >> 20, bytes >> 20, sw.seconds());
-  return written;
 }
 
 BlockCache& cholmod_block_cache() {

@@ -15,9 +15,7 @@
 // (advised huge pages from kHugePageMinBytes on), never kept. Thread-safe (CHOLMOD allocates from
 // the factorisation's worker threads too).
 #include <cstddef>
-#include <functional>
 #include <mutex>
-#include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -92,29 +90,5 @@ struct TrimKeptBlocksAtScopeEnd {
 };
 // Points SuiteSparse_config's allocator at cholmod_block_cache() (once; CHOLMOD builds only).
 void install_for_cholmod();
-
-// The heap faulted in ahead of a segment's first factorisation. While its solve waits for the
-// nested dissection order (METIS on the other threads; the waiting thread's core idle), the memory
-// the factorisation asks for next (its factor's row indices and values, 12 bytes per entry of L:
-// 37 entries per vertex on the CT rows' colons) is taken from the kernel on the waiting thread, so
-// that cholmod_change_factor's fresh blocks (touch_pages above) come from resident heap instead.
-// Only where the heap keeps a freed block: malloc maps nothing afresh and never trims
-// (core/malloc_tunables.h), and only on the process's main thread (glibc's main arena: another
-// thread's arena maps a block this large afresh and unmaps it when freed).
-constexpr std::size_t kPrefaultBytesPerVertex = 384;  // per vertex of the segment: 32 entries of L
-constexpr std::size_t kPrefaultStepBytes = std::size_t(8) << 20;  // written between two `done()` questions
-
-// Whether a block of `bytes` freed stays in the heap under these GLIBC_TUNABLES: both
-// glibc.malloc.mmap_threshold and glibc.malloc.trim_threshold set above `bytes`.
-bool heap_keeps_freed(const std::string& tunables, std::size_t bytes);
-
-// malloc(bytes) (advised onto huge pages), one byte written per page, kPrefaultStepBytes at a time
-// while `done()` says false, then freed. Returns the bytes written (a whole number of steps, at most
-// `bytes`).
-std::size_t prefault_heap(std::size_t bytes, const std::function<bool()>& done);
-
-// prefault_heap on the main thread when heap_keeps_freed(malloc_tunables(), bytes), else nothing
-// (0). COLONFLAT_FLATTEN_DEBUG: a line with the bytes written and the seconds.
-std::size_t prefault_heap_if_kept(std::size_t bytes, const std::function<bool()>& done);
 
 }  // namespace cf::flat_detail

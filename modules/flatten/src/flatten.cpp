@@ -4,7 +4,6 @@
 #include "colonflat/flatten/flatten.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -59,9 +58,8 @@ Surface component_surface(const TriangleList& mesh, const TopologyReport& topo, 
 // smallest input vertex id, for determinism), sets `E` to the annulus' edges (from the closed
 // surface's). The conformal solve's elimination order (w.prior.order_when_ready, restricted to the
 // annulus) is computed on a second thread meanwhile: on a large segment nested dissection's, launched
-// first (its graph from the faces, not the edges built here), the factorisation's heap faulted in
-// while the solve waits for it (prefault_heap_if_kept); else small_segment_vertex_order's (AMD's, or
-// METIS's where AMD's costs too much). Kept in w.dissection for the band's systems (area-balanced).
+// first (its graph from the faces, not the edges built here); else small_segment_vertex_order's (AMD's,
+// or METIS's where AMD's costs too much). Kept in w.dissection for the band's systems (area-balanced).
 std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops, const FlattenOptions& o,
                                            std::size_t c, SegmentWork& w, Edges& E) {
   {
@@ -77,10 +75,7 @@ std::vector<std::vector<int>> open_annulus(const Surface& s, std::size_t nloops,
     E = std::move(op.edges);
     w.seg.removed_faces = op.removed;
     auto to_annulus = std::make_shared<const std::vector<int>>(std::move(op.new_of_old));
-    const std::size_t prefault = dissect ? std::size_t(nv) * kPrefaultBytesPerVertex : 0;  // (factor_memory.h)
-    w.prior.order_when_ready = [order, to_annulus, prefault] {
-      const auto ready = [&order] { return order.wait_for(std::chrono::seconds(0)) != std::future_status::timeout; };
-      if (prefault > 0 && !ready()) prefault_heap_if_kept(prefault, ready);
+    w.prior.order_when_ready = [order, to_annulus] {
       std::vector<int> restricted;
       for (int v : order.get().order)
         if ((*to_annulus)[std::size_t(v)] >= 0) restricted.push_back((*to_annulus)[std::size_t(v)]);

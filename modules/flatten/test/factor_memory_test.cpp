@@ -2,7 +2,6 @@
 // (factor_memory.cpp): reuse by size, the bound on what is kept, zeroing, residency, and a second
 // factorisation that takes the first one's memory and gives the same solution.
 #include <gtest/gtest.h>
-#include <malloc.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -111,55 +110,6 @@ TEST(FactorMemory, FreshLargeBlockIsResidentWhenHandedOut) {
   const std::size_t page = std::size_t(sysconf(_SC_PAGESIZE));
   EXPECT_GE(resident_pages(p, bytes), bytes / page);
   cache.release(p);
-}
-
-// The heap keeps a freed block only when the tunables set both malloc thresholds above it (either
-// alone maps large blocks afresh); ColonFlat's own settings (core/malloc_tunables.h) keep 1 GiB.
-TEST(FactorMemory, HeapKeepsFreedOnlyWhenBothThresholdsAreAboveTheBlock) {
-  using cf::flat_detail::heap_keeps_freed;
-  const std::string ours = "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=4294967296:"
-                           "glibc.malloc.trim_threshold=4294967296:glibc.malloc.arena_max=2";
-  EXPECT_TRUE(heap_keeps_freed(ours, std::size_t(1) << 30));
-  EXPECT_FALSE(heap_keeps_freed(ours, std::size_t(5) << 30));  // above the thresholds
-  EXPECT_FALSE(heap_keeps_freed("", kMiB));
-  EXPECT_FALSE(heap_keeps_freed("glibc.malloc.mmap_threshold=4294967296", kMiB));  // no trim threshold
-  EXPECT_FALSE(heap_keeps_freed("glibc.malloc.trim_threshold=0x100000000", kMiB));  // no mmap threshold
-  EXPECT_TRUE(heap_keeps_freed("glibc.malloc.trim_threshold=0x100000000:glibc.malloc.mmap_threshold=0x100000000", kMiB));
-  EXPECT_FALSE(heap_keeps_freed("glibc.malloc.mmap_threshold=1048576:glibc.malloc.trim_threshold=4294967296", 4 * kMiB));
-  EXPECT_FALSE(heap_keeps_freed("xglibc.malloc.mmap_threshold=4294967296:glibc.malloc.trim_threshold=4294967296", kMiB));
-}
-
-// The prefault writes whole steps of kPrefaultStepBytes while done() says false (asked before each
-// step), the last step cut at the block's end: none when done at once, all when never done.
-TEST(FactorMemory, PrefaultWritesWholeStepsUntilDone) {
-  using cf::flat_detail::kPrefaultStepBytes;
-  using cf::flat_detail::prefault_heap;
-  const std::size_t bytes = 3 * kPrefaultStepBytes + kPrefaultStepBytes / 2;
-  EXPECT_EQ(prefault_heap(bytes, [] { return true; }), 0u);
-  EXPECT_EQ(prefault_heap(bytes, [] { return false; }), bytes);
-  int asked = 0;
-  EXPECT_EQ(prefault_heap(bytes, [&asked] { return ++asked > 2; }), 2 * kPrefaultStepBytes);
-  EXPECT_EQ(asked, 3);
-}
-
-// Where the heap keeps freed blocks (the thresholds set here as the tunables set them, on the main
-// thread: glibc's main arena), a block the prefault wrote is resident for the next allocation of its
-// size: that allocation's first write faults nothing in. Without the prefault it would not be
-// resident (checked first on a fresh block of the same size at the heap's top).
-TEST(FactorMemory, PrefaultedHeapServesTheNextBlockResident) {
-  ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 1 << 30), 1);
-  ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
-  const std::size_t bytes = 96 * kMiB, page = std::size_t(sysconf(_SC_PAGESIZE));
-  void* fresh = std::malloc(bytes);
-  ASSERT_NE(fresh, nullptr);
-  EXPECT_LT(resident_pages(fresh, bytes), bytes / page / 2);  // new heap: not yet faulted in
-  std::free(fresh);
-  malloc_trim(0);  // (the heap's top given back: the next block is new memory again)
-  EXPECT_EQ(cf::flat_detail::prefault_heap(bytes, [] { return false; }), bytes);
-  void* p = std::malloc(bytes);
-  ASSERT_NE(p, nullptr);
-  EXPECT_GE(resident_pages(p, bytes), bytes / page - 2);  // (the block's first and last page may be partial)
-  std::free(p);
 }
 
 // The second of two factorisations of about the same size (the first map's, then the whole band's)
