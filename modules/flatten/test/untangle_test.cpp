@@ -20,26 +20,31 @@ struct Grid {
   std::vector<std::vector<int>> vf;
 };
 
-// The flat grid as both the surface (z = 0) and its map (no seam: dy = 0, period far larger).
-Grid grid() {
+// A flat nx x ny grid as both the surface (z = 0) and its map (no seam: dy = 0, map period
+// `period`), its boundary fixed.
+Grid large_grid(int nx, int ny, double period = 1e6) {
   Grid g;
-  for (int j = 0; j < kNy; ++j)
-    for (int i = 0; i < kNx; ++i) {
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
       g.s.p.push_back(V3(i, j, 0));
       g.emb.pos.push_back(V2(i, j));
-      g.fixed.push_back(i == 0 || j == 0 || i == kNx - 1 || j == kNy - 1);
+      g.fixed.push_back(i == 0 || j == 0 || i == nx - 1 || j == ny - 1);
     }
-  for (int j = 0; j + 1 < kNy; ++j)
-    for (int i = 0; i + 1 < kNx; ++i) {
-      g.s.t.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      g.s.t.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int a = j * nx + i;
+      g.s.t.push_back({a, a + 1, a + nx + 1});
+      g.s.t.push_back({a, a + nx + 1, a + nx});
     }
   g.emb.dy.assign(g.s.t.size(), {0.0, 0.0, 0.0});
-  g.emb.period = 1000;
+  g.emb.period = period;
   g.degenerate.assign(g.s.t.size(), 0);
   g.vf = vertex_faces(g.s);
   return g;
 }
+
+// The kNx x kNy grid (period far larger than the grid).
+Grid grid() { return large_grid(kNx, kNy, 1000); }
 
 std::size_t folded_faces(const Grid& g) {
   std::size_t n = 0;
@@ -90,27 +95,6 @@ TEST(Untangle, RimCrossingItselfGivesWay) {
   }
 }
 
-// A flat nx x ny grid as surface and map (as grid() above, of any size), its boundary fixed.
-Grid large_grid(int nx, int ny) {
-  Grid g;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      g.s.p.push_back(V3(i, j, 0));
-      g.emb.pos.push_back(V2(i, j));
-      g.fixed.push_back(i == 0 || j == 0 || i == nx - 1 || j == ny - 1);
-    }
-  for (int j = 0; j + 1 < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i) {
-      const int a = j * nx + i;
-      g.s.t.push_back({a, a + 1, a + nx + 1});
-      g.s.t.push_back({a, a + nx + 1, a + nx});
-    }
-  g.emb.dy.assign(g.s.t.size(), {0.0, 0.0, 0.0});
-  g.emb.period = 1e6;
-  g.degenerate.assign(g.s.t.size(), 0);
-  g.vf = vertex_faces(g.s);
-  return g;
-}
 
 // Folds in two blocks of faces far apart (which faces are folded is asked block by block on the
 // worker threads): untangled with 1, 2 and 3 threads, the same vertices move to the same bits and
