@@ -4,6 +4,8 @@
 #include <atomic>
 #include <exception>
 
+#include <pthread.h>
+
 namespace cf::core_detail {
 
 // One run_indexed call: its indices, the next unclaimed one, and who helps. helpers_left and
@@ -35,9 +37,32 @@ struct PoolCall {
   std::size_t serial = 0;  // posting order, from 1
 };
 
+namespace {
+WorkerPool* g_pool = nullptr;  // deliberately never destroyed (sleeping workers outlive statics)
+}  // namespace
+
 WorkerPool& WorkerPool::instance() {
-  static WorkerPool* pool = new WorkerPool;  // NOLINT: deliberately never destroyed
-  return *pool;
+  static const bool made = [] {
+    g_pool = new WorkerPool;  // NOLINT: never destroyed
+    pthread_atfork(&WorkerPool::before_fork, &WorkerPool::after_fork_in_parent, &WorkerPool::after_fork_in_child);
+    return true;
+  }();
+  (void)made;
+  return *g_pool;
+}
+
+void WorkerPool::before_fork() {
+  g_pool->resize_mutex_.lock();  // the order resize() takes them in
+  g_pool->mutex_.lock();
+}
+
+void WorkerPool::after_fork_in_parent() {
+  g_pool->mutex_.unlock();
+  g_pool->resize_mutex_.unlock();
+}
+
+void WorkerPool::after_fork_in_child() {
+  g_pool = new WorkerPool;  // NOLINT: the parent's pool (its threads absent here) is left, locked
 }
 
 void WorkerPool::run_indexed(std::size_t count, int threads, std::size_t workers,

@@ -9,7 +9,8 @@
 // idle workers join the nested call, and callers waiting for their own call's helpers help the
 // calls posted after theirs; when no thread is free the nested call's caller runs every index
 // itself, so nesting never deadlocks (a caller waits only for indices other threads already run).
-// The exception of the lowest index that threw is rethrown after every index ran.
+// The exception of the lowest index that threw is rethrown after every index ran. A child made by
+// fork() gets a pool of its own (pthread_atfork), so it may call parallel_for like any process.
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -42,6 +43,12 @@ class WorkerPool {
 
  private:
   WorkerPool() = default;
+  // fork() keeps only the forking thread: the pool's locks are taken before a fork (so that no
+  // worker holds one at that instant), released after it in the parent, and the child gets a
+  // fresh pool (the parent's workers do not exist there; the old pool is left as it is).
+  static void before_fork();
+  static void after_fork_in_parent();
+  static void after_fork_in_child();
   void worker_loop(std::size_t index);
   PoolCall* joinable_call(std::size_t after);
   void help(PoolCall& call, std::unique_lock<std::mutex>& lock);

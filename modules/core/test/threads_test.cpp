@@ -4,6 +4,9 @@
 #include <vtkSMPTools.h>
 
 #include <atomic>
+#include <unistd.h>
+#include <sys/wait.h>
+#include <csignal>
 #include <chrono>
 #include <cstdlib>
 #include <stdexcept>
@@ -301,6 +304,41 @@ TEST_F(CoreThreads, IndicesGoToTheThreadThatIsFree) {
     }
   });
   EXPECT_GE(on_caller.load(), 15);
+}
+
+// A child made by fork() (as the robustness tests' run-as-nobody does) while the pool's workers
+// exist and another thread keeps them busy gets a working pool: its parallel_for, after a resize,
+// sums every index, and it exits within the time limit (before pthread_atfork the child joined
+// the parent's absent workers or waited on a lock one of them held at the fork, and hung).
+TEST_F(CoreThreads, ForkedChildRunsParallelLoopsOnAPoolOfItsOwn) {
+  cf::set_thread_count(2);
+  std::atomic<bool> stop{false};
+  std::thread busy([&] {
+    while (!stop) cf::parallel_for(64, [](std::size_t, std::size_t) {});
+  });
+  int hung_or_wrong = 0;
+  for (int k = 0; k < 20; ++k) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      cf::set_thread_count(3);
+      std::atomic<long> sum{0};
+      cf::parallel_for(1000, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) sum += long(i);
+      });
+      ::_exit(sum.load() == 999L * 1000 / 2 ? 0 : 3);
+    }
+    int status = -1;
+    pid_t got = 0;
+    for (int ms = 0; ms < 20000 && got == 0; ms += 10) {
+      got = ::waitpid(child, &status, WNOHANG);
+      if (got == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (got == 0) ::kill(child, SIGKILL), ::waitpid(child, &status, 0);
+    hung_or_wrong += !(got == child && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  }
+  stop = true;
+  busy.join();
+  EXPECT_EQ(hung_or_wrong, 0);
 }
 
 }  // namespace
