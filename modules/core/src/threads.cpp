@@ -93,8 +93,7 @@ void parallel_indices(std::size_t n, const std::function<void(std::size_t)>& bod
 }
 
 void parallel_tasks(const std::vector<std::function<void()>>& tasks) {
-  const int t = int(std::min<std::size_t>(std::size_t(thread_count()), tasks.size()));
-  run_indexed(tasks.size(), std::max(1, t), [&](std::size_t i) { tasks[i](); });
+  parallel_indices(tasks.size(), [&](std::size_t i) { tasks[i](); });
 }
 
 double process_cpu_seconds() {
