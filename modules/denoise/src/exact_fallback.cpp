@@ -6,6 +6,7 @@
 #include "colonflat/core/error.h"
 #include "colonflat/core/geodesic_ball.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/denoise/crossing_search.h"
 #include "exact_greedy.h"
 
 namespace cf::detail {
@@ -98,11 +99,26 @@ void ExactGreedy::revert_cut(const SurgeryResult& sr) {
 // The shortest loop crossing `loop` an odd number of times (crossing_cochain(): any such cycle
 // is non-separating and not of loop's class), among fundamental cycles from up to
 // kFallbackSources of loop's vertices (every such cycle passes through one of them); empty when
-// none is found within `limit`.
+// none is found within `limit`. The same loop as shortest_from_spread() over those sources, with
+// stretches of the loop certified by group searches (crossing_search.h).
 std::vector<Mesh::VertexHandle> ExactGreedy::crossing_loop(const std::vector<Mesh::VertexHandle>& loop, double limit) {
   Stopwatch sw;
   const std::vector<std::uint8_t> cochain = crossing_cochain(st_.mesh, loop);
-  const std::vector<Mesh::VertexHandle> found = shortest_from_spread(loop, limit, nullptr, &cochain, nullptr);
+  CrossingLoopInput in;
+  in.mesh = &st_.mesh;
+  in.loop = &loop;
+  in.cochain = &cochain;
+  in.limit = limit;
+  in.max_sources = kFallbackSources;
+  in.batch = kBatchLanes;
+  in.lanes = search_lanes(kBatchLanes);
+  in.lane_search = [this](int t) -> FundamentalCycleSearch& { return lane_search(t); };
+  if (worker_) in.run_lanes = [this](int n, const std::function<void(int)>& job) { worker_->run(n, job); };
+  CrossingSearchCount count;
+  const std::vector<Mesh::VertexHandle> found = shortest_crossing_loop(in, &count);
+  searches_ += count.searches;
+  settled_ += count.settled;
+  fallback_settled_ += count.settled;
   st_.t.search += sw.seconds();
   fallback_s_ += sw.seconds();
   return found;
