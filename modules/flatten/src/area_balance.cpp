@@ -173,12 +173,20 @@ namespace {
 
 double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
+// A face's area a0 + B t + C t^2 over t in [0, 1] is at least a0 + min(B, 0) + min(C, 0); when that
+// bound exceeds this fraction of |a0| + |B| + |C| (far above the rounding of its three terms) the
+// face keeps a positive area up to t = 1 and its roots are not computed (issue 26, session 36
+// "wholeband": most faces of a step, ~15 % of the grown CT mask row's CPU in these limits).
+constexpr double kClearOfRounding = 1e-12;
+
 // face_step_limit() of a face with edges e1, e2 (corner 0 to corners 1 and 2), A = cross2(e1, e2) > 0
 // and moves g1, g2 of corners 1 and 2 relative to corner 0.
 double step_limit(const V2& e1, const V2& e2, double A, const V2& g1, const V2& g2, double keep) {
   const double B = cross2(e1, g2) + cross2(g1, e2), C = cross2(g1, g2);
   // smallest t > 0 with C t^2 + B t + (1 - keep) A = 0 (twice the areas)
   const double a0 = (1 - std::clamp(keep, 0.0, 1.0)) * A;
+  const double low = a0 + std::min(B, 0.0) + std::min(C, 0.0);
+  if (low > kClearOfRounding * (std::abs(a0) + std::abs(B) + std::abs(C))) return 1e300;  // no root in (0, 1]
   double root = 1e300;
   if (std::abs(C) < 1e-300) {
     if (B < 0) root = -a0 / B;
@@ -225,7 +233,8 @@ double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V
       const double A = cross2(e1, e2), a = 0.5 * A;
       if (a <= 0) continue;
       const auto g = relative_moves(s.t[f], emb, next);
-      t = std::min(t, step_limit(e1, e2, A, g[0], g[1], std::min(0.5, floor_ratio * area3[f] / a)));
+      const double keep = floor_ratio > 0 ? std::min(0.5, floor_ratio * area3[f] / a) : 0.0;  // (the descents' 0)
+      t = std::min(t, step_limit(e1, e2, A, g[0], g[1], keep));
     }
     return t;
   });

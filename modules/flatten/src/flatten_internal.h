@@ -296,8 +296,8 @@ BalanceResult balance_area(const Surface& s, const std::vector<std::vector<int>>
 // correction: positive, so their systems are M-matrices).
 std::vector<std::array<double, 3>> corner_weights(const Surface& s, const std::vector<int>& faces);
 
-// Largest t > 0 (1e300: none) at which face f, moving along pos + t (next - pos), is down to `keep`
-// (in [0, 1)) x its current 2D area; 1e300 for a face whose area is not positive now.
+// Smallest t in (0, 1] at which face f, moving along pos + t (next - pos), is down to `keep` (in
+// [0, 1)) x its current 2D area; a value above 1 when none is; 1e300 for a face not positive now.
 double face_step_limit(const Surface& s, const Embedding& emb, const std::vector<V2>& next, int f, double keep);
 double max_area_step(const Surface& s, const Embedding& emb, const std::vector<V2>& next, const std::vector<int>& faces,
                      const std::vector<double>& area3, double floor_ratio);

@@ -13,16 +13,21 @@ HeldSteps::HeldSteps(const Surface& s, const Embedding& emb, std::function<doubl
     : s_(s), emb_(emb), hidden_(std::move(hidden)), tolerance_(tolerance), leave_stuck_(leave_stuck) {}
 
 double HeldSteps::cut(const std::vector<int>& judged, const std::vector<V2>& trial) {
-  limit_.resize(judged.size());
-  const double t = std::max(0.0, block_min(judged.size(), 1.0, [&](std::size_t begin, std::size_t end) {
-                              double m = 1.0;
-                              for (std::size_t i = begin; i < end; ++i)
-                                m = std::min(m, limit_[i] = face_step_limit(s_, emb_, trial, judged[i], 0.0));
-                              return m;
-                            }));
-  const auto least = std::min_element(limit_.begin(), limit_.end());
-  limiting_ = least != limit_.end() && *least < 1.0 ? judged[std::size_t(least - limit_.begin())] : -1;
-  return t;
+  // Per block of judged faces: its smallest limit and the first face holding it; the blocks read in
+  // order, so the face is the first smallest of all (a serial pass over every face's limit before).
+  std::vector<std::pair<double, std::size_t>> least(std::max<std::size_t>(1, face_blocks(judged.size())), {1e300, 0});
+  for_each_block(judged.size(), [&](std::size_t begin, std::size_t end) {
+    std::pair<double, std::size_t>& m = least[begin / kFaceBlock];
+    for (std::size_t i = begin; i < end; ++i) {
+      const double limit = face_step_limit(s_, emb_, trial, judged[i], 0.0);
+      if (limit < m.first) m = {limit, i};
+    }
+  });
+  std::pair<double, std::size_t> m = least.front();
+  for (const auto& b : least)
+    if (b.first < m.first) m = b;
+  limiting_ = m.first < 1.0 ? judged[m.second] : -1;
+  return std::max(0.0, std::min(1.0, m.first));
 }
 
 const char* HeldSteps::stop(double limit, double before, double after, int steps_left) {

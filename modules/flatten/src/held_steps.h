@@ -59,6 +59,8 @@ class HeldSteps {
   // with `steps_left` steps of the budget left: why the piece stops ("held": stalled and done;
   // "stuck": stalled below kStuckStep, showing nothing), or nullptr to go on.
   const char* stop(double limit, double before, double after, int steps_left);
+  // The face of `judged` that set the last cut() (the first with the smallest limit), -1 when none held it below 1.
+  int limiting_face() const { return limiting_; }
   // The largest cut() of the descent (0 before any).
   double largest_cut() const { return largest_; }
 
@@ -67,7 +69,6 @@ class HeldSteps {
   const Embedding& emb_;
   std::function<double()> hidden_;
   double tolerance_ = 0, last_hidden_ = -1;  // -1: not measured in this streak
-  std::vector<double> limit_;  // per judged face: its fold limit at the last cut()
   std::vector<int> recent_;    // the faces that set the last kRecent cuts
   int limiting_ = -1, streak_ = 0;
   double largest_ = 0;

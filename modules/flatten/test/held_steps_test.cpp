@@ -2,8 +2,11 @@
 // step sequences written out here: their cuts, energies and hidden wall.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <vector>
 
+#include "../src/face_blocks.h"
 #include "../src/held_steps.h"
 
 namespace cf {
@@ -64,6 +67,37 @@ TEST(HeldSteps, StuckStreakIsWeighedAgainstTheStepsLeft) {
   // the fall per step over the last kStallSteps steps (~1.5e-4) x steps left < 0.5 once fewer than
   // ~3 334 steps are left, judged every kStallSteps / 4 steps: at step 1 664.
   EXPECT_EQ(at, 1664);
+}
+
+// cut() over judged faces in several blocks (3 x kFaceBlock + 5 separate triangles, listed last to
+// first) is the smallest face_step_limit() to the bit, and the face it names is the first in the
+// list among those tied at it (two identical faces in different blocks), as a serial scan finds it.
+TEST(HeldSteps, CutIsTheFirstSmallestFaceLimitAcrossBlocks) {
+  flat_detail::Surface s;
+  flat_detail::Embedding emb;
+  std::vector<flat_detail::V2> next;
+  const int n = int(3 * flat_detail::kFaceBlock + 5);
+  for (int f = 0; f < n; ++f) {
+    const double shrink = f == 9000 || f == 20000 ? 4.0 : f == 3 ? 2.0 : 1.2 + 1e-5 * (f % 97);  // at the edge at t = 1 / shrink
+    const double x = 2.0 * f;
+    for (const flat_detail::V2& c : {flat_detail::V2(x, 0), flat_detail::V2(x + 1, 0), flat_detail::V2(x + 0.3, 1)}) {
+      s.p.emplace_back(c.x(), c.y(), 0.0), emb.pos.push_back(c), next.push_back(c);
+    }
+    next.back().y() -= shrink;
+    s.t.push_back({3 * f, 3 * f + 1, 3 * f + 2});
+    emb.dy.push_back({0.0, 0.0, 0.0});
+  }
+  std::vector<int> judged(std::size_t(n), 0);
+  for (int i = 0; i < n; ++i) judged[std::size_t(i)] = n - 1 - i;
+  HeldSteps held(s, emb, [] { return 0.0; }, 1.0);
+  const double want = flat_detail::face_step_limit(s, emb, next, 9000, 0.0);
+  ASSERT_EQ(want, flat_detail::face_step_limit(s, emb, next, 20000, 0.0));
+  EXPECT_EQ(want, 0.25);
+  EXPECT_EQ(held.cut(judged, next), want);
+  EXPECT_EQ(held.limiting_face(), 20000);
+  std::vector<flat_detail::V2> still = emb.pos;  // no move: nothing holds the step
+  EXPECT_EQ(held.cut(judged, still), 1.0);
+  EXPECT_EQ(held.limiting_face(), -1);
 }
 
 }  // namespace
