@@ -87,7 +87,8 @@ class ConformalAreaEnergy {
   }
   std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
     const Tri& t = s_.t[f];
-    return {pos[t[0]] + V2(0, emb_.dy[f][0]), pos[t[1]] + V2(0, emb_.dy[f][1]), pos[t[2]] + V2(0, emb_.dy[f][2])};
+    const std::array<double, 3>& dy = emb_.dy[f];  // shifted_corner.h: the same bits, in registers
+    return {shifted_corner(pos[t[0]], dy[0]), shifted_corner(pos[t[1]], dy[1]), shifted_corner(pos[t[2]], dy[2])};
   }
   const Surface& s_;
   const Embedding& emb_;

@@ -23,6 +23,7 @@
 #include "colonflat/flatten/flatten.h"
 #include "debug_clock.h"
 #include "segment_order.h"
+#include "shifted_corner.h"
 
 namespace cf::flat_detail {
 
@@ -159,7 +160,7 @@ struct Embedding {
   double period = 0;
   std::array<V2, 3> corners(const Surface& s, int f) const {
     const Tri& t = s.t[f];
-    return {pos[t[0]] + V2(0, dy[f][0]), pos[t[1]] + V2(0, dy[f][1]), pos[t[2]] + V2(0, dy[f][2])};
+    return {shifted_corner(pos[t[0]], dy[f][0]), shifted_corner(pos[t[1]], dy[f][1]), shifted_corner(pos[t[2]], dy[f][2])};
   }
   double area2(const Surface& s, int f) const {  // signed 2D area
     const auto c = corners(s, f);

@@ -41,9 +41,9 @@ struct SymmetricDirichlet {
     const int f = faces_[i];
     const Tri& t = s.t[f];
     Eigen::Matrix2d D;
-    const V2 c0 = pos[t[0]] + V2(0, emb.dy[f][0]);
-    D.col(0) = pos[t[1]] + V2(0, emb.dy[f][1]) - c0;
-    D.col(1) = pos[t[2]] + V2(0, emb.dy[f][2]) - c0;
+    const V2 c0 = shifted_corner(pos[t[0]], emb.dy[f][0]);  // shifted_corner.h: the same bits
+    D.col(0) = shifted_corner(pos[t[1]], emb.dy[f][1]) - c0;
+    D.col(1) = shifted_corner(pos[t[2]], emb.dy[f][2]) - c0;
     return D * x_inv[i];
   }
   double energy(const std::vector<V2>& pos) const { return energy_with(pos, nullptr); }

@@ -93,8 +93,8 @@ double AllFacesCheck::qc_mean(const std::vector<V2>& pos, const Embedding& emb) 
     for (std::size_t f = begin; f < end; ++f) {
       const Tri& t = s_.t[f];
       const auto& dy = emb.dy[f];
-      const FaceDistortion d = face_distortion(frames_[f], pos[t[0]] + V2(0, dy[0]), pos[t[1]] + V2(0, dy[1]),
-                                               pos[t[2]] + V2(0, dy[2]));
+      const FaceDistortion d = face_distortion(frames_[f], shifted_corner(pos[t[0]], dy[0]),
+                                               shifted_corner(pos[t[1]], dy[1]), shifted_corner(pos[t[2]], dy[2]));
       area2_[f] = d.area2, qc_[f] = d.qc;
     }
   });

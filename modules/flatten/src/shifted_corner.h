@@ -1,0 +1,17 @@
+#pragma once
+// A face's corner in the map: its vertex's position p shifted by the face's y offset dy (Embedding,
+// flatten_internal.h), as (p.x + 0, p.y + dy): the same two IEEE additions as p + Vector2d(0, dy),
+// hence the same bits, but built in registers. GCC -O3 (SSE2) builds Vector2d(0, dy) on the stack
+// from two 8-byte stores and reads it back with one 16-byte load, which cannot be forwarded from
+// them: a stall of ~a dozen cycles for each corner of each face (perf on the grown CT mask row,
+// issue 26 session 36 "compact": ~37 % of the area energy's samples and ~56 % of the fold limit's
+// sit right after those loads).
+#include <Eigen/Core>
+
+namespace cf::flat_detail {
+
+inline Eigen::Vector2d shifted_corner(const Eigen::Vector2d& p, double dy) {
+  return Eigen::Vector2d(p.x() + 0.0, p.y() + dy);  // + 0.0 kept: -0 + 0 is +0, as in p + (0, dy)
+}
+
+}  // namespace cf::flat_detail
