@@ -86,9 +86,7 @@ class ConformalAreaEnergy {
     }
   }
   std::array<V2, 3> corners(const std::vector<V2>& pos, int f) const {
-    const Tri& t = s_.t[f];
-    const std::array<double, 3>& dy = emb_.dy[f];  // shifted_corner.h: the same bits, in registers
-    return {shifted_corner(pos[t[0]], dy[0]), shifted_corner(pos[t[1]], dy[1]), shifted_corner(pos[t[2]], dy[2])};
+    return shifted_corners(s_.t[f], pos, emb_.dy[f]);  // shifted_corner.h: the same bits, in registers
   }
   const Surface& s_;
   const Embedding& emb_;

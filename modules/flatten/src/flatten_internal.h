@@ -158,10 +158,7 @@ struct Embedding {
   std::vector<V2> pos;
   std::vector<std::array<double, 3>> dy;
   double period = 0;
-  std::array<V2, 3> corners(const Surface& s, int f) const {
-    const Tri& t = s.t[f];
-    return {shifted_corner(pos[t[0]], dy[f][0]), shifted_corner(pos[t[1]], dy[f][1]), shifted_corner(pos[t[2]], dy[f][2])};
-  }
+  std::array<V2, 3> corners(const Surface& s, int f) const { return shifted_corners(s.t[f], pos, dy[f]); }
   double area2(const Surface& s, int f) const {  // signed 2D area
     const auto c = corners(s, f);
     const V2 a = c[1] - c[0], b = c[2] - c[0];

@@ -8,10 +8,19 @@
 // sit right after those loads).
 #include <Eigen/Core>
 
+#include <array>
+#include <vector>
+
 namespace cf::flat_detail {
 
 inline Eigen::Vector2d shifted_corner(const Eigen::Vector2d& p, double dy) {
   return Eigen::Vector2d(p.x() + 0.0, p.y() + dy);  // + 0.0 kept: -0 + 0 is +0, as in p + (0, dy)
+}
+
+// The three map corners of a face with vertices t: positions pos[t[k]] shifted by the face's dy[k].
+inline std::array<Eigen::Vector2d, 3> shifted_corners(const std::array<int, 3>& t, const std::vector<Eigen::Vector2d>& pos,
+                                                      const std::array<double, 3>& dy) {
+  return {shifted_corner(pos[t[0]], dy[0]), shifted_corner(pos[t[1]], dy[1]), shifted_corner(pos[t[2]], dy[2])};
 }
 
 }  // namespace cf::flat_detail

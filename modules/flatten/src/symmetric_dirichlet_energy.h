@@ -39,11 +39,10 @@ struct SymmetricDirichlet {
   const std::vector<int>& faces() const { return faces_; }
   Eigen::Matrix2d jacobian(const std::vector<V2>& pos, std::size_t i) const {
     const int f = faces_[i];
-    const Tri& t = s.t[f];
     Eigen::Matrix2d D;
-    const V2 c0 = shifted_corner(pos[t[0]], emb.dy[f][0]);  // shifted_corner.h: the same bits
-    D.col(0) = shifted_corner(pos[t[1]], emb.dy[f][1]) - c0;
-    D.col(1) = shifted_corner(pos[t[2]], emb.dy[f][2]) - c0;
+    const auto c = shifted_corners(s.t[f], pos, emb.dy[f]);  // shifted_corner.h: the same bits
+    D.col(0) = c[1] - c[0];
+    D.col(1) = c[2] - c[0];
     return D * x_inv[i];
   }
   double energy(const std::vector<V2>& pos) const { return energy_with(pos, nullptr); }

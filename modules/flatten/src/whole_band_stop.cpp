@@ -91,10 +91,8 @@ double AllFacesCheck::qc_mean(const std::vector<V2>& pos, const Embedding& emb) 
   area2_.resize(nf), qc_.resize(nf);
   for_each_block(nf, [&](std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f) {
-      const Tri& t = s_.t[f];
-      const auto& dy = emb.dy[f];
-      const FaceDistortion d = face_distortion(frames_[f], shifted_corner(pos[t[0]], dy[0]),
-                                               shifted_corner(pos[t[1]], dy[1]), shifted_corner(pos[t[2]], dy[2]));
+      const auto c = shifted_corners(s_.t[f], pos, emb.dy[f]);
+      const FaceDistortion d = face_distortion(frames_[f], c[0], c[1], c[2]);
       area2_[f] = d.area2, qc_[f] = d.qc;
     }
   });
