@@ -115,12 +115,18 @@ std::vector<CrossingOutcome> run_batch(const CrossingLoopInput& in, const std::v
 
 }  // namespace
 
+std::vector<std::size_t> spread_positions(std::size_t n, std::size_t max_picks) {
+  std::vector<std::size_t> picked;
+  const std::size_t stride = std::max<std::size_t>(1, n / std::max<std::size_t>(1, max_picks));
+  for (std::size_t i = 0; i < n; i += stride) picked.push_back(i);
+  return picked;
+}
+
 std::vector<Mesh::VertexHandle> shortest_crossing_loop(const CrossingLoopInput& in, CrossingSearchCount* count) {
   std::vector<Mesh::VertexHandle> found;
   if (in.loop->empty()) return found;
   std::vector<int> position;  // loop position of each picked source
-  const std::size_t stride = std::max<std::size_t>(1, in.loop->size() / std::max<std::size_t>(1, in.max_sources));
-  for (std::size_t i = 0; i < in.loop->size(); i += stride) position.push_back(static_cast<int>(i));
+  for (std::size_t i : spread_positions(in.loop->size(), in.max_sources)) position.push_back(static_cast<int>(i));
   std::vector<CrossingItem> work{{0, position.size() - 1, 0.0}};
   double best = in.limit;
   std::size_t best_source = position.size();  // none yet: a value must then be below the limit

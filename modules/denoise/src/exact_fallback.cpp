@@ -165,8 +165,7 @@ std::vector<Mesh::VertexHandle> ExactGreedy::shortest_from_spread(const std::vec
                                                                   const std::vector<std::uint8_t>* avoid,
                                                                   std::size_t max_sources) {
   std::vector<Mesh::VertexHandle> picked;
-  const std::size_t stride = std::max<std::size_t>(1, sources.size() / std::max<std::size_t>(1, max_sources));
-  for (std::size_t i = 0; i < sources.size(); i += stride) picked.push_back(sources[i]);
+  for (std::size_t i : spread_positions(sources.size(), max_sources)) picked.push_back(sources[i]);
   const int lanes = search_lanes(kBatchLanes);
   double best = limit;
   std::vector<Mesh::VertexHandle> found;

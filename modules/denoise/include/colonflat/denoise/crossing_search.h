@@ -25,6 +25,10 @@ struct CrossingLoopInput {
   std::function<void(int n, const std::function<void(int)>& job)> run_lanes;
 };
 
+// The picked positions of n candidate sources: 0, k, 2k, ... below n with k = max(1, n / max_picks)
+// (the exact fallback's spread: shortest_crossing_loop and ExactGreedy::shortest_from_spread).
+std::vector<std::size_t> spread_positions(std::size_t n, std::size_t max_picks);
+
 struct CrossingSearchCount {
   long long searches = 0, groups = 0, settled = 0;
 };
