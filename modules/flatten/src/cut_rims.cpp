@@ -194,13 +194,13 @@ void apply_plan(Embedding& emb, const RadialPlan& plan) {
   const double r0 = plan.r.front(), r1 = plan.r.back();
   for (V2& p : emb.pos) {
     const double shift = emb.period * std::round((p.y() - plan.centre.y()) / emb.period);
-    const V2 d = p - V2(0, shift) - plan.centre;
+    const V2 d = unshifted_corner(p, shift) - plan.centre;  // p - (0, shift) (shifted_corner.h: same bits)
     const double r = d.norm();
     if (!(r < r1)) continue;
     double h2 = plan.s * plan.s * std::min(r, r0) * std::min(r, r0);
     for (std::size_t i = 0; i + 1 < plan.r.size() && r > plan.r[i]; ++i)
       h2 += plan.J[i] * (std::min(r, plan.r[i + 1]) * std::min(r, plan.r[i + 1]) - plan.r[i] * plan.r[i]);
-    p = plan.centre + V2(0, shift) + d * (r > 0 ? std::sqrt(h2) / r : plan.s);
+    p = shifted_corner(plan.centre, shift) + d * (r > 0 ? std::sqrt(h2) / r : plan.s);
   }
 }
 

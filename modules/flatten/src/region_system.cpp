@@ -121,7 +121,7 @@ std::vector<V2> RegionSystem::solve(const Surface& s, const Embedding& emb,
     for (int k = 0; k < 3; ++k) {
       const int ka = (k + 1) % 3, kb = (k + 2) % 3;
       // term w |p_a - p_b - g|^2 with g = target - (offset_a - offset_b)
-      const V2 g = target[i][k] - V2(0, emb.dy[f][ka] - emb.dy[f][kb]);
+      const V2 g = unshifted_corner(target[i][k], emb.dy[f][ka] - emb.dy[f][kb]);  // shifted_corner.h: same bits
       const int a = index_[t[ka]], b = index_[t[kb]];
       const double wk = w_[i][k];
       if (a >= 0) {

@@ -17,6 +17,13 @@ inline Eigen::Vector2d shifted_corner(const Eigen::Vector2d& p, double dy) {
   return Eigen::Vector2d(p.x() + 0.0, p.y() + dy);  // + 0.0 kept: -0 + 0 is +0, as in p + (0, dy)
 }
 
+// p - Vector2d(0, dy), built the same way: (p.x - 0, p.y - dy), the same two IEEE subtractions
+// (x - 0 is x for every x, -0 included). The stall is the same (perf, issue 26 session 37 "stall":
+// RegionSystem::solve's target edges, a third of its samples after those loads).
+inline Eigen::Vector2d unshifted_corner(const Eigen::Vector2d& p, double dy) {
+  return Eigen::Vector2d(p.x() - 0.0, p.y() - dy);
+}
+
 // The three map corners of a face with vertices t: positions pos[t[k]] shifted by the face's dy[k].
 inline std::array<Eigen::Vector2d, 3> shifted_corners(const std::array<int, 3>& t, const std::vector<Eigen::Vector2d>& pos,
                                                       const std::array<double, 3>& dy) {

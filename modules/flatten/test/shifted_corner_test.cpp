@@ -17,24 +17,47 @@ using flat_detail::V2;
 
 bool same_bits(const V2& a, const V2& b) { return std::memcmp(a.data(), b.data(), 2 * sizeof(double)) == 0; }
 
-// shifted_corner(p, dy) is p + V2(0, dy) bit for bit: random positions and offsets (whole periods and
-// not), signed zeros (-0 + 0 is +0 in x, as the vector sum makes it), subnormals, infinities and NaN.
-TEST(ShiftedCorner, IsTheVectorSumsBits) {
+// Random positions and offsets (whole periods and not), signed zeros, subnormals, infinities and NaN.
+std::vector<double> corner_values() {
   const double inf = std::numeric_limits<double>::infinity(), tiny = std::numeric_limits<double>::denorm_min();
   std::vector<double> values = {0.0, -0.0, tiny, -tiny, 1.0, -1.0, 1e300, -1e300, inf, -inf,
                                 std::numeric_limits<double>::quiet_NaN(), 123.456, 62.83185307179586};
   std::mt19937_64 rng(36);
   std::uniform_real_distribution<double> u(-500.0, 500.0);
   for (int i = 0; i < 2000; ++i) values.push_back(u(rng));
+  return values;
+}
+
+// f(p, dy) against want(p, dy) by memcmp over pairs of corner_values(); the number compared.
+template <class F, class Want>
+int compare_over_values(F&& f, Want&& want) {
+  const std::vector<double> values = corner_values();
   int compared = 0;
   for (std::size_t i = 0; i < values.size(); ++i)
     for (std::size_t j = 0; j < 40; ++j) {
       const V2 p(values[i], values[(i * 7 + j) % values.size()]);
       const double dy = values[(i * 13 + j * 3) % values.size()];
-      ASSERT_TRUE(same_bits(flat_detail::shifted_corner(p, dy), p + V2(0, dy))) << p.transpose() << " " << dy;
+      EXPECT_TRUE(same_bits(f(p, dy), want(p, dy))) << p.transpose() << " " << dy;
       ++compared;
     }
+  return compared;
+}
+
+// shifted_corner(p, dy) is p + V2(0, dy) bit for bit over those values (-0 + 0 is +0 in x, as the
+// vector sum makes it).
+TEST(ShiftedCorner, IsTheVectorSumsBits) {
+  const int compared = compare_over_values([](const V2& p, double dy) { return flat_detail::shifted_corner(p, dy); },
+                                           [](const V2& p, double dy) { return V2(p + V2(0, dy)); });
   EXPECT_FALSE(std::signbit(flat_detail::shifted_corner(V2(-0.0, 1.0), 0.0).x()));  // -0 + 0: +0
+  EXPECT_GT(compared, 80000);
+}
+
+// unshifted_corner(p, dy) is p - V2(0, dy) bit for bit over the same values (-0 - 0 stays -0 in x;
+// +0 - 0 is +0).
+TEST(ShiftedCorner, UnshiftedIsTheVectorDifferencesBits) {
+  const int compared = compare_over_values([](const V2& p, double dy) { return flat_detail::unshifted_corner(p, dy); },
+                                           [](const V2& p, double dy) { return V2(p - V2(0, dy)); });
+  EXPECT_TRUE(std::signbit(flat_detail::unshifted_corner(V2(-0.0, 1.0), 0.0).x()));  // -0 - 0: -0
   EXPECT_GT(compared, 80000);
 }
 
