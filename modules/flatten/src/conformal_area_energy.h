@@ -11,6 +11,7 @@
 
 #include "face_blocks.h"
 #include "flatten_internal.h"
+#include "quotient_bounds.h"
 
 namespace cf::flat_detail {
 namespace area_energy_detail {
@@ -22,7 +23,8 @@ class ConformalAreaEnergy {
   // `scale`: 3D / 2D area of the whole band (ratios at the area-preserving scale).
   ConformalAreaEnergy(const Surface& s, const Embedding& emb, std::vector<int> faces, const std::vector<double>& area3,
                       double lo, double hi, double lambda, double scale)
-      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), excess_(lo, hi), lambda_(lambda), scale_(scale) {
+      : s_(s), emb_(emb), faces_(std::move(faces)), area3_(area3), excess_(lo, hi),
+        inside_(lo, hi, LogRatioExcess::kInsideMargin), lambda_(lambda), scale_(scale) {
     w_ = corner_weights(s, faces_);
   }
   const std::vector<std::array<double, 3>>& weights() const { return w_; }
@@ -66,8 +68,12 @@ class ConformalAreaEnergy {
   static constexpr double kHuge = 1e300;
 
  private:
-  // Face i's log area ratio outside [lo, hi] (a2: its signed map area).
-  double excess(std::size_t i, double a2) const { return excess_(scale_ * a2 / area3_[std::size_t(faces_[i])]); }
+  // Face i's log area ratio outside [lo, hi] (a2: its signed map area): excess_(scale a2 / A3), +0
+  // without the division when the ratio is surely inside excess_'s margins (quotient_bounds.h).
+  double excess(std::size_t i, double a2) const {
+    const double n = scale_ * a2, d = area3_[std::size_t(faces_[i])];
+    return inside_(n, d) ? 0.0 : excess_(n / d);
+  }
   // Face i's terms added to `part` one by one (the order energy() has always summed them in); x: excess().
   void add_face_energy(std::size_t i, const std::array<V2, 3>& c, double x, double& part) const {
     for (int k = 0; k < 3; ++k) part += w_[i][k] * (c[(k + 1) % 3] - c[(k + 2) % 3]).squaredNorm();
@@ -76,7 +82,8 @@ class ConformalAreaEnergy {
   // Face i's corner gradients at corners c (a2: its signed map area, x: excess()).
   void face_gradient(std::size_t i, const std::array<V2, 3>& c, double a2, double x, std::array<V2, 3>& grad) const {
     const int f = faces_[i];
-    const double dpen = a2 > 0 ? lambda_ * area3_[f] * 2 * x / a2 : 0.0;  // d(penalty)/d(a2)
+    // d(penalty)/d(a2): (lambda A3 2 x) / a2, not divided when x = 0 (quotient_bounds.h: the same bits)
+    const double dpen = a2 > 0 ? quotient_of_zero(lambda_ * area3_[f] * 2 * x, a2) : 0.0;
     grad = {V2::Zero(), V2::Zero(), V2::Zero()};
     for (int k = 0; k < 3; ++k) {
       const int a = (k + 1) % 3, b = (k + 2) % 3;
@@ -93,6 +100,7 @@ class ConformalAreaEnergy {
   std::vector<int> faces_;
   const std::vector<double>& area3_;
   LogRatioExcess excess_;
+  SurelyInside inside_;  // excess_'s inside test by products (quotient_bounds.h)
   double lambda_, scale_ = 1;
   std::vector<std::array<double, 3>> w_;
 };
