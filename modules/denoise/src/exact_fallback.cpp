@@ -76,7 +76,9 @@ SurgeryResult ExactGreedy::cut_recorded(const std::vector<Mesh::VertexHandle>& l
   const int comp = st_.component[loop.front().idx()];
   st_.record(loop, iteration, false);
   SurgeryResult sr;
-  if (!cut_loop(st_, loop, opts_, &homology_, &sr, attempt))
+  const bool connected = cut_loop(st_, loop, opts_, &homology_, &sr, attempt);
+  adjacency_.refresh(st_.mesh, touched_by_surgery(st_.mesh, sr.undo));
+  if (!connected)
     throw Error("denoise: surgery along loop " + std::to_string(iteration - 1) + " (length " +
                 format_number(st_.loops.back().length) + " mm) split component " + std::to_string(comp) +
                 " - the loop was separating; refusing to continue");
@@ -87,7 +89,9 @@ SurgeryResult ExactGreedy::cut_recorded(const std::vector<Mesh::VertexHandle>& l
 // rebuild of the whole grid cost 0.2-0.4 s per undo at 1.8 M faces).
 void ExactGreedy::revert_cut(const SurgeryResult& sr) {
   Stopwatch sw;
+  const std::vector<int> touched = touched_by_surgery(st_.mesh, sr.undo);  // on the mesh with the cut
   undo_surgery(st_.mesh, sr.undo);
+  adjacency_.refresh(st_.mesh, touched);
   if (st_.guard) st_.guard->forget_faces_from(static_cast<int>(sr.undo.faces));
   st_.cap_rings.resize(st_.cap_rings.size() - 2);
   st_.origin.resize(st_.mesh.n_vertices());

@@ -200,6 +200,9 @@ class ExactGreedy {
   FundamentalCycleSearch::Accept accept_;
   HomologyBasis homology_;
   Z2Span span_;
+  // The searches' walks read the mesh's adjacency from here (built with search_, refreshed by
+  // cut_recorded() and revert_cut(), the only changes of the mesh while searches exist).
+  VertexAdjacency adjacency_;
   std::unique_ptr<FundamentalCycleSearch> search_;
   std::vector<std::unique_ptr<FundamentalCycleSearch>> searches_extra_;  // helper thread t's is [t - 1]
   SearchWorker* worker_ = nullptr;  // DenoiseState::worker (null with one thread)

@@ -198,8 +198,10 @@ void ExactGreedy::run_groups(std::vector<GroupRun>& runs) {
 
 int ExactGreedy::search_lanes(std::size_t tasks) {
   const int lanes = worker_ ? static_cast<int>(std::min<std::size_t>(worker_->threads(), tasks)) : 1;
-  while (static_cast<int>(searches_extra_.size()) + 1 < lanes)
+  while (static_cast<int>(searches_extra_.size()) + 1 < lanes) {
     searches_extra_.push_back(std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_));
+    searches_extra_.back()->set_adjacency(&adjacency_);
+  }
   return lanes;
 }
 

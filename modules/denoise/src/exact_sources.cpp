@@ -39,7 +39,11 @@ void ExactGreedy::build_homology() {
   span_.reset(homology_.words());
   // The searches keep their per-vertex arrays (a fresh one page-faults 40 MB at 1.6 M vertices);
   // set_cochain(nullptr) takes the new class width.
-  if (!search_) search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+  if (!search_) {
+    adjacency_.build(st_.mesh);
+    search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
+    search_->set_adjacency(&adjacency_);
+  }
   search_->set_cochain(nullptr);
   for (auto& s : searches_extra_) s->set_cochain(nullptr);
   deactivate_all_slots();

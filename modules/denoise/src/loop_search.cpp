@@ -40,7 +40,7 @@ void FundamentalCycleSearch::reset_run() {
 
 void FundamentalCycleSearch::start(Mesh::VertexHandle s) {
   reset_run();
-  relax(s.idx(), 0.0, -1);
+  relax(s.idx(), 0.0, -1, -1);
 }
 
 // Every root at distance 0 with its tree parent, so that expanding one never re-parents another.
@@ -52,11 +52,12 @@ void FundamentalCycleSearch::start_roots(const std::vector<int>& roots, const st
     node.settled = 0;
     node.dist = 0.0;
     node.parent = root_parent[i];
+    node.from = root_parent[i] < 0 ? -1 : mesh_.from_vertex_handle(Mesh::HalfedgeHandle(root_parent[i])).idx();
   }
 }
 
-// Tentative distance d for w through parent halfedge `parent` (-1 at the source).
-void FundamentalCycleSearch::relax(int w, double d, int parent) {
+// Tentative distance d for w through parent halfedge `parent` (-1 at the source) from vertex `from`.
+void FundamentalCycleSearch::relax(int w, double d, int parent, int from) {
   Node& node = node_[w];
   if (node.stamp != run_id_) {
     node.stamp = run_id_;
@@ -66,6 +67,7 @@ void FundamentalCycleSearch::relax(int w, double d, int parent) {
   }
   node.dist = d;
   node.parent = parent;
+  node.from = from;
   heap_.push(d, w);
 }
 
@@ -78,7 +80,7 @@ void FundamentalCycleSearch::settle(int v) {
   node.slot = 0;
   if (node.parent < 0) return;
   const auto ph = Mesh::HalfedgeHandle(node.parent);
-  const int pu = mesh_.from_vertex_handle(ph).idx();
+  const int pu = node.from;
   if (node_[pu].slot == 0 && edge_zero(mesh_.edge_handle(ph))) return;  // most paths: no vector work
   node.slot = static_cast<int>(acc_.size() / W_);
   acc_.resize(acc_.size() + W_, 0);
@@ -90,10 +92,10 @@ void FundamentalCycleSearch::settle(int v) {
 
 // The fundamental cycle of the non-tree edge h (v -> w, both settled): kept in `best` when it is
 // shorter, within the limit, outside the span and accepted.
-void FundamentalCycleSearch::try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept,
+void FundamentalCycleSearch::try_cycle(int vi, int wi, int hi, double value, double limit, const Accept* accept,
                                        CycleCandidate& best) {
   if (value >= best.value || value > limit) return;
-  const int vi = mesh_.from_vertex_handle(h).idx(), wi = mesh_.to_vertex_handle(h).idx();
+  const auto h = Mesh::HalfedgeHandle(hi);  // vi -> wi
   if (node_[vi].slot == 0 && node_[wi].slot == 0 && edge_zero(mesh_.edge_handle(h))) return;  // class zero
   const std::uint64_t* a = &acc_[std::size_t(node_[vi].slot) * W_];
   const std::uint64_t* b = &acc_[std::size_t(node_[wi].slot) * W_];
@@ -158,24 +160,37 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
   }
 }
 
+// The neighbours of vi in voh_range() order: from the compact adjacency when there is one, from
+// the halfedges otherwise (the same ids, order and lengths).
+template <class Visit>
+void FundamentalCycleSearch::for_each_out(int vi, Visit&& visit) const {
+  if (adj_) {
+    for (const VertexAdjacency::Out& o : adj_->out(vi)) visit(o.to, o.halfedge, o.length);
+    return;
+  }
+  const auto v = Mesh::VertexHandle(vi);
+  const Vec3& pv = mesh_.point(v);
+  for (auto h : mesh_.voh_range(v)) {
+    const auto w = mesh_.to_vertex_handle(h);
+    visit(w.idx(), h.idx(), (mesh_.point(w) - pv).norm());
+  }
+}
+
 // The edges out of the settled vertex vi (distance d): non-tree edges to settled vertices close
 // fundamental cycles, the others relax their end.
 void FundamentalCycleSearch::expand(int vi, double d, double limit, const Accept* accept, CycleCandidate& best) {
-  const auto v = Mesh::VertexHandle(vi);
-  const Vec3& pv = mesh_.point(v);
   const int parent = node_[vi].parent;
   const int parent_edge = parent >= 0 ? mesh_.edge_handle(Mesh::HalfedgeHandle(parent)).idx() : -1;
-  for (auto h : mesh_.voh_range(v)) {
-    const int wi = mesh_.to_vertex_handle(h).idx();
+  for_each_out(vi, [&](int wi, int h, double len) {
     const Node& w = node_[wi];
-    if (w.blocked || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) continue;
-    const double len = (mesh_.point(Mesh::VertexHandle(wi)) - pv).norm();
+    if (w.blocked || (avoid_ && wi < static_cast<int>(avoid_->size()) && (*avoid_)[wi])) return;
     if (w.stamp == run_id_ && w.settled) {  // non-tree edge between settled vertices
-      if (mesh_.edge_handle(h).idx() != parent_edge) try_cycle(h, d + len + w.dist, limit, accept, best);
-      continue;
+      if (mesh_.edge_handle(Mesh::HalfedgeHandle(h)).idx() != parent_edge)
+        try_cycle(vi, wi, h, d + len + w.dist, limit, accept, best);
+      return;
     }
-    relax(wi, d + len, h.idx());
-  }
+    relax(wi, d + len, h, vi);
+  });
 }
 
 double FundamentalCycleSearch::frontier_bound() {
@@ -188,7 +203,7 @@ double FundamentalCycleSearch::frontier_bound() {
     if (node.settled || node.stamp != run_id_ || node.parent < 0 || dw != node.dist) continue;
     const auto w = Mesh::VertexHandle(wi);
     const auto ph = Mesh::HalfedgeHandle(node.parent);
-    const int p = mesh_.from_vertex_handle(ph).idx();
+    const int p = node.from;
     // Class of path(s, w) through its tentative parent.
     const std::uint64_t* ap = &acc_[std::size_t(node_[p].slot) * W_];
     const std::uint64_t* ae = edge_bits(mesh_.edge_handle(ph));
@@ -218,12 +233,12 @@ std::vector<Mesh::VertexHandle> FundamentalCycleSearch::extract(const CycleCandi
     mark_[x] = mark_id_;
     up_u.push_back(Mesh::VertexHandle(x));
     if (node_[x].parent < 0) break;
-    x = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[x].parent)).idx();
+    x = node_[x].from;
   }
   int lca = c.v.idx();
   while (mark_[lca] != mark_id_) {
     up_v.push_back(Mesh::VertexHandle(lca));
-    lca = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[lca].parent)).idx();
+    lca = node_[lca].from;
   }
   // Cycle: lca -> ... -> u, then v -> ... -> (child of lca on v's side).
   std::vector<Mesh::VertexHandle> loop;

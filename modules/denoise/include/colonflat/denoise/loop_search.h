@@ -18,6 +18,7 @@
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/quad_heap.h"
 #include "colonflat/denoise/homology.h"
+#include "colonflat/denoise/vertex_adjacency.h"
 
 namespace cf {
 
@@ -59,14 +60,17 @@ class FundamentalCycleSearch {
   // Vertices flagged in `avoid` (per vertex id) are never entered (the source excepted);
   // nullptr: none. Must outlive the runs.
   void set_avoid(const std::vector<std::uint8_t>* avoid) { avoid_ = avoid; }
+  // The walks read each vertex's neighbours and edge lengths from `adjacency` (kept up to date
+  // with the mesh by the caller; the same neighbours, order and lengths as the halfedges, so the
+  // same results, faster); nullptr: from the mesh's halfedges. Must outlive the runs.
+  void set_adjacency(const VertexAdjacency* adjacency) { adj_ = adjacency; }
   // The simple cycle of a candidate from the last run() (the common stem from s is dropped).
   std::vector<Mesh::VertexHandle> extract(const CycleCandidate& c);
   // Class of an edge cycle (XOR of edge classes), `words()` words.
   std::vector<std::uint64_t> cycle_class(const std::vector<Mesh::VertexHandle>& loop) const;
   // The root whose tree holds the settled vertex v (the first vertex at distance 0 above it).
   int root_of(int v) const {
-    while (node_[v].dist > 0 && node_[v].parent >= 0)
-      v = mesh_.from_vertex_handle(Mesh::HalfedgeHandle(node_[v].parent)).idx();
+    while (node_[v].dist > 0 && node_[v].parent >= 0) v = node_[v].from;
     return v;
   }
   std::size_t last_settled() const { return settled_count_; }
@@ -82,9 +86,11 @@ class FundamentalCycleSearch {
   void reset_run();
   void drain(double limit, const Accept* accept, bool frontier, CycleCandidate& best);
   void expand(int vi, double d, double limit, const Accept* accept, CycleCandidate& best);
-  void relax(int w, double d, int parent);
+  template <class Visit>
+  void for_each_out(int vi, Visit&& visit) const;  // visit(to, halfedge, length) per outgoing halfedge
+  void relax(int w, double d, int parent, int from);
   void settle(int v);
-  void try_cycle(Mesh::HalfedgeHandle h, double value, double limit, const Accept* accept, CycleCandidate& best);
+  void try_cycle(int vi, int wi, int h, double value, double limit, const Accept* accept, CycleCandidate& best);
   double frontier_bound();
   bool wanted(std::uint64_t* cls) const;  // in the searched family (cls may be modified)
   const std::uint64_t* edge_bits(Mesh::EdgeHandle e) const {
@@ -100,13 +106,15 @@ class FundamentalCycleSearch {
   const Z2Span& span_;
   const std::vector<std::uint8_t>* cochain_ = nullptr;
   const std::vector<std::uint8_t>* avoid_ = nullptr;
+  const VertexAdjacency* adj_ = nullptr;
   int W_;
   std::uint32_t run_id_ = 0;
   // Per-vertex search state in one record (one cache line fetch per neighbour visited).
-  struct Node {
+  struct alignas(32) Node {  // 32 bytes on 32: never across two cache lines
     double dist = 0;
     std::uint32_t stamp = 0;  // run_id_ of the run that reached it; the other fields hold only then
     int parent = -1;          // parent halfedge (parent -> v) idx, -1 at the source
+    int from = -1;            // the parent halfedge's from-vertex (kept: the halfedge array is not read again)
     int slot = -1;            // row of acc_ holding the class of path(s, v)
     std::uint8_t settled = 0;
     std::uint8_t blocked = 0;  // boundary vertex (never on a loop); set for all vertices below blocked_known_
