@@ -50,10 +50,18 @@ void FundamentalCycleSearch::start_roots(const std::vector<int>& roots, const st
     Node& node = node_[roots[i]];
     node.stamp = run_id_;
     node.settled = 0;
+    copy_list(node, roots[i]);
     node.dist = 0.0;
     node.parent = root_parent[i];
     node.from = root_parent[i] < 0 ? -1 : mesh_.from_vertex_handle(Mesh::HalfedgeHandle(root_parent[i])).idx();
   }
+}
+
+void FundamentalCycleSearch::copy_list(Node& node, int v) const {
+  if (!adj_) return;
+  const auto [first, last] = adj_->span(v);
+  node.first = first;
+  node.count = last - first < kLongList ? static_cast<std::uint16_t>(last - first) : kLongList;
 }
 
 // Tentative distance d for w through parent halfedge `parent` (-1 at the source) from vertex `from`.
@@ -62,6 +70,7 @@ void FundamentalCycleSearch::relax(int w, double d, int parent, int from) {
   if (node.stamp != run_id_) {
     node.stamp = run_id_;
     node.settled = 0;
+    copy_list(node, w);
   } else if (!(d < node.dist)) {
     return;
   }
@@ -165,7 +174,10 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
 template <class Visit>
 void FundamentalCycleSearch::for_each_out(int vi, Visit&& visit) const {
   if (adj_) {
-    for (const VertexAdjacency::Out& o : adj_->out(vi)) visit(o.to, o.halfedge, o.length);
+    const Node& node = node_[vi];
+    const VertexAdjacency::Range r = node.count == kLongList ? adj_->out(vi)
+        : VertexAdjacency::Range{adj_->entries() + node.first, adj_->entries() + node.first + node.count};
+    for (const VertexAdjacency::Out& o : r) visit(o.to, o.halfedge, o.length);
     return;
   }
   const auto v = Mesh::VertexHandle(vi);

@@ -116,9 +116,16 @@ class FundamentalCycleSearch {
     int parent = -1;          // parent halfedge (parent -> v) idx, -1 at the source
     int from = -1;            // the parent halfedge's from-vertex (kept: the halfedge array is not read again)
     int slot = -1;            // row of acc_ holding the class of path(s, v)
+    // Its list in the adjacency (with adj_): entries()[first, first + count), copied when the run
+    // reaches it, so that expanding it reads the list without a dependent load of the span.
+    std::uint32_t first = 0;
+    std::uint16_t count = 0;  // kLongList: longer, read from the adjacency's span
     std::uint8_t settled = 0;
     std::uint8_t blocked = 0;  // boundary vertex (never on a loop); set for all vertices below blocked_known_
   };
+  static_assert(sizeof(Node) == 32, "one Node per half cache line");
+  static constexpr std::uint16_t kLongList = 0xffff;
+  void copy_list(Node& node, int v) const;
   std::vector<Node> node_;
   std::size_t blocked_known_ = 0;
   std::vector<std::uint64_t> acc_;  // class rows of settled vertices' paths; row 0 is zero

@@ -42,6 +42,9 @@ class VertexAdjacency {
     const auto [b, e] = span_[std::size_t(v)];
     return Range{out_.data() + b, out_.data() + e};
   }
+  // v's list as [first, last) indices into entries() (for callers that keep them per vertex).
+  std::pair<std::uint32_t, std::uint32_t> span(int v) const { return span_[std::size_t(v)]; }
+  const Out* entries() const { return out_.data(); }
   std::size_t vertices() const { return span_.size(); }
   // Entries stored, stale ones (lists written again since) included.
   std::size_t stored() const { return out_.size(); }
