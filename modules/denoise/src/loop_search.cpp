@@ -64,6 +64,15 @@ void FundamentalCycleSearch::copy_list(Node& node, int v) const {
   node.count = last - first < kLongList ? static_cast<std::uint16_t>(last - first) : kLongList;
 }
 
+// A hint only: vi's list (its first and last entry) is fetched while the heap pops.
+void FundamentalCycleSearch::prefetch_list(int vi) const {
+  if (!adj_) return;
+  const Node& node = node_[vi];
+  const VertexAdjacency::Out* first = adj_->entries() + node.first;
+  __builtin_prefetch(first);
+  if (node.count > 1 && node.count != kLongList) __builtin_prefetch(first + node.count - 1);
+}
+
 // Tentative distance d for w through parent halfedge `parent` (-1 at the source) from vertex `from`.
 void FundamentalCycleSearch::relax(int w, double d, int parent, int from) {
   Node& node = node_[w];
@@ -162,7 +171,9 @@ void FundamentalCycleSearch::drain(double limit, const Accept* accept, bool fron
       if (!best.found && frontier) best.frontier_bound = frontier_bound();
       break;
     }
+    prefetch_list(vi);
     heap_.pop();
+    if (!heap_.empty()) prefetch_list(heap_.top().second);  // most often the next one settled
     if (node_[vi].settled || d > node_[vi].dist) continue;
     settle(vi);
     expand(vi, d, limit, accept, best);

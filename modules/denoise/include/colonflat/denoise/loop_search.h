@@ -126,6 +126,7 @@ class FundamentalCycleSearch {
   static_assert(sizeof(Node) == 32, "one Node per half cache line");
   static constexpr std::uint16_t kLongList = 0xffff;
   void copy_list(Node& node, int v) const;
+  void prefetch_list(int vi) const;
   std::vector<Node> node_;
   std::size_t blocked_known_ = 0;
   std::vector<std::uint64_t> acc_;  // class rows of settled vertices' paths; row 0 is zero
