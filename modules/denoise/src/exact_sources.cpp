@@ -40,7 +40,12 @@ void ExactGreedy::build_homology() {
   // The searches keep their per-vertex arrays (a fresh one page-faults 40 MB at 1.6 M vertices);
   // set_cochain(nullptr) takes the new class width.
   if (!search_) {
-    adjacency_.build(st_.mesh);
+    VertexAdjacency::RunBoth both;  // the second half of the lists on the helper
+    if (worker_)
+      both = [this](const std::function<void()>& mine, const std::function<void()>& theirs) {
+        run_both(*worker_, mine, theirs);
+      };
+    adjacency_.build(st_.mesh, both);
     search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
     search_->set_adjacency(&adjacency_);
   }

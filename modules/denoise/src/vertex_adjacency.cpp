@@ -27,12 +27,49 @@ void VertexAdjacency::append(const Mesh& mesh, int v) {
   live_ += out_.size() - begin;
 }
 
-void VertexAdjacency::build(const Mesh& mesh) {
-  const std::size_t n = mesh.n_vertices();
+// Writes the lists of vertices [from, to) at their spans' starts; false when a list is not as long as
+// its span (a vertex whose outgoing halfedges are not all in its voh_range() ring).
+bool VertexAdjacency::fill(const Mesh& mesh, std::size_t from, std::size_t to) {
+  for (std::size_t v = from; v < to; ++v) {
+    const auto vh = Mesh::VertexHandle(static_cast<int>(v));
+    const Vec3& pv = mesh.point(vh);
+    std::uint32_t i = span_[v].first;
+    for (auto h : mesh.voh_range(vh)) {
+      if (i == span_[v].second) return false;
+      const auto w = mesh.to_vertex_handle(h);
+      out_[i++] = Out{w.idx(), h.idx(), (mesh.point(w) - pv).norm()};  // the walks' own expression
+    }
+    if (i != span_[v].second) return false;
+  }
+  return true;
+}
+
+void VertexAdjacency::build(const Mesh& mesh, const RunBoth& run_both) {
+  const std::size_t n = mesh.n_vertices(), halfedges = mesh.n_halfedges();
   out_.clear();
   // Every halfedge once, the stale room beyond (a fresh block: advised before it is written).
-  reserve_huge(out_, mesh.n_halfedges() + static_cast<std::size_t>(kStaleRoom * double(mesh.n_halfedges())));
+  const std::size_t room = halfedges + static_cast<std::size_t>(kStaleRoom * double(halfedges));
+  if (out_.capacity() < room) {
+    decltype(out_) fresh;
+    fresh.reserve(room);
+    if (room * sizeof(Out) >= kHugePageMinBytes) advise_huge_pages(fresh.data(), room * sizeof(Out));
+    out_.swap(fresh);
+  }
   span_.assign(n, {0, 0});
+  for (std::size_t h = 0; h < halfedges; ++h)  // out-degrees, in one pass over the halfedges
+    ++span_[std::size_t(mesh.from_vertex_handle(Mesh::HalfedgeHandle(static_cast<int>(h))).idx())].second;
+  std::uint32_t at = 0;
+  for (auto& [first, last] : span_) {
+    first = at;
+    last = at += last;
+  }
+  out_.resize(halfedges);
+  live_ = halfedges;
+  bool ok[2] = {true, true};
+  if (run_both) run_both([&] { ok[0] = fill(mesh, 0, n / 2); }, [&] { ok[1] = fill(mesh, n / 2, n); });
+  else ok[0] = fill(mesh, 0, n);
+  if (ok[0] && ok[1]) return;
+  out_.clear();  // a ring that misses some outgoing halfedge: each vertex's list as its walk gives it
   live_ = 0;
   for (std::size_t v = 0; v < n; ++v) append(mesh, static_cast<int>(v));
 }

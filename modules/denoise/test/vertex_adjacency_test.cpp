@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <thread>
 
 #include "colonflat/core/synthetic.h"
 #include "colonflat/denoise/face_grid.h"
@@ -61,6 +62,24 @@ TEST(DenoiseVertexAdjacency, BuildMatchesHalfedgeWalk) {
   const VertexAdjacency adj(m);
   EXPECT_EQ(first_difference(adj, m), -1);
   EXPECT_EQ(adj.stored(), m.n_halfedges());
+}
+
+// Built in two halves (the second on another thread): the same lists, entry for entry, as one build.
+TEST(DenoiseVertexAdjacency, TwoHalvesBuildTheSameBlock) {
+  const Mesh m = bumpy_chain(2);
+  const VertexAdjacency one(m);
+  VertexAdjacency two;
+  two.build(m, [](const std::function<void()>& mine, const std::function<void()>& theirs) {
+    std::thread t(theirs);
+    mine();
+    t.join();
+  });
+  EXPECT_EQ(first_difference(two, m), -1);
+  ASSERT_EQ(two.stored(), one.stored());
+  for (std::size_t i = 0; i < one.stored(); ++i) {
+    ASSERT_EQ(one.entries()[i].to, two.entries()[i].to) << i;
+    ASSERT_EQ(one.entries()[i].halfedge, two.entries()[i].halfedge) << i;
+  }
 }
 
 // After two surgeries (concentric caps, then caps triangulated against a guard) and the undo of

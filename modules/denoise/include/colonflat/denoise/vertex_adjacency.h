@@ -8,6 +8,8 @@
 // The mesh may change by surgery: refresh() rewrites the lists of the vertices it touched
 // (touched_by_surgery()), after the cut and again after an undo.
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -20,10 +22,12 @@ struct SurgeryUndo;
 class VertexAdjacency {
  public:
   struct Out {
-    int to = -1;        // neighbour vertex id
-    int halfedge = -1;  // id of the halfedge from the vertex to `to`
-    double length = 0;  // (p_to - p_from).norm()
+    int to;         // neighbour vertex id
+    int halfedge;   // id of the halfedge from the vertex to `to`
+    double length;  // (p_to - p_from).norm()
   };
+  // Runs two jobs, on two threads where it can (HomologyBasis::RunBoth's shape).
+  using RunBoth = std::function<void(const std::function<void()>&, const std::function<void()>&)>;
   struct Range {
     const Out* first;
     const Out* last;
@@ -33,8 +37,9 @@ class VertexAdjacency {
 
   VertexAdjacency() = default;
   explicit VertexAdjacency(const Mesh& mesh) { build(mesh); }
-  // Every vertex's list from the mesh as it is.
-  void build(const Mesh& mesh);
+  // Every vertex's list from the mesh as it is. With run_both: the lists of the first and second
+  // half of the vertices are written beside each other (the same block, entry for entry).
+  void build(const Mesh& mesh, const RunBoth& run_both = {});
   // The lists of `vertices` (ids; those >= the mesh's vertex count are skipped) and of every vertex
   // added since the last build/refresh written again; vertices removed since are dropped.
   void refresh(const Mesh& mesh, const std::vector<int>& vertices);
@@ -51,7 +56,23 @@ class VertexAdjacency {
 
  private:
   void append(const Mesh& mesh, int v);
-  std::vector<Out> out_;
+  bool fill(const Mesh& mesh, std::size_t from, std::size_t to);
+  // Sized without writing (the entries are written once, by the thread that fills them).
+  template <class T>
+  struct NoInit : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = NoInit<U>;
+    };
+    NoInit() = default;
+    template <class U>
+    NoInit(const NoInit<U>&) {}
+    template <class U>
+    void construct(U* p) { ::new (static_cast<void*>(p)) U; }
+    template <class U, class... A>
+    void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
+  };
+  std::vector<Out, NoInit<Out>> out_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> span_;  // per vertex: [begin, end) in out_
   std::size_t live_ = 0;                                        // entries of the current lists
 };
