@@ -124,12 +124,7 @@ void build_first_homology(DenoiseState& st, const DenoiseOptions& o, const Topol
   if (o.method != "exact" || *b.genus <= o.target_genus) return;
   Stopwatch sw;
   st.initial_homology = std::make_unique<HomologyBasis>();
-  if (beside)
-    st.initial_homology->build(st.mesh, [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {
-      run_both(*st.worker, mine, theirs);
-    });
-  else
-    st.initial_homology->build(st.mesh);
+  st.initial_homology->build(st.mesh, beside ? on_helper(st.worker.get()) : RunBoth{});
   st.t.homology += sw.seconds();
 }
 

@@ -57,10 +57,7 @@ bool cut_loop(DenoiseState& st, const std::vector<Mesh::VertexHandle>& loop, con
   so.mincut = o.mincut_caps && attempt == CapAttempt::kAgain;  // a loop's last cut only
   so.mincut_cell = o.mincut_cell;
   so.mincut_widen = o.mincut_widen;
-  if (st.worker)
-    so.run_both = [&st](const std::function<void()>& mine, const std::function<void()>& theirs) {
-      run_both(*st.worker, mine, theirs);
-    };
+  so.run_both = on_helper(st.worker.get());
   if (o.check_caps) {
     if (!st.guard) st.guard = std::make_unique<FaceGrid>(st.mesh, kGuardCellEdges * st.mean_edge);
     so.guard = st.guard.get();

@@ -29,23 +29,13 @@ void ExactGreedy::build_homology() {
     homology_ = std::move(*st_.initial_homology);
     st_.initial_homology.reset();
   } else {
-    HomologyBasis::RunBoth both;  // the cut graph's pruning on the helper beside the annotations
-    if (worker_)
-      both = [this](const std::function<void()>& mine, const std::function<void()>& theirs) {
-        run_both(*worker_, mine, theirs);
-      };
-    homology_.build(st_.mesh, both);
+    homology_.build(st_.mesh, on_helper(worker_));  // the cut graph's pruning on the helper beside the annotations
   }
   span_.reset(homology_.words());
   // The searches keep their per-vertex arrays (a fresh one page-faults 40 MB at 1.6 M vertices);
   // set_cochain(nullptr) takes the new class width.
   if (!search_) {
-    VertexAdjacency::RunBoth both;  // the second half of the lists on the helper
-    if (worker_)
-      both = [this](const std::function<void()>& mine, const std::function<void()>& theirs) {
-        run_both(*worker_, mine, theirs);
-      };
-    adjacency_.build(st_.mesh, both);
+    adjacency_.build(st_.mesh, on_helper(worker_));  // the second half of the lists on the helper
     search_ = std::make_unique<FundamentalCycleSearch>(st_.mesh, homology_, span_);
     search_->set_adjacency(&adjacency_);
   }

@@ -9,6 +9,8 @@
 #include <thread>
 #include <vector>
 
+#include "colonflat/denoise/run_both.h"
+
 namespace cf::detail {
 
 class SearchWorker {
@@ -97,6 +99,15 @@ inline void run_both(SearchWorker& worker, const std::function<void()>& mine, co
   worker.run_both([&] { guarded(mine, mine_error); }, [&] { guarded(theirs, their_error); });
   if (mine_error) std::rethrow_exception(mine_error);
   if (their_error) std::rethrow_exception(their_error);
+}
+
+// A RunBoth (run_both.h) on `worker`'s helper thread through run_both() above; empty without a
+// worker (one thread). `worker` must outlive the calls.
+inline RunBoth on_helper(SearchWorker* worker) {
+  if (!worker) return {};
+  return [worker](const std::function<void()>& mine, const std::function<void()>& theirs) {
+    run_both(*worker, mine, theirs);
+  };
 }
 
 }  // namespace cf::detail

@@ -17,11 +17,11 @@
 // near the root), so each edge holds an index into a pool of its nonzero class rows (row 0 is
 // the zero class) instead of a dense edges x words table (188 MB at 2.3 M edges and genus 300).
 #include <cstdint>
-#include <functional>
 #include <utility>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
+#include "colonflat/denoise/run_both.h"
 
 namespace cf {
 
@@ -31,9 +31,7 @@ struct ClosedDual;  // the dual graph with one virtual face per boundary loop (h
 
 class HomologyBasis {
  public:
-  // Runs the first job on the calling thread and the second on a helper at once, returning when
-  // both are done (neither may throw); empty: one thread.
-  using RunBoth = std::function<void(const std::function<void()>&, const std::function<void()>&)>;
+  using RunBoth = cf::RunBoth;  // run_both.h
   // Precondition: `mesh` is a manifold (garbage-collected) triangle mesh. With `run_both`, the
   // pruning of the cut graph runs on the helper beside the annotations (both need only the dual
   // forest): the same result as one thread.

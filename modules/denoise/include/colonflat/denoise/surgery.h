@@ -12,11 +12,11 @@
 // vertex ids stay valid (right copies keep the original ids; left copies and caps are appended).
 #include <array>
 #include <cstddef>
-#include <functional>
 #include <utility>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
+#include "colonflat/denoise/run_both.h"
 #include "colonflat/denoise/face_grid.h"
 
 namespace cf {
@@ -48,12 +48,11 @@ struct SurgeryOptions {
                                   // searched for a clean one (each count stops at its first pair);
                                   // without one the caps stay in the first placement, whose pairs
                                   // are reported (the caller undoes such a cut)
-  // With a helper thread: runs the first job on the calling thread and the second on the helper
-  // at once and returns when both are done (neither may throw); empty: one thread. The restricted
-  // caps then triangulate the left ring alone on the helper beside the right ring's triangulation,
+  // With a helper thread (run_both.h; empty: one thread), the restricted caps
+  // triangulate the left ring alone on the helper beside the right ring's triangulation,
   // and use it only where the one-thread order computes that same triangulation within the same
   // query budget: the caps are the same for any thread count.
-  std::function<void(const std::function<void()>&, const std::function<void()>&)> run_both;
+  RunBoth run_both;
 };
 
 // What undo_surgery() needs to put the mesh back as it was before cut_and_cap(): the element

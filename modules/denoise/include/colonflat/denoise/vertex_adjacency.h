@@ -8,12 +8,12 @@
 // The mesh may change by surgery: refresh() rewrites the lists of the vertices it touched
 // (touched_by_surgery()), after the cut and again after an undo.
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
+#include "colonflat/denoise/run_both.h"
 
 namespace cf {
 
@@ -26,8 +26,7 @@ class VertexAdjacency {
     int halfedge;   // id of the halfedge from the vertex to `to`
     double length;  // (p_to - p_from).norm()
   };
-  // Runs two jobs, on two threads where it can (HomologyBasis::RunBoth's shape).
-  using RunBoth = std::function<void(const std::function<void()>&, const std::function<void()>&)>;
+  using RunBoth = cf::RunBoth;  // run_both.h
   struct Range {
     const Out* first;
     const Out* last;
