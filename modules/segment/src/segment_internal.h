@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colonflat/core/default_init_allocator.h"
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/segment/segment.h"
@@ -68,23 +69,7 @@ using Bytes = Buffer<unsigned char>;
 // written over the workers (fill_parallel, a parallel copy): a fresh block's pages are then first
 // touched, faulted and zeroed by the kernel on the worker threads, not serially on the caller's.
 template <class T>
-struct RawHugePageAllocator : HugePageAllocator<T> {
-  template <class U>
-  struct rebind {
-    using other = RawHugePageAllocator<U>;
-  };
-  RawHugePageAllocator() = default;
-  template <class U>
-  RawHugePageAllocator(const RawHugePageAllocator<U>&) {}
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... A>
-  void construct(U* p, A&&... a) {
-    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
-  }
-};
+using RawHugePageAllocator = DefaultInitAllocator<HugePageAllocator<T>>;  // core/default_init_allocator.h
 template <class T>
 using RawBuffer = std::vector<T, RawHugePageAllocator<T>>;
 

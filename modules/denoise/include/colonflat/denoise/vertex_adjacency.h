@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "colonflat/core/default_init_allocator.h"
 #include "colonflat/core/mesh.h"
 #include "colonflat/denoise/run_both.h"
 
@@ -57,21 +58,7 @@ class VertexAdjacency {
   void append(const Mesh& mesh, int v);
   bool fill(const Mesh& mesh, std::size_t from, std::size_t to);
   // Sized without writing (the entries are written once, by the thread that fills them).
-  template <class T>
-  struct NoInit : std::allocator<T> {
-    template <class U>
-    struct rebind {
-      using other = NoInit<U>;
-    };
-    NoInit() = default;
-    template <class U>
-    NoInit(const NoInit<U>&) {}
-    template <class U>
-    void construct(U* p) { ::new (static_cast<void*>(p)) U; }
-    template <class U, class... A>
-    void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
-  };
-  std::vector<Out, NoInit<Out>> out_;
+  std::vector<Out, DefaultInitAllocator<std::allocator<Out>>> out_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> span_;  // per vertex: [begin, end) in out_
   std::size_t live_ = 0;                                        // entries of the current lists
 };
