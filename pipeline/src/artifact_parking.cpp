@@ -8,17 +8,19 @@
 namespace cf {
 namespace {
 
-// The declared type of each artifact name the plan's stages read, and the names they write.
+// The declared type of each artifact name the plan's stages read, and the names that stage
+// `done` and the stages after it write.
 struct PlanPorts {
   std::map<std::string, const ArtifactType*> type;
   std::set<std::string> written;
 };
 
-PlanPorts plan_ports(const RunPlan& plan) {
+PlanPorts plan_ports(const RunPlan& plan, std::size_t done) {
   PlanPorts p;
-  for (const auto& st : plan.stages) {
-    for (const Port& in : st->spec().inputs) p.type.emplace(in.name, in.type);
-    for (const Port& out : st->spec().outputs) p.written.insert(out.name);
+  for (std::size_t j = 0; j < plan.stages.size(); ++j) {
+    for (const Port& in : plan.stages[j]->spec().inputs) p.type.emplace(in.name, in.type);
+    if (j >= done)
+      for (const Port& out : plan.stages[j]->spec().outputs) p.written.insert(out.name);
   }
   return p;
 }
@@ -33,7 +35,7 @@ bool read_after(const RunPlan& plan, std::size_t done, const std::string& name) 
 }  // namespace
 
 void ParkedArtifacts::park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
-  const PlanPorts ports = plan_ports(plan);
+  const PlanPorts ports = plan_ports(plan, done);
   for (const auto& [name, type] : ports.type) {
     if (!type->compact || !type->expand || parked_.count(name) || !bag.has(name)) continue;
     if (ports.written.count(name) || read_after(plan, done, name)) continue;

@@ -16,10 +16,12 @@ namespace cf {
 
 class ParkedArtifacts {
  public:
-  // After plan.stages[done] ran: every artifact in `bag` with a compactable type that none of
-  // the stages after it reads and none of the plan's stages writes (an output may still be on the
-  // background writer) is replaced by its stand-in; each one parked is appended to `log`
-  // ({"artifact", "after_stage", "time_s"}).
+  // After plan.stages[done] ran and its outputs went to the background writer: every artifact in
+  // `bag` with a compactable type that none of the stages after it reads, and that neither that
+  // stage nor a later one writes (the writer may still be writing stage `done`'s outputs; it has
+  // written every earlier stage's, BackgroundOutputWriter::submit waits for them), is replaced by
+  // its stand-in; each one parked is appended to `log` ({"artifact", "after_stage", "time_s"}).
+  // E.g. segment's lumen mask is parked after reconstruct, when segment's files are written.
   void park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log);
 
  private:

@@ -1,7 +1,11 @@
-// `colonflat run` holds the CT in 16 bits from reconstruct to the review report
-// (artifact_parking.h): the run report says so, and the report built from the run's memory (the
-// CT expanded back) equals, file for file, the one `colonflat report` builds from the CT on disk.
+// `colonflat run` holds the CT in 16 bits and the lumen mask in one bit per voxel from reconstruct
+// to the review report (artifact_parking.h): the run report says so, and the report built from the
+// run's memory (both expanded back) equals, file for file, the one `colonflat report` builds from
+// the files.
 #include <gtest/gtest.h>
+
+#include <set>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -16,10 +20,10 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
-// The CT is parked after reconstruct (the last stage that reads it), the Segmentation montages are
-// drawn beside the stages, and every image of report_files/ made from the run's memory is
+// The CT and the mask are parked after reconstruct (the last stage that reads them), the
+// Segmentation montages are drawn beside the stages, and every image of report_files/ made from the run's memory is
 // byte-identical to those `colonflat report` makes from the files.
-TEST(ArtifactParking, CtHeldCompactAndRestoredExactlyForTheReport) {
+TEST(ArtifactParking, CtAndMaskHeldCompactAndRestoredExactlyForTheReport) {
   for (const char* s : {"segment", "reconstruct", "denoise", "flatten", "render"})
     if (!find_stage(s)) GTEST_SKIP() << "this build has no " << s << " stage";
   testing::TempDir dir;
@@ -30,9 +34,13 @@ TEST(ArtifactParking, CtHeldCompactAndRestoredExactlyForTheReport) {
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = read_json_file(dir / "out" / "run_report.json");
   ASSERT_TRUE(report.contains("held_compact")) << report.dump(1).substr(0, 2000);
-  ASSERT_EQ(report["held_compact"].size(), 1u);
-  EXPECT_EQ(report["held_compact"][0]["artifact"], "ct");
-  EXPECT_EQ(report["held_compact"][0]["after_stage"], "reconstruct");
+  ASSERT_EQ(report["held_compact"].size(), 2u);
+  std::set<std::string> held;
+  for (const auto& h : report["held_compact"]) {
+    held.insert(h["artifact"].get<std::string>());
+    EXPECT_EQ(h["after_stage"], "reconstruct");
+  }
+  EXPECT_EQ(held, (std::set<std::string>{"ct", "mask"}));
   bool drawn_beside = false;
   for (const auto& finisher : report["after_stages"])
     for (const auto& phase : finisher.value("phases", nlohmann::json::array()))

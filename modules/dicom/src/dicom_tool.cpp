@@ -87,7 +87,7 @@ nlohmann::json write_results(const RunData& run, const MaskImage* mask, const So
 // The lumen mask of a run: the report's when it kept it, else the file as written (staged).
 MaskImage::Pointer run_mask(const RunData* data, const FinishedRun& run, const OutputTransaction& tx) {
   if (data && data->volume_is_mask && data->mask) return data->mask;
-  if (run.artifacts && run.artifacts->has("mask")) return run.artifacts->get<MaskImage::Pointer>("mask");
+  if (run.artifacts && run.artifacts->has("mask")) return expanded<MaskImage::Pointer>(*run.artifacts, "mask", mask_artifact());
   const fs::path staged = tx.staging_folder(run.dir) / "lumen_mask.nrrd";
   std::error_code ec;
   if (!fs::exists(staged, ec)) throw Error((run.dir / "dicom").string() + ": the run wrote no lumen mask");

@@ -95,14 +95,9 @@ bool run_started_from_mask(const nlohmann::json& run_report) {
 
 // The run's CT from the bag: as read, or held in 16 bits (`colonflat run` holds it so from
 // reconstruct on: pipeline/src/artifact_parking.h), then expanded here - after the report freed
-// the meshes - and put back in its place, so the 16-bit copy is freed at once.
-CtImage::Pointer ct_in_bag(ArtifactBag& bag) {
-  const std::any& held = bag.raw("ct");
-  if (const auto* ct = std::any_cast<CtImage::Pointer>(&held)) return *ct;
-  CtImage::Pointer ct = std::any_cast<CtImage::Pointer>(volume_artifact().expand(held));
-  bag.put("ct", std::any(ct));
-  return ct;
-}
+// the meshes - and put back in its place, so the 16-bit copy is freed at once. The lumen mask
+// likewise (held in one bit per voxel from reconstruct on).
+CtImage::Pointer ct_in_bag(ArtifactBag& bag) { return expanded<CtImage::Pointer>(bag, "ct", volume_artifact()); }
 
 void set_flat(RunData& run, FlatMap flat) {
   if (flat.centreline_mm.size() == flat.uv.size()) run.centreline_mm = flat.centreline_mm;
@@ -208,11 +203,11 @@ RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann
     run.ct = ct_in_bag(bag);
     run.ct_path = input;
   } else if (bag.has("mask")) {
-    run.mask = bag.get<MaskImage::Pointer>("mask");
+    run.mask = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
     run.ct_path = input;
     run.volume_is_mask = true;
   }
-  if (run.ct && bag.has("mask")) run.lumen = bag.get<MaskImage::Pointer>("mask");
+  if (run.ct && bag.has("mask")) run.lumen = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
   complete_run(run, opts);
   return run;
 }

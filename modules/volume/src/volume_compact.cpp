@@ -1,8 +1,11 @@
 // compact_ct / expand_ct (volume_io.h): a CT whose HU are 16-bit integers held in 16 bits while
-// no stage reads it, and the float image back, voxel for voxel.
+// no stage reads it, and the float image back, voxel for voxel; compact_mask / expand_mask: a
+// binary mask held in one bit per voxel.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <memory>
 
 #include "colonflat/core/threads.h"
 #include "colonflat/volume/volume_io.h"
@@ -51,6 +54,42 @@ CtImage::Pointer expand_ct(const CompactCtImage& compact) {
   float* dst = out->GetBufferPointer();
   parallel_for(n, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) dst[i] = static_cast<float>(src[i]);
+  });
+  return out;
+}
+
+std::shared_ptr<const CompactMask> compact_mask(const MaskImage& mask) {
+  const std::size_t n = mask.GetLargestPossibleRegion().GetNumberOfPixels();
+  const unsigned char* src = mask.GetBufferPointer();
+  auto out = std::make_shared<CompactMask>();
+  out->bits.resize((n + 63) / 64);
+  std::atomic<bool> binary{true};
+  parallel_for(out->bits.size(), [&](std::size_t b, std::size_t e) {
+    bool ok = true;
+    for (std::size_t w = b; w < e; ++w) {
+      std::uint64_t word = 0;
+      for (std::size_t i = w * 64, end = std::min(n, i + 64); i < end; ++i) {
+        ok = ok && src[i] <= 1;
+        word |= std::uint64_t(src[i] & 1) << (i % 64);
+      }
+      out->bits[w] = word;
+    }
+    if (!ok) binary = false;
+  });
+  if (!binary) return nullptr;
+  out->grid = MaskImage::New();
+  out->grid->CopyInformation(&mask);
+  out->grid->SetRegions(mask.GetLargestPossibleRegion());
+  out->grid->SetMetaDataDictionary(mask.GetMetaDataDictionary());
+  return out;
+}
+
+MaskImage::Pointer expand_mask(const CompactMask& compact) {
+  const std::size_t n = compact.grid->GetLargestPossibleRegion().GetNumberOfPixels();
+  auto out = image_like<MaskImage>(*compact.grid);
+  unsigned char* dst = out->GetBufferPointer();
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) dst[i] = static_cast<unsigned char>((compact.bits[i / 64] >> (i % 64)) & 1);
   });
   return out;
 }

@@ -187,7 +187,15 @@ const ArtifactType& mask_artifact() {
       [](const std::any& v, const fs::path& tmp, const fs::path& target) {
         write_mask_file(std::any_cast<const MaskImage::Pointer&>(v).GetPointer(), tmp, target);
       },
-      {".nrrd", ".nii", ".nii.gz", ".mha"}};
+      {".nrrd", ".nii", ".nii.gz", ".mha"},
+      [](const std::any& v) -> std::optional<std::any> {
+        std::shared_ptr<const CompactMask> c = compact_mask(*std::any_cast<const MaskImage::Pointer&>(v));
+        if (!c) return std::nullopt;
+        return std::any(c);
+      },
+      [](const std::any& v) {
+        return std::any(expand_mask(*std::any_cast<const std::shared_ptr<const CompactMask>&>(v)));
+      }};
   return t;
 }
 

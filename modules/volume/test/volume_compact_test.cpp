@@ -1,10 +1,13 @@
 // compact_ct / expand_ct: a CT of 16-bit integer HU is held in 16 bits and comes back voxel for
-// voxel with its geometry and header; any other CT is not compacted.
+// voxel with its geometry and header; any other CT is not compacted. compact_mask / expand_mask:
+// the same for a 0/1 mask in one bit per voxel.
 #include <gtest/gtest.h>
 
 #include <itkMetaDataObject.h>
 
+#include <array>
 #include <cmath>
+#include <memory>
 #include <limits>
 #include <string>
 
@@ -77,7 +80,64 @@ TEST(CompactCt, VolumeArtifactCompactsAndExpands) {
   ASSERT_NE(std::any_cast<CompactCtImage::Pointer>(&*stand_in), nullptr);
   const auto back = std::any_cast<CtImage::Pointer>(volume_artifact().expand(*stand_in));
   EXPECT_EQ(back->GetBufferPointer()[1], 32767.0f);
-  EXPECT_FALSE(mask_artifact().compact);
+}
+
+// nx x ny x nz voxels, oblique like small_ct, a header entry, voxel i = 1 where (i * 7919) % 5 < 2:
+// runs of both values that cross every 64-voxel word boundary.
+MaskImage::Pointer patterned_mask(unsigned nx, unsigned ny, unsigned nz) {
+  const CtImage::Pointer ct = small_ct();
+  auto m = MaskImage::New();
+  m->SetRegions(MaskImage::SizeType{{nx, ny, nz}});
+  m->SetSpacing(ct->GetSpacing());
+  m->SetOrigin(ct->GetOrigin());
+  m->SetDirection(ct->GetDirection());
+  m->Allocate();
+  const std::size_t n = m->GetLargestPossibleRegion().GetNumberOfPixels();
+  for (std::size_t i = 0; i < n; ++i) m->GetBufferPointer()[i] = (i * 7919) % 5 < 2 ? 1 : 0;
+  itk::EncapsulateMetaData<std::string>(m->GetMetaDataDictionary(), "PatientPosition", "HFS");
+  return m;
+}
+
+// A 0/1 mask (105 voxels: not a whole number of words; 140 000: many words over the threads) is
+// held in one bit per voxel and comes back voxel for voxel with its grid and header.
+TEST(CompactMask, BinaryMaskComesBackExactly) {
+  for (const auto& [nx, ny, nz] : {std::array<unsigned, 3>{7, 5, 3}, std::array<unsigned, 3>{70, 50, 40}}) {
+    const MaskImage::Pointer m = patterned_mask(nx, ny, nz);
+    const std::size_t n = m->GetLargestPossibleRegion().GetNumberOfPixels();
+    const std::shared_ptr<const CompactMask> c = compact_mask(*m);
+    ASSERT_TRUE(c);
+    EXPECT_EQ(c->bits.size(), (n + 63) / 64);
+    const MaskImage::Pointer back = expand_mask(*c);
+    ASSERT_EQ(back->GetLargestPossibleRegion(), m->GetLargestPossibleRegion());
+    EXPECT_EQ(back->GetSpacing(), m->GetSpacing());
+    EXPECT_EQ(back->GetOrigin(), m->GetOrigin());
+    EXPECT_EQ(back->GetDirection(), m->GetDirection());
+    EXPECT_EQ(patient_position(*back), "HFS");
+    for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(back->GetBufferPointer()[i], m->GetBufferPointer()[i]) << i;
+  }
+}
+
+// A mask with any voxel other than 0 and 1 (a label map) stays as it is.
+TEST(CompactMask, NonBinaryMaskIsNotCompacted) {
+  for (unsigned char bad : {2, 255}) {
+    MaskImage::Pointer m = patterned_mask(70, 50, 40);
+    m->GetBufferPointer()[70 * 50 * 40 - 1] = bad;
+    EXPECT_FALSE(compact_mask(*m)) << int(bad);
+  }
+}
+
+// The mask artifact's hooks use them, and expanded() puts the mask back in the bag in its place.
+TEST(CompactMask, MaskArtifactCompactsAndTheBagExpandsItOnRead) {
+  const MaskImage::Pointer m = patterned_mask(7, 5, 3);
+  const std::optional<std::any> stand_in = mask_artifact().compact(std::any(m));
+  ASSERT_TRUE(stand_in);
+  ASSERT_NE(std::any_cast<std::shared_ptr<const CompactMask>>(&*stand_in), nullptr);
+  ArtifactBag bag;
+  bag.put("mask", *stand_in);
+  const MaskImage::Pointer back = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
+  ASSERT_NE(std::any_cast<MaskImage::Pointer>(&bag.raw("mask")), nullptr);
+  EXPECT_NE(back.GetPointer(), m.GetPointer());
+  for (std::size_t i = 0; i < 105; ++i) ASSERT_EQ(back->GetBufferPointer()[i], m->GetBufferPointer()[i]) << i;
 }
 
 }  // namespace

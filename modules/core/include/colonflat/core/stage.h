@@ -79,6 +79,15 @@ class ArtifactBag {
   std::map<std::string, std::any> items_;
 };
 
+// The value of artifact `name` as a T. When the run holds it as its type's stand-in
+// (ArtifactType::compact, `colonflat run` from the stage after its last reader on), the value is
+// expanded and put back in its place first (the stand-in is freed then).
+template <class T>
+const T& expanded(ArtifactBag& bag, const std::string& name, const ArtifactType& type) {
+  if (!std::any_cast<T>(&bag.raw(name)) && type.expand) bag.put(name, type.expand(bag.raw(name)));
+  return bag.get<T>(name);
+}
+
 // What a running stage may use: a progress stream and its report (counts, timings).
 struct RunContext {
   std::ostream* log = nullptr;  // progress lines; null = quiet

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -109,8 +110,21 @@ using CompactCtImage = itk::Image<short, 3>;
 CompactCtImage::Pointer compact_ct(const CtImage& ct);
 CtImage::Pointer expand_ct(const CompactCtImage& compact);
 
+// A lumen mask held in one bit per voxel: every voxel 0 or 1 (a mask as segment and the readers
+// give it), 64 voxels a word in buffer order (voxel i: bit i % 64 of word i / 64). `grid`: an image
+// with the mask's geometry (region, origin, spacing, direction) and header dictionary, no pixels.
+// compact_mask: null when a voxel is neither 0 nor 1. expand_mask: the mask back, equal voxel for
+// voxel, with the same geometry and dictionary.
+struct CompactMask {
+  MaskImage::Pointer grid;
+  std::vector<std::uint64_t> bits;
+};
+std::shared_ptr<const CompactMask> compact_mask(const MaskImage& mask);
+MaskImage::Pointer expand_mask(const CompactMask& compact);
+
 // Pipeline artifacts: "volume" (std::any holding CtImage::Pointer; compactable to a
-// CompactCtImage::Pointer by compact_ct) and "mask" (MaskImage::Pointer).
+// CompactCtImage::Pointer by compact_ct) and "mask" (MaskImage::Pointer; compactable to a
+// std::shared_ptr<const CompactMask> by compact_mask).
 const ArtifactType& volume_artifact();
 const ArtifactType& mask_artifact();
 
