@@ -45,6 +45,14 @@ std::string patient_position(const itk::ImageBase<3>& im) {
   return v;
 }
 
+// `back` has the grid (spacing, origin, direction) of `original` and the header's position.
+void expect_same_grid(const itk::ImageBase<3>& back, const itk::ImageBase<3>& original, const std::string& position) {
+  EXPECT_EQ(back.GetSpacing(), original.GetSpacing());
+  EXPECT_EQ(back.GetOrigin(), original.GetOrigin());
+  EXPECT_EQ(back.GetDirection(), original.GetDirection());
+  EXPECT_EQ(patient_position(back), position);
+}
+
 // Integer HU over the whole 16-bit range: held as short, expanded back equal voxel for voxel with
 // the same grid and header.
 TEST(CompactCt, IntegerHuComeBackExactly) {
@@ -54,11 +62,8 @@ TEST(CompactCt, IntegerHuComeBackExactly) {
   EXPECT_EQ(c->GetBufferPointer()[0], -32768);
   EXPECT_EQ(patient_position(*c), "HFP");
   const CtImage::Pointer back = expand_ct(*c);
-  ASSERT_EQ(back->GetLargestPossibleRegion(), ct->GetLargestPossibleRegion());
-  EXPECT_EQ(back->GetSpacing(), ct->GetSpacing());
-  EXPECT_EQ(back->GetOrigin(), ct->GetOrigin());
-  EXPECT_EQ(back->GetDirection(), ct->GetDirection());
-  EXPECT_EQ(patient_position(*back), "HFP");
+  ASSERT_EQ(back->GetLargestPossibleRegion(), ct->GetLargestPossibleRegion());  // before the voxels are read
+  expect_same_grid(*back, *ct, "HFP");
   const std::size_t n = ct->GetLargestPossibleRegion().GetNumberOfPixels();
   for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(back->GetBufferPointer()[i], ct->GetBufferPointer()[i]) << i;
 }
@@ -108,11 +113,8 @@ TEST(CompactMask, BinaryMaskComesBackExactly) {
     ASSERT_TRUE(c);
     EXPECT_EQ(c->bits.size(), (n + 63) / 64);
     const MaskImage::Pointer back = expand_mask(*c);
-    ASSERT_EQ(back->GetLargestPossibleRegion(), m->GetLargestPossibleRegion());
-    EXPECT_EQ(back->GetSpacing(), m->GetSpacing());
-    EXPECT_EQ(back->GetOrigin(), m->GetOrigin());
-    EXPECT_EQ(back->GetDirection(), m->GetDirection());
-    EXPECT_EQ(patient_position(*back), "HFS");
+    ASSERT_EQ(back->GetLargestPossibleRegion(), m->GetLargestPossibleRegion());  // before the voxels are read
+    expect_same_grid(*back, *m, "HFS");
     for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(back->GetBufferPointer()[i], m->GetBufferPointer()[i]) << i;
   }
 }
