@@ -93,12 +93,6 @@ bool run_started_from_mask(const nlohmann::json& run_report) {
   return !stages.empty() && stages[0].value("stage", "") == "reconstruct";
 }
 
-// The run's CT from the bag: as read, or held in 16 bits (`colonflat run` holds it so from
-// reconstruct on: pipeline/src/artifact_parking.h), then expanded here - after the report freed
-// the meshes - and put back in its place, so the 16-bit copy is freed at once. The lumen mask
-// likewise (held in one bit per voxel from reconstruct on).
-CtImage::Pointer ct_in_bag(ArtifactBag& bag) { return expanded<CtImage::Pointer>(bag, "ct", volume_artifact()); }
-
 void set_flat(RunData& run, FlatMap flat) {
   if (flat.centreline_mm.size() == flat.uv.size()) run.centreline_mm = flat.centreline_mm;
   run.flat_segments = flat_report(flat).value("segments", nlohmann::json::array());
@@ -200,7 +194,11 @@ RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann
     run.ct_path = opts.ct;
     run.ct = read_ct_volume(opts.ct);
   } else if (bag.has("ct")) {
-    run.ct = ct_in_bag(bag);
+    // As read, or held in 16 bits (`colonflat run` holds it so from reconstruct on:
+    // pipeline/src/artifact_parking.h), then expanded here - after the report freed the meshes - and
+    // put back in its place, so the 16-bit copy is freed at once. The lumen mask likewise (one bit
+    // per voxel from reconstruct on).
+    run.ct = expanded<CtImage::Pointer>(bag, "ct", volume_artifact());
     run.ct_path = input;
   } else if (bag.has("mask")) {
     run.mask = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());

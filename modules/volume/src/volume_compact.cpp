@@ -14,14 +14,21 @@ namespace cf {
 namespace {
 
 // An image of type Out on the grid of `in` (origin, spacing, direction, region), its header
-// dictionary copied.
+// dictionary copied, no pixels allocated.
 template <class Out, class In>
-typename Out::Pointer image_like(const In& in) {
+typename Out::Pointer grid_like(const In& in) {
   auto out = Out::New();
   out->CopyInformation(&in);
   out->SetRegions(in.GetLargestPossibleRegion());
-  out->Allocate();
   out->SetMetaDataDictionary(in.GetMetaDataDictionary());
+  return out;
+}
+
+// The same with its pixels allocated.
+template <class Out, class In>
+typename Out::Pointer image_like(const In& in) {
+  auto out = grid_like<Out>(in);
+  out->Allocate();
   return out;
 }
 
@@ -77,10 +84,7 @@ std::shared_ptr<const CompactMask> compact_mask(const MaskImage& mask) {
     if (!ok) binary = false;
   });
   if (!binary) return nullptr;
-  out->grid = MaskImage::New();
-  out->grid->CopyInformation(&mask);
-  out->grid->SetRegions(mask.GetLargestPossibleRegion());
-  out->grid->SetMetaDataDictionary(mask.GetMetaDataDictionary());
+  out->grid = grid_like<MaskImage>(mask);
   return out;
 }
 

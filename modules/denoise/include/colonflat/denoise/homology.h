@@ -31,7 +31,6 @@ struct ClosedDual;  // the dual graph with one virtual face per boundary loop (h
 
 class HomologyBasis {
  public:
-  using RunBoth = cf::RunBoth;  // run_both.h
   // Precondition: `mesh` is a manifold (garbage-collected) triangle mesh. With `run_both`, the
   // pruning of the cut graph runs on the helper beside the annotations (both need only the dual
   // forest): the same result as one thread.

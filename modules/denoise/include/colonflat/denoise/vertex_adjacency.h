@@ -27,7 +27,6 @@ class VertexAdjacency {
     int halfedge;   // id of the halfedge from the vertex to `to`
     double length;  // (p_to - p_from).norm()
   };
-  using RunBoth = cf::RunBoth;  // run_both.h
   struct Range {
     const Out* first;
     const Out* last;
