@@ -29,6 +29,7 @@
 #include "colonflat/core/error.h"
 
 #include "colonflat/core/library_output.h"
+#include "colonflat/core/malloc_tunables.h"
 #include "volume_internal.h"
 
 namespace cf {
@@ -187,8 +188,14 @@ FloatImage::Pointer read_any(const fs::path& p, const VolumeReadOptions& opts) {
 
 using namespace vio;
 
+// ITK reads a file whose voxels are not float into a buffer of the file's type and converts it:
+// for a 16-bit CT that buffer is half the float image (457 MB at 512 x 512 x 873), freed into a
+// heap our malloc settings never shrink (core/malloc_tunables.h), while segment's large buffers
+// are mapped apart from the heap and cannot reuse it. So the reader's free memory goes back to
+// the kernel as soon as the volume is read, not at the end of the stage that read it.
 CtImage::Pointer read_ct_volume(const fs::path& p, const VolumeReadOptions& opts) {
   auto img = read_any(p, opts);
+  release_free_memory();
   check_geometry(img, p.string());
   check_finite_voxels(img, p.string());
   return img;
@@ -206,6 +213,8 @@ MaskImage::Pointer read_mask(const fs::path& p) {
   const float* src = f->GetBufferPointer();
   unsigned char* dst = m->GetBufferPointer();
   for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] != 0.f ? 1 : 0;
+  f = nullptr;  // the float copy (4 bytes a voxel) goes back to the kernel, as read_ct_volume's buffer
+  release_free_memory();
   return m;
 }
 

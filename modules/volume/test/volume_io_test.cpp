@@ -1,6 +1,8 @@
 // Volume input/output: formats, geometry (LPS, direction), DICOM series handling, bad input, and
 // the real CT in ../shared/ct/.
 #include <gtest/gtest.h>
+#include <malloc.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <sstream>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/testing/errors.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
@@ -89,6 +92,44 @@ TEST(VolumeIoFormats, CtIsStoredAsRoundedInt16) {
   auto back = read_ct_volume(tmp / "c.nrrd");
   EXPECT_EQ(back->GetPixel({{0, 0, 0}}), 13.f);
   EXPECT_EQ(back->GetPixel({{1, 0, 0}}), 32767.f);
+}
+
+// Resident memory of this process in MiB (/proc/self/statm, second field, in pages).
+double resident_mib() {
+  std::ifstream statm("/proc/self/statm");
+  double size = 0, resident = 0;
+  statm >> size >> resident;
+  return resident * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+// With the heap keeping what is freed (ColonFlat's malloc settings, set here with mallopt), reading
+// a 16-bit CT holds only the float image: the reader's 16-bit buffer (32 MiB here) is given back,
+// and a mask read holds only its bytes, not the float copy it was converted from (64 MiB).
+TEST(VolumeIoMemory, ReadersGiveTheirConversionBuffersBack) {
+  testing::TempDir tmp;
+  const unsigned n = 256;  // 16.8 M voxels: 64 MiB as float, 32 MiB as int16, 16 MiB as bytes
+  {
+    auto ct = make_ct(n, n, n, false);
+    write_ct_volume(ct, tmp / "ct.nrrd");
+    auto m = MaskImage::New();
+    m->CopyInformation(ct);
+    m->SetRegions(ct->GetLargestPossibleRegion());
+    m->Allocate(true);
+    write_mask(m, tmp / "mask.nrrd");
+  }
+  ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 1 << 30), 1);
+  ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
+  release_free_memory();
+  const double before = resident_mib();
+  auto ct = read_ct_volume(tmp / "ct.nrrd");
+  const double with_ct = resident_mib();
+  auto mask = read_mask(tmp / "mask.nrrd");
+  const double with_mask = resident_mib();
+  mallopt(M_TRIM_THRESHOLD, 128 * 1024);  // glibc's defaults again (the adaptive threshold stays off)
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  EXPECT_LT(with_ct - before, 64.0 + 12.0) << "the CT read holds more than its float image";
+  EXPECT_LT(with_mask - with_ct, 16.0 + 12.0) << "the mask read holds more than its bytes";
+  EXPECT_EQ(ct->GetPixel({{n - 1, n - 1, n - 1}}), std::round(10.f * (n - 1) - 3.f * (n - 1) + 100.f * (n - 1) - 1000.f));
 }
 
 // A label volume (small non-negative integers) reads as 0/1, a CT read as a mask is refused (issue
