@@ -50,8 +50,6 @@ OrientationReport read_orientation(Mesh& mesh) {
 
 // The bag's mesh `port`, in place: the bag's value is not const (ArtifactBag::take does the
 // same), and a copy of a 1.4 M-face mesh costs more than the check.
-Mesh& bag_mesh(ArtifactBag& bag, const std::string& port) { return const_cast<Mesh&>(bag.get<Mesh>(port)); }
-
 nlohmann::json noted(const OrientationReport& r, const RunContext& ctx, const std::string& stage,
                      const std::string& port) {
   for (const std::string& note : r.notes()) ctx.progress(stage + ": " + port + ": " + note);
@@ -59,19 +57,25 @@ nlohmann::json noted(const OrientationReport& r, const RunContext& ctx, const st
 }
 }  // namespace
 
-nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
-                                 const std::string& stage, TopologyReport* topology) {
-  Mesh& mesh = bag_mesh(bag, port);
+Mesh& bag_mesh_for_orienting(ArtifactBag& bag, const std::string& port) { return const_cast<Mesh&>(bag.get<Mesh>(port)); }
+
+nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string& stage, const std::string& port,
+                           TopologyReport* topology) {
   OrientationReport r = read_orientation(mesh);
   r.append(orient_outward(mesh, topology));
   return noted(r, ctx, stage, port);
+}
+
+nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage, TopologyReport* topology) {
+  return orient_mesh(bag_mesh_for_orienting(bag, port), ctx, stage, port, topology);
 }
 
 std::string topology_entry(const std::string& port) { return port + ".topology"; }
 
 OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage) {
-  Mesh& mesh = bag_mesh(bag, port);
+  Mesh& mesh = bag_mesh_for_orienting(bag, port);
   OrientationReport r = read_orientation(mesh);
   OrientedMesh in;
   in.triangles = to_triangle_list(mesh);

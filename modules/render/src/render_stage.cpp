@@ -55,36 +55,44 @@ ImagePtr snapshot_before(const Mesh& m, std::optional<int> genus, vtkPolyData* l
 
 }  // namespace
 
-// Snapshots on: orients the snapshot inputs, builds the loops' polylines and renders both
-// snapshots on a second thread, one after the other: they need only the surfaces (or the flat
-// map's) and the loops; the colon image drawn meanwhile on this thread needs no OpenGL, and the
-// display is set up here first (Xvfb is forked before any second thread runs). The snapshot after
+// Orients the snapshot surfaces in place (snapshots light the outside of the wall): the report of
+// each under "orientation", the seconds in orient_s; `surface_topology` gets the surface's.
+RenderStage::SnapshotImages RenderStage::orient_snapshot_inputs(Mesh* surface, Mesh* denoised, const RunContext& ctx,
+                                                                TopologyReport* surface_topology) {
+  SnapshotImages im;
+  Stopwatch sw;
+  if (surface) im.orientation["surface"] = orient_mesh(*surface, ctx, "render", "surface", surface_topology);
+  if (denoised) im.orientation["denoised"] = orient_mesh(*denoised, ctx, "render", "denoised");
+  im.orient_s = sw.seconds();
+  return im;
+}
+
+// Snapshots on: builds the loops' polylines, sets the display up (Xvfb is forked before any second
+// thread runs) and orients and renders both snapshots on a second thread, one after the other:
+// they need only the surfaces (or the flat map's) and the loops, and nothing else touches the
+// surfaces meanwhile; the colon image drawn on this thread needs no OpenGL. The snapshot after
 // denoising is rendered without its caption, which counts the candidates found meanwhile. Where no
-// display can be had, `error` says why.
+// display can be had, `error` says why (the surfaces are still oriented, here).
 RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const {
   Snapshots s;
-  TopologyReport surface_topology;
-  Stopwatch orient;
-  for (const char* port : {"surface", "denoised"})  // snapshots light the outside of the wall
-    if (bag.has(port))
-      ctx.report["orientation"][port] =
-          orient_mesh_input(bag, port, ctx, "render", std::string(port) == "surface" ? &surface_topology : nullptr);
-  ctx.report["snapshot_orient_s"] = orient.seconds();
   if (bag.has("loops")) s.loops = loops_to_polydata(bag.get<LoopSet>("loops"));
   s.options.width = s.options.height = opts_.snapshot_size;
+  Mesh* surface = bag.has("surface") ? &bag_mesh_for_orienting(bag, "surface") : nullptr;
+  Mesh* denoised = bag.has("denoised") ? &bag_mesh_for_orienting(bag, "denoised") : nullptr;
   try {
     s.display = ensure_display();
   } catch (const Error& e) {
     s.error = e.what();
+    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr);
+    ctx.report["orientation"] = oriented.orientation;
+    ctx.report["snapshot_orient_s"] = oriented.orient_s;
     return s;
   }
-  const Mesh* surface = bag.has("surface") ? &bag.get<Mesh>("surface") : nullptr;
-  const Mesh* denoised = bag.has("denoised") ? &bag.get<Mesh>("denoised") : nullptr;
-  s.images = std::async(std::launch::async, [surface, denoised, &flat, genus = surface_topology.genus,
-                                               loops = s.loops.Get(), so = s.options] {
-    SnapshotImages im;
+  s.images = std::async(std::launch::async, [surface, denoised, &flat, &ctx, loops = s.loops.Get(), so = s.options] {
+    TopologyReport surface_topology;
+    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology);
     Stopwatch sw;
-    if (surface) im.before = snapshot_before(*surface, genus, loops, so);
+    if (surface) im.before = snapshot_before(*surface, surface_topology.genus, loops, so);
     im.before_s = sw.lap();
     im.after = denoised ? render_snapshot(*denoised, loops, so) : render_snapshot(flat_to_surface(flat), loops, so);
     im.after_s = sw.lap();
@@ -101,6 +109,8 @@ void RenderStage::finish_snapshots(Snapshots& s, std::size_t candidates, Artifac
     Stopwatch wait;
     SnapshotImages im = s.images.get();
     ctx.report["snapshot_wait_s"] = wait.seconds();
+    ctx.report["orientation"] = im.orientation;
+    ctx.report["snapshot_orient_s"] = im.orient_s;
     ctx.report["snapshot_time_s"] = {{"before", im.before_s}, {"after", im.after_s}};
     phase_done("3D snapshots before and after denoising (beside the colon image)");
     if (im.before) bag.put("snapshot_before", im.before);

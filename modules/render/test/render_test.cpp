@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "colonflat/core/mesh_io.h"
+#include "colonflat/core/orientation.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/core/synthetic.h"
@@ -382,6 +383,43 @@ TEST(RenderSnapshot, MeshPolydataIsTriangleListPolydata) {
 
 testing::CommandResult render_cli(const std::vector<std::string>& args) {
   return testing::run_stage_command(make_render_stage, args);
+}
+
+// Six times the volume a closed triangle list encloses: positive when its normals point out.
+double signed_volume6(const TriangleList& t) {
+  double v = 0;
+  for (const auto& f : t.triangles) {
+    const auto &a = t.points[f[0]], &b = t.points[f[1]], &c = t.points[f[2]];
+    v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return v;
+}
+
+// The stage orients its snapshot surfaces (on the snapshot thread, beside the colon image): a closed
+// surface whose normals point into it is reversed in the bag and reported under "orientation" with
+// its progress line; the surface after denoising, already outward, is left as it is.
+TEST(RenderStage, SnapshotThreadOrientsTheSurfacesAndReportsIt) {
+  auto c = test_colon();
+  TriangleList inward = synthetic::sphere(20, 40, 20);
+  for (auto& f : inward.triangles) std::swap(f[1], f[2]);
+  ASSERT_LT(signed_volume6(inward), 0);
+  ArtifactBag bag;
+  bag.put("flat", flatten_colon(c.mesh));
+  bag.put("surface", build_mesh(inward));
+  bag.put("denoised", build_mesh(c.mesh));
+  auto stage = make_render_stage();
+  stage->set_params_json({{"snapshot-size", 128}}, "test");
+  std::ostringstream log;
+  RunContext ctx;
+  ctx.log = &log;
+  stage->run(bag, ctx);
+  EXPECT_EQ(ctx.report["orientation"]["surface"]["reversed_components"], 1) << ctx.report.dump();
+  EXPECT_EQ(ctx.report["orientation"]["denoised"]["reversed_components"], 0);
+  EXPECT_GE(ctx.report["snapshot_orient_s"].get<double>(), 0.0);
+  EXPECT_NE(log.str().find("render: surface: component 0"), std::string::npos) << log.str();
+  EXPECT_GT(signed_volume6(to_triangle_list(bag.get<Mesh>("surface"))), 0);
+  EXPECT_EQ(to_triangle_list(bag.get<Mesh>("denoised")).triangles, c.mesh.triangles);
+  if (!ctx.report.contains("snapshot_error")) EXPECT_TRUE(bag.has("snapshot_before"));
 }
 
 // `colonflat render` writes the colon PNG, the candidate JSON and both snapshots.

@@ -28,6 +28,12 @@ inline constexpr const char* kReadOrientationProperty = "colonflat:read_orientat
 // the mesh's analyze_topology, computed on the way (orient_outward).
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage, TopologyReport* topology = nullptr);
+// The same on a mesh already taken from the bag as bag_mesh_for_orienting(bag, port): what a stage
+// calls to orient its input on another thread (nothing else may touch the bag's entry meanwhile).
+nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string& stage, const std::string& port,
+                           TopologyReport* topology = nullptr);
+// The bag's mesh `port`, to be oriented in place by orient_mesh (throws when it is not a mesh).
+Mesh& bag_mesh_for_orienting(ArtifactBag& bag, const std::string& port);
 
 // The bag entry in which a stage may leave analyze_topology of its mesh output `port` for the next
 // stage ("<port>.topology", a TopologyReport; denoise leaves its verification's report of

@@ -11,6 +11,7 @@
 #include <vtkSmartPointer.h>
 
 #include "colonflat/core/stage.h"
+#include "colonflat/core/topology.h"
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/render/colon_image.h"
 #include "colonflat/render/polyps.h"
@@ -48,12 +49,14 @@ class RenderStage : public StageWithOptions<RenderOptions> {
   const ParamTable<RenderOptions>& table() const override { return render_param_table(); }
 
  private:
-  // The 3D snapshots of one run: the one before denoising renders on a second thread while the
-  // colon image is drawn.
+  // The 3D snapshots of one run: both surfaces are oriented and rendered on a second thread while
+  // the colon image is drawn.
   struct SnapshotImages {
     ImagePtr before;  // null without a surface before denoising
     ImagePtr after;   // without its caption (it counts the candidates)
     double before_s = 0, after_s = 0;  // wall seconds of each on the snapshot thread (report "snapshot_time_s")
+    nlohmann::json orientation = nlohmann::json::object();  // per port: orient_mesh's report (report "orientation")
+    double orient_s = 0;  // wall seconds of orienting both surfaces on the snapshot thread
   };
   struct Snapshots {
     vtkSmartPointer<vtkPolyData> loops;
@@ -61,6 +64,8 @@ class RenderStage : public StageWithOptions<RenderOptions> {
     std::string display, error;
     std::future<SnapshotImages> images;
   };
+  static SnapshotImages orient_snapshot_inputs(Mesh* surface, Mesh* denoised, const RunContext& ctx,
+                                               TopologyReport* surface_topology);
   Snapshots start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const;
   void finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const;
 };
