@@ -4,9 +4,12 @@
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
+#include <vtkUnsignedCharArray.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <mutex>
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
@@ -94,24 +97,41 @@ PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<do
   return sample_plane(ct, plane, lps[a.fixed_axis], u0, v0, pixels, pixels, pix);
 }
 
-void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels, const fs::path& path) {
-  if (pixels.size() != std::size_t(w) * h * components) throw Error(path.string() + ": PNG pixel count does not match its size");
+std::vector<unsigned char> encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels) {
+  if (pixels.size() != std::size_t(w) * h * components) throw Error("PNG pixel count does not match its size");
   vtkNew<vtkImageData> img;
   img->SetDimensions(w, h, 1);
   img->AllocateScalars(VTK_UNSIGNED_CHAR, components);
   auto* px = static_cast<unsigned char*>(img->GetScalarPointer());
   const std::size_t row = std::size_t(w) * components;
   for (int r = 0; r < h; ++r) std::copy_n(pixels.data() + r * row, row, px + std::size_t(h - 1 - r) * row);  // VTK rows count from the bottom
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetInputData(img);
+  writer->WriteToMemoryOn();
+  writer->SetCompressionLevel(1);  // fast; these images are small
+  VtkMessageCapture msgs;
+  writer->Write();
+  vtkUnsignedCharArray* out = writer->GetResult();
+  if (writer->GetErrorCode() != 0 || !msgs.errors().empty() || !out)
+    throw Error("cannot encode a PNG: " + (msgs.errors().empty() ? std::string("VTK's PNG writer failed") : msgs.errors().front()));
+  const unsigned char* b = out->GetPointer(0);
+  return std::vector<unsigned char>(b, b + out->GetNumberOfValues());
+}
+
+namespace {
+void write_bytes(const std::vector<unsigned char>& bytes, const fs::path& path) {
   write_atomically(path, [&](const fs::path& tmp) {
-    vtkNew<vtkPNGWriter> writer;
-    writer->SetInputData(img);
-    writer->SetFileName(tmp.c_str());
-    writer->SetCompressionLevel(1);  // fast; these images are small
-    VtkMessageCapture msgs;
-    writer->Write();
-    if (writer->GetErrorCode() != 0 || !msgs.errors().empty())
-      throw Error(path.string() + ": cannot write PNG: " + msgs.write_problem(writer, tmp.string()));
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    f.close();
+    if (!f) throw Error(path.string() + ": cannot write PNG");
   });
+}
+}  // namespace
+
+void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels, const fs::path& path) {
+  if (pixels.size() != std::size_t(w) * h * components) throw Error(path.string() + ": PNG pixel count does not match its size");
+  write_bytes(encode_png(w, h, components, pixels), path);
 }
 
 unsigned char window_grey(float hu, const CtWindow& win) {
@@ -119,16 +139,17 @@ unsigned char window_grey(float hu, const CtWindow& win) {
   return static_cast<unsigned char>(std::lround(255 * std::clamp(v, 0.0, 1.0)));
 }
 
-void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
+namespace {
+std::vector<unsigned char> windowed_png(const PlaneImage& im, const CtWindow& win) {
   std::vector<unsigned char> grey(im.hu.size());
   std::transform(im.hu.begin(), im.hu.end(), grey.begin(), [&](float v) { return window_grey(v, win); });
-  write_png_pixels(im.w, im.h, 1, grey, path);
+  return encode_png(im.w, im.h, 1, grey);
 }
+}  // namespace
 
 template <class Image>
-nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
-                                 const std::array<double, 3>& box_max, const SliceStackOptions& o,
-                                 const fs::path& dir, const std::string& rel_prefix) {
+DrawnSliceStack draw_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
+                                 const std::array<double, 3>& box_max, const SliceStackOptions& o) {
   const PlaneAxes a = plane_axes(plane);
   auto screen_range = [&](int axis, int sign) {
     const double lo = sign * box_min[axis], hi = sign * box_max[axis];
@@ -139,24 +160,85 @@ nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<
   const int h = std::max(1, int(std::ceil((vr[1] - vr[0]) / o.pixel_mm)));
   const double f0 = box_min[a.fixed_axis], f1 = box_max[a.fixed_axis];
   const int n = std::max(1, int(std::floor((f1 - f0) / o.step_mm)) + 1);
-  nlohmann::json j = {{"plane", plane_name(plane)}, {"u_axis", a.u_axis}, {"u_sign", a.u_sign},
-                      {"v_axis", a.v_axis}, {"v_sign", a.v_sign}, {"fixed_axis", a.fixed_axis},
-                      {"u0", ur[0]}, {"v0", vr[0]}, {"pixel_mm", o.pixel_mm}, {"w", w}, {"h", h},
-                      {"positions", nlohmann::json::array()}, {"files", nlohmann::json::array()}};
+  DrawnSliceStack d;
+  d.json = {{"plane", plane_name(plane)}, {"u_axis", a.u_axis}, {"u_sign", a.u_sign},
+            {"v_axis", a.v_axis}, {"v_sign", a.v_sign}, {"fixed_axis", a.fixed_axis},
+            {"u0", ur[0]}, {"v0", vr[0]}, {"pixel_mm", o.pixel_mm}, {"w", w}, {"h", h},
+            {"positions", nlohmann::json::array()}, {"files", nlohmann::json::array()}};
   auto fixed_of = [&](int i) { return f0 + 0.5 * ((f1 - f0) - (n - 1) * o.step_mm) + i * o.step_mm; };
-  // Each plane is sampled and written on the threads (a VtkMessageCapture collects its own
-  // thread's messages); the list is made in order here.
   const CtWindow& window = o.window ? *o.window : lung_window();
-  const auto name_of = [&](int i) { return std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png"; };
+  d.pngs.resize(std::size_t(n));
+  // Each plane is sampled and encoded on the threads (a VtkMessageCapture collects its own
+  // thread's messages); the list is made in order here.
   parallel_for(std::size_t(n), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i)
-      write_windowed_png(sample_plane(ct, plane, fixed_of(int(i)), ur[0], vr[0], w, h, o.pixel_mm), window, dir / name_of(int(i)));
+      d.pngs[i] = windowed_png(sample_plane(ct, plane, fixed_of(int(i)), ur[0], vr[0], w, h, o.pixel_mm), window);
   });
   for (int i = 0; i < n; ++i) {
-    j["positions"].push_back(std::round(fixed_of(i) * 100) / 100);
-    j["files"].push_back(rel_prefix + name_of(i));
+    d.json["positions"].push_back(std::round(fixed_of(i) * 100) / 100);
+    d.names.push_back(std::string(plane_name(plane)) + "_" + std::to_string(i) + ".png");
   }
+  return d;
+}
+
+void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
+  write_bytes(windowed_png(im, win), path);
+}
+
+nlohmann::json write_drawn_stack(const DrawnSliceStack& d, const fs::path& dir, const std::string& rel_prefix) {
+  nlohmann::json j = d.json;
+  parallel_for(d.pngs.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) write_bytes(d.pngs[i], dir / d.names[i]);
+  });
+  for (const std::string& name : d.names) j["files"].push_back(rel_prefix + name);
   return j;
+}
+
+template <class Image>
+nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
+                                 const std::array<double, 3>& box_max, const SliceStackOptions& o,
+                                 const fs::path& dir, const std::string& rel_prefix) {
+  return write_drawn_stack(draw_slice_stack(ct, plane, box_min, box_max, o), dir, rel_prefix);
+}
+
+DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3>& box_min,
+                                   const std::array<double, 3>& box_max, const SliceStackOptions& o) {
+  DrawnPlaneStacks s;
+  s.box_min = box_min, s.box_max = box_max, s.step_mm = o.step_mm, s.pixel_mm = o.pixel_mm;
+  for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) s.planes.push_back(draw_slice_stack(ct, p, box_min, box_max, o));
+  return s;
+}
+
+bool mask_box_lps(const MaskImage& mask, std::array<double, 3>& box_min, std::array<double, 3>& box_max) {
+  const auto size = mask.GetLargestPossibleRegion().GetSize();
+  const std::size_t nx = size[0], ny = size[1], nz = size[2];
+  const unsigned char* m = mask.GetBufferPointer();
+  std::mutex mu;
+  std::array<long, 3> lo{long(nx), long(ny), long(nz)}, hi{-1, -1, -1};
+  parallel_for(nz, [&](std::size_t k0, std::size_t k1) {  // per thread its own box, merged under the lock
+    std::array<long, 3> l{long(nx), long(ny), long(nz)}, h{-1, -1, -1};
+    for (std::size_t k = k0; k < k1; ++k)
+      for (std::size_t j = 0; j < ny; ++j) {
+        const unsigned char* row = m + (k * ny + j) * nx;
+        for (std::size_t i = 0; i < nx; ++i)
+          if (row[i]) {
+            const long c[3] = {long(i), long(j), long(k)};
+            for (int a = 0; a < 3; ++a) l[a] = std::min(l[a], c[a]), h[a] = std::max(h[a], c[a]);
+          }
+      }
+    std::lock_guard<std::mutex> lock(mu);
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], l[a]), hi[a] = std::max(hi[a], h[a]);
+  });
+  if (hi[0] < 0) return false;
+  box_min = {1e300, 1e300, 1e300}, box_max = {-1e300, -1e300, -1e300};
+  for (int corner = 0; corner < 8; ++corner) {
+    MaskImage::IndexType idx;
+    for (int a = 0; a < 3; ++a) idx[a] = (corner >> a) & 1 ? hi[a] : lo[a];
+    MaskImage::PointType p;
+    mask.TransformIndexToPhysicalPoint(idx, p);
+    for (int a = 0; a < 3; ++a) box_min[a] = std::min(box_min[a], p[a]), box_max[a] = std::max(box_max[a], p[a]);
+  }
+  return true;
 }
 
 template <class Image>
@@ -184,6 +266,8 @@ nlohmann::json ct_geometry_json(const Image* ct) {
 #define CF_VIEW_VOLUME(Image)                                                                                     \
   template PlaneImage sample_plane(const Image*, Plane, double, double, double, int, int, double);             \
   template PlaneImage sample_plane_around(const Image*, Plane, const std::array<double, 3>&, double, int);       \
+  template DrawnSliceStack draw_slice_stack(const Image*, Plane, const std::array<double, 3>&,                  \
+                                            const std::array<double, 3>&, const SliceStackOptions&);            \
   template nlohmann::json write_slice_stack(const Image*, Plane, const std::array<double, 3>&,                  \
                                             const std::array<double, 3>&, const SliceStackOptions&,             \
                                             const fs::path&, const std::string&);                               \

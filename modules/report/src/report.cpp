@@ -37,6 +37,7 @@ struct Builder {
   std::optional<ColonImageLayout> layout;
   ImagePtr colon;
   ReportResult result;
+  bool planes_drawn_ahead = false;
 
   // colon.png, its layout check and the hover/click lookup grid.
   void add_image() {
@@ -61,29 +62,47 @@ struct Builder {
     data["lookup"] = lookup_json(run, build_lookup_grid(*run.flat, *layout, opts.lookup_step_px));
   }
 
-  // The CT geometry and the stacks of planes a click on the map shows.
-  void add_ct() {
+  // The LPS box the CT planes a click on the map shows are spread over: the lumen's voxels when the
+  // run has a lumen mask (known from segment on, so the run draws the planes beside the stages),
+  // else the flat map's wall; a candidate or known polyp outside it widens it. False: nothing to show.
+  bool plane_box(std::array<double, 3>& lo, std::array<double, 3>& hi) const {
+    lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
+    const auto grow = [&](const std::array<double, 3>& p) {
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    };
+    const MaskImage* lumen = run.volume_is_mask ? run.mask.GetPointer() : run.lumen.GetPointer();
+    std::array<double, 3> mlo, mhi;
+    if (lumen && mask_box_lps(*lumen, mlo, mhi)) grow(mlo), grow(mhi);
+    else if (run.flat) for (const auto& p : run.flat->position) grow(p);
+    for (const auto& f : run.candidates) grow(f.lps_mm);
+    for (const auto& f : run.known) grow(f.lps_mm);
+    return lo[0] <= hi[0];
+  }
+
+  // The CT geometry and the stacks of planes a click on the map shows (`drawn`: those drawn ahead,
+  // written when they are of this box and these options).
+  void add_ct(const DrawnPlaneStacks* drawn) {
     if (!run.ct && !run.mask) return;
     data["ct"] = run.ct ? ct_geometry_json(run.ct.GetPointer()) : ct_geometry_json(run.mask.GetPointer());
     data["ct"]["file"] = run.ct_path.string();
     data["ct"]["is_mask"] = run.volume_is_mask;
-    std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-    const auto grow = [&](const std::array<double, 3>& p) {
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    };
-    if (run.flat) for (const auto& p : run.flat->position) grow(p);
-    for (const auto& f : run.candidates) grow(f.lps_mm);
-    for (const auto& f : run.known) grow(f.lps_mm);
-    if (lo[0] > hi[0]) return;  // nothing to show the CT around
+    std::array<double, 3> lo, hi;
+    if (!plane_box(lo, hi)) return;
     SliceStackOptions so;
     so.step_mm = opts.stack_step_mm;
     so.pixel_mm = opts.stack_pixel_mm;
     if (run.volume_is_mask) so.window = &mask_window();
+    const bool ahead = drawn && run.ct && drawn->box_min == lo && drawn->box_max == hi && drawn->step_mm == so.step_mm &&
+                       drawn->pixel_mm == so.pixel_mm && drawn->planes.size() == 3;
+    int i = 0;
     for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-      data["stacks"][plane_name(p)] = run.ct ? write_slice_stack(run.ct.GetPointer(), p, lo, hi, so, files_dir, "report_files/")
-                                             : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
-      result.images += int(data["stacks"][plane_name(p)]["files"].size());
+      nlohmann::json& stack = data["stacks"][plane_name(p)];
+      if (ahead) stack = write_drawn_stack(drawn->planes[std::size_t(i++)], files_dir, "report_files/");
+      else stack = run.ct ? write_slice_stack(run.ct.GetPointer(), p, lo, hi, so, files_dir, "report_files/")
+                          : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
+      result.images += int(stack["files"].size());
     }
+    planes_drawn_ahead = ahead;
   }
 
   // The Segmentation section: montages with the lumen and the bodies segment rejected.
@@ -198,7 +217,7 @@ nlohmann::json report_page_data(const fs::path& html) {
 }
 
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
-                                 std::ostream* log, const SegmentationQcDrawing* segmentation) {
+                                 std::ostream* log, const SegmentationQcDrawing* segmentation, const DrawnPlaneStacks* planes) {
   Stopwatch clock;
   ProgressScope scope(log, "report");
   const fs::path dir = run.dir;
@@ -211,8 +230,9 @@ ReportResult build_review_report(const RunData& run, const ReportOptions& opts, 
   b.data["candidates_file"] = b.run.candidates_file;
   b.add_image();
   phase_done("colon image and lookup grid");
-  b.add_ct();
-  phase_done(std::string(b.run.volume_is_mask ? "mask" : "CT") + " planes (" + std::to_string(b.result.images) + " images)");
+  b.add_ct(planes);
+  phase_done(std::string(b.run.volume_is_mask ? "mask" : "CT") + " planes (" + std::to_string(b.result.images) + " images" +
+             (b.planes_drawn_ahead ? ", drawn beside the stages)" : ")"));
   const int before = b.result.images;
   b.add_segmentation(segmentation);
   phase_done("segmentation montages (" + std::to_string(b.result.images - before) + " images" +

@@ -10,6 +10,7 @@
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_finisher.h"
 #include "colonflat/core/run_stats.h"
+#include "colonflat/report/ct_views.h"
 #include "colonflat/report/run_data.h"
 #include "colonflat/report/segmentation_qc.h"
 
@@ -85,18 +86,28 @@ class ReportTool : public Tool, public RunFinisher {
   // After segment: the Segmentation section is drawn on a second thread while the later stages
   // run (it needs only the CT, the lumen and segment's decisions). The thread drops its CT and
   // lumen references when done, so the run can park the CT after reconstruct as before.
+  // The CT planes a click on the map shows are drawn on the same thread next: their box is the
+  // lumen's (build_review_report), known now.
   void stage_done(const std::string& stage, const ArtifactBag& bag, const nlohmann::json& record) override {
     if (stage != "segment" || !bag.has("ct") || !bag.has("mask")) return;
     const std::any& ct_held = bag.raw("ct");
     const auto* ct = std::any_cast<CtImage::Pointer>(&ct_held);
     if (!ct) return;  // not the float CT: the report draws the section itself
-    segmentation_ = std::async(std::launch::async,
-                               [ct = *ct, lumen = bag.get<MaskImage::Pointer>("mask"),
-                                result = record.value("result", nlohmann::json::object())]() mutable {
-                                 SegmentationQcDrawing d = draw_segmentation_qc(ct.GetPointer(), lumen.GetPointer(), result);
-                                 ct = nullptr, lumen = nullptr;
-                                 return d;
-                               });
+    drawn_ = std::async(std::launch::async, [ct = *ct, lumen = bag.get<MaskImage::Pointer>("mask"),
+                                             result = record.value("result", nlohmann::json::object())]() mutable {
+      DrawnAhead d;
+      d.segmentation = draw_segmentation_qc(ct.GetPointer(), lumen.GetPointer(), result);
+      std::array<double, 3> lo, hi;
+      if (mask_box_lps(*lumen, lo, hi)) {
+        const ReportOptions defaults;  // the finisher's (finish below)
+        SliceStackOptions so;
+        so.step_mm = defaults.stack_step_mm;
+        so.pixel_mm = defaults.stack_pixel_mm;
+        d.planes = draw_plane_stacks(ct.GetPointer(), lo, hi, so);
+      }
+      ct = nullptr, lumen = nullptr;
+      return d;
+    });
   }
 
   nlohmann::json finish(FinishedRun& run, OutputTransaction& tx) override {
@@ -109,9 +120,10 @@ class ReportTool : public Tool, public RunFinisher {
     for (const auto& target : tx.targets())
       if (target.parent_path() == run.dir) data->staged_files.push_back(target.filename().string());
     phase_done("run data from memory");
-    std::optional<SegmentationQcDrawing> drawn;
-    if (segmentation_.valid()) drawn = segmentation_.get();
-    const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log, drawn ? &*drawn : nullptr);
+    std::optional<DrawnAhead> drawn;
+    if (drawn_.valid()) drawn = drawn_.get();
+    const ReportResult r = build_review_report(*data, ReportOptions{}, tx, run.log, drawn ? &drawn->segmentation : nullptr,
+                                               drawn && drawn->planes ? &*drawn->planes : nullptr);
     // Left for what follows on the same memory (`colonflat run --prone`: the supine-prone review);
     // the lumen mask is not needed any more when the views show the CT.
     if (!data->volume_is_mask) run.artifacts->erase("mask");
@@ -126,7 +138,12 @@ class ReportTool : public Tool, public RunFinisher {
   }
 
  private:
-  std::future<SegmentationQcDrawing> segmentation_;  // drawn beside the stages after segment
+  // Drawn beside the stages after segment: the Segmentation section and the CT planes.
+  struct DrawnAhead {
+    SegmentationQcDrawing segmentation;
+    std::optional<DrawnPlaneStacks> planes;  // none when the lumen is empty
+  };
+  std::future<DrawnAhead> drawn_;
 };
 
 }  // namespace

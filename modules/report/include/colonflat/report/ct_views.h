@@ -52,6 +52,8 @@ PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<do
 
 // 8-bit grey value of `hu` through `window` (0 below, 255 above).
 unsigned char window_grey(float hu, const CtWindow& window);
+// w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, encoded as a PNG.
+std::vector<unsigned char> encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels);
 // Writes w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, as a PNG (atomic).
 void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels,
                       const std::filesystem::path& path);
@@ -71,6 +73,33 @@ template <class Image>
 nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
                                  const std::array<double, 3>& box_max, const SliceStackOptions& opts,
                                  const std::filesystem::path& dir, const std::string& rel_prefix);
+
+// write_slice_stack in two steps: the planes sampled and encoded in memory (the volume is only
+// read during the call), then written as the same files with the same JSON.
+struct DrawnSliceStack {
+  nlohmann::json json;                           // write_slice_stack's, "files" still empty
+  std::vector<std::string> names;                // "<plane>_<n>.png", one per position
+  std::vector<std::vector<unsigned char>> pngs;  // each plane's PNG bytes
+};
+template <class Image>
+DrawnSliceStack draw_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
+                                 const std::array<double, 3>& box_max, const SliceStackOptions& opts);
+nlohmann::json write_drawn_stack(const DrawnSliceStack& stack, const std::filesystem::path& dir,
+                                 const std::string& rel_prefix);
+
+// The axial, coronal and sagittal stacks through one box, drawn ahead (the run draws them beside
+// the stages); the report writes them when its own box and options are these.
+struct DrawnPlaneStacks {
+  std::array<double, 3> box_min{}, box_max{};
+  double step_mm = 0, pixel_mm = 0;
+  std::vector<DrawnSliceStack> planes;  // axial, coronal, sagittal
+};
+DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3>& box_min,
+                                   const std::array<double, 3>& box_max, const SliceStackOptions& opts);
+
+// The LPS box of the centres of the non-zero voxels of `mask` (any direction: the corners of their
+// index box mapped to LPS); false when every voxel is zero.
+bool mask_box_lps(const MaskImage& mask, std::array<double, 3>& box_min, std::array<double, 3>& box_max);
 
 // The volume's geometry for the page: size, spacing, origin, direction and the 3x3 matrix taking
 // (LPS - origin) to continuous voxel indices.

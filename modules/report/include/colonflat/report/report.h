@@ -19,6 +19,7 @@ namespace cf {
 
 struct RunData;
 struct SegmentationQcDrawing;
+struct DrawnPlaneStacks;
 class OutputTransaction;
 
 struct ReportOptions {
@@ -54,9 +55,12 @@ ReportResult write_review_report(const std::filesystem::path& run_dir, const Rep
 // `colonflat run`): report.html, polyps.mrk.json, known_polyps.mrk.json (with truth) and the
 // folder report_files/ in run.dir, staged through `tx`; nothing appears until the caller commits.
 // `segmentation`: the Segmentation section drawn already from the run's CT, lumen and segment
-// result (`colonflat run` draws it beside its later stages); null: drawn here.
+// result (`colonflat run` draws it beside its later stages); null: drawn here. `planes`: the CT
+// planes a click on the map shows, drawn ahead from the run's CT over its lumen's box (the same
+// run), written when their box and options are the report's own (draw_plane_stacks); else drawn here.
 ReportResult build_review_report(const RunData& run, const ReportOptions& opts, OutputTransaction& tx,
-                                 std::ostream* log = nullptr, const SegmentationQcDrawing* segmentation = nullptr);
+                                 std::ostream* log = nullptr, const SegmentationQcDrawing* segmentation = nullptr,
+                                 const DrawnPlaneStacks* planes = nullptr);
 
 // A report page: the shared skeleton (resources/page.html: head, footer, scripts) titled `title`
 // around `body_html`, with the report's style sheet followed by `page_css`, `window.REPORT = data`,
