@@ -30,6 +30,7 @@
 
 #include "colonflat/core/library_output.h"
 #include "colonflat/core/malloc_tunables.h"
+#include "colonflat/core/threads.h"
 #include "volume_internal.h"
 
 namespace cf {
@@ -82,6 +83,40 @@ bool sanitized_nrrd_header(const fs::path& p, fs::path& out) {
   return bool(o);
 }
 
+// A NRRD or MetaImage file of 16-bit voxels (how CT is stored): formats without a rescale of
+// their own, so the float image is the stored value, as ITK's conversion gives it.
+bool stored_as_short(const itk::ImageIOBase& io) {
+  const bool plain = dynamic_cast<const itk::NrrdImageIO*>(&io) || dynamic_cast<const itk::MetaImageIO*>(&io);
+  return plain && io.GetComponentType() == itk::IOComponentEnum::SHORT && io.GetNumberOfComponents() == 1;
+}
+
+// Reads such a file as stored and converts it to float on the threads, each first touching its
+// share of the float image: ITK's own conversion is one serial loop (0.6 s of the real CT's read,
+// 512 x 512 x 430 voxels). The same voxels, geometry and header dictionary as ITK's float read.
+FloatImage::Pointer read_short_as_float(itk::ImageIOBase* io, const fs::path& p) {
+  using ShortImage = itk::Image<short, 3>;
+  auto reader = itk::ImageFileReader<ShortImage>::New();
+  reader->SetImageIO(io);
+  reader->SetFileName(p.string());
+  try {
+    reader->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError(p.string(), itk_message(e));
+  }
+  const ShortImage* in = reader->GetOutput();
+  auto out = FloatImage::New();
+  out->CopyInformation(in);
+  out->SetRegions(in->GetLargestPossibleRegion());
+  out->SetMetaDataDictionary(in->GetMetaDataDictionary());
+  out->Allocate();  // every voxel is written below
+  const short* src = in->GetBufferPointer();
+  float* dst = out->GetBufferPointer();
+  parallel_for(in->GetLargestPossibleRegion().GetNumberOfPixels(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) dst[i] = static_cast<float>(src[i]);
+  });
+  return out;
+}
+
 FloatImage::Pointer read_image_file(const fs::path& p) {
   const std::string where = p.string();
   auto io = io_for(p, false);
@@ -126,6 +161,7 @@ FloatImage::Pointer read_image_file(const fs::path& p) {
   }
   check_declared_volume(p, *io);
   if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer())) check_dicom_length(p, where, dicom_transfer_syntax(p));
+  if (stored_as_short(*io)) return read_short_as_float(io, p);
   auto reader = itk::ImageFileReader<FloatImage>::New();
   reader->SetImageIO(io);
   reader->SetFileName(p.string());

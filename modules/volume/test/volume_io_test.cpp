@@ -1,6 +1,10 @@
 // Volume input/output: formats, geometry (LPS, direction), DICOM series handling, bad input, and
 // the real CT in ../shared/ct/.
 #include <gtest/gtest.h>
+#include <itkImageFileReader.h>
+#include <itkMetaDataObject.h>
+#include <itkMetaImageIO.h>
+#include <itkNrrdImageIO.h>
 #include <malloc.h>
 #include <unistd.h>
 
@@ -92,6 +96,33 @@ TEST(VolumeIoFormats, CtIsStoredAsRoundedInt16) {
   auto back = read_ct_volume(tmp / "c.nrrd");
   EXPECT_EQ(back->GetPixel({{0, 0, 0}}), 13.f);
   EXPECT_EQ(back->GetPixel({{1, 0, 0}}), 32767.f);
+}
+
+// A 16-bit NRRD or MetaImage CT (read as stored, converted on the threads) reads as ITK's own float
+// read gives it: every voxel, the geometry of an oblique volume and the header dictionary.
+TEST(VolumeIoFormats, SixteenBitFilesReadAsItksFloatRead) {
+  testing::TempDir tmp;
+  auto ct = make_ct(33, 21, 17);
+  ct->SetPixel({{4, 5, 6}}, -1024.f);
+  ct->SetPixel({{32, 20, 16}}, 3071.f);
+  itk::EncapsulateMetaData<std::string>(ct->GetMetaDataDictionary(), "0018|5100", "FFS");
+  for (const char* name : {"c.nrrd", "c.mha"}) {
+    write_ct_volume(ct, tmp / name);
+    const auto ours = read_ct_volume(tmp / name);
+    auto itk_read = itk::ImageFileReader<CtImage>::New();
+    if (std::string(name) == "c.nrrd") itk_read->SetImageIO(itk::NrrdImageIO::New());
+    else itk_read->SetImageIO(itk::MetaImageIO::New());
+    itk_read->SetFileName((tmp / name).string());
+    itk_read->Update();
+    const CtImage* want = itk_read->GetOutput();
+    expect_same_geometry(ours, want, 0.0);
+    const std::size_t n = want->GetLargestPossibleRegion().GetNumberOfPixels();
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < n; ++i) differ += ours->GetBufferPointer()[i] != want->GetBufferPointer()[i];
+    EXPECT_EQ(differ, 0u) << name;
+    EXPECT_EQ(ours->GetPixel({{32, 20, 16}}), 3071.f) << name;
+    EXPECT_EQ(ours->GetMetaDataDictionary().GetKeys(), want->GetMetaDataDictionary().GetKeys()) << name;
+  }
 }
 
 // Resident memory of this process in MiB (/proc/self/statm, second field, in pages).
