@@ -10,6 +10,7 @@
 #include <string>
 
 #include "colonflat/core/malloc_tunables.h"
+#include "colonflat/testing/resident_memory.h"
 
 namespace cf {
 
@@ -18,13 +19,6 @@ const std::string kOurs =
     "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=4294967296:glibc.malloc.trim_threshold=4294967296"
     ":glibc.malloc.arena_max=";
 
-// Resident memory of this process in MiB (/proc/self/statm, second field, in pages).
-double resident_mib() {
-  std::ifstream statm("/proc/self/statm");
-  double size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
 }  // namespace
 
 // Unset or unrelated tunables get all four malloc settings added (arena_max = the cores, >= 1);
@@ -51,15 +45,15 @@ TEST(MallocTunables, ReleaseGivesHeldFreeMemoryBack) {
   ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 1 << 30), 1);
   ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
   const std::size_t bytes = std::size_t(64) << 20;
-  const double before = resident_mib();
+  const double before = testing::resident_mib();
   char* block = static_cast<char*>(std::malloc(bytes));
   ASSERT_NE(block, nullptr);
   std::memset(block, 1, bytes);
   __asm__ volatile("" : : "r"(block) : "memory");  // the writes happen (not optimised away)
   std::free(block);
-  const double held = resident_mib();
+  const double held = testing::resident_mib();
   release_free_memory();
-  const double released = resident_mib();
+  const double released = testing::resident_mib();
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);  // glibc's defaults again (the adaptive threshold stays off)
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   EXPECT_GT(held - before, 48.0) << "the freed block was not held";

@@ -3,6 +3,8 @@
 // run_stage_recorded's release of the memory a stage freed.
 #include <gtest/gtest.h>
 
+#include "colonflat/testing/resident_memory.h"
+
 #include <malloc.h>
 #include <unistd.h>
 
@@ -146,26 +148,18 @@ class ScratchStage : public Stage {
   static constexpr std::size_t kBytes = std::size_t(64) << 20;
 };
 
-// Resident memory of this process in MiB (/proc/self/statm, second field, in pages).
-double resident_mib() {
-  std::ifstream statm("/proc/self/statm");
-  double size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
 // With malloc keeping freed blocks in the heap (ColonFlat's thresholds, set here with mallopt),
 // the 64 MiB a stage freed are not resident any more once run_stage_recorded returns: the next
 // stage's peak does not carry them.
 TEST(CoreStageRunner, MemoryTheStageFreedIsGivenBack) {
   ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 1 << 30), 1);
   ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
-  const double before = resident_mib();
+  const double before = testing::resident_mib();
   ScratchStage stage;
   ArtifactBag bag;
   RunContext ctx;
   run_stage_recorded(stage, bag, ctx, 0.0);
-  const double after = resident_mib();
+  const double after = testing::resident_mib();
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   EXPECT_LT(after - before, 16.0) << "resident after the stage: +" << after - before << " MiB";

@@ -3,13 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <iterator>
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/report/ct_views.h"
 #include "colonflat/report/report.h"
 #include "colonflat/report/run_data.h"
+#include "colonflat/testing/files.h"
 #include "colonflat/testing/temp_dir.h"
 #include "synthetic_run.h"
 
@@ -17,11 +16,6 @@ namespace fs = std::filesystem;
 
 namespace cf {
 namespace {
-
-std::string file_bytes(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
 
 // A mask on an oblique grid (axes turned by 90 degrees about S, anisotropic voxels): the box is
 // that of the two lumen voxels' index box mapped to LPS, worked out by hand; an empty mask has none.
@@ -70,7 +64,7 @@ TEST(ReportCt, PlanesDrawnAheadWriteTheSameFilesAndJson) {
     ASSERT_GT(now["files"].size(), 2u);
     for (const auto& f : now["files"]) {
       const std::string name = f.get<std::string>().substr(2);
-      EXPECT_EQ(file_bytes(tmp / "ahead" / name), file_bytes(tmp / "now" / name)) << name;
+      EXPECT_EQ(testing::slurp(tmp / "ahead" / name), testing::slurp(tmp / "now" / name)) << name;
     }
   }
 }
@@ -104,7 +98,7 @@ TEST(ReportCt, ReportWritesPlanesDrawnAheadOnlyForItsOwnBox) {
     OutputTransaction tx;
     const ReportResult r = build_review_report(run, opts, tx, nullptr, nullptr, &drawn);
     tx.commit();
-    const std::string axial0 = file_bytes(tmp / "run" / "report_files" / "axial_0.png");
+    const std::string axial0 = testing::slurp(tmp / "run" / "report_files" / "axial_0.png");
     if (shift == 0.0) EXPECT_EQ(axial0, std::string(sentinel.begin(), sentinel.end()));
     else EXPECT_EQ(axial0.substr(1, 3), "PNG") << "drawn for another box, yet written";
     bool said = false;

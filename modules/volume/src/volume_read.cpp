@@ -83,6 +83,20 @@ bool sanitized_nrrd_header(const fs::path& p, fs::path& out) {
   return bool(o);
 }
 
+// The file `p` read by `io` as an Image (ITK converts the stored voxels); InputError naming the file.
+template <class Image>
+typename Image::Pointer read_through(itk::ImageIOBase* io, const fs::path& p) {
+  auto reader = itk::ImageFileReader<Image>::New();
+  reader->SetImageIO(io);
+  reader->SetFileName(p.string());
+  try {
+    reader->Update();
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError(p.string(), itk_message(e));
+  }
+  return reader->GetOutput();
+}
+
 // A NRRD or MetaImage file of 16-bit voxels (how CT is stored): formats without a rescale of
 // their own, so the float image is the stored value, as ITK's conversion gives it.
 bool stored_as_short(const itk::ImageIOBase& io) {
@@ -95,15 +109,7 @@ bool stored_as_short(const itk::ImageIOBase& io) {
 // 512 x 512 x 430 voxels). The same voxels, geometry and header dictionary as ITK's float read.
 FloatImage::Pointer read_short_as_float(itk::ImageIOBase* io, const fs::path& p) {
   using ShortImage = itk::Image<short, 3>;
-  auto reader = itk::ImageFileReader<ShortImage>::New();
-  reader->SetImageIO(io);
-  reader->SetFileName(p.string());
-  try {
-    reader->Update();
-  } catch (const itk::ExceptionObject& e) {
-    throw InputError(p.string(), itk_message(e));
-  }
-  const ShortImage* in = reader->GetOutput();
+  const ShortImage::Pointer in = read_through<ShortImage>(io, p);
   auto out = FloatImage::New();
   out->CopyInformation(in);
   out->SetRegions(in->GetLargestPossibleRegion());
@@ -162,15 +168,7 @@ FloatImage::Pointer read_image_file(const fs::path& p) {
   check_declared_volume(p, *io);
   if (dynamic_cast<itk::GDCMImageIO*>(io.GetPointer())) check_dicom_length(p, where, dicom_transfer_syntax(p));
   if (stored_as_short(*io)) return read_short_as_float(io, p);
-  auto reader = itk::ImageFileReader<FloatImage>::New();
-  reader->SetImageIO(io);
-  reader->SetFileName(p.string());
-  try {
-    reader->Update();
-  } catch (const itk::ExceptionObject& e) {
-    throw InputError(where, itk_message(e));
-  }
-  return reader->GetOutput();
+  return read_through<FloatImage>(io, p);
 }
 
 

@@ -15,6 +15,7 @@
 
 #include "colonflat/core/error.h"
 #include "colonflat/core/malloc_tunables.h"
+#include "colonflat/testing/resident_memory.h"
 #include "colonflat/testing/errors.h"
 #include "colonflat/testing/temp_dir.h"
 #include "colonflat/volume/volume_io.h"
@@ -125,14 +126,6 @@ TEST(VolumeIoFormats, SixteenBitFilesReadAsItksFloatRead) {
   }
 }
 
-// Resident memory of this process in MiB (/proc/self/statm, second field, in pages).
-double resident_mib() {
-  std::ifstream statm("/proc/self/statm");
-  double size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
 // With the heap keeping what is freed (ColonFlat's malloc settings, set here with mallopt), reading
 // a 16-bit CT holds only the float image: the reader's 16-bit buffer (32 MiB here) is given back,
 // and a mask read holds only its bytes, not the float copy it was converted from (64 MiB).
@@ -151,11 +144,11 @@ TEST(VolumeIoMemory, ReadersGiveTheirConversionBuffersBack) {
   ASSERT_EQ(mallopt(M_MMAP_THRESHOLD, 1 << 30), 1);
   ASSERT_EQ(mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
   release_free_memory();
-  const double before = resident_mib();
+  const double before = testing::resident_mib();
   auto ct = read_ct_volume(tmp / "ct.nrrd");
-  const double with_ct = resident_mib();
+  const double with_ct = testing::resident_mib();
   auto mask = read_mask(tmp / "mask.nrrd");
-  const double with_mask = resident_mib();
+  const double with_mask = testing::resident_mib();
   mallopt(M_TRIM_THRESHOLD, 128 * 1024);  // glibc's defaults again (the adaptive threshold stays off)
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   EXPECT_LT(with_ct - before, 64.0 + 12.0) << "the CT read holds more than its float image";
