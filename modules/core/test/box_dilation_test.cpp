@@ -44,13 +44,12 @@ Volume brute_force(const Volume& v, const std::array<std::size_t, 3>& n, const i
   return out;
 }
 
-// dilate_box of v with `threads` threads, as 0/1 bytes.
+// dilate_box of v (in place) with `threads` threads.
 Volume dilated(Volume v, const std::array<std::size_t, 3>& n, const int r[3], int threads) {
   set_thread_count(threads);
-  Volume tmp(v.size(), 7);
-  const unsigned char* out = dilate_box(v.data(), tmp.data(), n, r);
+  dilate_box(v.data(), n, r);
   set_thread_count(0);
-  return Volume(out, out + v.size());
+  return v;
 }
 
 // Every voxel equals the brute-force box OR, for cubic and anisotropic boxes (one axis skipped),
@@ -69,15 +68,27 @@ TEST(CoreBoxDilation, EqualsBruteForceForAnyThreadCount) {
   }
 }
 
-// No axis to dilate along: the input buffer itself comes back, unchanged.
-TEST(CoreBoxDilation, ZeroRadiusReturnsTheInput) {
+// No axis to dilate along: the volume is left as it is (not binarised).
+TEST(CoreBoxDilation, ZeroRadiusLeavesTheInput) {
   const std::array<std::size_t, 3> n{5, 4, 3};
   const Volume v = random_volume(n, 3);
   const int r[3] = {0, 0, 0};
-  Volume in = v, tmp(v.size());
-  const unsigned char* out = dilate_box(in.data(), tmp.data(), n, r);
-  EXPECT_EQ(out, in.data());
-  EXPECT_EQ(Volume(out, out + v.size()), v);
+  EXPECT_EQ(dilated(v, n, r, 2), v);
+}
+
+// Half-widths of 255 voxels and more (the nearest-set-row sweeps in 32-bit positions) along y and
+// along z equal the brute-force OR too, on lines long enough for the window to be cut on one side.
+TEST(CoreBoxDilation, LongRadiiEqualBruteForce) {
+  for (const auto& [n, r] : {std::pair<std::array<std::size_t, 3>, std::array<int, 3>>{{3, 700, 2}, {0, 300, 0}},
+                             {{2, 3, 900}, {1, 0, 256}}}) {
+    const Volume v = random_volume(n, 400);
+    const Volume expected = brute_force(v, n, r.data());
+    std::size_t set = 0;
+    for (auto b : expected) set += b;
+    ASSERT_GT(set, 0u);
+    ASSERT_LT(set, expected.size());
+    EXPECT_EQ(dilated(v, n, r.data(), 2), expected);
+  }
 }
 
 }  // namespace

@@ -117,13 +117,13 @@ std::size_t ct_field(vtkImageData* binary, const CtImage* ct, const Box& box, co
   const auto n = dims_of(binary);
   const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
   std::vector<unsigned char> fluid(n[0] * n[1] * n[2], 0);
-  const std::unique_ptr<unsigned char[]> scratch(new unsigned char[fluid.size()]);  // dilate_box's, no fill
   unsigned char* fl = fluid.data();
   const std::size_t fluid_voxels = for_slices(
       n, [&](std::size_t k0, std::size_t k1) { return ct_slices(lumen, ct, box, o, n, k0, k1, out, fl); });
   if (!fluid_voxels) return 0;
   const int radius[3] = {2, 2, 2};  // the 5 x 5 x 5 box around each fluid voxel
-  const unsigned char* near_fluid = dilate_box(fl, scratch.get(), n, radius);
+  dilate_box(fl, n, radius);
+  const unsigned char* near_fluid = fl;
   const std::size_t slice = n[0] * n[1];
   for_slices(n, [&](std::size_t k0, std::size_t k1) {
     for (std::size_t i = k0 * slice; i < k1 * slice; ++i)

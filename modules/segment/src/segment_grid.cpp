@@ -177,13 +177,7 @@ std::vector<std::pair<Run, std::uint32_t>> RunLabels::raster(const std::vector<u
   return out;
 }
 
-void dilate_box(Bytes& v, const Dims& d, const int r[3]) {
-  RawBuffer<unsigned char> tmp;
-  tmp.resize(v.size());  // no serial zeroing: the first axis' pass writes every byte, over the workers
-  const unsigned char* out = cf::dilate_box(v.data(), tmp.data(), {d.n[0], d.n[1], d.n[2]}, r);
-  if (out != v.data())
-    parallel_for(v.size(), [&](std::size_t q0, std::size_t q1) { std::copy(out + q0, out + q1, v.data() + q0); });
-}
+void dilate_box(Bytes& v, const Dims& d, const int r[3]) { cf::dilate_box(v.data(), {d.n[0], d.n[1], d.n[2]}, r); }
 
 void erode_box(Bytes& v, const Dims& d, const int r[3]) {
   for_each_voxel(v.size(), [&](std::size_t q) { v[q] = !v[q]; });

@@ -7,11 +7,10 @@
 
 namespace cf {
 
-// v, tmp: two buffers of n[0] * n[1] * n[2] bytes (x fastest); v holds the volume (any non-zero
-// byte is set), tmp is scratch. r: half-widths along x, y, z in voxels (<= 0: that axis is
-// skipped). Returns the buffer (v or tmp) that holds the dilated volume, as 0/1 bytes; the other
-// buffer's contents are unspecified.
-// With every r <= 0 nothing is done: v itself is returned, unchanged (not binarised). Pre: r[a] < 2^31.
-unsigned char* dilate_box(unsigned char* v, unsigned char* tmp, const std::array<std::size_t, 3>& n, const int r[3]);
+// v: n[0] * n[1] * n[2] bytes (x fastest), any non-zero byte set; dilated in place, left as 0/1
+// bytes (no scratch volume: each pass keeps a voxel's own bit beside its result). r: half-widths
+// along x, y, z in voxels (<= 0: that axis is skipped). With every r <= 0 nothing is done (v is
+// not binarised). Pre: r[a] < 2^31.
+void dilate_box(unsigned char* v, const std::array<std::size_t, 3>& n, const int r[3]);
 
 }  // namespace cf
