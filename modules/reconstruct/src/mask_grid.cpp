@@ -62,27 +62,6 @@ long long euler_6_18(const unsigned char* d, std::size_t nx, std::size_t ny, std
   return chi;
 }
 
-Box lumen_box(const unsigned char* d, const std::array<std::size_t, 3>& n) {
-  Box b;
-  b.lo = n;
-  for (std::size_t k = 0; k < n[2]; ++k)
-    for (std::size_t j = 0; j < n[1]; ++j) {
-      const unsigned char* r = d + (k * n[1] + j) * n[0];
-      std::size_t first = n[0], last = 0, cnt = 0;
-      for (std::size_t i = 0; i < n[0]; ++i)
-        if (r[i]) {
-          if (first == n[0]) first = i;
-          last = i;
-          ++cnt;
-        }
-      if (!cnt) continue;
-      b.count += cnt;
-      b.lo = {std::min(b.lo[0], first), std::min(b.lo[1], j), std::min(b.lo[2], k)};
-      b.hi = {std::max(b.hi[0], last), std::max(b.hi[1], j), std::max(b.hi[2], k)};
-    }
-  return b;
-}
-
 vtkSmartPointer<vtkImageData> padded_crop(const unsigned char* d, const std::array<std::size_t, 3>& n, const Box& b,
                                           int pad) {
   const int px = int(b.hi[0] - b.lo[0]) + 1 + 2 * pad, py = int(b.hi[1] - b.lo[1]) + 1 + 2 * pad,
@@ -192,7 +171,7 @@ long long mask_euler_characteristic_6_18(const MaskImage* mask) {
   if (!mask) throw PreconditionError("no mask");
   const auto size = mask->GetBufferedRegion().GetSize();
   const std::array<std::size_t, 3> n{size[0], size[1], size[2]};
-  const Box b = lumen_box(mask->GetBufferPointer(), n);
+  const Box b = nonzero_box(mask->GetBufferPointer(), n);
   if (!b.count) return 0;
   auto img = padded_crop(mask->GetBufferPointer(), n, b);
   int dims[3];

@@ -223,7 +223,7 @@ class SurfaceReconstruction {
   // 1. Crop to the lumen, pad, build the sub-voxel field, extract its isosurface in LPS mm.
   void extract() {
     Stopwatch watch;
-    box_ = lumen_box(mask_->GetBufferPointer(), size_);
+    box_ = nonzero_box(mask_->GetBufferPointer(), size_);
     st_.lumen_voxels = box_.count;
     if (!box_.count) throw PreconditionError("mask: no lumen voxels (the mask is empty)");
     for (int a = 0; a < 3; ++a) st_.crop_size[a] = box_.hi[a] - box_.lo[a] + 1;

@@ -13,18 +13,14 @@
 #include <vector>
 
 #include "colonflat/core/soup.h"
+#include "colonflat/core/voxel_box.h"
 #include "colonflat/reconstruct/reconstruct.h"
 
 namespace cf::reconstruct_detail {
 
-// Inclusive bounding box of the lumen in buffer indices, and its voxel count.
-struct Box {
-  std::array<std::size_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
-  std::size_t count = 0;
-};
-
-// d: the mask buffer (x fastest), n: its size. Any non-zero voxel is lumen.
-Box lumen_box(const unsigned char* d, const std::array<std::size_t, 3>& n);
+// Inclusive bounding box of the lumen in buffer indices, and its voxel count (nonzero_box of the
+// mask buffer: any non-zero voxel is lumen).
+using Box = VoxelBox;
 
 // The cropped lumen, binarised (0/1), with `pad` voxels of background on every side, as VTK
 // image data in index space (origin = buffer index of its first voxel, spacing 1).

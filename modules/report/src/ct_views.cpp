@@ -8,12 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <mutex>
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/threads.h"
+#include "colonflat/core/voxel_box.h"
 #include "colonflat/core/vtk_messages.h"
 
 namespace fs = std::filesystem;
@@ -97,7 +96,7 @@ PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<do
   return sample_plane(ct, plane, lps[a.fixed_axis], u0, v0, pixels, pixels, pix);
 }
 
-std::vector<unsigned char> encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels) {
+std::string encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels) {
   if (pixels.size() != std::size_t(w) * h * components) throw Error("PNG pixel count does not match its size");
   vtkNew<vtkImageData> img;
   img->SetDimensions(w, h, 1);
@@ -114,24 +113,13 @@ std::vector<unsigned char> encode_png(int w, int h, int components, const std::v
   vtkUnsignedCharArray* out = writer->GetResult();
   if (writer->GetErrorCode() != 0 || !msgs.errors().empty() || !out)
     throw Error("cannot encode a PNG: " + (msgs.errors().empty() ? std::string("VTK's PNG writer failed") : msgs.errors().front()));
-  const unsigned char* b = out->GetPointer(0);
-  return std::vector<unsigned char>(b, b + out->GetNumberOfValues());
+  const auto* b = reinterpret_cast<const char*>(out->GetPointer(0));
+  return std::string(b, b + out->GetNumberOfValues());
 }
-
-namespace {
-void write_bytes(const std::vector<unsigned char>& bytes, const fs::path& path) {
-  write_atomically(path, [&](const fs::path& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    f.close();
-    if (!f) throw Error(path.string() + ": cannot write PNG");
-  });
-}
-}  // namespace
 
 void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels, const fs::path& path) {
   if (pixels.size() != std::size_t(w) * h * components) throw Error(path.string() + ": PNG pixel count does not match its size");
-  write_bytes(encode_png(w, h, components, pixels), path);
+  write_text_atomically(path, encode_png(w, h, components, pixels));
 }
 
 unsigned char window_grey(float hu, const CtWindow& win) {
@@ -140,7 +128,7 @@ unsigned char window_grey(float hu, const CtWindow& win) {
 }
 
 namespace {
-std::vector<unsigned char> windowed_png(const PlaneImage& im, const CtWindow& win) {
+std::string windowed_png(const PlaneImage& im, const CtWindow& win) {
   std::vector<unsigned char> grey(im.hu.size());
   std::transform(im.hu.begin(), im.hu.end(), grey.begin(), [&](float v) { return window_grey(v, win); });
   return encode_png(im.w, im.h, 1, grey);
@@ -182,13 +170,13 @@ DrawnSliceStack draw_slice_stack(const Image* ct, Plane plane, const std::array<
 }
 
 void write_windowed_png(const PlaneImage& im, const CtWindow& win, const fs::path& path) {
-  write_bytes(windowed_png(im, win), path);
+  write_text_atomically(path, windowed_png(im, win));
 }
 
 nlohmann::json write_drawn_stack(const DrawnSliceStack& d, const fs::path& dir, const std::string& rel_prefix) {
   nlohmann::json j = d.json;
   parallel_for(d.pngs.size(), [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) write_bytes(d.pngs[i], dir / d.names[i]);
+    for (std::size_t i = b; i < e; ++i) write_text_atomically(dir / d.names[i], d.pngs[i]);
   });
   for (const std::string& name : d.names) j["files"].push_back(rel_prefix + name);
   return j;
@@ -211,29 +199,12 @@ DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3
 
 bool mask_box_lps(const MaskImage& mask, std::array<double, 3>& box_min, std::array<double, 3>& box_max) {
   const auto size = mask.GetLargestPossibleRegion().GetSize();
-  const std::size_t nx = size[0], ny = size[1], nz = size[2];
-  const unsigned char* m = mask.GetBufferPointer();
-  std::mutex mu;
-  std::array<long, 3> lo{long(nx), long(ny), long(nz)}, hi{-1, -1, -1};
-  parallel_for(nz, [&](std::size_t k0, std::size_t k1) {  // per thread its own box, merged under the lock
-    std::array<long, 3> l{long(nx), long(ny), long(nz)}, h{-1, -1, -1};
-    for (std::size_t k = k0; k < k1; ++k)
-      for (std::size_t j = 0; j < ny; ++j) {
-        const unsigned char* row = m + (k * ny + j) * nx;
-        for (std::size_t i = 0; i < nx; ++i)
-          if (row[i]) {
-            const long c[3] = {long(i), long(j), long(k)};
-            for (int a = 0; a < 3; ++a) l[a] = std::min(l[a], c[a]), h[a] = std::max(h[a], c[a]);
-          }
-      }
-    std::lock_guard<std::mutex> lock(mu);
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], l[a]), hi[a] = std::max(hi[a], h[a]);
-  });
-  if (hi[0] < 0) return false;
+  const VoxelBox b = nonzero_box(mask.GetBufferPointer(), {size[0], size[1], size[2]});
+  if (!b.count) return false;
   box_min = {1e300, 1e300, 1e300}, box_max = {-1e300, -1e300, -1e300};
   for (int corner = 0; corner < 8; ++corner) {
     MaskImage::IndexType idx;
-    for (int a = 0; a < 3; ++a) idx[a] = (corner >> a) & 1 ? hi[a] : lo[a];
+    for (int a = 0; a < 3; ++a) idx[a] = itk::IndexValueType((corner >> a) & 1 ? b.hi[a] : b.lo[a]);
     MaskImage::PointType p;
     mask.TransformIndexToPhysicalPoint(idx, p);
     for (int a = 0; a < 3; ++a) box_min[a] = std::min(box_min[a], p[a]), box_max[a] = std::max(box_max[a], p[a]);

@@ -88,7 +88,7 @@ TEST(ReportCt, ReportWritesPlanesDrawnAheadOnlyForItsOwnBox) {
   SliceStackOptions so;
   so.step_mm = opts.stack_step_mm;
   so.pixel_mm = opts.stack_pixel_mm;
-  const std::vector<unsigned char> sentinel{'n', 'o', 't', ' ', 'a', ' ', 'p', 'n', 'g'};
+  const std::string sentinel = "not a png";
   for (const double shift : {0.0, 1.0}) {
     std::array<double, 3> box_hi = hi;
     box_hi[2] += shift;
@@ -99,7 +99,7 @@ TEST(ReportCt, ReportWritesPlanesDrawnAheadOnlyForItsOwnBox) {
     const ReportResult r = build_review_report(run, opts, tx, nullptr, nullptr, &drawn);
     tx.commit();
     const std::string axial0 = testing::slurp(tmp / "run" / "report_files" / "axial_0.png");
-    if (shift == 0.0) EXPECT_EQ(axial0, std::string(sentinel.begin(), sentinel.end()));
+    if (shift == 0.0) EXPECT_EQ(axial0, sentinel);
     else EXPECT_EQ(axial0.substr(1, 3), "PNG") << "drawn for another box, yet written";
     bool said = false;
     for (const auto& [phase, s] : r.phases) said = said || phase.find("planes") != std::string::npos &&

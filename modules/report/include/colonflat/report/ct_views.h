@@ -52,8 +52,9 @@ PlaneImage sample_plane_around(const Image* ct, Plane plane, const std::array<do
 
 // 8-bit grey value of `hu` through `window` (0 below, 255 above).
 unsigned char window_grey(float hu, const CtWindow& window);
-// w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, encoded as a PNG.
-std::vector<unsigned char> encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels);
+// w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, encoded as a PNG
+// (its bytes).
+std::string encode_png(int w, int h, int components, const std::vector<unsigned char>& pixels);
 // Writes w x h pixels of `components` (1 grey, 3 RGB) bytes each, rows from the top, as a PNG (atomic).
 void write_png_pixels(int w, int h, int components, const std::vector<unsigned char>& pixels,
                       const std::filesystem::path& path);
@@ -79,7 +80,7 @@ nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<
 struct DrawnSliceStack {
   nlohmann::json json;                           // write_slice_stack's, "files" still empty
   std::vector<std::string> names;                // "<plane>_<n>.png", one per position
-  std::vector<std::vector<unsigned char>> pngs;  // each plane's PNG bytes
+  std::vector<std::string> pngs;                 // each plane's PNG bytes
 };
 template <class Image>
 DrawnSliceStack draw_slice_stack(const Image* ct, Plane plane, const std::array<double, 3>& box_min,
