@@ -8,6 +8,13 @@
 #include "mesh_read.h"
 
 namespace cf {
+namespace {
+// Whether the reader's note of what it turned or reversed is still on the mesh (a stage reports it).
+bool has_read_orientation(const Mesh& mesh) {
+  OpenMesh::MPropHandleT<std::string> h;
+  return const_cast<Mesh&>(mesh).get_property_handle(h, kReadOrientationProperty);
+}
+}  // namespace
 
 const ArtifactType& mesh_artifact() {
   static const ArtifactType t{
@@ -30,9 +37,17 @@ const ArtifactType& mesh_artifact() {
       [](const std::any& v, const std::filesystem::path& tmp, const std::filesystem::path& target) {
         // write_mesh renames atomically itself; the caller's transaction renames tmp later.
         (void)target;
+        if (const auto* list = std::any_cast<TriangleList>(&v)) return write_mesh(*list, tmp);
         write_mesh(std::any_cast<const Mesh&>(v), tmp);
       },
-      {".vtp", ".vtk", ".off", ".obj", ".ply", ".stl"}};
+      {".vtp", ".vtk", ".off", ".obj", ".ply", ".stl"},
+      [](const std::any& v) -> std::optional<std::any> {
+        const Mesh& mesh = std::any_cast<const Mesh&>(v);
+        if (has_read_orientation(mesh)) return std::nullopt;
+        if (has_deleted_elements(mesh)) return std::nullopt;
+        return std::any(to_triangle_list(mesh));
+      },
+      [](const std::any& v) { return std::any(build_mesh(std::any_cast<const TriangleList&>(v))); }};
   return t;
 }
 
@@ -59,6 +74,22 @@ nlohmann::json noted(const OrientationReport& r, const RunContext& ctx, const st
 
 Mesh& bag_mesh_for_orienting(ArtifactBag& bag, const std::string& port) { return const_cast<Mesh&>(bag.get<Mesh>(port)); }
 
+BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port) {
+  BagSurface s;
+  if (std::any_cast<TriangleList>(&bag.raw(port))) s.triangles = &const_cast<TriangleList&>(bag.get<TriangleList>(port));
+  else s.mesh = &bag_mesh_for_orienting(bag, port);
+  return s;
+}
+
+nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, const std::string& stage,
+                              const std::string& port, TopologyReport* topology) {
+  if (surface.mesh) return orient_mesh(*surface.mesh, ctx, stage, port, topology);
+  TopologyReport topo = analyze_topology(*surface.triangles);
+  const OrientationReport r = orient_outward(*surface.triangles, topo);
+  if (topology) *topology = std::move(topo);
+  return noted(r, ctx, stage, port);
+}
+
 nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string& stage, const std::string& port,
                            TopologyReport* topology) {
   OrientationReport r = read_orientation(mesh);
@@ -73,23 +104,36 @@ nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, cons
 
 std::string topology_entry(const std::string& port) { return port + ".topology"; }
 
-OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
-                                 const std::string& stage) {
-  Mesh& mesh = bag_mesh_for_orienting(bag, port);
-  OrientationReport r = read_orientation(mesh);
-  OrientedMesh in;
-  in.triangles = to_triangle_list(mesh);
+namespace {
+// The bag's topology_entry(port) when it fits `list`, else analyze_topology(list); the entry erased.
+TopologyReport handed_topology(ArtifactBag& bag, const std::string& port, const TriangleList& list) {
   const std::string entry = topology_entry(port);
-  bool taken = false;
   if (bag.has(entry)) {
     TopologyReport handed = bag.take<TopologyReport>(entry);
-    if ((taken = topology_fits(handed, in.triangles))) in.topology = std::move(handed);
+    if (topology_fits(handed, list)) return handed;
   }
-  if (!taken) in.topology = analyze_topology(in.triangles);
-  const OrientationReport turned = orient_outward(in.triangles, in.topology);
+  return analyze_topology(list);
+}
+}  // namespace
+
+OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
+                                 const std::string& stage) {
+  const BagSurface held = bag_surface_for_orienting(bag, port);
+  OrientedMesh in;
+  if (held.triangles) {  // the stand-in: oriented in place, as orient_surface does
+    in.held = held.triangles;
+    in.topology = handed_topology(bag, port, *held.triangles);
+    in.orientation = noted(orient_outward(*held.triangles, in.topology), ctx, stage, port);
+    return in;
+  }
+  Mesh& mesh = *held.mesh;
+  OrientationReport r = read_orientation(mesh);
+  in.converted = to_triangle_list(mesh);
+  in.topology = handed_topology(bag, port, *in.converted);
+  const OrientationReport turned = orient_outward(*in.converted, in.topology);
   if (!turned.empty()) {  // the bag's mesh reversed as orient_mesh_input does, and the list read back from it
-    mesh = build_mesh(in.triangles);
-    in.triangles = to_triangle_list(mesh);
+    mesh = build_mesh(*in.converted);
+    in.converted = to_triangle_list(mesh);
   }
   r.append(turned);
   in.orientation = noted(r, ctx, stage, port);

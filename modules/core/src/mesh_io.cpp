@@ -265,46 +265,66 @@ LoadedMesh load_mesh_oriented(const fs::path& path, const LoadPolicy& policy, bo
   return out;
 }
 
-void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) {
+namespace {
+
+MeshFormat writable_format(const fs::path& path) {
   const auto fmt = mesh_format_from_path(path);
   if (!fmt)
     throw UsageError(path.string() + ": unknown mesh format '" + path.extension().string() +
                      "' (known: " + mesh_format_list() + ")");
+  return *fmt;
+}
+
+// A .vtp (appended, fast compression) or legacy .vtk file of `pd` at `tmp`, tagged with its units
+// and space; `path` names the target in the error.
+void write_polydata_mesh(vtkPolyData* pd, MeshFormat fmt, const fs::path& tmp, const fs::path& path,
+                         const WriteOptions& wo) {
+  tag_polydata_space(pd, wo.units, wo.space);
+  VtkMessageCapture vtk_messages;
+  int ok = 0;
+  vtkSmartPointer<vtkAlgorithm> writer;
+  if (fmt == MeshFormat::kVTP) {
+    vtkNew<vtkXMLPolyDataWriter> w;
+    writer = w.GetPointer();
+    w->SetFileName(tmp.c_str());
+    w->SetInputData(pd);
+    use_fast_compression(w);
+    ok = w->Write();
+  } else {
+    vtkNew<vtkPolyDataWriter> w;
+    writer = w.GetPointer();
+    w->SetFileName(tmp.c_str());
+    w->SetInputData(pd);
+    if (wo.binary) w->SetFileTypeToBinary();
+    else w->SetFileTypeToASCII();
+    ok = w->Write();
+  }
+  if (!ok || !vtk_messages.errors().empty())
+    throw Error(path.string() + ": cannot write: " + vtk_messages.write_problem(writer, tmp.string()));
+}
+
+bool vtk_format(MeshFormat fmt) { return fmt == MeshFormat::kVTP || fmt == MeshFormat::kVTK; }
+
+}  // namespace
+
+void write_mesh(const Mesh& mesh, const fs::path& path, const WriteOptions& wo) {
+  const MeshFormat fmt = writable_format(path);
   write_atomically(path, [&](const fs::path& tmp) {
-    if (*fmt == MeshFormat::kVTP || *fmt == MeshFormat::kVTK) {
-      auto pd = mesh_to_polydata(mesh);
-      tag_polydata_space(pd, wo.units, wo.space);
-      VtkMessageCapture vtk_messages;
-      int ok = 0;
-      vtkSmartPointer<vtkAlgorithm> writer;
-      if (*fmt == MeshFormat::kVTP) {
-        vtkNew<vtkXMLPolyDataWriter> w;
-        writer = w.GetPointer();
-        w->SetFileName(tmp.c_str());
-        w->SetInputData(pd);
-        use_fast_compression(w);
-        ok = w->Write();
-      } else {
-        vtkNew<vtkPolyDataWriter> w;
-        writer = w.GetPointer();
-        w->SetFileName(tmp.c_str());
-        w->SetInputData(pd);
-        if (wo.binary) w->SetFileTypeToBinary();
-        else w->SetFileTypeToASCII();
-        ok = w->Write();
-      }
-      if (!ok || !vtk_messages.errors().empty())
-        throw Error(path.string() + ": cannot write: " + vtk_messages.write_problem(writer, tmp.string()));
-      return;
-    }
+    if (vtk_format(fmt)) return write_polydata_mesh(mesh_to_polydata(mesh), fmt, tmp, path, wo);
     OpenMesh::IO::Options opt;
-    if (wo.binary && (*fmt == MeshFormat::kPLY || *fmt == MeshFormat::kSTL)) opt += OpenMesh::IO::Options::Binary;
+    if (wo.binary && (fmt == MeshFormat::kPLY || fmt == MeshFormat::kSTL)) opt += OpenMesh::IO::Options::Binary;
     LibraryOutputCapture printed;  // OpenMesh's writers log "[OBJWriter] : write file"
     if (!OpenMesh::IO::write_mesh(mesh, tmp.string(), opt, static_cast<std::streamsize>(wo.ascii_precision))) {
       const std::string why = file_system_problem(tmp);
       throw Error(path.string() + ": cannot write mesh" + (why.empty() ? "" : ": " + why));
     }
   });
+}
+
+void write_mesh(const TriangleList& mesh, const fs::path& path, const WriteOptions& wo) {
+  const MeshFormat fmt = writable_format(path);
+  if (!vtk_format(fmt)) return write_mesh(build_mesh(mesh), path, wo);
+  write_atomically(path, [&](const fs::path& tmp) { write_polydata_mesh(triangles_to_polydata(mesh), fmt, tmp, path, wo); });
 }
 
 }  // namespace cf

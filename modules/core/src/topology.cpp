@@ -384,6 +384,14 @@ TriangleList to_triangle_list(const Mesh& mesh) {
   return t;
 }
 
+bool has_deleted_elements(const Mesh& mesh) {
+  for (std::size_t f = 0; f < mesh.n_faces(); ++f)
+    if (mesh.status(Mesh::FaceHandle(int(f))).deleted()) return true;
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
+    if (mesh.status(Mesh::VertexHandle(int(v))).deleted()) return true;
+  return false;
+}
+
 bool topology_fits(const TopologyReport& t, const TriangleList& mesh) {
   if (t.faces != mesh.triangles.size() || t.face_component.size() != mesh.triangles.size() ||
       t.vertices + t.unreferenced_vertices != mesh.points.size())

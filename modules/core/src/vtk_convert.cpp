@@ -33,6 +33,23 @@ vtkSmartPointer<vtkPolyData> mesh_to_polydata(const Mesh& mesh) {
   return pd;
 }
 
+vtkSmartPointer<vtkPolyData> triangles_to_polydata(const TriangleList& t) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(static_cast<vtkIdType>(t.points.size()));
+  for (std::size_t i = 0; i < t.points.size(); ++i) pts->SetPoint(static_cast<vtkIdType>(i), t.points[i].data());
+  vtkNew<vtkCellArray> polys;
+  polys->AllocateExact(static_cast<vtkIdType>(t.triangles.size()), static_cast<vtkIdType>(3 * t.triangles.size()));
+  for (const auto& tri : t.triangles) {
+    const vtkIdType ids[3] = {tri[0], tri[1], tri[2]};
+    polys->InsertNextCell(3, ids);
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  return pd;
+}
+
 PolygonSoup polydata_to_soup(vtkPolyData* pd) {
   PolygonSoup soup;
   vtkPoints* pts = pd->GetPoints();

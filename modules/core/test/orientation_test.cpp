@@ -238,9 +238,38 @@ TEST(CoreOrientation, OrientedInputEqualsOrientMeshInput) {
   EXPECT_EQ(log_b.str(), log_a.str());
   const TriangleList bag_list = to_triangle_list(b.get<Mesh>("denoised"));
   EXPECT_EQ(to_triangle_list(a.get<Mesh>("denoised")).triangles, bag_list.triangles);
-  EXPECT_EQ(in.triangles.triangles, bag_list.triangles);
+  EXPECT_EQ(in.triangles().triangles, bag_list.triangles);
   EXPECT_EQ(in.topology.face_component, analyze_topology(bag_list).face_component);
   EXPECT_EQ(in.topology.genus, std::optional<int>(1));
+}
+
+// On the mesh's stand-in (the triangle list `colonflat run` holds it as), oriented_mesh_input and
+// orient_surface orient as on the mesh: the same report and progress lines, the bag's list itself
+// reversed in place (no copy: triangles() is that list) and equal to the mesh's, the same topology.
+TEST(CoreOrientation, StandInIsOrientedAsTheMesh) {
+  const TriangleList inward = reversed(synthetic::torus(30, 10, 40, 16));
+  ArtifactBag a, b, c;
+  a.put("denoised", synthetic::to_mesh(inward));
+  b.put("denoised", to_triangle_list(synthetic::to_mesh(inward)));
+  c.put("surface", to_triangle_list(synthetic::to_mesh(inward)));
+  std::ostringstream log_a, log_b, log_c;
+  RunContext ctx_a, ctx_b, ctx_c;
+  ctx_a.log = &log_a, ctx_b.log = &log_b, ctx_c.log = &log_c;
+  const OrientedMesh on_mesh = oriented_mesh_input(a, "denoised", ctx_a, "flatten");
+  const OrientedMesh on_list = oriented_mesh_input(b, "denoised", ctx_b, "flatten");
+  EXPECT_EQ(on_list.orientation, on_mesh.orientation);
+  EXPECT_EQ(on_list.orientation["reversed_components"], 1);
+  EXPECT_EQ(log_b.str(), log_a.str());
+  EXPECT_EQ(&on_list.triangles(), &b.get<TriangleList>("denoised"));
+  EXPECT_EQ(on_list.triangles().triangles, on_mesh.triangles().triangles);
+  EXPECT_EQ(on_list.triangles().triangles, to_triangle_list(a.get<Mesh>("denoised")).triangles);
+  EXPECT_EQ(on_list.topology.face_component, on_mesh.topology.face_component);
+  TopologyReport topo;
+  const nlohmann::json j = orient_surface(bag_surface_for_orienting(c, "surface"), ctx_c, "render", "surface", &topo);
+  EXPECT_EQ(j, on_mesh.orientation);
+  EXPECT_EQ(c.get<TriangleList>("surface").triangles, on_mesh.triangles().triangles);
+  EXPECT_EQ(topo.genus, std::optional<int>(1));
+  EXPECT_NE(log_c.str().find("render: surface: "), std::string::npos);
 }
 
 // A topology handed on in the bag ("<port>.topology", as denoise leaves it) is taken only when it
@@ -258,7 +287,7 @@ TEST(CoreOrientation, HandedOnTopologyIsTakenOnlyWhenItFitsTheMesh) {
     RunContext ctx;
     const OrientedMesh in = oriented_mesh_input(bag, "denoised", ctx, "flatten");
     EXPECT_FALSE(bag.has(topology_entry("denoised")));
-    EXPECT_EQ(in.triangles.triangles, sphere.triangles);
+    EXPECT_EQ(in.triangles().triangles, sphere.triangles);
     EXPECT_EQ(in.topology.face_component, own.face_component);
     EXPECT_EQ(in.topology.faces, own.faces);
     return in.topology.mean_edge_length;

@@ -13,7 +13,7 @@ const StageSpec& FlattenStage::spec() const {
       "flatten",
       "flattening of the colon wall onto bands: x from the rectum along the centreline, y around; area-balanced "
       "or conformal",
-      {{"denoised", &mesh_artifact(), "genus-0 colon surface (after denoise)", "denoised.vtp"}},
+      {{"denoised", &mesh_artifact(), "genus-0 colon surface (after denoise)", "denoised.vtp", true, true}},
       {{"flat", &flat_artifact(), "flat colon map", "flat.vtp"}}};
   return s;
 }
@@ -42,7 +42,7 @@ void FlattenStage::run(ArtifactBag& bag, RunContext& ctx) {
   // run) go to flatten_colon, which converts and analyses nothing again.
   OrientedMesh in = oriented_mesh_input(bag, "denoised", ctx, "flatten");
   Stopwatch sw;
-  FlatMap flat = flatten_colon(in.triangles, opts_, &in.topology);
+  FlatMap flat = flatten_colon(in.triangles(), opts_, &in.topology);
   ctx.report = flat_report(flat);
   ctx.report["orientation"] = std::move(in.orientation);
   for (const auto& s : flat.skipped) ctx.progress("flatten: skipped " + s);

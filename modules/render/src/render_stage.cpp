@@ -22,9 +22,9 @@ const StageSpec& RenderStage::spec() const {
       "render",
       "2D colon-wall image with polyp candidates, candidate JSON, 3D snapshots",
       {{"flat", &flat_artifact(), "flat colon map (from flatten)", "flat.vtp"},
-       {"surface", &mesh_artifact(), "surface before denoising (snapshot)", "surface.vtp", false},
+       {"surface", &mesh_artifact(), "surface before denoising (snapshot)", "surface.vtp", false, true},
        {"loops", &loops_artifact(), "cut loops of denoise (snapshot)", "loops.vtp", false},
-       {"denoised", &mesh_artifact(), "surface after denoising (snapshot)", "denoised.vtp", false}},
+       {"denoised", &mesh_artifact(), "surface after denoising (snapshot)", "denoised.vtp", false, true}},
       {{"colon_image", &png_image_artifact(), "2D colon-wall image", "colon.png"},
        {"candidates", &json_artifact(), "polyp candidates (3D and 2D positions, size, score)", "candidates.json"},
        {"snapshot_before", &png_image_artifact(), "3D snapshot of the surface before denoising, loops highlighted",
@@ -45,24 +45,30 @@ const ParamTable<RenderOptions>& render_param_table() {
 
 namespace {
 
+// The snapshot of a surface held as the mesh or as its stand-in (the same pixels either way).
+ImagePtr snapshot_of(const BagSurface& s, vtkPolyData* loops, const SnapshotOptions& so) {
+  return s.mesh ? render_snapshot(*s.mesh, loops, so) : render_snapshot(*s.triangles, loops, so);
+}
+
 // The snapshot of the surface before denoising, its caption giving the genus (of the surface's
 // topology, found when it was oriented) and the loop count.
-ImagePtr snapshot_before(const Mesh& m, std::optional<int> genus, vtkPolyData* loops, SnapshotOptions so) {
+ImagePtr snapshot_before(const BagSurface& s, std::optional<int> genus, vtkPolyData* loops, SnapshotOptions so) {
   so.caption = "before denoising: genus " + (genus ? std::to_string(*genus) : std::string("?")) +
                (loops ? ", " + std::to_string(loops->GetNumberOfCells()) + " cut loops" : std::string());
-  return render_snapshot(m, loops, so);
+  return snapshot_of(s, loops, so);
 }
 
 }  // namespace
 
 // Orients the snapshot surfaces in place (snapshots light the outside of the wall): the report of
 // each under "orientation", the seconds in orient_s; `surface_topology` gets the surface's.
-RenderStage::SnapshotImages RenderStage::orient_snapshot_inputs(Mesh* surface, Mesh* denoised, const RunContext& ctx,
+RenderStage::SnapshotImages RenderStage::orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
+                                                                const RunContext& ctx,
                                                                 TopologyReport* surface_topology) {
   SnapshotImages im;
   Stopwatch sw;
-  if (surface) im.orientation["surface"] = orient_mesh(*surface, ctx, "render", "surface", surface_topology);
-  if (denoised) im.orientation["denoised"] = orient_mesh(*denoised, ctx, "render", "denoised");
+  if (surface) im.orientation["surface"] = orient_surface(surface, ctx, "render", "surface", surface_topology);
+  if (denoised) im.orientation["denoised"] = orient_surface(denoised, ctx, "render", "denoised");
   im.orient_s = sw.seconds();
   return im;
 }
@@ -77,8 +83,8 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   Snapshots s;
   if (bag.has("loops")) s.loops = loops_to_polydata(bag.get<LoopSet>("loops"));
   s.options.width = s.options.height = opts_.snapshot_size;
-  Mesh* surface = bag.has("surface") ? &bag_mesh_for_orienting(bag, "surface") : nullptr;
-  Mesh* denoised = bag.has("denoised") ? &bag_mesh_for_orienting(bag, "denoised") : nullptr;
+  const BagSurface surface = bag.has("surface") ? bag_surface_for_orienting(bag, "surface") : BagSurface{};
+  const BagSurface denoised = bag.has("denoised") ? bag_surface_for_orienting(bag, "denoised") : BagSurface{};
   try {
     s.display = ensure_display();
   } catch (const Error& e) {
@@ -92,9 +98,9 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
     TopologyReport surface_topology;
     SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology);
     Stopwatch sw;
-    if (surface) im.before = snapshot_before(*surface, surface_topology.genus, loops, so);
+    if (surface) im.before = snapshot_before(surface, surface_topology.genus, loops, so);
     im.before_s = sw.lap();
-    im.after = denoised ? render_snapshot(*denoised, loops, so) : render_snapshot(flat_to_surface(flat), loops, so);
+    im.after = denoised ? snapshot_of(denoised, loops, so) : render_snapshot(flat_to_surface(flat), loops, so);
     im.after_s = sw.lap();
     return im;
   });

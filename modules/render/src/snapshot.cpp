@@ -190,15 +190,6 @@ vtkSmartPointer<vtkFloatArray> point_normals(const double* xyz, std::size_t P, c
   return normals;
 }
 
-// True when a vertex or face is marked deleted (not yet garbage-collected).
-bool has_deleted_elements(const Mesh& mesh) {
-  for (std::size_t f = 0; f < mesh.n_faces(); ++f)
-    if (mesh.status(Mesh::FaceHandle(int(f))).deleted()) return true;
-  for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
-    if (mesh.status(Mesh::VertexHandle(int(v))).deleted()) return true;
-  return false;
-}
-
 }  // namespace
 
 vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {

@@ -2,6 +2,7 @@
 // The "mesh" artifact (triangle surface in LPS mm) and topology reports as JSON and text.
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 
 #include "colonflat/core/mesh.h"
@@ -14,6 +15,11 @@ namespace cf {
 // Reads any supported mesh file through load_mesh() (boundaries and several components
 // accepted, polygons triangulated, orientation made consistent and outward: what was turned or
 // reversed is kept in the mesh property kReadOrientationProperty); writes via write_mesh().
+// Its stand-in in `colonflat run` (ArtifactType::compact) is the TriangleList (to_triangle_list,
+// about a quarter of the halfedge mesh's memory), expanded by build_mesh; a mesh with deleted
+// elements or with the reader's orientation note still on it is not compacted. A stage that
+// declares a mesh input reads_stand_in takes it through bag_surface_for_orienting or
+// oriented_mesh_input, which accept both.
 const ArtifactType& mesh_artifact();
 
 // Name of the mesh property in which mesh_artifact()'s reader leaves the faces it turned (an
@@ -35,6 +41,21 @@ nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string&
 // The bag's mesh `port`, to be oriented in place by orient_mesh (throws when it is not a mesh).
 Mesh& bag_mesh_for_orienting(ArtifactBag& bag, const std::string& port);
 
+// A mesh input as a stage that reads its stand-in (Port::reads_stand_in) finds it in the bag:
+// exactly one of the two is set (the Mesh, or in `colonflat run` the TriangleList stand-in).
+struct BagSurface {
+  Mesh* mesh = nullptr;
+  TriangleList* triangles = nullptr;
+  explicit operator bool() const { return mesh || triangles; }  // false: the bag has no such entry
+};
+// The bag's mesh or stand-in `port`, to be oriented in place by orient_surface (throws when it is
+// neither).
+BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port);
+// orient_mesh on either: a triangle list is analysed (analyze_topology, into `topology` when given)
+// and its inward components reversed (orient_outward), with the same notes and report.
+nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, const std::string& stage,
+                              const std::string& port, TopologyReport* topology = nullptr);
+
 // The bag entry in which a stage may leave analyze_topology of its mesh output `port` for the next
 // stage ("<port>.topology", a TopologyReport; denoise leaves its verification's report of
 // "denoised"). Not a port: never written; taken (erased) by oriented_mesh_input.
@@ -42,12 +63,16 @@ std::string topology_entry(const std::string& port);
 
 // A stage's input mesh as orient_mesh_input leaves it, as a triangle list with its topology.
 struct OrientedMesh {
-  TriangleList triangles;      // to_triangle_list of the bag's mesh after orienting (same order)
-  TopologyReport topology;     // analyze_topology(triangles)
+  // to_triangle_list of the bag's mesh after orienting (same order); or, when the bag holds the
+  // mesh's stand-in, that list itself, oriented in place (no copy; it lives as long as the bag's entry).
+  const TriangleList& triangles() const { return converted ? *converted : *held; }
+  std::optional<TriangleList> converted;  // the list made from the bag's Mesh
+  const TriangleList* held = nullptr;     // the bag's stand-in when there was no Mesh
+  TopologyReport topology;     // analyze_topology(triangles())
   nlohmann::json orientation;  // OrientationReport::to_json(), as orient_mesh_input returns it
 };
 // orient_mesh_input for a stage that works on a triangle list: the same orientation, notes and
-// bag mesh, and the list and its topology without converting or analysing twice. The topology is
+// bag mesh (or stand-in), and the list and its topology without converting or analysing twice. The topology is
 // the bag's topology_entry(port) when one is there and fits the mesh (topology_fits, topology.h), else a new
 // analysis; the entry is erased either way.
 OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,

@@ -46,5 +46,10 @@ struct WriteOptions {
 
 // Writes atomically. Throws cf::Error on failure (the target is then untouched).
 void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& = {});
+// The same file from a triangle list (what `colonflat run` holds a mesh as while no stage needs its
+// halfedges: mesh_artifact's stand-in): write_mesh(to_triangle_list(m), ...) writes the bytes
+// write_mesh(m, ...) writes for a mesh without deleted elements. OFF, OBJ, PLY and STL go through
+// build_mesh (throws PreconditionError when a face cannot be added to a halfedge mesh).
+void write_mesh(const TriangleList& mesh, const std::filesystem::path& path, const WriteOptions& = {});
 
 }  // namespace cf

@@ -27,16 +27,18 @@ struct ArtifactType {
   std::string description;  // for --help: "triangle mesh (.vtp .vtk .off .obj .ply .stl)"
   // Reads a file into a value; throws InputError.
   std::function<std::any(const std::filesystem::path&)> read;
-  // Writes a value to `tmp` (a temporary path with the target's extension); `target` names the
-  // final file for messages. The caller renames tmp -> target when every output is written.
+  // Writes a value, or its stand-in (compact below), to `tmp` (a temporary path with the target's
+  // extension); the stand-in gives the same file. `target` names the final file for messages.
+  // The caller renames tmp -> target when every output is written.
   std::function<void(const std::any&, const std::filesystem::path& tmp, const std::filesystem::path& target)> write;
   // Output extensions the writer knows (lower case with the dot, e.g. ".vtp", ".nii.gz"); empty =
   // not declared (then the writer itself refuses an unknown one, after the work).
   std::vector<std::string> extensions = {};
-  // Optional, for `colonflat run`: a smaller stand-in of a value that no later stage reads (kept
-  // while the other stages run, so their peak memory is lower), or nothing when the value cannot
-  // be held smaller without loss; and the value back from its stand-in, equal to the original
-  // (voxel for voxel, same geometry and header). Both empty: never compacted.
+  // Optional, for `colonflat run`: a smaller stand-in of a value that no later stage reads, or
+  // whose later readers all take the stand-in (Port::reads_stand_in) (kept while the other stages
+  // run, so their peak memory is lower), or nothing when the value cannot be held smaller without
+  // loss; and the value back from its stand-in, equal to the original (voxel for voxel, same
+  // geometry and header; vertex and face for face). Both empty: never compacted.
   std::function<std::optional<std::any>(const std::any&)> compact = {};
   std::function<std::any(const std::any&)> expand = {};
 };
@@ -47,6 +49,10 @@ struct Port {
   std::string help;
   std::string file_name;      // default file name in run and debug folders, e.g. "surface.vtp"
   bool required = true;       // inputs: must be given; outputs: always produced
+  // Inputs: the stage also takes the value as its type's stand-in (ArtifactType::compact), so
+  // `colonflat run` may hold it so until this stage and after (e.g. render's snapshot meshes as
+  // triangle lists while flatten runs).
+  bool reads_stand_in = false;
 };
 
 struct StageSpec {

@@ -64,6 +64,9 @@ bool topology_fits(const TopologyReport& t, const TriangleList& mesh);
 
 // Conversions between the two representations (same vertex and face order).
 TriangleList to_triangle_list(const Mesh& mesh);
+// True when a vertex or face of `mesh` is marked deleted (not yet garbage-collected): its
+// to_triangle_list then keeps the deleted vertices' slots and leaves the deleted faces out.
+bool has_deleted_elements(const Mesh& mesh);
 // The mesh's live faces in face order, each face's corners in fv_range order (#F x 3 vertex ids;
 // the triangles of to_triangle_list).
 std::vector<std::array<int, 3>> mesh_triangles(const Mesh& mesh);

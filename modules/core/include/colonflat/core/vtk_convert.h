@@ -14,6 +14,10 @@ class vtkXMLWriter;
 namespace cf {
 
 vtkSmartPointer<vtkPolyData> mesh_to_polydata(const Mesh& mesh);
+// The same PolyData (double points, one triangle cell per face, in order) from a triangle list:
+// triangles_to_polydata(to_triangle_list(m)) equals mesh_to_polydata(m) for a mesh without
+// deleted elements.
+vtkSmartPointer<vtkPolyData> triangles_to_polydata(const TriangleList& t);
 // Polygons (and triangle strips, split into triangles) of a PolyData; lines and vertices ignored.
 PolygonSoup polydata_to_soup(vtkPolyData* pd);
 void tag_polydata_space(vtkPolyData* pd, const std::string& units, const std::string& space);

@@ -10,6 +10,7 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
+#include "colonflat/core/mesh_artifact.h"
 #include "colonflat/core/stage.h"
 #include "colonflat/core/topology.h"
 #include "colonflat/flatten/flatten.h"
@@ -64,8 +65,9 @@ class RenderStage : public StageWithOptions<RenderOptions> {
     std::string display, error;
     std::future<SnapshotImages> images;
   };
-  static SnapshotImages orient_snapshot_inputs(Mesh* surface, Mesh* denoised, const RunContext& ctx,
-                                               TopologyReport* surface_topology);
+  // Each surface may be the mesh or, in `colonflat run`, its stand-in (the inputs read_stand_in).
+  static SnapshotImages orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
+                                               const RunContext& ctx, TopologyReport* surface_topology);
   Snapshots start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const;
   void finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const;
 };
