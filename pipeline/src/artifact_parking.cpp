@@ -3,48 +3,67 @@
 
 #include <set>
 
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/core/run_stats.h"
 
 namespace cf {
 namespace {
 
 // The declared type of each artifact name the plan's stages read, and the names that stage
-// `done` and the stages after it write.
+// `from` and the stages after it write.
 struct PlanPorts {
   std::map<std::string, const ArtifactType*> type;
   std::set<std::string> written;
 };
 
-PlanPorts plan_ports(const RunPlan& plan, std::size_t done) {
+PlanPorts plan_ports(const RunPlan& plan, std::size_t from) {
   PlanPorts p;
   for (std::size_t j = 0; j < plan.stages.size(); ++j) {
     for (const Port& in : plan.stages[j]->spec().inputs) p.type.emplace(in.name, in.type);
-    if (j >= done)
+    if (j >= from)
       for (const Port& out : plan.stages[j]->spec().outputs) p.written.insert(out.name);
   }
   return p;
 }
 
-bool read_after(const RunPlan& plan, std::size_t done, const std::string& name) {
+// Whether a stage after `done` reads `name` whole (an input port not declared reads_stand_in).
+bool read_whole_after(const RunPlan& plan, std::size_t done, const std::string& name) {
   for (std::size_t j = done + 1; j < plan.stages.size(); ++j)
     for (const Port& in : plan.stages[j]->spec().inputs)
-      if (in.name == name) return true;
+      if (in.name == name && !in.reads_stand_in) return true;
   return false;
 }
 
+bool compactable(const ArtifactType& type) { return type.compact && type.expand; }
+
 }  // namespace
+
+void ParkedArtifacts::park(const std::string& name, const ArtifactType& type, const std::string& stage,
+                           ArtifactBag& bag, nlohmann::json& log) {
+  Stopwatch sw;
+  std::optional<std::any> stand_in = type.compact(bag.raw(name));
+  if (!stand_in) return;
+  bag.put(name, std::move(*stand_in));
+  release_free_memory();  // the full value's pages back to the kernel now, not after the next stage
+  parked_[name] = &type;
+  log.push_back({{"artifact", name}, {"after_stage", stage}, {"time_s", sw.seconds()}});
+}
+
+void ParkedArtifacts::park_outputs(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
+  const PlanPorts later = plan_ports(plan, done + 1);
+  for (const Port& out : plan.stages[done]->spec().outputs) {
+    if (!compactable(*out.type) || parked_.count(out.name) || !bag.has(out.name)) continue;
+    if (later.written.count(out.name) || read_whole_after(plan, done, out.name)) continue;
+    park(out.name, *out.type, plan.stages[done]->spec().name, bag, log);
+  }
+}
 
 void ParkedArtifacts::park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
   const PlanPorts ports = plan_ports(plan, done);
   for (const auto& [name, type] : ports.type) {
-    if (!type->compact || !type->expand || parked_.count(name) || !bag.has(name)) continue;
-    if (ports.written.count(name) || read_after(plan, done, name)) continue;
-    Stopwatch sw;
-    std::optional<std::any> stand_in = type->compact(bag.raw(name));
-    if (!stand_in) continue;
-    bag.put(name, std::move(*stand_in));
-    parked_[name] = type;
-    log.push_back({{"artifact", name}, {"after_stage", plan.stages[done]->spec().name}, {"time_s", sw.seconds()}});
+    if (!compactable(*type) || parked_.count(name) || !bag.has(name)) continue;
+    if (ports.written.count(name) || read_whole_after(plan, done, name)) continue;
+    park(name, *type, plan.stages[done]->spec().name, bag, log);
   }
 }
 

@@ -183,7 +183,7 @@ class RunTool : public Tool {
     // Each stage's files are written on a second thread while the next stage runs (the
     // artifacts stay in the bag unchanged); all are written before the finishers, which may take them.
     BackgroundOutputWriter writer;
-    ParkedArtifacts parked;  // e.g. the CT in 16 bits from reconstruct to the review report
+    ParkedArtifacts parked;  // e.g. the CT in 16 bits from reconstruct to the review report, the meshes as triangle lists
     nlohmann::json parked_log = nlohmann::json::array();
     for (std::size_t i = 0; i < plan.stages.size(); ++i) {
       Stage& st = *plan.stages[i];
@@ -194,6 +194,7 @@ class RunTool : public Tool {
       std::map<std::string, fs::path> targets;
       for (const Port& p : st.spec().outputs) targets[p.name] = outdir / p.file_name;
       for (auto& tool : plan.finishers) as_finisher(*tool).stage_done(st.spec().name, bag, record);
+      parked.park_outputs(plan, i, bag, parked_log);
       PendingOutputs outputs = stage_outputs(st, bag, targets, tx);
       record["outputs"] = outputs.files;
       writer.submit(std::move(outputs));

@@ -1,14 +1,18 @@
 // `colonflat run` holds the CT in 16 bits and the lumen mask in one bit per voxel from reconstruct
-// to the review report (artifact_parking.h): the run report says so, and the report built from the
-// run's memory (both expanded back) equals, file for file, the one `colonflat report` builds from
-// the files.
+// to the review report, and the surfaces before and after denoising as triangle lists from denoise
+// on (artifact_parking.h): the run report says so, the report built from the run's memory (CT and
+// mask expanded back) equals, file for file, the one `colonflat report` builds from the files, and
+// the mesh files and the flat map equal those of the stages run alone on the files.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <map>
 #include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "artifact_parking.h"
 #include "colonflat/core/stage.h"
 #include "colonflat/pipeline/registry.h"
 #include "colonflat/testing/command.h"
@@ -20,7 +24,81 @@ namespace fs = std::filesystem;
 namespace cf {
 namespace {
 
+// A toy artifact: an int whose stand-in is its decimal string.
+const ArtifactType& toy_type() {
+  static const ArtifactType t{"toy", "toy", {}, {}, {},
+                              [](const std::any& v) -> std::optional<std::any> { return std::to_string(std::any_cast<int>(v)); },
+                              [](const std::any& v) { return std::any(std::stoi(std::any_cast<std::string>(v))); }};
+  return t;
+}
+
+// A stage that only declares its ports.
+class PortsOnly : public Stage {
+ public:
+  explicit PortsOnly(StageSpec s) : spec_(std::move(s)) {}
+  const StageSpec& spec() const override { return spec_; }
+  std::vector<ParamInfo> params() const override { return {}; }
+  void add_cli_options(CLI::App&) override {}
+  nlohmann::json params_json() const override { return nlohmann::json::object(); }
+  void set_params_json(const nlohmann::json&, const std::string&) override {}
+  void validate_params() const override {}
+  void run(ArtifactBag&, RunContext&) override {}
+
+ private:
+  StageSpec spec_;
+};
+
+// Port `name` of the toy type; `stand_in`: the reader takes the stand-in.
+Port toy(const std::string& name, bool stand_in = false) { return {name, &toy_type(), "", name, true, stand_in}; }
+
+RunPlan plan_of(std::vector<StageSpec> specs) {
+  RunPlan plan;
+  for (auto& s : specs) plan.stages.push_back(std::make_unique<PortsOnly>(std::move(s)));
+  return plan;
+}
+
+// Which artifacts the two calls park after each stage, in order ("stage:artifact").
+std::vector<std::string> parked_by_stage(const RunPlan& plan, ArtifactBag& bag) {
+  ParkedArtifacts parked;
+  nlohmann::json log = nlohmann::json::array();
+  for (std::size_t i = 0; i < plan.stages.size(); ++i) {
+    parked.park_outputs(plan, i, bag, log);
+    parked.park_unread(plan, i, bag, log);
+  }
+  std::vector<std::string> out;
+  for (const auto& e : log) out.push_back(e["after_stage"].get<std::string>() + ":" + e["artifact"].get<std::string>());
+  return out;
+}
+
+// The parking rule: an artifact is held as its stand-in once every later stage that reads it takes
+// the stand-in (or none reads it), never while a later stage reads it whole or writes it; a stage's
+// own output is held before it is written (park_outputs), another stage's only after (park_unread).
+TEST(ArtifactParking, HeldOnceEveryLaterReaderTakesTheStandIn) {
+  ArtifactBag bag;
+  bag.put("x", 7);
+  bag.put("y", 8);
+  // A writes x; B reads x whole, writes y; C reads both as stand-ins; D reads y whole.
+  const RunPlan abcd = plan_of({{"A", "", {}, {toy("x")}},
+                                {"B", "", {toy("x")}, {toy("y")}},
+                                {"C", "", {toy("x", true), toy("y", true)}, {}},
+                                {"D", "", {toy("y")}, {}}});
+  EXPECT_EQ(parked_by_stage(abcd, bag), (std::vector<std::string>{"B:x", "D:y"}));
+  EXPECT_EQ(bag.get<std::string>("x"), "7");
+  EXPECT_EQ(expanded<int>(bag, "y", toy_type()), 8);
+  // P writes w, read later only as a stand-in: held before its file is written; not when a later
+  // stage writes w again.
+  ArtifactBag bag2;
+  bag2.put("w", 5);
+  EXPECT_EQ(parked_by_stage(plan_of({{"P", "", {}, {toy("w")}}, {"Q", "", {toy("w", true)}, {}}}), bag2),
+            (std::vector<std::string>{"P:w"}));
+  ArtifactBag bag3;
+  bag3.put("w", 5);
+  EXPECT_EQ(parked_by_stage(plan_of({{"P", "", {}, {toy("w")}}, {"Q", "", {toy("w", true)}, {toy("w")}}}), bag3),
+            (std::vector<std::string>{"Q:w"}));
+}
+
 // The CT and the mask are parked after reconstruct (the last stage that reads them), the
+// surfaces after denoise (flatten and render take triangle lists), the
 // Segmentation montages are drawn beside the stages, and every image of report_files/ made from the run's memory is
 // byte-identical to those `colonflat report` makes from the files.
 TEST(ArtifactParking, CtAndMaskHeldCompactAndRestoredExactlyForTheReport) {
@@ -34,13 +112,19 @@ TEST(ArtifactParking, CtAndMaskHeldCompactAndRestoredExactlyForTheReport) {
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = read_json_file(dir / "out" / "run_report.json");
   ASSERT_TRUE(report.contains("held_compact")) << report.dump(1).substr(0, 2000);
-  ASSERT_EQ(report["held_compact"].size(), 2u);
-  std::set<std::string> held;
-  for (const auto& h : report["held_compact"]) {
-    held.insert(h["artifact"].get<std::string>());
-    EXPECT_EQ(h["after_stage"], "reconstruct");
+  std::map<std::string, std::set<std::string>> held;  // stage -> artifacts parked after it
+  for (const auto& h : report["held_compact"])
+    held[h["after_stage"].get<std::string>()].insert(h["artifact"].get<std::string>());
+  EXPECT_EQ(held, (std::map<std::string, std::set<std::string>>{{"reconstruct", {"ct", "mask"}},
+                                                                 {"denoise", {"surface", "denoised"}}}));
+  // denoised.vtp, written from its triangle list, and flat.vtp, mapped from it, are the files of
+  // `colonflat denoise` and `colonflat flatten` on the run's surface.vtp.
+  for (auto [stage, in, out] : {std::array<std::string, 3>{"denoise", "surface.vtp", "denoised.vtp"},
+                                std::array<std::string, 3>{"flatten", "denoised.vtp", "flat.vtp"}}) {
+    auto alone = testing::run_colonflat({stage, dir.str("out/" + in), "-o", dir.str("alone_" + out), "-q"});
+    ASSERT_EQ(alone.code, 0) << alone.err;
+    EXPECT_EQ(testing::slurp(dir / ("alone_" + out)), testing::slurp(dir / "out" / out)) << out;
   }
-  EXPECT_EQ(held, (std::set<std::string>{"ct", "mask"}));
   bool drawn_beside = false;
   for (const auto& finisher : report["after_stages"])
     for (const auto& phase : finisher.value("phases", nlohmann::json::array()))
