@@ -22,7 +22,7 @@ constexpr unsigned char kGas = 1, kPool = 2, kLayer = 3, kCandidate = 4, kExclud
 void ColonSegmenter::find_fluid_bodies() {
   Bytes bright(d_.total);
   const std::size_t plane = d_.n[0] * d_.n[1];
-  box_mean3_slices(hu_.data(), d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
+  box_mean3_slices(hu_, d_, [&](std::size_t k, const float* mean) {  // noise spikes in soft tissue are not fluid
     for (std::size_t t = 0, q = k * plane; t < plane; ++t, ++q) {
       bright[q] = !lab_[q] && mean[t] >= opts_.fluid_threshold && mean[t] <= opts_.fluid_max;
       if (bright[q]) lab_[q] = kCandidate;

@@ -112,19 +112,15 @@ void ColonSegmenter::crop_to_gas(const unsigned char* gas) {
     cn[a] = bhi_[a] - blo_[a] + 1;
   }
   d_ = make_dims(cn, full_.sp);
-  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
-    std::fprintf(stderr, "crop %zu x %zu x %zu of %zu x %zu x %zu\n", cn[0], cn[1], cn[2], full_.n[0], full_.n[1], full_.n[2]);
   lab_.assign(d_.total, 0);
-  hu_.resize(d_.total);  // not initialised: every row is copied below, slabs of z over the workers
-  const float* fhu = ct_->GetBufferPointer();
-  parallel_for(cn[2], [&](std::size_t k0, std::size_t k1) {
-    for (std::size_t k = k0; k < k1; ++k)
-      for (std::size_t j = 0; j < cn[1]; ++j) {
-        const std::size_t from = full_.idx(blo_[0], blo_[1] + j, blo_[2] + k), to = (k * cn[1] + j) * cn[0];
-        std::copy_n(gas + from, cn[0], lab_.data() + to);
-        std::copy_n(fhu + from, cn[0], hu_.data() + to);
-      }
+  const auto row_start = [&](std::size_t r) { return full_.idx(blo_[0], blo_[1] + r % cn[1], blo_[2] + r / cn[1]); };
+  parallel_for(cn[1] * cn[2], [&](std::size_t r0, std::size_t r1) {
+    for (std::size_t r = r0; r < r1; ++r) std::copy_n(gas + row_start(r), cn[0], lab_.data() + r * cn[0]);
   });
+  hu_.copy(ct_->GetBufferPointer(), cn[1] * cn[2], cn[0], row_start);
+  if (std::getenv("COLONFLAT_SEGMENT_DEBUG"))
+    std::fprintf(stderr, "crop %zu x %zu x %zu of %zu x %zu x %zu, HU in %s\n", cn[0], cn[1], cn[2], full_.n[0], full_.n[1],
+                 full_.n[2], hu_.narrow() ? "16 bits" : "float");
   for (std::size_t q : tube_) {  // the rectal tube's channel and wall: never lumen
     std::size_t c[3];
     full_.coords(q, c[0], c[1], c[2]);

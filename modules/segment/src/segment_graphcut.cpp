@@ -28,7 +28,7 @@ constexpr double kScale = 1000.0;  // capacities are integers: costs x 1000
 // half) and the contrast-sensitive pair weight, tabulated per 1/4 HU up to 8 sigma (0 beyond).
 class Energy {
  public:
-  explicit Energy(const GraphCutInput& in) : in_(in), hu_(in.hu), near_fluid_(in.near_fluid->data()) {
+  explicit Energy(const GraphCutInput& in) : in_(in), hu_(*in.hu), near_fluid_(in.near_fluid->data()) {
     const Dims& d = *in.d;
     const double hmin = std::min({d.sp[0], d.sp[1], d.sp[2]});
     for (int a = 0; a < 3; ++a) wax_[a] = kScale * in.smoothness * hmin / d.sp[a];
@@ -54,7 +54,7 @@ class Energy {
  private:
   static constexpr double kStep = 0.25;
   const GraphCutInput& in_;
-  const float* hu_;
+  const HuCrop& hu_;
   const unsigned char* near_fluid_;
   double wax_[3] = {0, 0, 0};
   std::vector<double> gauss_;

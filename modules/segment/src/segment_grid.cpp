@@ -187,13 +187,15 @@ void erode_box(Bytes& v, const Dims& d, const int r[3]) {
 
 namespace {
 // The x-then-y 3 x 3 box mean of slice k (edges clamped) into `out`; `tmp` holds the x pass.
-void mean_xy(const float* in, const Dims& d, std::size_t k, float* tmp, float* out) {
+template <class T>
+void mean_xy(const T* in, const Dims& d, std::size_t k, float* tmp, float* out) {
   const std::size_t nx = d.n[0], ny = d.n[1];
-  const float* plane = in + k * nx * ny;
+  const T* plane = in + k * nx * ny;
   for (std::size_t j = 0; j < ny; ++j) {
-    const float* mid = plane + j * nx;
+    const T* mid = plane + j * nx;
     float* row = tmp + j * nx;
-    for (std::size_t i = 0; i < nx; ++i) row[i] = (mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
+    for (std::size_t i = 0; i < nx; ++i)  // a sum of integer-valued floats is the int sum: exact below 2^24
+      row[i] = float(mid[i > 0 ? i - 1 : i] + mid[i] + mid[i + 1 < nx ? i + 1 : i]) * (1.0f / 3.0f);
   }
   for (std::size_t j = 0; j < ny; ++j) {
     const float* mid = tmp + j * nx;
@@ -203,9 +205,9 @@ void mean_xy(const float* in, const Dims& d, std::size_t k, float* tmp, float* o
     for (std::size_t i = 0; i < nx; ++i) row[i] = (lo[i] + mid[i] + hi[i]) * (1.0f / 3.0f);
   }
 }
-}  // namespace
 
-void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+template <class T>
+void box_mean3_slices_of(const T* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
   const std::size_t plane = d.n[0] * d.n[1], nz = d.n[2];
   parallel_for(nz, [&](std::size_t k0, std::size_t k1) {
     if (k0 >= k1) return;
@@ -220,6 +222,20 @@ void box_mean3_slices(const float* in, const Dims& d, const std::function<void(s
       mid.swap(hi);
     }
   });
+}
+}  // namespace
+
+void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+  box_mean3_slices_of(in, d, slice);
+}
+
+void box_mean3_slices(const std::int16_t* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+  box_mean3_slices_of(in, d, slice);
+}
+
+void box_mean3_slices(const HuCrop& in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice) {
+  if (in.narrow()) box_mean3_slices_of(in.narrow_data(), d, slice);
+  else box_mean3_slices_of(in.wide_data(), d, slice);
 }
 
 RunLookup::RunLookup(const RunLabels& labels) {

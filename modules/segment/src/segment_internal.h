@@ -22,6 +22,8 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/segment/segment.h"
+#include "hu_crop.h"
+#include "segment_buffers.h"
 
 namespace cf::segment_detail {
 
@@ -29,49 +31,6 @@ class LinkGrid;
 struct Contact;
 struct LocalShape;
 
-// Large voxel buffers (crop-sized and more): blocks of at least 4 MiB are mapped directly and
-// advised for transparent huge pages, so a fresh buffer costs 1/512 of the page faults (on 2 loaded
-// virtual cores the 4 KiB faults of the ~20 full-crop buffers cost about a third of the CPU time).
-// While a BlockReuse is alive, a freed block is kept mapped and handed to the next request of its
-// mapped size (its pages already backed: no page faults, no zeroing by the kernel); a request no kept
-// block fits releases them all before mapping a new one, so kept blocks never raise the peak.
-void* huge_page_alloc(std::size_t bytes);
-void huge_page_free(void* p, std::size_t bytes);
-class BlockReuse {
- public:
-  BlockReuse();
-  ~BlockReuse();  // the last open scope releases the kept blocks
-  BlockReuse(const BlockReuse&) = delete;
-  BlockReuse& operator=(const BlockReuse&) = delete;
-};
-// Bytes of freed blocks kept for reuse now (0 outside a BlockReuse scope).
-std::size_t kept_block_bytes();
-// Unmaps the kept blocks now (before allocations of other kinds, e.g. the heap's or ITK's).
-void release_kept_blocks();
-template <class T>
-struct HugePageAllocator {
-  using value_type = T;
-  HugePageAllocator() = default;
-  template <class U>
-  HugePageAllocator(const HugePageAllocator<U>&) {}
-  T* allocate(std::size_t n) { return static_cast<T*>(huge_page_alloc(n * sizeof(T))); }
-  void deallocate(T* p, std::size_t n) { huge_page_free(p, n * sizeof(T)); }
-  template <class U>
-  bool operator==(const HugePageAllocator<U>&) const { return true; }
-  template <class U>
-  bool operator!=(const HugePageAllocator<U>&) const { return false; }
-};
-template <class T>
-using Buffer = std::vector<T, HugePageAllocator<T>>;
-using Bytes = Buffer<unsigned char>;
-// The same blocks, but resize(n) leaves new elements default-initialised (no value-initialising
-// pass: a trivial T keeps whatever the block holds). Only for buffers whose every element is then
-// written over the workers (fill_parallel, a parallel copy): a fresh block's pages are then first
-// touched, faulted and zeroed by the kernel on the worker threads, not serially on the caller's.
-template <class T>
-using RawHugePageAllocator = DefaultInitAllocator<HugePageAllocator<T>>;  // core/default_init_allocator.h
-template <class T>
-using RawBuffer = std::vector<T, RawHugePageAllocator<T>>;
 
 struct Dims {
   std::size_t n[3];
@@ -174,7 +133,7 @@ HuTally tally_hu(const float* hu, std::size_t n);
 struct GrowInput {
   const Dims* d;
   const unsigned char* bright;
-  const float* hu;
+  const HuCrop* hu;
   double fluid_threshold;
   std::uint32_t* label;
 };
@@ -209,6 +168,10 @@ Bytes erode_ball(const Bytes& m, const Dims& d, double r_mm);
 // slice(k, mean of slice k) for every k, from two workers (each slice once, slices of one worker
 // in order); only a few slices are held in memory.
 void box_mean3_slices(const float* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
+// The same on 16-bit values (an integer CT): the same means, as the sums are exact either way.
+void box_mean3_slices(const std::int16_t* in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
+// The same on the crop's CT, whichever its width.
+void box_mean3_slices(const HuCrop& in, const Dims& d, const std::function<void(std::size_t, const float*)>& slice);
 // Calls f(r) for each face neighbour r of voxel q (inside the volume).
 template <class F>
 void for_face_neighbours(const Dims& d, std::size_t q, F&& f) {
@@ -226,7 +189,7 @@ std::size_t line_base(const Dims& d, int ax, std::size_t l);
 // Graph cut on the band: state 0 fixed wall, 1 fixed lumen, 2 free; free voxels get 0/1.
 struct GraphCutInput {
   const Dims* d = nullptr;
-  const float* hu = nullptr;
+  const HuCrop* hu = nullptr;
   const Bytes* near_fluid = nullptr;  // where bright voxels count as lumen
   double air = -1000, tissue = 40, fluid = 450;            // class means (HU)
   double smoothness = 0.5, edge_sigma = 60;
@@ -386,7 +349,7 @@ class ColonSegmenter {
   bool gravity_known_ = false;
   std::string gravity_source_;
   std::size_t blo_[3] = {0, 0, 0}, bhi_[3] = {0, 0, 0};
-  RawBuffer<float> hu_;                // CT in the crop
+  HuCrop hu_;                          // CT in the crop (16 bits when the CT holds integers)
   std::vector<std::size_t> tube_;      // full volume: rectal tube channel and wall voxels (until the crop)
   Bytes lab_;                          // crop: 1 gas, 2 fluid (pool or kept stretch), 3 layer, 4 candidate, 5 rectal tube (never lumen)
   RawBuffer<std::uint32_t> fluid_label_;  // fluid pieces in the crop (split_fluid_bodies .. candidate_bodies; then released)

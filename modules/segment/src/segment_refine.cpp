@@ -66,7 +66,7 @@ void ColonSegmenter::refine_boundary() {
   st_.band_voxels = std::size_t(std::count(state_.begin(), state_.end(), 2));
   GraphCutInput in;
   in.d = &d_;
-  in.hu = hu_.data();
+  in.hu = &hu_;
   in.near_fluid = &near_fluid;
   in.air = st_.air_hu;
   in.tissue = st_.tissue_hu;

@@ -83,7 +83,7 @@ void grow_queue(const GrowInput& in, std::vector<std::size_t>& queue) {
     bool wall_next = false;
     for_face_neighbours(d, q, [&](std::size_t r) {
       if (!in.bright[r] || label[r]) return;
-      if (in.hu[r] < in.fluid_threshold) return void(wall_next = true);
+      if ((*in.hu)[r] < in.fluid_threshold) return void(wall_next = true);
       label[r] = label[q];
       queue.push_back(r);
     });
@@ -165,7 +165,7 @@ std::size_t grow_labels(const GrowInput& in, const ComponentOwners& owners, std:
 // through fluid voxels only (a core does not reach across a wall into the next lumen's fluid), then
 // into the mask's other voxels (grow_labels: the bright components over the workers).
 void ColonSegmenter::grow_pieces(const Bytes& bright, const ComponentOwners& owners, std::vector<std::size_t>& queue) {
-  const GrowInput in{&d_, bright.data(), hu_.data(), opts_.fluid_threshold, fluid_label_.data()};
+  const GrowInput in{&d_, bright.data(), &hu_, opts_.fluid_threshold, fluid_label_.data()};
   grow_labels(in, owners, queue);
 }
 
@@ -235,7 +235,7 @@ std::vector<float> ColonSegmenter::core_levels(const RunLabels& cl) const {
   for (std::uint32_t l = 1; l <= cl.count(); ++l) {
     v.clear();
     for (const Run* r = cl.begin(l); r != cl.end(l); ++r)
-      v.insert(v.end(), hu_.begin() + std::ptrdiff_t(r->start), hu_.begin() + std::ptrdiff_t(r->start + r->length));
+      for (std::size_t q = r->start; q < r->start + r->length; ++q) v.push_back(hu_[q]);
     std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
     level[l] = v[v.size() / 2];
   }

@@ -66,11 +66,13 @@ TEST(SegmentSplit, GrowthPerWorkerEqualsOneSerialGrowth) {
   for (std::size_t q = 0; q < d.total; ++q)
     if (bright[q] && hu[q] >= 200 && rng() % 40 == 0) seeds.push_back(q);
   std::shuffle(seeds.begin(), seeds.end(), rng);
+  HuCrop crop;
+  crop.copy(hu.data(), 1, d.total, [](std::size_t) { return std::size_t(0); });
   auto grow = [&](const ComponentOwners& owners, std::size_t* used) {
     std::vector<std::uint32_t> label(d.total, 0);
     std::vector<std::size_t> queue = seeds;
     for (std::size_t t = 0; t < seeds.size(); ++t) label[seeds[t]] = std::uint32_t(t % 7 + 1);
-    *used = grow_labels({&d, bright.data(), hu.data(), 200.0, label.data()}, owners, queue);
+    *used = grow_labels({&d, bright.data(), &crop, 200.0, label.data()}, owners, queue);
     EXPECT_TRUE(queue.empty());
     return label;
   };
