@@ -26,12 +26,17 @@ PlanPorts plan_ports(const RunPlan& plan, std::size_t from) {
   return p;
 }
 
-// Whether a stage after `done` reads `name` whole (an input port not declared reads_stand_in).
-bool read_whole_after(const RunPlan& plan, std::size_t done, const std::string& name) {
+// Whether a stage after `done` reads `name`; `whole`: only as the full value (an input port not
+// declared reads_stand_in).
+bool read_after(const RunPlan& plan, std::size_t done, const std::string& name, bool whole = false) {
   for (std::size_t j = done + 1; j < plan.stages.size(); ++j)
     for (const Port& in : plan.stages[j]->spec().inputs)
-      if (in.name == name && !in.reads_stand_in) return true;
+      if (in.name == name && !(whole && in.reads_stand_in)) return true;
   return false;
+}
+
+bool read_whole_after(const RunPlan& plan, std::size_t done, const std::string& name) {
+  return read_after(plan, done, name, true);
 }
 
 bool compactable(const ArtifactType& type) { return type.compact && type.expand; }
@@ -54,6 +59,7 @@ void ParkedArtifacts::park_outputs(const RunPlan& plan, std::size_t done, Artifa
   for (const Port& out : plan.stages[done]->spec().outputs) {
     if (!compactable(*out.type) || parked_.count(out.name) || !bag.has(out.name)) continue;
     if (later.written.count(out.name) || read_whole_after(plan, done, out.name)) continue;
+    if (!read_after(plan, done, out.name)) continue;  // nothing gained before its file: park_unread, after
     park(out.name, *out.type, plan.stages[done]->spec().name, bag, log);
   }
 }

@@ -18,9 +18,11 @@ namespace cf {
 class ParkedArtifacts {
  public:
   // After plan.stages[done] ran, before its outputs go to the background writer: each of its own
-  // outputs with a compactable type that no later stage writes and that every later stage reading
-  // it takes as a stand-in is replaced by its stand-in (the writer then writes the stand-in, which
-  // gives the same file: ArtifactType::write). E.g. denoise's "denoised", read by flatten and render.
+  // outputs with a compactable type that no later stage writes, that a later stage reads, and that
+  // every later stage reading it takes as a stand-in is replaced by its stand-in (the writer then
+  // writes the stand-in, which gives the same file: ArtifactType::write). E.g. denoise's
+  // "denoised", read by flatten and render. An output no later stage reads is left whole for its
+  // writer (nothing would run smaller meanwhile); park_unread takes it after the next stage.
   void park_outputs(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log);
   // After plan.stages[done]'s outputs went to the writer: every other artifact in `bag` with a
   // compactable type that every stage after it reading it takes as a stand-in (none reading it

@@ -168,6 +168,8 @@ const ArtifactType& volume_artifact() {
       "volume", "CT volume in HU (" + std::string(kReadFormats) + "), LPS mm",
       [](const fs::path& p) { return std::any(read_ct_volume(p)); },
       [](const std::any& v, const fs::path& tmp, const fs::path& target) {
+        if (const auto* c = std::any_cast<CompactCtImage::Pointer>(&v))  // the stand-in: the same file
+          return write_ct_file(expand_ct(**c).GetPointer(), tmp, target);
         write_ct_file(std::any_cast<const CtImage::Pointer&>(v).GetPointer(), tmp, target);
       },
       {".nrrd", ".nii", ".nii.gz", ".mha"},
@@ -185,6 +187,8 @@ const ArtifactType& mask_artifact() {
       "mask", "binary mask, 1 = lumen (" + std::string(kWriteFormats) + "), LPS mm",
       [](const fs::path& p) { return std::any(read_mask(p)); },
       [](const std::any& v, const fs::path& tmp, const fs::path& target) {
+        if (const auto* c = std::any_cast<std::shared_ptr<const CompactMask>>(&v))  // the stand-in: the same file
+          return write_mask_file(expand_mask(**c).GetPointer(), tmp, target);
         write_mask_file(std::any_cast<const MaskImage::Pointer&>(v).GetPointer(), tmp, target);
       },
       {".nrrd", ".nii", ".nii.gz", ".mha"},
