@@ -1,8 +1,13 @@
 #include "colonflat/core/vtk_convert.h"
 
+#include "colonflat/core/threads.h"
+
+#include <algorithm>
+
 #include <vtkCellArray.h>
 #include <vtkFieldData.h>
 #include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -37,13 +42,16 @@ vtkSmartPointer<vtkPolyData> triangles_to_polydata(const TriangleList& t) {
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
   pts->SetNumberOfPoints(static_cast<vtkIdType>(t.points.size()));
-  for (std::size_t i = 0; i < t.points.size(); ++i) pts->SetPoint(static_cast<vtkIdType>(i), t.points[i].data());
+  double* xyz = static_cast<double*>(pts->GetVoidPointer(0));
+  vtkNew<vtkIdTypeArray> ids;
+  ids->SetNumberOfValues(static_cast<vtkIdType>(3 * t.triangles.size()));
+  vtkIdType* c = ids->GetPointer(0);
+  parallel_for(std::max(t.points.size(), t.triangles.size()), [&](std::size_t i0, std::size_t i1) {
+    for (std::size_t i = i0; i < std::min(i1, t.points.size()); ++i) std::copy_n(t.points[i].data(), 3, xyz + 3 * i);
+    for (std::size_t i = i0; i < std::min(i1, t.triangles.size()); ++i) std::copy_n(t.triangles[i].data(), 3, c + 3 * i);
+  });
   vtkNew<vtkCellArray> polys;
-  polys->AllocateExact(static_cast<vtkIdType>(t.triangles.size()), static_cast<vtkIdType>(3 * t.triangles.size()));
-  for (const auto& tri : t.triangles) {
-    const vtkIdType ids[3] = {tri[0], tri[1], tri[2]};
-    polys->InsertNextCell(3, ids);
-  }
+  polys->SetData(3, ids);  // fixed-size cells: the offsets are made from the ids
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetPolys(polys);

@@ -1,6 +1,7 @@
 #include "colonflat/render/snapshot.h"
 
 #include "colonflat/render/colon_image.h"
+#include "colonflat/core/vtk_convert.h"
 
 #include <vtkAutoInit.h>
 VTK_MODULE_INIT(vtkRenderingOpenGL2);
@@ -193,8 +194,7 @@ vtkSmartPointer<vtkFloatArray> point_normals(const double* xyz, std::size_t P, c
 }  // namespace
 
 vtkSmartPointer<vtkPolyData> surface_polydata(const TriangleList& surface) {
-  return polydata_of(point_array(surface.points.size(), [&](std::size_t i) { return surface.points[i].data(); }),
-                     surface.triangles);
+  return triangles_to_polydata(surface);
 }
 
 vtkSmartPointer<vtkFloatArray> smooth_point_normals(const TriangleList& surface) {

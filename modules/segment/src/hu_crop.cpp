@@ -8,7 +8,10 @@
 #include "colonflat/core/threads.h"
 
 namespace cf::segment_detail {
+namespace {
 
+// Whether every one of v[0 .. n) is an integer in [-32768, 32767]; copies them to out (as int16)
+// up to the first that is not.
 bool copy_as_int16(const float* v, std::size_t n, std::int16_t* out) {
   for (std::size_t i = 0; i < n; ++i) {
     const float x = v[i];
@@ -17,6 +20,8 @@ bool copy_as_int16(const float* v, std::size_t n, std::int16_t* out) {
   }
   return true;
 }
+
+}  // namespace
 
 void HuCrop::copy(const float* hu, std::size_t rows, std::size_t row_length,
                   const std::function<std::size_t(std::size_t)>& row_start) {
