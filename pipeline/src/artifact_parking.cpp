@@ -44,14 +44,14 @@ bool compactable(const ArtifactType& type) { return type.compact && type.expand;
 }  // namespace
 
 void ParkedArtifacts::park(const std::string& name, const ArtifactType& type, const std::string& stage,
-                           ArtifactBag& bag, nlohmann::json& log) {
+                           ArtifactBag& bag, nlohmann::json& log, const char* when) {
   Stopwatch sw;
   std::optional<std::any> stand_in = type.compact(bag.raw(name));
   if (!stand_in) return;
   bag.put(name, std::move(*stand_in));
   release_free_memory();  // the full value's pages back to the kernel now, not after the next stage
   parked_[name] = &type;
-  log.push_back({{"artifact", name}, {"after_stage", stage}, {"time_s", sw.seconds()}});
+  log.push_back({{"artifact", name}, {when, stage}, {"time_s", sw.seconds()}});
 }
 
 void ParkedArtifacts::park_outputs(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
@@ -70,6 +70,17 @@ void ParkedArtifacts::park_unread(const RunPlan& plan, std::size_t done, Artifac
     if (!compactable(*type) || parked_.count(name) || !bag.has(name)) continue;
     if (ports.written.count(name) || read_whole_after(plan, done, name)) continue;
     park(name, *type, plan.stages[done]->spec().name, bag, log);
+  }
+}
+
+void ParkedArtifacts::park_released(const RunPlan& plan, std::size_t running, const std::string& port,
+                                    ArtifactBag& bag, nlohmann::json& log) {
+  const Stage& stage = *plan.stages[running];
+  for (const Port& in : stage.spec().inputs) {
+    if (in.name != port || !compactable(*in.type) || parked_.count(port) || !bag.has(port)) continue;
+    // (the writer may still be writing the previous stage's outputs)
+    if (plan_ports(plan, running ? running - 1 : 0).written.count(port) || read_whole_after(plan, running, port)) continue;
+    park(port, *in.type, stage.spec().name, bag, log, "during_stage");
   }
 }
 

@@ -32,10 +32,18 @@ class ParkedArtifacts {
   // reconstruct's surface after denoise. Each one parked is appended to `log` ({"artifact",
   // "after_stage", "time_s"}), by both calls.
   void park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log);
+  // While plan.stages[running] runs, when it has released its input `port`
+  // (RunContext::release_input): that input is replaced by its stand-in when its type is
+  // compactable, neither the previous stage (its writer may still be at work), this one nor a later
+  // one writes it, and every later stage reading it
+  // takes the stand-in (none reading it included: the rest of this stage runs smaller). E.g. the
+  // CT after segment's crop. Logged as {"artifact", "during_stage", "time_s"}.
+  void park_released(const RunPlan& plan, std::size_t running, const std::string& port, ArtifactBag& bag,
+                     nlohmann::json& log);
 
  private:
   void park(const std::string& name, const ArtifactType& type, const std::string& stage, ArtifactBag& bag,
-            nlohmann::json& log);
+            nlohmann::json& log, const char* when = "after_stage");
   std::map<std::string, const ArtifactType*> parked_;  // name -> its type
 };
 

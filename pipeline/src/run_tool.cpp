@@ -190,6 +190,7 @@ class RunTool : public Tool {
       if (log) *log << "[" << (i + 1) << "/" << plan.stages.size() << "] " << st.spec().name << ": " << st.spec().summary << "\n";
       RunContext ctx;
       ctx.log = log;
+      ctx.input_released = [&](const std::string& port) { parked.park_released(plan, i, port, bag, parked_log); };
       nlohmann::json record = run_stage_recorded(st, bag, ctx);
       std::map<std::string, fs::path> targets;
       for (const Port& p : st.spec().outputs) targets[p.name] = outdir / p.file_name;

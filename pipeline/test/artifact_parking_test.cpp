@@ -1,11 +1,12 @@
-// `colonflat run` holds the CT in 16 bits and the lumen mask in one bit per voxel from reconstruct
-// to the review report, and the surfaces before and after denoising as triangle lists from denoise
+// `colonflat run` holds the CT in 16 bits from segment's crop and the lumen mask in one bit per
+// voxel from reconstruct to the review report, and the surfaces before and after denoising as triangle lists from denoise
 // on (artifact_parking.h): the run report says so, the report built from the run's memory (CT and
 // mask expanded back) equals, file for file, the one `colonflat report` builds from the files, and
 // the mesh files and the flat map equal those of the stages run alone on the files.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <typeinfo>
 #include <map>
 #include <set>
 #include <string>
@@ -103,6 +104,34 @@ TEST(ArtifactParking, HeldOnceEveryLaterReaderTakesTheStandIn) {
   EXPECT_EQ(bag4.get<int>("w"), 5);
 }
 
+// What park_released does with `port` released by plan.stages[running]: "held" (the bag then holds
+// the stand-in) or "whole".
+std::string on_release(const RunPlan& plan, std::size_t running, const std::string& port = "c") {
+  ArtifactBag bag;
+  bag.put(port, 4);
+  ParkedArtifacts parked;
+  nlohmann::json log = nlohmann::json::array();
+  parked.park_released(plan, running, port, bag, log);
+  if (log.empty()) return bag.raw(port).type() == typeid(int) ? "whole" : "stand-in without a log";
+  EXPECT_EQ(log[0]["during_stage"], plan.stages[running]->spec().name);
+  return bag.raw(port).type() == typeid(std::string) ? "held" : "logged, not held";
+}
+
+// An input a stage releases while it runs (RunContext::release_input: segment's CT once its crop is
+// copied) is held as its stand-in at once when every later stage reading it takes the stand-in, or
+// none reads it; never when a later stage reads it whole, when this or a later stage writes it, when
+// the previous stage wrote it (its files may still be being written), or when it is not an input.
+TEST(ArtifactParking, ReleasedInputHeldWhileItsStageRuns) {
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("c")}, {toy("m")}}, {"R", "", {toy("m"), toy("c", true)}, {}}}), 0), "held");
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("c")}, {toy("m")}}}), 0), "held");
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("c")}, {toy("m")}}, {"R", "", {toy("m"), toy("c")}, {}}}), 0), "whole");
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("c")}, {toy("c")}}}), 0), "whole");
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("c")}, {}}, {"T", "", {}, {toy("c")}}}), 0), "whole");
+  EXPECT_EQ(on_release(plan_of({{"P", "", {}, {toy("c")}}, {"S", "", {toy("c")}, {}}}), 1), "whole");
+  EXPECT_EQ(on_release(plan_of({{"P", "", {}, {toy("c")}}, {"Q", "", {}, {}}, {"S", "", {toy("c")}, {}}}), 2), "held");
+  EXPECT_EQ(on_release(plan_of({{"S", "", {toy("m")}, {}}}), 0, "c"), "whole");
+}
+
 // `colonflat run --to segment` (segment the last stage: its mask read by no later stage) writes
 // lumen_mask.nrrd; it failed with "bad any_cast" when the mask was held as its stand-in first.
 TEST(ArtifactParking, LastStagesOutputIsWrittenWhole) {
@@ -115,8 +144,9 @@ TEST(ArtifactParking, LastStagesOutputIsWrittenWhole) {
   EXPECT_TRUE(fs::exists(dir / "out" / "lumen_mask.nrrd"));
 }
 
-// The CT and the mask are parked after reconstruct (the last stage that reads them), the
-// surfaces after denoise (flatten and render take triangle lists), the
+// The CT is parked during segment (once its crop is copied; reconstruct takes the 16 bits), the
+// mask after reconstruct (the last stage that reads it), the surfaces after denoise (flatten and
+// render take triangle lists), the
 // Segmentation montages are drawn beside the stages, and every image of report_files/ made from the run's memory is
 // byte-identical to those `colonflat report` makes from the files.
 TEST(ArtifactParking, CtAndMaskHeldCompactAndRestoredExactlyForTheReport) {
@@ -130,10 +160,12 @@ TEST(ArtifactParking, CtAndMaskHeldCompactAndRestoredExactlyForTheReport) {
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = read_json_file(dir / "out" / "run_report.json");
   ASSERT_TRUE(report.contains("held_compact")) << report.dump(1).substr(0, 2000);
-  std::map<std::string, std::set<std::string>> held;  // stage -> artifacts parked after it
+  std::map<std::string, std::set<std::string>> held;  // stage -> artifacts parked after it ("during S": while it ran)
   for (const auto& h : report["held_compact"])
-    held[h["after_stage"].get<std::string>()].insert(h["artifact"].get<std::string>());
-  EXPECT_EQ(held, (std::map<std::string, std::set<std::string>>{{"reconstruct", {"ct", "mask"}},
+    held[h.contains("during_stage") ? "during " + h["during_stage"].get<std::string>() : h["after_stage"].get<std::string>()]
+        .insert(h["artifact"].get<std::string>());
+  EXPECT_EQ(held, (std::map<std::string, std::set<std::string>>{{"during segment", {"ct"}},
+                                                                 {"reconstruct", {"mask"}},
                                                                  {"denoise", {"surface", "denoised"}}}));
   // denoised.vtp, written from its triangle list, and flat.vtp, mapped from it, are the files of
   // `colonflat denoise` and `colonflat flatten` on the run's surface.vtp.

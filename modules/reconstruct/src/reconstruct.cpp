@@ -142,7 +142,7 @@ void add_to_openmesh(const TriangleList& t, Mesh& m) {
 class SurfaceReconstruction {
  public:
   // `out`: an empty mesh the surface is built in.
-  SurfaceReconstruction(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options, Mesh& out)
+  SurfaceReconstruction(const MaskImage* mask, const CtVoxels& ct, const ReconstructOptions& options, Mesh& out)
       : mask_(mask), ct_(ct), opts_(options), mesh_(out) {}
 
   void run(ReconstructStats* stats_out) {
@@ -201,14 +201,14 @@ class SurfaceReconstruction {
     if (opts_.subvoxel == "ct" && !ct_)
       throw PreconditionError("--subvoxel ct needs the CT (--ct CT, or `colonflat run` on a CT)");
     if (!ct_ || opts_.subvoxel == "mask" || opts_.subvoxel == "off") {
-      ct_ = nullptr;
+      ct_ = CtVoxels{};
       return;
     }
-    const auto region = ct_->GetBufferedRegion();
-    const auto sp = ct_->GetSpacing();
-    const auto org = ct_->GetOrigin();
-    const auto dir = ct_->GetDirection(), mask_dir = mask_->GetDirection();
-    bool same = ct_->GetBufferPointer() != nullptr;
+    const auto region = ct_.image->GetBufferedRegion();
+    const auto sp = ct_.image->GetSpacing();
+    const auto org = ct_.image->GetOrigin();
+    const auto dir = ct_.image->GetDirection(), mask_dir = mask_->GetDirection();
+    bool same = ct_.f || ct_.s;
     for (int a = 0; a < 3; ++a) {
       same = same && region.GetSize()[a] == size_[a] && region.GetIndex()[a] == mask_->GetBufferedRegion().GetIndex()[a];
       same = same && std::abs(sp[a] - spacing_[a]) <= 1e-4 * spacing_[a];
@@ -446,7 +446,7 @@ class SurfaceReconstruction {
   }
 
   const MaskImage* mask_;
-  const CtImage* ct_;
+  CtVoxels ct_;
   const ReconstructOptions& opts_;
   ReconstructStats st_;
   Stopwatch total_;
@@ -465,12 +465,24 @@ class SurfaceReconstruction {
 
 }  // namespace
 
-void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
-                              ReconstructStats* stats) {
+namespace {
+void reconstruct_into(Mesh& out, const MaskImage* mask, const CtVoxels& ct, const ReconstructOptions& options,
+                      ReconstructStats* stats) {
   validate(options);
   if (!mask) throw PreconditionError("no mask");
   if (out.n_vertices() != 0 || out.n_faces() != 0) throw PreconditionError("reconstruct: the output mesh is not empty");
   SurfaceReconstruction(mask, ct, options, out).run(stats);
+}
+}  // namespace
+
+void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
+                              ReconstructStats* stats) {
+  reconstruct_into(out, mask, ct ? CtVoxels{ct, ct->GetBufferPointer(), nullptr} : CtVoxels{}, options, stats);
+}
+
+void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CompactCtImage* ct,
+                              const ReconstructOptions& options, ReconstructStats* stats) {
+  reconstruct_into(out, mask, ct ? CtVoxels{ct, nullptr, ct->GetBufferPointer()} : CtVoxels{}, options, stats);
 }
 
 Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,

@@ -60,7 +60,14 @@ std::vector<std::array<double, 3>> staircase_positions(vtkPolyData* pd, const In
 // centres. `ct` (may be null) must share the mask's grid; `box` gives the crop's buffer offset.
 // spacing: voxel size in mm along each index axis. Fills the field statistics of `stats`.
 constexpr float kFieldMargin = 0.02f;
-vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtImage* ct, const Box& box,
+// The CT as reconstruct reads it: its geometry and its HU as float or in 16 bits (one of them).
+struct CtVoxels {
+  const itk::ImageBase<3>* image = nullptr;  // null: no CT
+  const float* f = nullptr;
+  const short* s = nullptr;
+  explicit operator bool() const { return image != nullptr; }
+};
+vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtVoxels& ct, const Box& box,
                                              const std::array<double, 3>& spacing, const ReconstructOptions& options,
                                              ReconstructStats& stats);
 

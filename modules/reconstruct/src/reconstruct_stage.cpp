@@ -15,17 +15,21 @@ const StageSpec& ReconstructStage::spec() const {
       "lumen mask -> closed manifold colon surface (LPS mm, normals out of the lumen)",
       {{"mask", &mask_artifact(), "lumen mask", "lumen_mask.nrrd"},
        {"ct", &volume_artifact(), "the CT the mask was segmented from (HU, same grid): surface at its air/tissue boundary",
-        "ct.nrrd", false}},
+        "ct.nrrd", false, true}},
       {{"surface", &mesh_artifact(), "colon surface (LPS mm)", "surface.vtp"}}};
   return s;
 }
 
 void ReconstructStage::run(ArtifactBag& bag, RunContext& ctx) {
   const auto& mask = bag.get<MaskImage::Pointer>("mask");
-  const CtImage* ct = bag.has("ct") ? bag.get<CtImage::Pointer>("ct").GetPointer() : nullptr;
   ReconstructStats st;
   std::any surface;  // the mesh built where the bag keeps it (reconstruct_surface_into: no copy)
-  reconstruct_surface_into(surface.emplace<Mesh>(), mask.GetPointer(), ct, opts_, &st);
+  const auto* ct16 = bag.has("ct") ? std::any_cast<CompactCtImage::Pointer>(&bag.raw("ct")) : nullptr;
+  if (ct16)  // the run holds the CT in 16 bits from segment's crop on: the same surface
+    reconstruct_surface_into(surface.emplace<Mesh>(), mask.GetPointer(), ct16->GetPointer(), opts_, &st);
+  else
+    reconstruct_surface_into(surface.emplace<Mesh>(), mask.GetPointer(),
+                             bag.has("ct") ? bag.get<CtImage::Pointer>("ct").GetPointer() : nullptr, opts_, &st);
   ctx.report = st.to_json();
   std::ostringstream line;
   line << "  reconstruct: " << st.lumen_voxels << " lumen voxels -> " << st.extracted_faces << " triangles ("

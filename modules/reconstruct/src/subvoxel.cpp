@@ -79,12 +79,12 @@ void antialias_field(const FloatImage::Pointer& binary, const ReconstructOptions
 // The CT's air/tissue value of the padded crop's slices [k0, k1): 0.5 at air_tissue_hu, 1 at 500 HU
 // below it (air), 0 at 500 HU above it (soft tissue); marks in `fl` the lumen voxels at or above
 // fluid_hu (tagged fluid) and returns their count. Slices are independent (parallel_for chunks).
-std::size_t ct_slices(const unsigned char* lumen, const CtImage* ct, const Box& box, const ReconstructOptions& o,
-                      const std::array<std::size_t, 3>& n, std::size_t k0, std::size_t k1, float* out,
-                      unsigned char* fl) {
-  const auto ct_size = ct->GetBufferedRegion().GetSize();
+template <class Hu>
+std::size_t ct_slices(const unsigned char* lumen, const CtVoxels& ct, const Hu* hu, const Box& box,
+                      const ReconstructOptions& o, const std::array<std::size_t, 3>& n, std::size_t k0, std::size_t k1,
+                      float* out, unsigned char* fl) {
+  const auto ct_size = ct.image->GetBufferedRegion().GetSize();
   const long lo[3] = {long(box.lo[0]) - 1, long(box.lo[1]) - 1, long(box.lo[2]) - 1};  // padded crop origin
-  const float* hu = ct->GetBufferPointer();
   std::size_t fluid_voxels = 0, idx = k0 * n[1] * n[0];
   for (std::size_t k = k0; k < k1; ++k)
     for (std::size_t j = 0; j < n[1]; ++j)
@@ -92,7 +92,7 @@ std::size_t ct_slices(const unsigned char* lumen, const CtImage* ct, const Box& 
         const long g[3] = {lo[0] + long(i), lo[1] + long(j), lo[2] + long(k)};
         bool in_ct = true;
         for (int a = 0; a < 3; ++a) in_ct = in_ct && g[a] >= 0 && g[a] < long(ct_size[a]);
-        const float v = in_ct ? hu[(std::size_t(g[2]) * ct_size[1] + std::size_t(g[1])) * ct_size[0] + std::size_t(g[0])]
+        const float v = in_ct ? (float)hu[(std::size_t(g[2]) * ct_size[1] + std::size_t(g[1])) * ct_size[0] + std::size_t(g[0])]
                               : float(o.air_tissue_hu + 500.0);  // outside the scan: tissue
         out[idx] = float(0.5 + (o.air_tissue_hu - double(v)) / 1000.0);
         if (lumen[idx] && double(v) >= o.fluid_hu) fl[idx] = 1, ++fluid_voxels;
@@ -113,13 +113,15 @@ std::size_t for_slices(const std::array<std::size_t, 3>& n,
 
 // The CT field over the padded crop (ct_slices); NaN marks tagged fluid and its neighbourhood
 // (2 voxels), where the mask field is used instead. Returns the fluid voxel count.
-std::size_t ct_field(vtkImageData* binary, const CtImage* ct, const Box& box, const ReconstructOptions& o, float* out) {
+std::size_t ct_field(vtkImageData* binary, const CtVoxels& ct, const Box& box, const ReconstructOptions& o, float* out) {
   const auto n = dims_of(binary);
   const auto* lumen = static_cast<const unsigned char*>(binary->GetScalarPointer());
   std::vector<unsigned char> fluid(n[0] * n[1] * n[2], 0);
   unsigned char* fl = fluid.data();
   const std::size_t fluid_voxels = for_slices(
-      n, [&](std::size_t k0, std::size_t k1) { return ct_slices(lumen, ct, box, o, n, k0, k1, out, fl); });
+      n, [&](std::size_t k0, std::size_t k1) {  // a 16-bit HU gives the float it came from
+        return ct.f ? ct_slices(lumen, ct, ct.f, box, o, n, k0, k1, out, fl) : ct_slices(lumen, ct, ct.s, box, o, n, k0, k1, out, fl);
+      });
   if (!fluid_voxels) return 0;
   const int radius[3] = {2, 2, 2};  // the 5 x 5 x 5 box around each fluid voxel
   dilate_box(fl, n, radius);
@@ -172,7 +174,7 @@ std::size_t constrain(vtkImageData* binary, float* out) {
 
 }  // namespace
 
-vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtImage* ct, const Box& box,
+vtkSmartPointer<vtkImageData> subvoxel_field(vtkImageData* binary, const CtVoxels& ct, const Box& box,
                                              const std::array<double, 3>& spacing, const ReconstructOptions& o,
                                              ReconstructStats& st) {
   Stopwatch watch;

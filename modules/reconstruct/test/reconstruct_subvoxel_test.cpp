@@ -310,6 +310,38 @@ TEST(ReconstructSubvoxel, FieldIsTheSameForAnyThreadCount) {
   }
 }
 
+// The CT in 16 bits (`colonflat run` holds it so from segment's crop on) gives the surface of the
+// float CT it holds, vertex for vertex: the partial-volume ball with tagged fluid, rounded to whole HU.
+TEST(ReconstructSubvoxel, CtInSixteenBitsGivesTheSameSurface) {
+  MaskSpec s;
+  s.size = {24, 24, 24};
+  const SyntheticCt data = partial_volume_ball(s, {11.3, 11.6, 11.45}, 7.3, 9.0);
+  auto ct16 = CompactCtImage::New();
+  ct16->CopyInformation(data.ct);
+  ct16->SetRegions(data.ct->GetLargestPossibleRegion());
+  ct16->Allocate();
+  float* hu = data.ct->GetBufferPointer();
+  std::size_t fractions = 0;
+  for (std::size_t q = 0, n = ct16->GetLargestPossibleRegion().GetNumberOfPixels(); q < n; ++q) {
+    fractions += hu[q] != std::round(hu[q]);
+    hu[q] = std::round(hu[q]);
+    ct16->GetBufferPointer()[q] = short(hu[q]);
+  }
+  EXPECT_GT(fractions, 100u);  // rounding changed the partial-volume voxels: the CT field is used
+  ReconstructStats f, c;
+  Mesh a, b;
+  reconstruct_surface_into(a, data.mask, data.ct.GetPointer(), with_subvoxel("ct"), &f);
+  reconstruct_surface_into(b, data.mask, ct16.GetPointer(), with_subvoxel("ct"), &c);
+  EXPECT_EQ(f.field_source, "ct");
+  EXPECT_EQ(c.field_source, "ct");
+  EXPECT_GT(f.fluid_voxels, 100u);
+  EXPECT_EQ(f.fluid_voxels, c.fluid_voxels);
+  EXPECT_EQ(f.field_clamped_voxels, c.field_clamped_voxels);
+  expect_same_triangles(a, b);
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  for (auto v : a.vertices()) ASSERT_EQ(a.point(v), b.point(Mesh::VertexHandle(v.idx()))) << "vertex " << v.idx();
+}
+
 // Noise voxels and edge/corner contacts: the sub-voxel surface has exactly the staircase's
 // triangles, so the (6,18) topology is kept (chi = 2 chi(lumen)) whatever the smoothing.
 TEST(ReconstructSubvoxel, TopologyIsTheMasksOnNoise) {

@@ -189,12 +189,25 @@ nlohmann::json write_slice_stack(const Image* ct, Plane plane, const std::array<
   return write_drawn_stack(draw_slice_stack(ct, plane, box_min, box_max, o), dir, rel_prefix);
 }
 
-DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3>& box_min,
-                                   const std::array<double, 3>& box_max, const SliceStackOptions& o) {
+namespace {
+template <class Image>
+DrawnPlaneStacks plane_stacks(const Image* ct, const std::array<double, 3>& box_min,
+                              const std::array<double, 3>& box_max, const SliceStackOptions& o) {
   DrawnPlaneStacks s;
   s.box_min = box_min, s.box_max = box_max, s.step_mm = o.step_mm, s.pixel_mm = o.pixel_mm;
   for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) s.planes.push_back(draw_slice_stack(ct, p, box_min, box_max, o));
   return s;
+}
+}  // namespace
+
+DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3>& box_min,
+                                   const std::array<double, 3>& box_max, const SliceStackOptions& o) {
+  return plane_stacks(ct, box_min, box_max, o);
+}
+
+DrawnPlaneStacks draw_plane_stacks(const CompactCtImage* ct, const std::array<double, 3>& box_min,
+                                   const std::array<double, 3>& box_max, const SliceStackOptions& o) {
+  return plane_stacks(ct, box_min, box_max, o);
 }
 
 bool mask_box_lps(const MaskImage& mask, std::array<double, 3>& box_min, std::array<double, 3>& box_max) {
@@ -244,6 +257,7 @@ nlohmann::json ct_geometry_json(const Image* ct) {
                                             const fs::path&, const std::string&);                               \
   template nlohmann::json ct_geometry_json(const Image*);
 CF_VIEW_VOLUME(CtImage)
+CF_VIEW_VOLUME(CompactCtImage)
 CF_VIEW_VOLUME(MaskImage)
 #undef CF_VIEW_VOLUME
 

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "colonflat/core/error.h"
+#include "colonflat/core/malloc_tunables.h"
 #include "colonflat/core/progress.h"
 #include "colonflat/core/run_finisher.h"
 #include "colonflat/core/run_stats.h"
@@ -84,16 +85,24 @@ class ReportTool : public Tool, public RunFinisher {
     return {dir / "report_files"};
   }
   // After segment: the Segmentation section is drawn on a second thread while the later stages
-  // run (it needs only the CT, the lumen and segment's decisions). The thread drops its CT and
-  // lumen references when done, so the run can park the CT after reconstruct as before.
+  // run (it needs only the CT, the lumen and segment's decisions), from the CT as the bag holds it
+  // (in 16 bits once the run has parked it during segment). The thread drops its CT and lumen
+  // references when done, so the run can park the mask (and a float CT) after reconstruct.
   // The CT planes a click on the map shows are drawn on the same thread next: their box is the
   // lumen's (build_review_report), known now.
   void stage_done(const std::string& stage, const ArtifactBag& bag, const nlohmann::json& record) override {
     if (stage != "segment" || !bag.has("ct") || !bag.has("mask")) return;
     const std::any& ct_held = bag.raw("ct");
-    const auto* ct = std::any_cast<CtImage::Pointer>(&ct_held);
-    if (!ct) return;  // not the float CT: the report draws the section itself
-    drawn_ = std::async(std::launch::async, [ct = *ct, lumen = bag.get<MaskImage::Pointer>("mask"),
+    if (const auto* ct = std::any_cast<CtImage::Pointer>(&ct_held)) draw_ahead(*ct, bag, record);
+    // the run holds the CT in 16 bits from segment's crop on: the same drawings
+    else if (const auto* ct16 = std::any_cast<CompactCtImage::Pointer>(&ct_held)) draw_ahead(*ct16, bag, record);
+  }
+
+ private:
+  // The Segmentation section and the CT planes drawn on a second thread (stage_done).
+  template <class CtPointer>
+  void draw_ahead(const CtPointer& ct_held, const ArtifactBag& bag, const nlohmann::json& record) {
+    drawn_ = std::async(std::launch::async, [ct = ct_held, lumen = bag.get<MaskImage::Pointer>("mask"),
                                              result = record.value("result", nlohmann::json::object())]() mutable {
       DrawnAhead d;
       d.segmentation = draw_segmentation_qc(ct.GetPointer(), lumen.GetPointer(), result);
@@ -106,10 +115,12 @@ class ReportTool : public Tool, public RunFinisher {
         d.planes = draw_plane_stacks(ct.GetPointer(), lo, hi, so);
       }
       ct = nullptr, lumen = nullptr;
+      release_free_memory();  // the CT's or mask's pages, when the run parked them meanwhile, back now
       return d;
     });
   }
 
+ public:
   nlohmann::json finish(FinishedRun& run, OutputTransaction& tx) override {
     Stopwatch clock;
     ProgressScope scope(run.log, "report");

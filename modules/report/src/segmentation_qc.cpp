@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <iterator>
 #include <string>
+#include <type_traits>
 
 #include "colonflat/core/threads.h"
 #include "colonflat/report/ct_views.h"
@@ -66,8 +68,13 @@ void add_seen(nlohmann::json& section) {
 
 class SegmentationQc {
  public:
-  SegmentationQc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& result, const SegmentationQcOptions& o)
-      : ct_(ct), lumen_(lumen), result_(result), o_(o), hu_(ct->GetBufferPointer()), m_(lumen->GetBufferPointer()) {
+  // `ct`: CtImage, or CompactCtImage (the run's CT in 16 bits: the same HU, the same pixels drawn).
+  template <class Image>
+  SegmentationQc(const Image* ct, const MaskImage* lumen, const nlohmann::json& result, const SegmentationQcOptions& o)
+      : ct_(ct), lumen_(lumen), result_(result), o_(o), m_(lumen->GetBufferPointer()),
+        sample_([ct](Plane p, double at, double u0, double v0, int w, int h, double pix) { return sample_plane(ct, p, at, u0, v0, w, h, pix); }) {
+    if constexpr (std::is_same_v<typename Image::PixelType, float>) huf_ = ct->GetBufferPointer();
+    else hus_ = ct->GetBufferPointer();
     const auto sz = ct->GetLargestPossibleRegion().GetSize();
     for (int d = 0; d < 3; ++d) n_[d] = sz[d];
     voxel_ml_ = ct->GetSpacing()[0] * ct->GetSpacing()[1] * ct->GetSpacing()[2] / 1000.0;
@@ -82,7 +89,8 @@ class SegmentationQc {
   void flood(QcBody& b, std::size_t seed, std::size_t cap);
   int voxel_class(std::size_t q) const {
     if (m_[q]) return -1;
-    return hu_[q] < gas_thr_ ? 0 : hu_[q] > fluid_thr_ ? 1 : -1;
+    const float hu = huf_ ? huf_[q] : float(hus_[q]);
+    return hu < gas_thr_ ? 0 : hu > fluid_thr_ ? 1 : -1;
   }
   std::array<double, 3> lps_of(std::size_t q) const {
     CtImage::IndexType i = {{long(q % n_[0]), long((q / n_[0]) % n_[1]), long(q / (n_[0] * n_[1]))}};
@@ -102,12 +110,14 @@ class SegmentationQc {
   nlohmann::json tag(SliceCanvas& cv) const;
   nlohmann::json tables() const;
 
-  const CtImage* ct_;
+  const itk::ImageBase<3>* ct_;  // its geometry
   const MaskImage* lumen_;
   const nlohmann::json& result_;
   const SegmentationQcOptions& o_;
-  const float* hu_;
   const unsigned char* m_;
+  std::function<PlaneImage(Plane, double, double, double, int, int, double)> sample_;  // sample_plane on the CT
+  const float* huf_ = nullptr;  // the CT's HU: float, or
+  const short* hus_ = nullptr;  // 16 bits
   std::size_t n_[3];
   double voxel_ml_ = 0, gas_thr_ = -500, fluid_thr_ = 200, lumen_ml_ = 0, pix_ = 1;
   std::array<double, 3> lo_{1e300, 1e300, 1e300}, hi_{-1e300, -1e300, -1e300}, hist_lo_{};
@@ -344,7 +354,7 @@ SliceCanvas SegmentationQc::paint(Plane p, double fixed) const {
   const auto ur = range(a.u_axis, a.u_sign), vr = range(a.v_axis, a.v_sign);
   SliceCanvas cv;
   cv.w = std::max(1, int(std::ceil((ur[1] - ur[0]) / pix_))), cv.h = std::max(1, int(std::ceil((vr[1] - vr[0]) / pix_)));
-  const PlaneImage im = sample_plane(ct_, p, fixed, ur[0], vr[0], cv.w, cv.h, pix_);
+  const PlaneImage im = sample_(p, fixed, ur[0], vr[0], cv.w, cv.h, pix_);
   const std::size_t np = std::size_t(cv.w) * cv.h;
   cv.lum.assign(np, 0), cv.rgb.assign(np * 3, 0), cv.body.assign(np, 0);
   for (int r = 0; r < cv.h; ++r)
@@ -446,10 +456,9 @@ nlohmann::json SegmentationQc::tables() const {
           {"reasons", reasons}, {"colours", {{"lumen", css_rgb(kLumenRgb)}}}};
 }
 
-}  // namespace
-
-SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
-                                           const SegmentationQcOptions& opts) {
+template <class Image>
+SegmentationQcDrawing draw_qc(const Image* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                              const SegmentationQcOptions& opts) {
   SegmentationQcDrawing missing;
   if (!ct || !lumen) {
     missing.section = {{"missing", "no CT or no lumen mask in the run folder"}};
@@ -466,28 +475,16 @@ SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* l
   return SegmentationQc(ct, lumen, segment_result, opts).run();
 }
 
-nlohmann::json write_segmentation_qc(const SegmentationQcDrawing& drawing, const fs::path& dir,
-                                     const std::string& rel_prefix, int* images) {
-  nlohmann::json section = drawing.section;
-  std::size_t k = 0;
-  for (Plane p : {Plane::coronal, Plane::axial, Plane::sagittal}) {
-    if (!section.contains("planes") || !section["planes"].contains(plane_name(p))) continue;
-    for (auto& entry : section["planes"][plane_name(p)]) entry["file"] = rel_prefix + drawing.montages.at(k++).name;
-  }
-  parallel_for(k, [&](std::size_t b, std::size_t e) {  // each thread's VtkMessageCapture is its own
-    for (std::size_t i = b; i < e; ++i) {
-      const QcMontage& m = drawing.montages[i];
-      write_png_pixels(m.w, m.h, 3, m.rgb, dir / m.name);
-    }
-  });
-  *images += int(k);
-  return section;
+}  // namespace
+
+SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
+                                           const SegmentationQcOptions& opts) {
+  return draw_qc(ct, lumen, segment_result, opts);
 }
 
-nlohmann::json write_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
-                                     const fs::path& dir, const std::string& rel_prefix, int* images,
-                                     const SegmentationQcOptions& opts) {
-  return write_segmentation_qc(draw_segmentation_qc(ct, lumen, segment_result, opts), dir, rel_prefix, images);
+SegmentationQcDrawing draw_segmentation_qc(const CompactCtImage* ct, const MaskImage* lumen,
+                                           const nlohmann::json& segment_result, const SegmentationQcOptions& opts) {
+  return draw_qc(ct, lumen, segment_result, opts);
 }
 
 }  // namespace cf

@@ -69,6 +69,37 @@ TEST(ReportCt, PlanesDrawnAheadWriteTheSameFilesAndJson) {
   }
 }
 
+// The CT in 16 bits (`colonflat run` holds it so from segment's crop on) draws the stacks of the
+// float CT it holds, byte for byte; with 100.5 HU added everywhere (no 16-bit copy then) the float
+// CT draws other pixels, so the comparison sees the HU.
+TEST(ReportCt, PlanesOfTheCtInSixteenBitsAreThoseOfTheFloatCt) {
+  const std::array<double, 3> lo{-20, -15, -10}, hi{20, 15, 12};
+  const auto ct = testing::ball_ct(lo, hi, {3, -2, 1});
+  float* hu = ct->GetBufferPointer();
+  for (std::size_t q = 0, n = ct->GetLargestPossibleRegion().GetNumberOfPixels(); q < n; ++q) hu[q] = std::round(hu[q]);
+  const CompactCtImage::Pointer ct16 = compact_ct(*ct);
+  ASSERT_TRUE(ct16);
+  SliceStackOptions so;
+  so.step_mm = 4;
+  so.margin_mm = 5;
+  const DrawnPlaneStacks a = draw_plane_stacks(ct.GetPointer(), lo, hi, so);
+  const DrawnPlaneStacks b = draw_plane_stacks(ct16.GetPointer(), lo, hi, so);
+  ASSERT_EQ(a.planes.size(), 3u);
+  ASSERT_EQ(b.planes.size(), 3u);
+  std::size_t images = 0;
+  for (std::size_t p = 0; p < 3; ++p) {
+    EXPECT_EQ(a.planes[p].json, b.planes[p].json) << p;
+    EXPECT_EQ(a.planes[p].pngs, b.planes[p].pngs) << p;
+    images += a.planes[p].pngs.size();
+  }
+  EXPECT_GT(images, 6u);
+  for (std::size_t q = 0, n = ct->GetLargestPossibleRegion().GetNumberOfPixels(); q < n; ++q) hu[q] += 100.5f;
+  const DrawnPlaneStacks c = draw_plane_stacks(ct.GetPointer(), lo, hi, so);
+  bool differs = false;
+  for (std::size_t p = 0; p < 3; ++p) differs = differs || c.planes[p].pngs != b.planes[p].pngs;
+  EXPECT_TRUE(differs);
+}
+
 // The report writes the planes it is given when they are of its box (its lumen's, here every
 // voxel of the CT) and options, and draws its own when their box differs by 1 mm.
 TEST(ReportCt, ReportWritesPlanesDrawnAheadOnlyForItsOwnBox) {

@@ -237,6 +237,26 @@ TEST(ReportSegmentation, DrawingIsTheSameForOneAndTwoThreads) {
   }
 }
 
+// The CT in 16 bits (`colonflat run` holds it so from segment's crop on) gives the drawing of the
+// float CT it holds: the same section and every montage's pixels.
+TEST(ReportSegmentation, DrawingFromTheCtInSixteenBitsIsTheSame) {
+  testing::TempDir tmp;
+  double fluid_ml = 0;
+  make_run(tmp / "run", &fluid_ml);
+  const auto ct = read_ct_volume(tmp / "run" / "ct.nrrd");
+  const auto ct16 = compact_ct(*ct);  // the phantom's HU are whole numbers
+  ASSERT_TRUE(ct16);
+  const auto mask = read_mask(tmp / "run" / "lumen_mask.nrrd");
+  const nlohmann::json result = read_json_file(tmp / "run" / "run_report.json")["stages"][0]["result"];
+  const SegmentationQcDrawing a = draw_segmentation_qc(ct.GetPointer(), mask.GetPointer(), result);
+  const SegmentationQcDrawing b = draw_segmentation_qc(ct16.GetPointer(), mask.GetPointer(), result);
+  ASSERT_GE(a.montages.size(), 12u);
+  EXPECT_GE(a.section["bodies"].size(), 1u);
+  EXPECT_EQ(a.section, b.section);
+  ASSERT_EQ(a.montages.size(), b.montages.size());
+  for (std::size_t i = 0; i < a.montages.size(); ++i) EXPECT_EQ(a.montages[i].rgb, b.montages[i].rgb) << a.montages[i].name;
+}
+
 bool have_chromium() { return std::system("command -v chromium > /dev/null 2>&1") == 0; }
 
 // Headless Chromium builds the section of the crowded run: >= 12 montage images, one numbered

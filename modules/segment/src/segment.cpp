@@ -58,10 +58,11 @@ void validate(const SegmentOptions& o) {
                      format_number(o.fluid_threshold) + ")");
 }
 
-MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, SegmentStats* stats_out) {
+MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts, SegmentStats* stats_out,
+                                 const std::function<void()>& voxels_read) {
   validate(opts);
   if (!ct) throw PreconditionError("segment: no volume");
-  return segment_detail::ColonSegmenter(ct, opts).run(stats_out);
+  return segment_detail::ColonSegmenter(ct, opts, voxels_read).run(stats_out);
 }
 
 namespace segment_detail {
@@ -73,6 +74,7 @@ MaskImage::Pointer ColonSegmenter::run(SegmentStats* stats) {
   lap("checks");
   step_time("checks");  // starts the sub-step clock
   find_gas_bodies();
+  release_ct_voxels();
   step_time("crop");
   find_fluid_bodies();
   step_time("find_fluid_bodies");
@@ -123,6 +125,18 @@ void ColonSegmenter::lap(const char* name) {
   cpu_timings_[name] = cpu - cpu_lap_;
   cpu_lap_ = cpu;
   phase_done(name);
+}
+
+// From the crop on only the crop's own copy (hu_) is read: ct_ becomes a copy of the CT's geometry
+// and dictionary without voxels, and the caller is told it may free the CT's.
+void ColonSegmenter::release_ct_voxels() {
+  if (!voxels_read_) return;
+  geometry_ = CtImage::New();
+  geometry_->CopyInformation(ct_);
+  geometry_->SetRegions(ct_->GetLargestPossibleRegion());  // no buffer: a stray voxel read is a null read
+  geometry_->SetMetaDataDictionary(ct_->GetMetaDataDictionary());
+  ct_ = geometry_.GetPointer();
+  voxels_read_();
 }
 
 void ColonSegmenter::check_input() {

@@ -253,7 +253,7 @@ struct InterfaceTally {
 
 class ColonSegmenter {
  public:
-  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts);
+  ColonSegmenter(const CtImage* ct, const SegmentOptions& opts, std::function<void()> voxels_read = {});
   ~ColonSegmenter();
   MaskImage::Pointer run(SegmentStats* stats);
 
@@ -332,9 +332,12 @@ class ColonSegmenter {
   void decide(const std::string& what, double ml, const double centroid_crop[3], bool kept, const std::string& reason);
   void lap(const char* name);
   void summarize_decisions();
+  void release_ct_voxels();
 
   BlockReuse reuse_;  // first member: released after every buffer below is freed into it
-  const CtImage* ct_;
+  const CtImage* ct_;                  // the CT; from the crop on its geometry_ only (release_ct_voxels)
+  std::function<void()> voxels_read_;  // segment_colon's voxels_read
+  CtImage::Pointer geometry_;
   SegmentOptions opts_;
   SegmentStats st_;
   nlohmann::json timings_ = nlohmann::json::object();

@@ -83,7 +83,8 @@ std::string fixed1(double v) {
 }
 }  // namespace
 
-ColonSegmenter::ColonSegmenter(const CtImage* ct, const SegmentOptions& opts) : ct_(ct), opts_(opts) {}
+ColonSegmenter::ColonSegmenter(const CtImage* ct, const SegmentOptions& opts, std::function<void()> voxels_read)
+    : ct_(ct), voxels_read_(std::move(voxels_read)), opts_(opts) {}
 ColonSegmenter::~ColonSegmenter() = default;
 
 // Components of gas + pools + layer, largest first: kept while they hold >= min-segment-volume of

@@ -25,9 +25,9 @@ const ParamTable<SegmentOptions>& segment_param_table() {
 }
 
 void SegmentStage::run(ArtifactBag& bag, RunContext& ctx) {
-  const auto& ct = bag.get<CtImage::Pointer>("ct");
+  const CtImage* ct = bag.get<CtImage::Pointer>("ct").GetPointer();  // the bag's entry may be replaced from the crop on
   SegmentStats stats;
-  MaskImage::Pointer mask = segment_colon(ct.GetPointer(), opts_, &stats);
+  MaskImage::Pointer mask = segment_colon(ct, opts_, &stats, [&ctx] { ctx.release_input("ct"); });
   std::ostringstream s;
   s << "segment: " << stats.segments << " segment(s) (" << stats.tagged_stretches << " fully tagged stretch(es)), lumen "
     << format_number(stats.lumen_volume_ml) << " mL, gravity " << stats.gravity << " from " << stats.gravity_source << ", in "

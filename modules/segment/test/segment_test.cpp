@@ -223,6 +223,34 @@ TEST(SegmentPhantom, SmallPhantomDice) {
   }
 }
 
+// segment_colon's voxels_read is called once, after which the CT's voxels are not read again: they
+// are overwritten with 3000 HU in the call, and the mask is still the one of the untouched CT, byte
+// for byte, on the same grid, with the same volume and gravity (read from the CT's header).
+TEST(SegmentPhantom, VoxelsAreNotReadAfterTheCropIsCopied) {
+  const Phantom& p = small_phantom(1);
+  SegmentStats ref_st, st;
+  const auto ref = segment_colon(p.ct, {}, &ref_st);
+  auto ct = CtImage::New();
+  ct->CopyInformation(p.ct);
+  ct->SetRegions(p.ct->GetLargestPossibleRegion());
+  ct->SetMetaDataDictionary(p.ct->GetMetaDataDictionary());
+  ct->Allocate();
+  const std::size_t n = ct->GetLargestPossibleRegion().GetNumberOfPixels();
+  std::copy_n(p.ct->GetBufferPointer(), n, ct->GetBufferPointer());
+  int calls = 0;
+  const auto m = segment_colon(ct, {}, &st, [&] { ++calls, std::fill_n(ct->GetBufferPointer(), n, 3000.0f); });
+  EXPECT_EQ(calls, 1);
+  ASSERT_EQ(m->GetLargestPossibleRegion(), ref->GetLargestPossibleRegion());
+  EXPECT_EQ(std::memcmp(m->GetBufferPointer(), ref->GetBufferPointer(), n), 0);
+  EXPECT_EQ(m->GetOrigin(), ref->GetOrigin());
+  EXPECT_EQ(m->GetSpacing(), ref->GetSpacing());
+  EXPECT_EQ(m->GetDirection(), ref->GetDirection());
+  EXPECT_EQ(st.lumen_volume_ml, ref_st.lumen_volume_ml);
+  EXPECT_EQ(st.gravity, ref_st.gravity);
+  EXPECT_EQ(st.gravity_source, ref_st.gravity_source);
+  EXPECT_GT(st.lumen_volume_ml, 0.0);
+}
+
 // A collapsed colon gives two segments, both kept.
 TEST(SegmentPhantom, CollapsedColonTwoSegments) {
   const Phantom& p = small_phantom(2, true);

@@ -100,6 +100,15 @@ struct RunContext {
   nlohmann::json report = nlohmann::json::object();
   // Writes one progress line (thread-safe: the runner's "still running" heartbeat shares `log`).
   void progress(const std::string& line) const;
+  // A stage calls release_input(port), on its own thread, once it reads no more of input `port`'s
+  // value (what it still needs of it copied before) and will not touch the bag's entry again in
+  // this run. `colonflat run` may then hold the artifact as its type's stand-in for the rest of the
+  // stage (ParkedArtifacts::park_released), e.g. the CT in 16 bits from segment's crop on. Outside
+  // a run (input_released unset) nothing happens.
+  std::function<void(const std::string& port)> input_released;
+  void release_input(const std::string& port) const {
+    if (input_released) input_released(port);
+  }
 };
 
 class Stage {

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,7 @@ namespace cf {
 // Same aliases as colonflat/volume/volume_io.h (0 outside, 1 lumen; any non-zero value is lumen).
 using MaskImage = itk::Image<unsigned char, 3>;
 using CtImage = itk::Image<float, 3>;  // HU, on the mask's voxel grid
+using CompactCtImage = itk::Image<short, 3>;  // the same HU in 16 bits (`colonflat run` holds the CT so)
 
 // The options of reconstruct: every field is a parameter declared once, with its default, unit, range and
 // help, in reconstruct_params.def (also the source of `colonflat reconstruct`'s options and docs/reconstruct.md's table).
@@ -99,6 +101,13 @@ Mesh reconstruct_surface(const MaskImage* mask, const CtImage* ct, const Reconst
 // again into fresh pages). PreconditionError when `out` is not empty.
 void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CtImage* ct, const ReconstructOptions& options,
                               ReconstructStats* stats = nullptr);
+// The same from the CT in 16 bits: the same surface, bit for bit, as from the float CT it holds.
+void reconstruct_surface_into(Mesh& out, const MaskImage* mask, const CompactCtImage* ct,
+                              const ReconstructOptions& options, ReconstructStats* stats = nullptr);
+inline void reconstruct_surface_into(Mesh& out, const MaskImage* mask, std::nullptr_t, const ReconstructOptions& options,
+                                     ReconstructStats* stats = nullptr) {  // no CT
+  reconstruct_surface_into(out, mask, static_cast<const CtImage*>(nullptr), options, stats);
+}
 
 // Euler characteristic of the lumen (non-zero voxels) in the (6,18) digital topology, i.e. of
 // the solid the marching-cubes surface bounds: #voxels - #face-adjacent pairs + #2x2 squares

@@ -42,7 +42,7 @@ struct PlaneImage {
   double pixel_mm = 1, u0 = 0, v0 = 0, fixed = 0;
   std::vector<float> hu;
 };
-template <class Image>  // CtImage (HU) or MaskImage (0/1, a run without a CT)
+template <class Image>  // CtImage or CompactCtImage (HU), or MaskImage (0/1, a run without a CT)
 PlaneImage sample_plane(const Image* ct, Plane plane, double fixed, double u0, double v0, int w, int h,
                         double pixel_mm);
 // A square plane of side `fov_mm` centred on `lps`.
@@ -96,6 +96,9 @@ struct DrawnPlaneStacks {
   std::vector<DrawnSliceStack> planes;  // axial, coronal, sagittal
 };
 DrawnPlaneStacks draw_plane_stacks(const CtImage* ct, const std::array<double, 3>& box_min,
+                                   const std::array<double, 3>& box_max, const SliceStackOptions& opts);
+// The same from the CT in 16 bits (`colonflat run` holds it so from segment's crop on): the same pixels.
+DrawnPlaneStacks draw_plane_stacks(const CompactCtImage* ct, const std::array<double, 3>& box_min,
                                    const std::array<double, 3>& box_max, const SliceStackOptions& opts);
 
 // The LPS box of the centres of the non-zero voxels of `mask` (any direction: the corners of their

@@ -46,6 +46,9 @@ struct SegmentationQcDrawing {
 // Pre: the lumen is on the CT's grid, else section = {"missing": why} and no montage.
 SegmentationQcDrawing draw_segmentation_qc(const CtImage* ct, const MaskImage* lumen, const nlohmann::json& segment_result,
                                            const SegmentationQcOptions& opts = {});
+// The same from the CT in 16 bits (`colonflat run` holds it so from segment's crop on): the same drawing.
+SegmentationQcDrawing draw_segmentation_qc(const CompactCtImage* ct, const MaskImage* lumen,
+                                           const nlohmann::json& segment_result, const SegmentationQcOptions& opts = {});
 
 // Writes a drawing's montages as `<dir>/<name>` and returns its section with each montage's
 // "file" (`rel_prefix` + name) filled in; `images` += PNGs written.

@@ -7,6 +7,7 @@
 //
 //   cf::SegmentStats stats;
 //   cf::MaskImage::Pointer mask = cf::segment_colon(ct, cf::SegmentOptions{}, &stats);
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -55,7 +56,12 @@ struct SegmentStats {
 
 // Segments the colon lumen (1 = lumen). Throws UsageError for invalid options, PreconditionError
 // for a volume that is not CT-like, has absurd spacing, or in which no colon is found.
-MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts = {}, SegmentStats* stats = nullptr);
+// `voxels_read` (optional) is called once, on the calling thread, as soon as the segmentation
+// reads no more of ct's voxels: after the crop to the gas (the rest works on its own copy of the
+// crop). ct's geometry and metadata dictionary are copied before the call, so the caller may free
+// or replace ct's voxel buffer from then on (`colonflat run` holds the CT in 16 bits from there).
+MaskImage::Pointer segment_colon(const CtImage* ct, const SegmentOptions& opts = {}, SegmentStats* stats = nullptr,
+                                 const std::function<void()>& voxels_read = {});
 
 // Checks the options (UsageError naming the first bad one).
 void validate(const SegmentOptions& opts);
