@@ -156,8 +156,7 @@ class ReviewBuilder {
     const RunData& run = *s.run;
     nlohmann::json j = {{"run_dir", fs::absolute(run.dir).lexically_normal().string()},
                         {"candidates_file", run.candidates_file}};
-    if (run.ct) j["ct"] = ct_geometry_json(run.ct.GetPointer());
-    else if (run.mask) j["ct"] = ct_geometry_json(run.mask.GetPointer());
+    if (has_ct(run) || run.mask) j["ct"] = with_view_volume(run, [](const auto* volume) { return ct_geometry_json(volume); });
     if (j.contains("ct")) j["ct"]["is_mask"] = run.volume_is_mask;
     j["image"] = {{"pixel_size_mm", colon_image_pixel_size(run)}};
     nlohmann::json known = nlohmann::json::array();

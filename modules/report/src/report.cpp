@@ -82,8 +82,8 @@ struct Builder {
   // The CT geometry and the stacks of planes a click on the map shows (`drawn`: those drawn ahead,
   // written when they are of this box and these options).
   void add_ct(const DrawnPlaneStacks* drawn) {
-    if (!run.ct && !run.mask) return;
-    data["ct"] = run.ct ? ct_geometry_json(run.ct.GetPointer()) : ct_geometry_json(run.mask.GetPointer());
+    if (!has_ct(run) && !run.mask) return;
+    data["ct"] = with_view_volume(run, [](const auto* volume) { return ct_geometry_json(volume); });
     data["ct"]["file"] = run.ct_path.string();
     data["ct"]["is_mask"] = run.volume_is_mask;
     std::array<double, 3> lo, hi;
@@ -92,14 +92,15 @@ struct Builder {
     so.step_mm = opts.stack_step_mm;
     so.pixel_mm = opts.stack_pixel_mm;
     if (run.volume_is_mask) so.window = &mask_window();
-    const bool ahead = drawn && run.ct && drawn->box_min == lo && drawn->box_max == hi && drawn->step_mm == so.step_mm &&
+    const bool ahead = drawn && has_ct(run) && drawn->box_min == lo && drawn->box_max == hi && drawn->step_mm == so.step_mm &&
                        drawn->pixel_mm == so.pixel_mm && drawn->planes.size() == 3;
     int i = 0;
     for (Plane p : {Plane::axial, Plane::coronal, Plane::sagittal}) {
       nlohmann::json& stack = data["stacks"][plane_name(p)];
       if (ahead) stack = write_drawn_stack(drawn->planes[std::size_t(i++)], files_dir, "report_files/");
-      else stack = run.ct ? write_slice_stack(run.ct.GetPointer(), p, lo, hi, so, files_dir, "report_files/")
-                          : write_slice_stack(run.mask.GetPointer(), p, lo, hi, so, files_dir, "report_files/");
+      else stack = with_view_volume(run, [&](const auto* volume) {
+        return write_slice_stack(volume, p, lo, hi, so, files_dir, "report_files/");
+      });
       result.images += int(stack["files"].size());
     }
     planes_drawn_ahead = ahead;
@@ -107,7 +108,7 @@ struct Builder {
 
   // The Segmentation section: montages with the lumen and the bodies segment rejected.
   void add_segmentation(const SegmentationQcDrawing* drawn) {
-    if (!run.ct || !run.lumen) {
+    if (!has_ct(run) || !run.lumen) {
       data["segmentation"] = {{"missing", run.volume_is_mask ? "the run started from a lumen mask (no segmentation)"
                                                              : "no CT or no lumen_mask.nrrd in the run folder"}};
       return;
@@ -115,9 +116,10 @@ struct Builder {
     nlohmann::json seg = nlohmann::json::object();
     for (const auto& s : run.run_report.value("stages", nlohmann::json::array()))
       if (s.value("stage", "") == "segment") seg = s.value("result", nlohmann::json::object());
-    data["segmentation"] = drawn ? write_segmentation_qc(*drawn, files_dir, "report_files/", &result.images)
-                                 : write_segmentation_qc(run.ct.GetPointer(), run.lumen.GetPointer(), seg, files_dir,
-                                                         "report_files/", &result.images);
+    const SegmentationQcDrawing here = drawn ? SegmentationQcDrawing{}
+                                       : run.ct ? draw_segmentation_qc(run.ct.GetPointer(), run.lumen.GetPointer(), seg)
+                                                : draw_segmentation_qc(run.ct16.GetPointer(), run.lumen.GetPointer(), seg);
+    data["segmentation"] = write_segmentation_qc(drawn ? *drawn : here, files_dir, "report_files/", &result.images);
   }
 
   void add_findings() {

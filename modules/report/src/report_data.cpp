@@ -116,7 +116,7 @@ int write_finding_images(const RunData& run, const ReportFinding& f, const Repor
                          vtkImageData* colon_image, EndoluminalRenderer* endo, nlohmann::json& fj) {
   int written = 0;
   const std::string rel = "report_files/";
-  if (run.ct || run.mask) {
+  if (has_ct(run) || run.mask) {
     const double fov = std::clamp(o.fov_per_size * f.size_mm, o.min_fov_mm, o.max_fov_mm);
     fj["fov_mm"] = std::round(fov * 10) / 10;
     // A CT in the lung and soft-tissue windows; a mask (no CT) once, in the mask window.
@@ -124,8 +124,8 @@ int write_finding_images(const RunData& run, const ReportFinding& f, const Repor
                                                                     {&soft_tissue_window(), "soft"}};
     if (run.volume_is_mask) windows = {{&mask_window(), "mask"}};
     for (Plane plane : {Plane::axial, Plane::coronal, Plane::sagittal}) {
-      const PlaneImage im = run.ct ? sample_plane_around(run.ct.GetPointer(), plane, f.lps_mm, fov, o.tile_pixels)
-                                   : sample_plane_around(run.mask.GetPointer(), plane, f.lps_mm, fov, o.tile_pixels);
+      const PlaneImage im = with_view_volume(
+          run, [&](const auto* volume) { return sample_plane_around(volume, plane, f.lps_mm, fov, o.tile_pixels); });
       for (const auto& [window, key] : windows) {
         const std::string name = f.key + "_" + plane_name(plane) + "_" + key + ".png";
         write_windowed_png(im, *window, dir / name);

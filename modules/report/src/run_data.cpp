@@ -128,7 +128,7 @@ void load_truth(RunData& run, const RunLoadOptions& opts) {
 // What both loaders share: the truth polyps, findings placed on the flat map, missing pieces.
 void complete_run(RunData& run, const RunLoadOptions& opts) {
   if (!run.flat) run.warnings.push_back("no flat map: no colon map lookup, no positions along the colon");
-  if (!run.ct && !run.mask) run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
+  if (!has_ct(run) && !run.mask) run.warnings.push_back("the CT the run read was not found (pass --ct): no CT views");
   else if (run.volume_is_mask) run.warnings.push_back("the run started from a lumen mask: the views show the mask, not a CT");
   load_truth(run, opts);
   if (run.flat) {
@@ -194,18 +194,19 @@ RunData run_from_artifacts(ArtifactBag& bag, const fs::path& dir, const nlohmann
     run.ct_path = opts.ct;
     run.ct = read_ct_volume(opts.ct);
   } else if (bag.has("ct")) {
-    // As read, or held in 16 bits (`colonflat run` holds it so from reconstruct on:
-    // pipeline/src/artifact_parking.h), then expanded here - after the report freed the meshes - and
-    // put back in its place, so the 16-bit copy is freed at once. The lumen mask likewise (one bit
-    // per voxel from reconstruct on).
-    run.ct = expanded<CtImage::Pointer>(bag, "ct", volume_artifact());
+    // As read, or in 16 bits as `colonflat run` holds it from segment's crop on
+    // (pipeline/src/artifact_parking.h): the views read either, the same pixels. The lumen mask, held
+    // in one bit per voxel from reconstruct on, is expanded here (after the report freed the meshes)
+    // and put back in its place, so its compact copy is freed at once.
+    if (const auto* ct16 = std::any_cast<CompactCtImage::Pointer>(&bag.raw("ct"))) run.ct16 = *ct16;
+    else run.ct = bag.get<CtImage::Pointer>("ct");
     run.ct_path = input;
   } else if (bag.has("mask")) {
     run.mask = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
     run.ct_path = input;
     run.volume_is_mask = true;
   }
-  if (run.ct && bag.has("mask")) run.lumen = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
+  if (has_ct(run) && bag.has("mask")) run.lumen = expanded<MaskImage::Pointer>(bag, "mask", mask_artifact());
   complete_run(run, opts);
   return run;
 }

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "colonflat/core/atomic_file.h"
 #include "colonflat/report/ct_views.h"
 #include "colonflat/report/report.h"
+#include "colonflat/report/report_data.h"
 #include "colonflat/report/run_data.h"
 #include "colonflat/testing/files.h"
 #include "colonflat/testing/temp_dir.h"
@@ -98,6 +100,37 @@ TEST(ReportCt, PlanesOfTheCtInSixteenBitsAreThoseOfTheFloatCt) {
   bool differs = false;
   for (std::size_t p = 0; p < 3; ++p) differs = differs || c.planes[p].pngs != b.planes[p].pngs;
   EXPECT_TRUE(differs);
+}
+
+// run_from_artifacts shares the CT as the run holds it: in 16 bits it stays so (the same image in
+// the bag and in the RunData, no float copy), and a finding's CT views drawn from it are the float
+// CT's, byte for byte.
+TEST(ReportCt, RunDataKeepsTheCtInSixteenBitsAndDrawsTheSameViews) {
+  testing::TempDir tmp;
+  const std::array<double, 3> lo{-20, -15, -10}, hi{20, 15, 12};
+  const auto ct = testing::ball_ct(lo, hi, {3, -2, 1});
+  const CompactCtImage::Pointer ct16 = compact_ct(*ct);
+  ASSERT_TRUE(ct16);
+  ArtifactBag held, whole;
+  held.put("ct", ct16);
+  whole.put("ct", ct);
+  const RunData a = run_from_artifacts(held, tmp / "a", nlohmann::json::object(), "ct.nrrd");
+  const RunData b = run_from_artifacts(whole, tmp / "b", nlohmann::json::object(), "ct.nrrd");
+  EXPECT_FALSE(a.ct);
+  EXPECT_EQ(a.ct16.GetPointer(), ct16.GetPointer());
+  EXPECT_EQ(std::any_cast<CompactCtImage::Pointer>(held.raw("ct")).GetPointer(), ct16.GetPointer());
+  EXPECT_EQ(b.ct.GetPointer(), ct.GetPointer());
+  EXPECT_TRUE(has_ct(a) && has_ct(b));
+  ReportFinding f;
+  f.key = "P1", f.id = 1, f.lps_mm = {3, -2, 1}, f.size_mm = 3;
+  nlohmann::json ja, jb;
+  for (auto [run, dir, j] : {std::tuple{&a, tmp / "a_files", &ja}, std::tuple{&b, tmp / "b_files", &jb}}) {
+    fs::create_directories(dir);
+    EXPECT_EQ(write_finding_images(*run, f, ReportOptions{}, dir, nullptr, nullptr, *j), 6);
+  }
+  EXPECT_EQ(ja, jb);
+  for (const auto& e : fs::directory_iterator(tmp / "a_files"))
+    EXPECT_EQ(testing::slurp(e.path()), testing::slurp(tmp / "b_files" / e.path().filename())) << e.path().filename();
 }
 
 // The report writes the planes it is given when they are of its box (its lumen's, here every

@@ -49,7 +49,8 @@ struct RunData {
   std::optional<FlatMap> flat;
   std::vector<double> centreline_mm;           // per flat vertex (contract 1); empty when absent
   nlohmann::json flat_segments = nlohmann::json::array();  // FlatSegments "segments" (as written)
-  CtImage::Pointer ct;                         // null when no CT was found
+  CtImage::Pointer ct;                         // null when no CT was found, or held in ct16
+  CompactCtImage::Pointer ct16;                // the CT in 16 bits as `colonflat run` holds it (the same HU), else null
   MaskImage::Pointer mask;                     // without a CT: the lumen mask the run started from
   bool volume_is_mask = false;                 // the views show `mask` (0/1), not a CT
   MaskImage::Pointer lumen;                    // with a CT: the run's lumen mask (segment's output), else null
@@ -58,6 +59,17 @@ struct RunData {
   std::vector<std::string> warnings;           // what is missing or inconsistent, for the page
   std::vector<std::string> staged_files;       // run-folder files of the same (uncommitted) transaction
 };
+
+// Whether the run has a CT (float or in 16 bits).
+inline bool has_ct(const RunData& run) { return run.ct || run.ct16; }
+// f(volume) on the volume the views show: the CT (float or in 16 bits), else the lumen mask
+// (volume_is_mask). Pre: has_ct(run) or run.mask. f takes a const CtImage*, CompactCtImage* or MaskImage*.
+template <class F>
+decltype(auto) with_view_volume(const RunData& run, F&& f) {
+  if (run.ct) return f(run.ct.GetPointer());
+  if (run.ct16) return f(run.ct16.GetPointer());
+  return f(run.mask.GetPointer());
+}
 
 // The bag name under which the report finisher of `colonflat run` leaves the run's RunData
 // (std::shared_ptr<const RunData>) for a later step on the same memory (the supine-prone review).
@@ -71,8 +83,9 @@ bool run_has_file(const RunData& run, const std::string& name);
 RunData load_run(const std::filesystem::path& dir, const RunLoadOptions& opts = {});
 
 // The same from the artifacts `colonflat run` still holds after its last stage (no file is read
-// but the truth polyps.json): "flat" is moved out of `bag`; the view volume is "ct", else the
-// lumen mask "mask" (volume_is_mask); "colon_image" and "candidates" are shared.
+// but the truth polyps.json): "flat" is moved out of `bag`; the view volume is "ct" (shared as it
+// is held: float, or in 16 bits in ct16, never expanded), else the lumen mask "mask"
+// (volume_is_mask); "colon_image" and "candidates" are shared.
 // `run_report` is the run's report so far; `input` the run's input (shown as the CT's file).
 RunData run_from_artifacts(ArtifactBag& bag, const std::filesystem::path& dir, const nlohmann::json& run_report,
                            const std::string& input, const RunLoadOptions& opts = {});
