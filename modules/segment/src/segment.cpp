@@ -131,6 +131,9 @@ void ColonSegmenter::lap(const char* name) {
 // and dictionary without voxels, and the caller is told it may free the CT's.
 void ColonSegmenter::release_ct_voxels() {
   if (!voxels_read_) return;
+  // The caller's stand-in is allocated on the heap (the CT in 16 bits, beside the float CT until it
+  // is freed): the full-volume gas mask freed into BlockReuse must not add to that moment's peak.
+  release_kept_blocks();
   geometry_ = CtImage::New();
   geometry_->CopyInformation(ct_);
   geometry_->SetRegions(ct_->GetLargestPossibleRegion());  // no buffer: a stray voxel read is a null read
