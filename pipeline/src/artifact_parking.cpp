@@ -1,29 +1,26 @@
 // ParkedArtifacts (artifact_parking.h).
 #include "artifact_parking.h"
 
-#include <set>
-
 #include "colonflat/core/malloc_tunables.h"
 #include "colonflat/core/run_stats.h"
 
 namespace cf {
 namespace {
 
-// The declared type of each artifact name the plan's stages read, and the names that stage
-// `from` and the stages after it write.
-struct PlanPorts {
+// The declared type of each artifact name the plan's stages read.
+std::map<std::string, const ArtifactType*> read_types(const RunPlan& plan) {
   std::map<std::string, const ArtifactType*> type;
-  std::set<std::string> written;
-};
+  for (const auto& st : plan.stages)
+    for (const Port& in : st->spec().inputs) type.emplace(in.name, in.type);
+  return type;
+}
 
-PlanPorts plan_ports(const RunPlan& plan, std::size_t from) {
-  PlanPorts p;
-  for (std::size_t j = 0; j < plan.stages.size(); ++j) {
-    for (const Port& in : plan.stages[j]->spec().inputs) p.type.emplace(in.name, in.type);
-    if (j >= from)
-      for (const Port& out : plan.stages[j]->spec().outputs) p.written.insert(out.name);
-  }
-  return p;
+// Whether stage `from` or a later one writes `name`.
+bool written_from(const RunPlan& plan, std::size_t from, const std::string& name) {
+  for (std::size_t j = from; j < plan.stages.size(); ++j)
+    for (const Port& out : plan.stages[j]->spec().outputs)
+      if (out.name == name) return true;
+  return false;
 }
 
 // Whether a stage after `done` reads `name`; `whole`: only as the full value (an input port not
@@ -55,20 +52,18 @@ void ParkedArtifacts::park(const std::string& name, const ArtifactType& type, co
 }
 
 void ParkedArtifacts::park_outputs(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
-  const PlanPorts later = plan_ports(plan, done + 1);
   for (const Port& out : plan.stages[done]->spec().outputs) {
     if (!compactable(*out.type) || parked_.count(out.name) || !bag.has(out.name)) continue;
-    if (later.written.count(out.name) || read_whole_after(plan, done, out.name)) continue;
+    if (written_from(plan, done + 1, out.name) || read_whole_after(plan, done, out.name)) continue;
     if (!read_after(plan, done, out.name)) continue;  // nothing gained before its file: park_unread, after
     park(out.name, *out.type, plan.stages[done]->spec().name, bag, log);
   }
 }
 
 void ParkedArtifacts::park_unread(const RunPlan& plan, std::size_t done, ArtifactBag& bag, nlohmann::json& log) {
-  const PlanPorts ports = plan_ports(plan, done);
-  for (const auto& [name, type] : ports.type) {
+  for (const auto& [name, type] : read_types(plan)) {
     if (!compactable(*type) || parked_.count(name) || !bag.has(name)) continue;
-    if (ports.written.count(name) || read_whole_after(plan, done, name)) continue;
+    if (written_from(plan, done, name) || read_whole_after(plan, done, name)) continue;
     park(name, *type, plan.stages[done]->spec().name, bag, log);
   }
 }
@@ -79,7 +74,7 @@ void ParkedArtifacts::park_released(const RunPlan& plan, std::size_t running, co
   for (const Port& in : stage.spec().inputs) {
     if (in.name != port || !compactable(*in.type) || parked_.count(port) || !bag.has(port)) continue;
     // (the writer may still be writing the previous stage's outputs)
-    if (plan_ports(plan, running ? running - 1 : 0).written.count(port) || read_whole_after(plan, running, port)) continue;
+    if (written_from(plan, running ? running - 1 : 0, port) || read_whole_after(plan, running, port)) continue;
     park(port, *in.type, stage.spec().name, bag, log, "during_stage");
   }
 }

@@ -35,9 +35,9 @@ class ParkedArtifacts {
   // While plan.stages[running] runs, when it has released its input `port`
   // (RunContext::release_input): that input is replaced by its stand-in when its type is
   // compactable, neither the previous stage (its writer may still be at work), this one nor a later
-  // one writes it, and every later stage reading it
-  // takes the stand-in (none reading it included: the rest of this stage runs smaller). E.g. the
-  // CT after segment's crop. Logged as {"artifact", "during_stage", "time_s"}.
+  // one writes it, and every later stage reading it takes the stand-in (none reading it included:
+  // the rest of this stage runs smaller). E.g. the CT after segment's crop. Logged as
+  // {"artifact", "during_stage", "time_s"}.
   void park_released(const RunPlan& plan, std::size_t running, const std::string& port, ArtifactBag& bag,
                      nlohmann::json& log);
 
