@@ -4,8 +4,10 @@
 #include <itkBinaryBallStructuringElement.h>
 #include <itkBinaryDilateImageFilter.h>
 #include <itkBinaryErodeImageFilter.h>
+#include <itkConstantPadImageFilter.h>
 #include <itkImageDuplicator.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 namespace cf::bench {
@@ -44,6 +46,18 @@ MaskImage::Pointer grown_mask(const MaskImage* mask, int voxels) {
   copy->SetInputImage(mask);
   copy->Update();
   return copy->GetOutput();
+}
+
+MaskImage::Pointer padded_mask(const MaskImage* mask, int slices) {
+  auto pad = itk::ConstantPadImageFilter<MaskImage, MaskImage>::New();
+  pad->SetInput(mask);
+  MaskImage::SizeType after{{0, 0, static_cast<MaskImage::SizeValueType>(std::max(slices, 0))}};
+  pad->SetPadUpperBound(after);
+  pad->SetConstant(0);
+  pad->Update();
+  MaskImage::Pointer out = pad->GetOutput();
+  out->DisconnectPipeline();
+  return out;
 }
 
 }  // namespace cf::bench

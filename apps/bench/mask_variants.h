@@ -12,4 +12,9 @@ namespace cf::bench {
 // Post: the same size, origin, spacing and direction as `mask`; values 0/1; voxels == 0: a copy.
 MaskImage::Pointer grown_mask(const MaskImage* mask, int voxels);
 
+// `mask` with `slices` empty slices (value 0) added after its last slice (the third index axis), as
+// a longer scan of the same colon would hold them (ITK's ConstantPadImageFilter). Post: size[2] grown
+// by `slices`; origin, spacing, direction and every original voxel unchanged. slices >= 0.
+MaskImage::Pointer padded_mask(const MaskImage* mask, int slices);
+
 }  // namespace cf::bench

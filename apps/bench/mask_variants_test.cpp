@@ -1,4 +1,4 @@
-// The benches' varied real anatomy (mask_variants.h): a mask grown and shrunk by one voxel.
+// The benches' varied real anatomy (mask_variants.h): a mask grown, shrunk and padded with empty slices.
 #include <gtest/gtest.h>
 
 #include "mask_variants.h"
@@ -61,4 +61,26 @@ TEST(BenchMasks, ThinWallFusesWhenGrownAndThinStrandOpensWhenShrunk) {
   MaskImage::Pointer strand = empty_mask();
   for (int x = 1; x < 11; ++x) strand->SetPixel({x, 6, 6}, 1);
   EXPECT_EQ(lumen_voxels(cf::bench::grown_mask(strand.GetPointer(), -1).GetPointer()), 0u);
+}
+
+// Padding adds empty slices after the last one and moves nothing: the same origin, spacing and
+// direction, every original voxel in place, the new slices 0, the lumen count unchanged.
+TEST(BenchMasks, PaddedSlicesAreEmptyAndTheGeometryIsKept) {
+  MaskImage::Pointer m = empty_mask();
+  m->SetPixel({6, 6, 11}, 1);
+  m->SetPixel({2, 3, 0}, 1);
+  const MaskImage::Pointer p = cf::bench::padded_mask(m.GetPointer(), 5);
+  const auto size = p->GetLargestPossibleRegion().GetSize();
+  EXPECT_EQ(size[0], 12u);
+  EXPECT_EQ(size[1], 12u);
+  EXPECT_EQ(size[2], 17u);
+  EXPECT_EQ(p->GetLargestPossibleRegion().GetIndex(), m->GetLargestPossibleRegion().GetIndex());
+  EXPECT_EQ(p->GetOrigin(), m->GetOrigin());
+  EXPECT_EQ(p->GetSpacing(), m->GetSpacing());
+  EXPECT_EQ(p->GetDirection(), m->GetDirection());
+  EXPECT_EQ(p->GetPixel({6, 6, 11}), 1);
+  EXPECT_EQ(p->GetPixel({2, 3, 0}), 1);
+  EXPECT_EQ(lumen_voxels(p.GetPointer()), 2u);
+  for (int k = 12; k < 17; ++k) EXPECT_EQ(p->GetPixel({6, 6, k}), 0) << k;
+  EXPECT_EQ(lumen_voxels(cf::bench::padded_mask(m.GetPointer(), 0).GetPointer()), 2u);
 }
