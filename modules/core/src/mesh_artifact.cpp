@@ -81,10 +81,32 @@ BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port) 
   return s;
 }
 
+namespace {
+// `known` when it fits `list` (topology_fits), else analyze_topology(list).
+TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList& list) {
+  return known && topology_fits(*known, list) ? *known : analyze_topology(list);
+}
+
+// orient_mesh with the mesh's topology known (`known`, checked against the mesh by topology_fits):
+// the same report, notes and mesh as analysing it.
+nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const RunContext& ctx,
+                                 const std::string& stage, const std::string& port, TopologyReport* topology) {
+  OrientationReport r = read_orientation(mesh);
+  TriangleList list = to_triangle_list(mesh);
+  TopologyReport topo = known_or_analysed(known, list);
+  const OrientationReport turned = orient_outward(list, topo);
+  if (!turned.empty()) mesh = build_mesh(list);
+  r.append(turned);
+  if (topology) *topology = std::move(topo);
+  return noted(r, ctx, stage, port);
+}
+}  // namespace
+
 nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, const std::string& stage,
-                              const std::string& port, TopologyReport* topology) {
-  if (surface.mesh) return orient_mesh(*surface.mesh, ctx, stage, port, topology);
-  TopologyReport topo = analyze_topology(*surface.triangles);
+                              const std::string& port, TopologyReport* topology, const TopologyReport* known) {
+  if (surface.mesh) return known ? orient_mesh_known(*surface.mesh, known, ctx, stage, port, topology)
+                                 : orient_mesh(*surface.mesh, ctx, stage, port, topology);
+  TopologyReport topo = known_or_analysed(known, *surface.triangles);
   const OrientationReport r = orient_outward(*surface.triangles, topo);
   if (topology) *topology = std::move(topo);
   return noted(r, ctx, stage, port);
@@ -97,9 +119,17 @@ nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string&
   return noted(r, ctx, stage, port);
 }
 
+const TopologyReport* handed_topology_entry(const ArtifactBag& bag, const std::string& port) {
+  const std::string entry = topology_entry(port);
+  return bag.has(entry) ? &bag.get<TopologyReport>(entry) : nullptr;
+}
+
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage, TopologyReport* topology) {
-  return orient_mesh(bag_mesh_for_orienting(bag, port), ctx, stage, port, topology);
+  Mesh& mesh = bag_mesh_for_orienting(bag, port);
+  if (const TopologyReport* known = handed_topology_entry(bag, port))
+    return orient_mesh_known(mesh, known, ctx, stage, port, topology);
+  return orient_mesh(mesh, ctx, stage, port, topology);
 }
 
 std::string topology_entry(const std::string& port) { return port + ".topology"; }

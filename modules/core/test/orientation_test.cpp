@@ -299,6 +299,49 @@ TEST(CoreOrientation, HandedOnTopologyIsTakenOnlyWhenItFitsTheMesh) {
   EXPECT_FALSE(topology_fits(own, synthetic::translated(sphere, 0, 0, -1)));
 }
 
+// orient_mesh_input and orient_surface (mesh or stand-in) take a topology handed on in the bag
+// (reconstruct's of "surface") only when it fits the surface: the same mesh's report is used as it
+// is (a marked field survives) and the entry stays for the next reader; a report of another mesh is
+// not (a new analysis). Either way the inward torus is reversed with the same report and progress
+// line as without an entry.
+TEST(CoreOrientation, HandedOnTopologyOrientsTheStageInputAndStays) {
+  const TriangleList inward = reversed(synthetic::torus(30, 10, 40, 16));
+  const TopologyReport own = analyze_topology(inward);
+  ArtifactBag plain;
+  plain.put("surface", synthetic::to_mesh(inward));
+  std::ostringstream plain_log;
+  RunContext plain_ctx;
+  plain_ctx.log = &plain_log;
+  const nlohmann::json expected = orient_mesh_input(plain, "surface", plain_ctx, "denoise");
+  ASSERT_EQ(expected["reversed_components"], 1);
+  auto oriented = [&](TopologyReport handed, bool as_list) {
+    handed.mean_edge_length = -1;  // the mark: no analysis gives it
+    ArtifactBag bag;
+    if (as_list) bag.put("surface", to_triangle_list(synthetic::to_mesh(inward)));
+    else bag.put("surface", synthetic::to_mesh(inward));
+    bag.put(topology_entry("surface"), std::move(handed));
+    std::ostringstream log;
+    RunContext ctx;
+    ctx.log = &log;
+    TopologyReport topo;
+    const nlohmann::json j = as_list ? orient_surface(bag_surface_for_orienting(bag, "surface"), ctx, "denoise",
+                                                      "surface", &topo, handed_topology_entry(bag, "surface"))
+                                     : orient_mesh_input(bag, "surface", ctx, "denoise", &topo);
+    EXPECT_EQ(j, expected);
+    EXPECT_EQ(log.str(), plain_log.str());
+    EXPECT_TRUE(bag.has(topology_entry("surface")));
+    const TriangleList now = as_list ? bag.get<TriangleList>("surface") : to_triangle_list(bag.get<Mesh>("surface"));
+    EXPECT_EQ(now.triangles, to_triangle_list(plain.get<Mesh>("surface")).triangles);
+    EXPECT_EQ(topo.face_component, own.face_component);
+    EXPECT_EQ(topo.genus, std::optional<int>(1));
+    return topo.mean_edge_length;
+  };
+  for (bool as_list : {false, true}) {
+    EXPECT_EQ(oriented(own, as_list), -1) << as_list;
+    EXPECT_EQ(oriented(analyze_topology(synthetic::torus(30, 10, 36, 16)), as_list), own.mean_edge_length) << as_list;
+  }
+}
+
 // Reading a non-orientable file fails with one line naming the file and the reason.
 TEST(CoreOrientation, NonOrientableFileIsRefused) {
   testing::TempDir tmp;

@@ -38,6 +38,9 @@ void ReconstructStage::run(ArtifactBag& bag, RunContext& ctx) {
        << " components, genus " << st.genus << ", surface " << st.field_source << std::fixed << std::setprecision(2) << ", " << st.time_total_s << " s";
   ctx.progress(line.str());
   bag.put("surface", std::move(surface));
+  // The final check's analysis of the surface, for the stages that orient it (denoise, render's
+  // snapshot): core orient_mesh_input and orient_surface use it instead of analysing it again.
+  if (st.topology) bag.put(topology_entry("surface"), std::move(*st.topology));
 }
 
 std::unique_ptr<Stage> make_reconstruct_stage() { return std::make_unique<ReconstructStage>(); }

@@ -277,6 +277,39 @@ TEST(ReconstructTopology, SurfaceBuiltInTheCallersMeshIsTheReturnedOne) {
   EXPECT_THROW(reconstruct_surface_into(b, m, nullptr, o), PreconditionError);
 }
 
+// The topology reconstruct hands on (ReconstructStats::topology: its final check's, read by the
+// stages that orient the surface instead of analysing it again) is the surface's own, as
+// analyze_topology of its triangle list gives it, field for field, and fits it (topology_fits).
+TEST(ReconstructTopology, HandedOnTopologyIsTheSurfacesOwn) {
+  auto m = solid_torus();
+  ReconstructOptions o;
+  o.target_faces = 800;
+  ReconstructStats st;
+  const Mesh a = reconstruct_surface(m, o, &st);
+  ASSERT_TRUE(st.topology);
+  const TriangleList list = to_triangle_list(a);
+  const TopologyReport own = analyze_topology(list);
+  const TopologyReport& h = *st.topology;
+  EXPECT_TRUE(topology_fits(h, list));
+  EXPECT_EQ(h.vertices, own.vertices);
+  EXPECT_EQ(h.edges, own.edges);
+  EXPECT_EQ(h.faces, own.faces);
+  EXPECT_EQ(h.euler, own.euler);
+  EXPECT_EQ(h.genus, own.genus);
+  EXPECT_EQ(h.genus, std::optional<int>(1));
+  EXPECT_EQ(h.closed && h.manifold && h.orientable && h.consistently_oriented,
+            own.closed && own.manifold && own.orientable && own.consistently_oriented);
+  EXPECT_EQ(h.face_component, own.face_component);
+  ASSERT_EQ(h.components.size(), own.components.size());
+  for (std::size_t c = 0; c < own.components.size(); ++c) {
+    EXPECT_EQ(h.components[c].faces, own.components[c].faces);
+    EXPECT_EQ(h.components[c].genus, own.components[c].genus);
+  }
+  EXPECT_EQ(h.bbox_min, own.bbox_min);
+  EXPECT_EQ(h.bbox_max, own.bbox_max);
+  EXPECT_EQ(h.mean_edge_length, own.mean_edge_length);
+}
+
 // The three VTK filters give the same surface (same faces and the same set of points).
 TEST(ReconstructTopology, MethodsAgree) {
   MaskSpec s;

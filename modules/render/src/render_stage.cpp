@@ -64,10 +64,12 @@ ImagePtr snapshot_before(const BagSurface& s, std::optional<int> genus, vtkPolyD
 // each under "orientation", the seconds in orient_s; `surface_topology` gets the surface's.
 RenderStage::SnapshotImages RenderStage::orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
                                                                 const RunContext& ctx,
-                                                                TopologyReport* surface_topology) {
+                                                                TopologyReport* surface_topology,
+                                                                const TopologyReport* known_surface) {
   SnapshotImages im;
   Stopwatch sw;
-  if (surface) im.orientation["surface"] = orient_surface(surface, ctx, "render", "surface", surface_topology);
+  if (surface)
+    im.orientation["surface"] = orient_surface(surface, ctx, "render", "surface", surface_topology, known_surface);
   if (denoised) im.orientation["denoised"] = orient_surface(denoised, ctx, "render", "denoised");
   im.orient_s = sw.seconds();
   return im;
@@ -85,18 +87,19 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   s.options.width = s.options.height = opts_.snapshot_size;
   const BagSurface surface = bag.has("surface") ? bag_surface_for_orienting(bag, "surface") : BagSurface{};
   const BagSurface denoised = bag.has("denoised") ? bag_surface_for_orienting(bag, "denoised") : BagSurface{};
+  const TopologyReport* known = handed_topology_entry(bag, "surface");  // reconstruct's, in `colonflat run`
   try {
     s.display = ensure_display();
   } catch (const Error& e) {
     s.error = e.what();
-    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr);
+    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr, known);
     ctx.report["orientation"] = oriented.orientation;
     ctx.report["snapshot_orient_s"] = oriented.orient_s;
     return s;
   }
-  s.images = std::async(std::launch::async, [surface, denoised, &flat, &ctx, loops = s.loops.Get(), so = s.options] {
+  s.images = std::async(std::launch::async, [surface, denoised, known, &flat, &ctx, loops = s.loops.Get(), so = s.options] {
     TopologyReport surface_topology;
-    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology);
+    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology, known);
     Stopwatch sw;
     if (surface) im.before = snapshot_before(surface, surface_topology.genus, loops, so);
     im.before_s = sw.lap();

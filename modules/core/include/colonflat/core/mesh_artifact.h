@@ -31,9 +31,13 @@ inline constexpr const char* kReadOrientationProperty = "colonflat:read_orientat
 // point into the lumen (orient_outward, orientation.h: a mesh not read from a file) in the bag, prints one progress line per changed
 // component ("<stage>: <port>: component 0 (...): normals pointed into the lumen; reversed")
 // and returns the report entry (OrientationReport::to_json()). `topology` (optional) receives
-// the mesh's analyze_topology, computed on the way (orient_outward).
+// the mesh's analyze_topology, computed on the way (orient_outward), or the bag's
+// topology_entry(port) when one is there and fits the mesh (topology_fits: the producing stage's
+// analysis, e.g. reconstruct's; the entry stays in the bag).
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage, TopologyReport* topology = nullptr);
+// The bag's topology_entry(port), or null when it has none (not checked against the mesh).
+const TopologyReport* handed_topology_entry(const ArtifactBag& bag, const std::string& port);
 // The same on a mesh already taken from the bag as bag_mesh_for_orienting(bag, port): what a stage
 // calls to orient its input on another thread (nothing else may touch the bag's entry meanwhile).
 nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string& stage, const std::string& port,
@@ -52,12 +56,16 @@ struct BagSurface {
 // neither).
 BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port);
 // orient_mesh on either: a triangle list is analysed (analyze_topology, into `topology` when given)
-// and its inward components reversed (orient_outward), with the same notes and report.
+// and its inward components reversed (orient_outward), with the same notes and report. `known`
+// (optional): the surface's topology when the caller has it (handed_topology_entry); used instead of
+// analysing when it fits the surface (topology_fits), the same report and surface either way.
 nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, const std::string& stage,
-                              const std::string& port, TopologyReport* topology = nullptr);
+                              const std::string& port, TopologyReport* topology = nullptr,
+                              const TopologyReport* known = nullptr);
 
 // The bag entry in which a stage may leave analyze_topology of its mesh output `port` for the next
-// stage ("<port>.topology", a TopologyReport; denoise leaves its verification's report of
+// stages ("<port>.topology", a TopologyReport; reconstruct leaves its final check's of "surface",
+// read by denoise's orient_mesh_input and render's snapshot; denoise leaves its verification's of
 // "denoised"). Not a port: never written; taken (erased) by oriented_mesh_input.
 std::string topology_entry(const std::string& port);
 

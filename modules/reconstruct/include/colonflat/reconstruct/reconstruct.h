@@ -26,11 +26,13 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "colonflat/core/mesh.h"
 #include "colonflat/core/params.h"
+#include "colonflat/core/topology.h"
 
 namespace cf {
 
@@ -82,6 +84,9 @@ struct ReconstructStats {
   std::size_t vertices = 0, faces = 0;
   int genus = 0;  // total over kept components
   double time_field_s = 0, time_extract_s = 0, time_check_s = 0, time_smooth_s = 0, time_fairing_s = 0, time_decimate_s = 0, time_total_s = 0;
+  // analyze_topology of the surface returned (its final check's; not in to_json): the stage hands it
+  // on to the stages that orient the surface (core topology_entry), which then need not analyse it.
+  std::shared_ptr<TopologyReport> topology;
   nlohmann::json to_json() const;
 };
 

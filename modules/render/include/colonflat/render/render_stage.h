@@ -66,8 +66,10 @@ class RenderStage : public StageWithOptions<RenderOptions> {
     std::future<SnapshotImages> images;
   };
   // Each surface may be the mesh or, in `colonflat run`, its stand-in (the inputs read_stand_in).
+  // `known_surface` (optional): the surface's topology handed on by reconstruct (orient_surface).
   static SnapshotImages orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
-                                               const RunContext& ctx, TopologyReport* surface_topology);
+                                               const RunContext& ctx, TopologyReport* surface_topology,
+                                               const TopologyReport* known_surface = nullptr);
   Snapshots start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const;
   void finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const;
 };
