@@ -415,8 +415,7 @@ class SurfaceReconstruction {
   // 6. The result is a closed oriented manifold with the kept components and their genus.
   void final_check() {
     Stopwatch watch;
-    auto fin_kept = std::make_shared<TopologyReport>(analyze_topology(mesh_));
-    const TopologyReport& fin = *fin_kept;
+    const TopologyReport& fin = *(st_.topology = std::make_shared<TopologyReport>(analyze_topology(mesh_)));
     if (fin.unreferenced_vertices || !fin.closed || !fin.manifold || !fin.consistently_oriented)
       throw Error("reconstruct: the final surface is not a closed oriented 2-manifold (" +
                   describe_topology_failure(fin) + ")");
@@ -439,7 +438,6 @@ class SurfaceReconstruction {
     st_.vertices = mesh_.n_vertices();
     st_.faces = mesh_.n_faces();
     st_.genus = *fin.genus;
-    st_.topology = std::move(fin_kept);
     st_.time_check_s += watch.seconds();
   }
 
