@@ -135,14 +135,9 @@ nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, cons
 std::string topology_entry(const std::string& port) { return port + ".topology"; }
 
 namespace {
-// The bag's topology_entry(port) when it fits `list`, else analyze_topology(list); the entry erased.
-TopologyReport handed_topology(ArtifactBag& bag, const std::string& port, const TriangleList& list) {
-  const std::string entry = topology_entry(port);
-  if (bag.has(entry)) {
-    TopologyReport handed = bag.take<TopologyReport>(entry);
-    if (topology_fits(handed, list)) return handed;
-  }
-  return analyze_topology(list);
+// The bag's topology_entry(port) when it fits `list`, else analyze_topology(list); the entry stays.
+TopologyReport handed_topology(const ArtifactBag& bag, const std::string& port, const TriangleList& list) {
+  return known_or_analysed(handed_topology_entry(bag, port), list);
 }
 }  // namespace
 

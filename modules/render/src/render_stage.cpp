@@ -65,12 +65,14 @@ ImagePtr snapshot_before(const BagSurface& s, std::optional<int> genus, vtkPolyD
 RenderStage::SnapshotImages RenderStage::orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
                                                                 const RunContext& ctx,
                                                                 TopologyReport* surface_topology,
-                                                                const TopologyReport* known_surface) {
+                                                                const TopologyReport* known_surface,
+                                                                const TopologyReport* known_denoised) {
   SnapshotImages im;
   Stopwatch sw;
   if (surface)
     im.orientation["surface"] = orient_surface(surface, ctx, "render", "surface", surface_topology, known_surface);
-  if (denoised) im.orientation["denoised"] = orient_surface(denoised, ctx, "render", "denoised");
+  if (denoised)
+    im.orientation["denoised"] = orient_surface(denoised, ctx, "render", "denoised", nullptr, known_denoised);
   im.orient_s = sw.seconds();
   return im;
 }
@@ -87,19 +89,22 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   s.options.width = s.options.height = opts_.snapshot_size;
   const BagSurface surface = bag.has("surface") ? bag_surface_for_orienting(bag, "surface") : BagSurface{};
   const BagSurface denoised = bag.has("denoised") ? bag_surface_for_orienting(bag, "denoised") : BagSurface{};
-  const TopologyReport* known = handed_topology_entry(bag, "surface");  // reconstruct's, in `colonflat run`
+  // Their topologies as reconstruct and denoise handed them on, in `colonflat run`.
+  const TopologyReport* known = handed_topology_entry(bag, "surface");
+  const TopologyReport* known_denoised = handed_topology_entry(bag, "denoised");
   try {
     s.display = ensure_display();
   } catch (const Error& e) {
     s.error = e.what();
-    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr, known);
+    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr, known, known_denoised);
     ctx.report["orientation"] = oriented.orientation;
     ctx.report["snapshot_orient_s"] = oriented.orient_s;
     return s;
   }
-  s.images = std::async(std::launch::async, [surface, denoised, known, &flat, &ctx, loops = s.loops.Get(), so = s.options] {
+  s.images = std::async(std::launch::async, [surface, denoised, known, known_denoised, &flat, &ctx,
+                                              loops = s.loops.Get(), so = s.options] {
     TopologyReport surface_topology;
-    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology, known);
+    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology, known, known_denoised);
     Stopwatch sw;
     if (surface) im.before = snapshot_before(surface, surface_topology.genus, loops, so);
     im.before_s = sw.lap();

@@ -66,7 +66,8 @@ nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, 
 // The bag entry in which a stage may leave analyze_topology of its mesh output `port` for the next
 // stages ("<port>.topology", a TopologyReport; reconstruct leaves its final check's of "surface",
 // read by denoise's orient_mesh_input and render's snapshot; denoise leaves its verification's of
-// "denoised"). Not a port: never written; taken (erased) by oriented_mesh_input.
+// "denoised", read by flatten's oriented_mesh_input and render's snapshot). Not a port: never
+// written; it stays in the bag, and each reader uses it only when it fits the mesh (topology_fits).
 std::string topology_entry(const std::string& port);
 
 // A stage's input mesh as orient_mesh_input leaves it, as a triangle list with its topology.
@@ -82,7 +83,7 @@ struct OrientedMesh {
 // orient_mesh_input for a stage that works on a triangle list: the same orientation, notes and
 // bag mesh (or stand-in), and the list and its topology without converting or analysing twice. The topology is
 // the bag's topology_entry(port) when one is there and fits the mesh (topology_fits, topology.h), else a new
-// analysis; the entry is erased either way.
+// analysis; the entry stays in the bag either way.
 OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage);
 

@@ -66,10 +66,12 @@ class RenderStage : public StageWithOptions<RenderOptions> {
     std::future<SnapshotImages> images;
   };
   // Each surface may be the mesh or, in `colonflat run`, its stand-in (the inputs read_stand_in).
-  // `known_surface` (optional): the surface's topology handed on by reconstruct (orient_surface).
+  // `known_surface`, `known_denoised` (optional): their topologies handed on by reconstruct and
+  // denoise (handed_topology_entry; orient_surface uses each only when it fits).
   static SnapshotImages orient_snapshot_inputs(const BagSurface& surface, const BagSurface& denoised,
                                                const RunContext& ctx, TopologyReport* surface_topology,
-                                               const TopologyReport* known_surface = nullptr);
+                                               const TopologyReport* known_surface = nullptr,
+                                               const TopologyReport* known_denoised = nullptr);
   Snapshots start_snapshots(ArtifactBag& bag, const FlatMap& flat, RunContext& ctx) const;
   void finish_snapshots(Snapshots& s, std::size_t candidates, ArtifactBag& bag, RunContext& ctx) const;
 };
