@@ -87,8 +87,8 @@ TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList
   return known && topology_fits(*known, list) ? *known : analyze_topology(list);
 }
 
-// orient_mesh with the mesh's topology known (`known`, checked against the mesh by topology_fits):
-// the same report, notes and mesh as analysing it.
+// orient_mesh with the mesh's topology when known (`known`, used only when topology_fits the mesh;
+// null: analysed): the same report, notes and mesh either way.
 nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const RunContext& ctx,
                                  const std::string& stage, const std::string& port, TopologyReport* topology) {
   OrientationReport r = read_orientation(mesh);
@@ -104,8 +104,7 @@ nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const 
 
 nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, const std::string& stage,
                               const std::string& port, TopologyReport* topology, const TopologyReport* known) {
-  if (surface.mesh) return known ? orient_mesh_known(*surface.mesh, known, ctx, stage, port, topology)
-                                 : orient_mesh(*surface.mesh, ctx, stage, port, topology);
+  if (surface.mesh) return orient_mesh_known(*surface.mesh, known, ctx, stage, port, topology);
   TopologyReport topo = known_or_analysed(known, *surface.triangles);
   const OrientationReport r = orient_outward(*surface.triangles, topo);
   if (topology) *topology = std::move(topo);
@@ -114,9 +113,7 @@ nlohmann::json orient_surface(const BagSurface& surface, const RunContext& ctx, 
 
 nlohmann::json orient_mesh(Mesh& mesh, const RunContext& ctx, const std::string& stage, const std::string& port,
                            TopologyReport* topology) {
-  OrientationReport r = read_orientation(mesh);
-  r.append(orient_outward(mesh, topology));
-  return noted(r, ctx, stage, port);
+  return orient_mesh_known(mesh, nullptr, ctx, stage, port, topology);
 }
 
 const TopologyReport* handed_topology_entry(const ArtifactBag& bag, const std::string& port) {
@@ -126,10 +123,8 @@ const TopologyReport* handed_topology_entry(const ArtifactBag& bag, const std::s
 
 nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage, TopologyReport* topology) {
-  Mesh& mesh = bag_mesh_for_orienting(bag, port);
-  if (const TopologyReport* known = handed_topology_entry(bag, port))
-    return orient_mesh_known(mesh, known, ctx, stage, port, topology);
-  return orient_mesh(mesh, ctx, stage, port, topology);
+  return orient_mesh_known(bag_mesh_for_orienting(bag, port), handed_topology_entry(bag, port), ctx, stage, port,
+                           topology);
 }
 
 std::string topology_entry(const std::string& port) { return port + ".topology"; }

@@ -90,21 +90,21 @@ RenderStage::Snapshots RenderStage::start_snapshots(ArtifactBag& bag, const Flat
   const BagSurface surface = bag.has("surface") ? bag_surface_for_orienting(bag, "surface") : BagSurface{};
   const BagSurface denoised = bag.has("denoised") ? bag_surface_for_orienting(bag, "denoised") : BagSurface{};
   // Their topologies as reconstruct and denoise handed them on, in `colonflat run`.
-  const TopologyReport* known = handed_topology_entry(bag, "surface");
+  const TopologyReport* known_surface = handed_topology_entry(bag, "surface");
   const TopologyReport* known_denoised = handed_topology_entry(bag, "denoised");
   try {
     s.display = ensure_display();
   } catch (const Error& e) {
     s.error = e.what();
-    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr, known, known_denoised);
+    const SnapshotImages oriented = orient_snapshot_inputs(surface, denoised, ctx, nullptr, known_surface, known_denoised);
     ctx.report["orientation"] = oriented.orientation;
     ctx.report["snapshot_orient_s"] = oriented.orient_s;
     return s;
   }
-  s.images = std::async(std::launch::async, [surface, denoised, known, known_denoised, &flat, &ctx,
+  s.images = std::async(std::launch::async, [surface, denoised, known_surface, known_denoised, &flat, &ctx,
                                               loops = s.loops.Get(), so = s.options] {
     TopologyReport surface_topology;
-    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology, known, known_denoised);
+    SnapshotImages im = orient_snapshot_inputs(surface, denoised, ctx, &surface_topology, known_surface, known_denoised);
     Stopwatch sw;
     if (surface) im.before = snapshot_before(surface, surface_topology.genus, loops, so);
     im.before_s = sw.lap();
