@@ -87,16 +87,31 @@ TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList
   return known && topology_fits(*known, list) ? *known : analyze_topology(list);
 }
 
+// The mesh oriented outward in place: its recorded orientation (read_orientation) with what
+// orient_outward turned appended, the mesh rebuilt only when a face turned. `topo` gets `known` when it
+// fits the mesh (topology_fits), else its analysis; `list`, when given, to_triangle_list of the mesh as
+// it is left (read back after a rebuild, so that it matches the bag's mesh).
+OrientationReport orient_mesh_in_place(Mesh& mesh, const TopologyReport* known, TopologyReport& topo,
+                                       std::optional<TriangleList>* list = nullptr) {
+  OrientationReport r = read_orientation(mesh);
+  TriangleList made = to_triangle_list(mesh);
+  topo = known_or_analysed(known, made);
+  const OrientationReport turned = orient_outward(made, topo);
+  if (!turned.empty()) {
+    mesh = build_mesh(made);
+    if (list) made = to_triangle_list(mesh);
+  }
+  if (list) *list = std::move(made);
+  r.append(turned);
+  return r;
+}
+
 // orient_mesh with the mesh's topology when known (`known`, used only when topology_fits the mesh;
 // null: analysed): the same report, notes and mesh either way.
 nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const RunContext& ctx,
                                  const std::string& stage, const std::string& port, TopologyReport* topology) {
-  OrientationReport r = read_orientation(mesh);
-  TriangleList list = to_triangle_list(mesh);
-  TopologyReport topo = known_or_analysed(known, list);
-  const OrientationReport turned = orient_outward(list, topo);
-  if (!turned.empty()) mesh = build_mesh(list);
-  r.append(turned);
+  TopologyReport topo;
+  const OrientationReport r = orient_mesh_in_place(mesh, known, topo);
   if (topology) *topology = std::move(topo);
   return noted(r, ctx, stage, port);
 }
@@ -129,34 +144,17 @@ nlohmann::json orient_mesh_input(ArtifactBag& bag, const std::string& port, cons
 
 std::string topology_entry(const std::string& port) { return port + ".topology"; }
 
-namespace {
-// The bag's topology_entry(port) when it fits `list`, else analyze_topology(list); the entry stays.
-TopologyReport handed_topology(const ArtifactBag& bag, const std::string& port, const TriangleList& list) {
-  return known_or_analysed(handed_topology_entry(bag, port), list);
-}
-}  // namespace
-
 OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, const RunContext& ctx,
                                  const std::string& stage) {
   const BagSurface held = bag_surface_for_orienting(bag, port);
+  const TopologyReport* known = handed_topology_entry(bag, port);
   OrientedMesh in;
-  if (held.triangles) {  // the stand-in: oriented in place, as orient_surface does
+  if (held.triangles) {  // the stand-in: oriented in place, no copy
     in.held = held.triangles;
-    in.topology = handed_topology(bag, port, *held.triangles);
-    in.orientation = noted(orient_outward(*held.triangles, in.topology), ctx, stage, port);
+    in.orientation = orient_surface(held, ctx, stage, port, &in.topology, known);
     return in;
   }
-  Mesh& mesh = *held.mesh;
-  OrientationReport r = read_orientation(mesh);
-  in.converted = to_triangle_list(mesh);
-  in.topology = handed_topology(bag, port, *in.converted);
-  const OrientationReport turned = orient_outward(*in.converted, in.topology);
-  if (!turned.empty()) {  // the bag's mesh reversed as orient_mesh_input does, and the list read back from it
-    mesh = build_mesh(*in.converted);
-    in.converted = to_triangle_list(mesh);
-  }
-  r.append(turned);
-  in.orientation = noted(r, ctx, stage, port);
+  in.orientation = noted(orient_mesh_in_place(*held.mesh, known, in.topology, &in.converted), ctx, stage, port);
   return in;
 }
 
