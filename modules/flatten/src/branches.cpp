@@ -355,4 +355,62 @@ std::vector<BranchCut> find_branches(const Surface& s, const Edges& E, const Emb
   return cuts;
 }
 
+namespace {
+
+// Per vertex of s: 1 for a vertex of `loops` that no face with keep 1 has as a corner.
+std::vector<char> loop_vertices_lost(const Surface& s, const std::vector<char>& keep,
+                                     const std::vector<std::vector<int>>& loops) {
+  std::vector<char> kept_corner(s.p.size(), 0), lost(s.p.size(), 0);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (keep[f])
+      for (int v : s.t[f]) kept_corner[std::size_t(v)] = 1;
+  for (const auto& loop : loops)
+    for (int v : loop) lost[std::size_t(v)] = !kept_corner[std::size_t(v)];
+  return lost;
+}
+
+// The removed faces (keep 0) joined through edges to a removed face at a `lost` vertex.
+std::vector<char> removed_region_at(const Surface& s, const Edges& E, const std::vector<char>& keep,
+                                    const std::vector<char>& lost) {
+  std::vector<char> reached(s.t.size(), 0);
+  std::vector<int> stack;
+  for (std::size_t f = 0; f < s.t.size(); ++f) {
+    const Tri& t = s.t[f];
+    if (!keep[f] && (lost[std::size_t(t[0])] || lost[std::size_t(t[1])] || lost[std::size_t(t[2])]))
+      reached[f] = 1, stack.push_back(int(f));
+  }
+  while (!stack.empty()) {
+    const int f = stack.back();
+    stack.pop_back();
+    for (int e : E.fe[std::size_t(f)])
+      for (int g : E.ef[std::size_t(e)])
+        if (g >= 0 && !keep[std::size_t(g)] && !reached[std::size_t(g)]) reached[std::size_t(g)] = 1, stack.push_back(g);
+  }
+  return reached;
+}
+
+}  // namespace
+
+std::vector<char> band_faces_after_cuts(const Surface& s, const Edges& E, const std::vector<std::vector<int>>& loops,
+                                        std::vector<BranchCut>& cuts) {
+  while (!cuts.empty()) {
+    std::vector<char> keep(s.t.size(), 1);
+    for (const auto& cut : cuts)
+      for (int f : cut.faces) keep[std::size_t(f)] = 0;
+    clean_selection(s, E, keep);
+    const std::vector<char> lost = loop_vertices_lost(s, keep, loops);
+    if (std::find(lost.begin(), lost.end(), 1) == lost.end()) return keep;
+    const std::vector<char> reached = removed_region_at(s, E, keep, lost);
+    const std::size_t before = cuts.size();
+    cuts.erase(std::remove_if(cuts.begin(), cuts.end(), [&](const BranchCut& c) {
+                 return std::any_of(c.faces.begin(), c.faces.end(), [&](int f) { return reached[std::size_t(f)] != 0; });
+               }), cuts.end());
+    if (cuts.size() == before) cuts.clear();  // the clean-up alone took them: no cut is safe to make
+    if (std::getenv("COLONFLAT_FLATTEN_DEBUG"))
+      std::fprintf(stderr, "flatten debug branches: %zu cut(s) dropped, they reached the band's end\n",
+                   before - cuts.size());
+  }
+  return std::vector<char>(s.t.size(), 1);
+}
+
 }  // namespace cf::flat_detail

@@ -194,18 +194,14 @@ struct FlattenedBranches {
 // balance) while its branches are flattened. The future is invalid when nothing was cut.
 std::future<FlattenedBranches> cut_branches(SegmentWork& w, std::vector<std::vector<int>>& loops, Prepared& p,
                                       const FlattenOptions& o, int depth) {
-  const auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
+  auto cuts = find_branches(w.ann, p.E, w.emb, w.seg.length, w.lumen_sign, o.branch_min_area);
+  const std::vector<char> keep = band_faces_after_cuts(w.ann, p.E, loops, cuts);  // the ends keep every vertex
   if (depth == 0) debug_clock("branches found");
   w.folds_pending = false;
   if (cuts.empty()) {  // this map stays: its folds are untangled now
     w.seg.untangled_vertices = untangle(w.ann, p.vf, w.emb, p.fixed, p.degenerate);
     return std::future<FlattenedBranches>();
   }
-  const std::size_t nf = w.ann.t.size();
-  std::vector<char> keep(nf, 1);
-  for (const auto& cut : cuts)
-    for (int f : cut.faces) keep[f] = 0;
-  clean_selection(w.ann, p.E, keep);
   std::vector<int> new_of_old;
   Surface rest = sub_surface(w.ann, keep, &new_of_old);
   Edges rest_edges = sub_edges(p.E, keep, new_of_old);

@@ -303,6 +303,9 @@ Harmonic solve_harmonic(const Surface& s, const Edges& E, const std::vector<int>
   h.weights = clamp ? "clamped" : "cotan";
   const int nv = int(s.p.size());
   if (loop_a.empty() || loop_b.empty()) throw Error("a segment end without vertices");
+  for (const std::vector<int>* loop : {&loop_a, &loop_b})  // (an index out of the band would write past `mark`)
+    if (std::any_of(loop->begin(), loop->end(), [nv](int v) { return v < 0 || v >= nv; }))
+      throw Error("a segment end with a vertex that is not the band's (internal error)");
   const std::vector<double> w = cot_weights(s, E, clamp);
   std::vector<char> mark(nv, 0);
   for (int v : loop_a) mark[v] = 1;

@@ -443,5 +443,42 @@ TEST(FlattenBranches, NegativeMinAreaIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "flat.vtp"));
 }
 
+// A tube (32 x 40 quads) and cuts as find_branches gives them: one in the middle is made; one that
+// takes a notch out of an end ring, and one that leaves only a row of faces the clean-up removes
+// before the ring, are dropped, so every vertex of both ends stays a corner of a kept face (the
+// end loops are the harmonic solve's boundary: a lost vertex wrote outside the band's arrays).
+TEST(FlattenBranches, CutsThatWouldTakeAnEndVertexAreDroppedAndTheEndsStayWhole) {
+  const TriangleList tube = synthetic::open_cylinder(10, 80, 32, 40);
+  flat_detail::Surface s;
+  for (const auto& p : tube.points) s.p.emplace_back(p[0], p[1], p[2]);
+  s.t.assign(tube.triangles.begin(), tube.triangles.end());
+  const flat_detail::Edges E = flat_detail::build_edges(s.t);
+  const std::vector<std::vector<int>> ends = flat_detail::boundary_loops(s, E);
+  ASSERT_EQ(ends.size(), 2u);
+  const auto quads = [](int j0, int j1, int i0, int i1) {  // both triangles of quads [j0, j1) x [i0, i1)
+    flat_detail::BranchCut c;
+    for (int j = j0; j < j1; ++j)
+      for (int i = i0; i < i1; ++i) c.faces.push_back(2 * (j * 32 + i)), c.faces.push_back(2 * (j * 32 + i) + 1);
+    return c;
+  };
+  const flat_detail::BranchCut middle = quads(18, 22, 5, 9), notch = quads(0, 3, 20, 24), near_end = quads(1, 4, 12, 15);
+  std::vector<flat_detail::BranchCut> cuts = {notch, middle, near_end};
+  const std::vector<char> keep = flat_detail::band_faces_after_cuts(s, E, ends, cuts);
+  ASSERT_EQ(cuts.size(), 1u);
+  EXPECT_EQ(cuts[0].faces, middle.faces);
+  std::vector<char> want(s.t.size(), 1), corner(s.p.size(), 0);
+  for (int f : middle.faces) want[std::size_t(f)] = 0;
+  EXPECT_EQ(keep, want);
+  for (std::size_t f = 0; f < s.t.size(); ++f)
+    if (keep[f])
+      for (int v : s.t[f]) corner[std::size_t(v)] = 1;
+  for (const auto& end : ends)
+    for (int v : end) EXPECT_TRUE(corner[std::size_t(v)]) << "end vertex " << v;
+  // Only cuts at the ends: none is made, and the band keeps every face.
+  std::vector<flat_detail::BranchCut> end_cuts = {notch, near_end};
+  EXPECT_EQ(flat_detail::band_faces_after_cuts(s, E, ends, end_cuts), std::vector<char>(s.t.size(), 1));
+  EXPECT_TRUE(end_cuts.empty());
+}
+
 }  // namespace
 }  // namespace cf
