@@ -23,6 +23,7 @@
 #include <string>
 
 #include "colonflat/core/threads.h"
+#include "branch_ends.h"
 #include "flatten_internal.h"
 
 namespace cf::flat_detail {

@@ -16,6 +16,7 @@
 #include "colonflat/core/threads.h"
 #include "colonflat/core/topology.h"
 #include "band_faces.h"
+#include "branch_ends.h"
 #include "branch_bands.h"
 #include "disk_map.h"
 #include "face_blocks.h"

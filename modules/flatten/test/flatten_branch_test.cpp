@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../src/branch_ends.h"
 #include "../src/flatten_internal.h"
 #include "colonflat/core/error.h"
 #include "colonflat/core/mesh_io.h"
