@@ -1,14 +1,15 @@
 // End-to-end benchmark of `colonflat run` (issue 26's headline: a real scan in <= 60 s and <= 3 GB
 // on 2 cores, >= 150 % CPU over the run), Release:
-//   run_bench                      the real CT and two CTs painted around the real lumen mask at 0.5 mm
+//   run_bench                      the real CT, two CTs painted around the real lumen mask at 0.5 mm
 //                                  slice spacing (the mask's own length, and the mask padded with empty
-//                                  slices: a longer thin-slice scan), 2 threads: one row per case
+//                                  slices: a longer thin-slice scan) and one painted around the real CT's
+//                                  own lumen grown by one voxel (touching loops), 2 threads: one row per case
 //   run_bench --threads-list 1,2   the same for each thread count
-//   run_bench --cases real         only some cases (real, thin, long)
+//   run_bench --cases real         only some cases (real, thin, long, grown)
 // Each run is `colonflat run CT -o DIR --threads N -q` in a child process (the one next to this
 // binary, or --colonflat): wall time, CPU time (user + system) and peak resident set from wait4(),
-// the stages' times from DIR/run_report.json. The painted CTs (colonflat phantom --from-mask
-// --slice-spacing 0.5) are kept in --work and reused (--fresh paints them again).
+// the stages' times from DIR/run_report.json. The painted CTs (colonflat phantom --from-mask) are
+// kept in --work and reused (--fresh paints them again).
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -24,6 +25,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -83,24 +85,46 @@ struct Case {
   std::string name, ct, size;
 };
 
-// The CT painted around the real mask padded with `pad` empty slices, at 0.5 mm slices, in
-// work/NAME/ct.nrrd (painted when absent or `fresh`).
-std::string painted_ct(const fs::path& colonflat, const fs::path& mask_file, int pad, const fs::path& work,
-                       const std::string& name, bool fresh) {
+// Runs `colonflat ARGS... -q` (log in dir/LOG); throws naming `what` when it fails.
+void run_or_throw(const fs::path& colonflat, std::vector<std::string> args, const fs::path& dir, const std::string& log,
+                  const std::string& what) {
+  args.insert(args.begin(), colonflat.string());
+  args.push_back("-q");
+  const ChildRun r = run_child(args, dir / log);
+  if (r.rc != 0) throw std::runtime_error(what + " failed (exit " + std::to_string(r.rc) + "), see " + (dir / log).string());
+}
+
+// The CT painted around `mask` (`paint`: phantom's position, seed and slices), in work/NAME/ct.nrrd;
+// `make_mask(dir)` (optional) gives the mask to paint around, made in that folder. Painted when
+// absent or `fresh`.
+std::string painted_ct(const fs::path& colonflat, fs::path mask, const std::vector<std::string>& paint,
+                       const fs::path& work, const std::string& name, bool fresh,
+                       const std::function<fs::path(const fs::path&)>& make_mask = {}) {
   const fs::path dir = work / name, ct = dir / "ct.nrrd";
   if (fs::exists(ct) && !fresh) return ct.string();
   fs::create_directories(dir);
-  fs::path mask = mask_file;
-  if (pad > 0) {
-    mask = dir / "padded_mask.nii.gz";
-    cf::write_mask(cf::bench::padded_mask(cf::read_binary_mask(mask_file), pad).GetPointer(), mask);
-  }
-  const ChildRun r = run_child({colonflat.string(), "phantom", "--from-mask", mask.string(), "--position", "supine",
-                                "--seed", "14", "--slice-spacing", "0.5", "-o", dir.string(), "-q"},
-                               dir / "phantom.log");
-  if (r.rc != 0) throw std::runtime_error("painting " + name + " failed (exit " + std::to_string(r.rc) + "), see " +
-                                          (dir / "phantom.log").string());
+  if (make_mask) mask = make_mask(dir);
+  std::vector<std::string> args = {"phantom", "--from-mask", mask.string(), "-o", dir.string()};
+  args.insert(args.end(), paint.begin(), paint.end());
+  run_or_throw(colonflat, args, dir, "phantom.log", "painting " + name);
   return ct.string();
+}
+
+// The real mask with `pad` empty slices after its last (dir/padded_mask.nii.gz).
+fs::path padded_real_mask(const fs::path& mask_file, int pad, const fs::path& dir) {
+  const fs::path mask = dir / "padded_mask.nii.gz";
+  cf::write_mask(cf::bench::padded_mask(cf::read_binary_mask(mask_file), pad).GetPointer(), mask);
+  return mask;
+}
+
+// The real CT's own lumen (`colonflat run --to segment`) grown by one voxel (dir/grown_mask.nii.gz):
+// its colon loops touch where the real ones nearly do, and the denoised surface has ~250 handles.
+fs::path grown_ct_mask(const fs::path& colonflat, const fs::path& real_ct, const fs::path& dir) {
+  const fs::path seg = dir / "segment", mask = dir / "grown_mask.nii.gz";
+  run_or_throw(colonflat, {"run", real_ct.string(), "--to", "segment", "-o", seg.string()}, dir, "segment.log",
+               "segmenting the real CT");
+  cf::write_mask(cf::bench::grown_mask(cf::read_binary_mask(seg / "lumen_mask.nrrd").GetPointer(), 1).GetPointer(), mask);
+  return mask;
 }
 
 // Whether `list` (comma-separated; empty: all) names `name`.
@@ -178,7 +202,7 @@ int main(int argc, char** argv) {
   cli.app().add_option("--real", real, "folder of the real data (ctc_prone_a.nrrd, ctc_lumen_mask_a.nii.gz)")
       ->capture_default_str();
   cli.app().add_option("--work", work, "folder for the painted CTs (kept, reused) and the runs' outputs");
-  cli.app().add_option("--cases", cases, "comma-separated: real, thin, long (default all)");
+  cli.app().add_option("--cases", cases, "comma-separated: real, thin, long, grown (default all)");
   cli.app().add_option("--threads-list", threads_list, "comma-separated thread counts (default 2)");
   cli.app().add_option("--pad-slices", pad, "empty 1.25 mm slices added to the mask for the long case (default 90)")
       ->check(CLI::Range(0, 2000));
@@ -190,8 +214,15 @@ int main(int argc, char** argv) {
     fs::create_directories(work);
     std::vector<Case> list;
     if (selected(cases, "real")) list.push_back({"real", (fs::path(real) / "ctc_prone_a.nrrd").string(), ""});
-    if (selected(cases, "thin")) list.push_back({"thin", painted_ct(bin, mask, 0, work, "thin", fresh), ""});
-    if (selected(cases, "long")) list.push_back({"long", painted_ct(bin, mask, pad, work, "long", fresh), ""});
+    const std::vector<std::string> thin_slices = {"--position", "supine", "--seed", "14", "--slice-spacing", "0.5"};
+    if (selected(cases, "thin")) list.push_back({"thin", painted_ct(bin, mask, thin_slices, work, "thin", fresh), ""});
+    if (selected(cases, "long"))
+      list.push_back({"long", painted_ct(bin, mask, thin_slices, work, "long", fresh,
+                                         [&](const fs::path& dir) { return padded_real_mask(mask, pad, dir); }), ""});
+    const fs::path real_ct = fs::path(real) / "ctc_prone_a.nrrd";
+    if (selected(cases, "grown"))
+      list.push_back({"grown", painted_ct(bin, {}, {"--position", "prone", "--seed", "14"}, work, "grown", fresh,
+                                          [&](const fs::path& dir) { return grown_ct_mask(bin, real_ct, dir); }), ""});
     for (Case& c : list) c.size = volume_size(c.ct);
     std::printf("run_bench: colonflat run, load %.2f at the start\n", cf::bench::load_average());
     print_header();
@@ -202,8 +233,9 @@ int main(int argc, char** argv) {
     for (const Case& c : list)
       for (int n : threads) ok = bench_case(bin, c, n, work) && ok;
     std::printf("cases: real = %s; thin = the CT painted around %s at 0.5 mm slices; long = the same mask with %d "
-                "empty slices after its last, painted at 0.5 mm\n",
-                list.empty() ? "-" : (fs::path(real) / "ctc_prone_a.nrrd").c_str(), mask.c_str(), pad);
+                "empty slices after its last, painted at 0.5 mm; grown = the real CT's own lumen grown by one voxel, "
+                "painted prone at its slices\n",
+                real_ct.c_str(), mask.c_str(), pad);
     return ok ? 0 : 1;
   });
 }
