@@ -197,6 +197,28 @@ cf::flat_detail::Surface bumpy_tube(int na, int nz) {
 
 }  // namespace
 
+// An end loop holding a vertex that is not the surface's (-1, or one past its last) is refused with
+// one error before anything is written (it would index outside the band's arrays); the loops
+// themselves solve.
+TEST(FlattenSolver, EndLoopWithAVertexOutsideTheBandIsRefused) {
+  using namespace cf::flat_detail;
+  const Surface tube = bumpy_tube(12, 20);
+  const Edges E = build_edges(tube.t);
+  const auto loops = boundary_loops(tube, E);
+  ASSERT_EQ(loops.size(), 2u);
+  EXPECT_GT(solve_harmonic(tube, E, loops[0], loops[1], false).period, 0);
+  for (int bad : {-1, int(tube.p.size())}) {
+    std::vector<int> a = loops[0];
+    a.push_back(bad);
+    try {
+      solve_harmonic(tube, E, a, loops[1], false);
+      ADD_FAILURE() << "vertex " << bad << " was accepted";
+    } catch (const cf::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("not the band's"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // The map after cutting pieces out of a surface, solved by updating the first map's factorisation
 // (rank-one terms for the changed weights, the cut-off vertices grounded), equals a new solve on
 // what remains; two cut-off pieces (two holes) are each grounded.
