@@ -82,37 +82,12 @@ BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port) 
 }
 
 namespace {
-// `known` when it fits `list` (topology_fits), else analyze_topology(list).
-TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList& list) {
-  return known && topology_fits(*known, list) ? *known : analyze_topology(list);
-}
-
-// The mesh oriented outward in place: its recorded orientation (read_orientation) with what
-// orient_outward turned appended, the mesh rebuilt only when a face turned. `topo` gets `known` when it
-// fits the mesh (topology_fits), else its analysis; `list`, when given, to_triangle_list of the mesh as
-// it is left (read back after a rebuild, so that it matches the bag's mesh).
-OrientationReport orient_mesh_in_place(Mesh& mesh, const TopologyReport* known, TopologyReport& topo,
-                                       std::optional<TriangleList>* list = nullptr) {
-  OrientationReport r = read_orientation(mesh);
-  TriangleList made = to_triangle_list(mesh);
-  topo = known_or_analysed(known, made);
-  const OrientationReport turned = orient_outward(made, topo);
-  if (!turned.empty()) {
-    mesh = build_mesh(made);
-    if (list) made = to_triangle_list(mesh);
-  }
-  if (list) *list = std::move(made);
-  r.append(turned);
-  return r;
-}
-
 // orient_mesh with the mesh's topology when known (`known`, used only when topology_fits the mesh;
 // null: analysed): the same report, notes and mesh either way.
 nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const RunContext& ctx,
                                  const std::string& stage, const std::string& port, TopologyReport* topology) {
-  TopologyReport topo;
-  const OrientationReport r = orient_mesh_in_place(mesh, known, topo);
-  if (topology) *topology = std::move(topo);
+  OrientationReport r = read_orientation(mesh);
+  r.append(orient_outward(mesh, topology, known));
   return noted(r, ctx, stage, port);
 }
 }  // namespace
@@ -154,7 +129,9 @@ OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, cons
     in.orientation = orient_surface(held, ctx, stage, port, &in.topology, known);
     return in;
   }
-  in.orientation = noted(orient_mesh_in_place(*held.mesh, known, in.topology, &in.converted), ctx, stage, port);
+  OrientationReport r = read_orientation(*held.mesh);
+  r.append(orient_outward(*held.mesh, &in.topology, known, &in.converted));
+  in.orientation = noted(r, ctx, stage, port);
   return in;
 }
 

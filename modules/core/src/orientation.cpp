@@ -303,11 +303,16 @@ OrientationReport orient_outward(TriangleList& t, const TopologyReport& topo) {
   return r;
 }
 
-OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology) {
+OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology, const TopologyReport* known,
+                                 std::optional<TriangleList>* list) {
   TriangleList t = to_triangle_list(mesh);
-  TopologyReport topo = analyze_topology(t);
+  TopologyReport topo = known_or_analysed(known, t);
   OrientationReport r = orient_outward(t, topo);
-  if (!r.empty()) mesh = build_mesh(t);
+  if (!r.empty()) {
+    mesh = build_mesh(t);
+    if (list) t = to_triangle_list(mesh);
+  }
+  if (list) *list = std::move(t);
   if (topology) *topology = std::move(topo);
   return r;
 }

@@ -403,6 +403,10 @@ bool topology_fits(const TopologyReport& t, const TriangleList& mesh) {
   return lo == t.bbox_min && hi == t.bbox_max;
 }
 
+TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList& mesh) {
+  return known && topology_fits(*known, mesh) ? *known : analyze_topology(mesh);
+}
+
 // The mesh's points are read in place (no copy of 24 bytes per vertex).
 TopologyReport analyze_topology(const Mesh& mesh) {
   return TopologyAnalysis<Vec3>(mesh.points(), mesh.n_vertices(), mesh_triangles(mesh)).run();

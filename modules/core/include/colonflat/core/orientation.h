@@ -14,6 +14,7 @@
 // Both return what they changed, one note per component, e.g.
 //   "component 0 (1460112 faces, 3.80 L): normals pointed into the lumen; reversed".
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,8 +81,12 @@ OrientationReport make_consistent(TriangleList& t, const TopologyReport& topo);
 OrientationReport orient_outward(TriangleList& t, const TopologyReport& topo);
 // The same on a mesh (no deleted elements); rebuilt, same vertex and face order, when a
 // component is reversed. `topology` (optional) receives analyze_topology of the mesh, which
-// reversing whole components does not change (components, counts, Euler characteristic, genus).
-OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology = nullptr);
+// reversing whole components does not change (components, counts, Euler characteristic, genus);
+// `known` (optional): the mesh's topology when the caller has it, used instead of analysing when it
+// fits (known_or_analysed); `list` (optional) receives to_triangle_list of the mesh as it is left
+// (read back after a rebuild). The same report and mesh with or without `known`.
+OrientationReport orient_outward(Mesh& mesh, TopologyReport* topology = nullptr, const TopologyReport* known = nullptr,
+                                 std::optional<TriangleList>* list = nullptr);
 
 // Builds an OpenMesh mesh from a manifold, consistently oriented triangle list (same order).
 // Throws PreconditionError when a face cannot be added.

@@ -61,6 +61,9 @@ TopologyReport analyze_topology(const Mesh& mesh);
 // analysis: one face_component per triangle, the mesh's face and vertex counts, and (every vertex
 // referenced) its exact bounding box. O(#P); a cheap guard, not a proof (callers vouch for the rest).
 bool topology_fits(const TopologyReport& t, const TriangleList& mesh);
+// `known` (a report handed on with `mesh`; null: none) when it fits the mesh (topology_fits), else
+// analyze_topology(mesh).
+TopologyReport known_or_analysed(const TopologyReport* known, const TriangleList& mesh);
 
 // Conversions between the two representations (same vertex and face order).
 TriangleList to_triangle_list(const Mesh& mesh);
