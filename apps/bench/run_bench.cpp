@@ -8,9 +8,8 @@
 //   run_bench --cases real         only some cases (real, thin, long, grown)
 // Each run is `colonflat run CT -o DIR --threads N -q` in a child process (the one next to this
 // binary, or --colonflat): wall time, CPU time (user + system), its system part and peak resident
-// set from wait4(),
-// the stages' times from DIR/run_report.json. The painted CTs (colonflat phantom --from-mask) are
-// kept in --work and reused (--fresh paints them again).
+// set from wait4(), the stages' times from DIR/run_report.json. The painted CTs (colonflat phantom
+// --from-mask) are kept in --work and reused (--fresh paints them again).
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
