@@ -216,13 +216,13 @@ int main(int argc, char** argv) {
     const fs::path mask = fs::path(real) / "ctc_lumen_mask_a.nii.gz";
     fs::create_directories(work);
     std::vector<Case> list;
-    if (selected(cases, "real")) list.push_back({"real", (fs::path(real) / "ctc_prone_a.nrrd").string(), ""});
+    const fs::path real_ct = fs::path(real) / "ctc_prone_a.nrrd";
+    if (selected(cases, "real")) list.push_back({"real", real_ct.string(), ""});
     const std::vector<std::string> thin_slices = {"--position", "supine", "--seed", "14", "--slice-spacing", "0.5"};
     if (selected(cases, "thin")) list.push_back({"thin", painted_ct(bin, mask, thin_slices, work, "thin", fresh), ""});
     if (selected(cases, "long"))
       list.push_back({"long", painted_ct(bin, mask, thin_slices, work, "long", fresh,
                                          [&](const fs::path& dir) { return padded_real_mask(mask, pad, dir); }), ""});
-    const fs::path real_ct = fs::path(real) / "ctc_prone_a.nrrd";
     if (selected(cases, "grown"))
       list.push_back({"grown", painted_ct(bin, {}, {"--position", "prone", "--seed", "14"}, work, "grown", fresh,
                                           [&](const fs::path& dir) { return grown_ct_mask(bin, real_ct, dir); }), ""});

@@ -83,11 +83,13 @@ BagSurface bag_surface_for_orienting(ArtifactBag& bag, const std::string& port) 
 
 namespace {
 // orient_mesh with the mesh's topology when known (`known`, used only when topology_fits the mesh;
-// null: analysed): the same report, notes and mesh either way.
+// null: analysed): the same report, notes and mesh either way. `list` (optional): the mesh's
+// triangle list as it is left (orient_outward's).
 nlohmann::json orient_mesh_known(Mesh& mesh, const TopologyReport* known, const RunContext& ctx,
-                                 const std::string& stage, const std::string& port, TopologyReport* topology) {
+                                 const std::string& stage, const std::string& port, TopologyReport* topology,
+                                 std::optional<TriangleList>* list = nullptr) {
   OrientationReport r = read_orientation(mesh);
-  r.append(orient_outward(mesh, topology, known));
+  r.append(orient_outward(mesh, topology, known, list));
   return noted(r, ctx, stage, port);
 }
 }  // namespace
@@ -129,9 +131,7 @@ OrientedMesh oriented_mesh_input(ArtifactBag& bag, const std::string& port, cons
     in.orientation = orient_surface(held, ctx, stage, port, &in.topology, known);
     return in;
   }
-  OrientationReport r = read_orientation(*held.mesh);
-  r.append(orient_outward(*held.mesh, &in.topology, known, &in.converted));
-  in.orientation = noted(r, ctx, stage, port);
+  in.orientation = orient_mesh_known(*held.mesh, known, ctx, stage, port, &in.topology, &in.converted);
   return in;
 }
 
