@@ -3,9 +3,11 @@
 //   run_bench                      the real CT, two CTs painted around the real lumen mask at 0.5 mm
 //                                  slice spacing (the mask's own length, and the mask padded with empty
 //                                  slices: a longer thin-slice scan) and one painted around the real CT's
-//                                  own lumen grown by one voxel (touching loops), 2 threads: one row per case
+//                                  own lumen grown by one voxel (touching loops), and that lumen (not grown)
+//                                  at 1.25 mm slices (a thick-slice scan: thin walls between loops drop out),
+//                                  2 threads: one row per case
 //   run_bench --threads-list 1,2   the same for each thread count
-//   run_bench --cases real         only some cases (real, thin, long, grown)
+//   run_bench --cases real         only some cases (real, thin, long, grown, sliced)
 // Each run is `colonflat run CT -o DIR --threads N -q` in a child process (the one next to this
 // binary, or --colonflat): wall time, CPU time (user + system), its system part and peak resident
 // set from wait4(), the stages' times from DIR/run_report.json. The painted CTs (colonflat phantom
@@ -120,13 +122,14 @@ fs::path padded_real_mask(const fs::path& mask_file, int pad, const fs::path& di
   return mask;
 }
 
-// The real CT's own lumen (`colonflat run --to segment`) grown by one voxel (dir/grown_mask.nii.gz):
-// its colon loops touch where the real ones nearly do, and the denoised surface has ~250 handles.
-fs::path grown_ct_mask(const fs::path& colonflat, const fs::path& real_ct, const fs::path& dir) {
-  const fs::path seg = dir / "segment", mask = dir / "grown_mask.nii.gz";
+// The real CT's own lumen (`colonflat run --to segment`), grown by `grow` voxels (dir/ct_mask.nii.gz).
+// Grown by one voxel, its colon loops touch where the real ones nearly do, and the denoised surface
+// has ~250 handles.
+fs::path real_ct_mask(const fs::path& colonflat, const fs::path& real_ct, int grow, const fs::path& dir) {
+  const fs::path seg = dir / "segment", mask = dir / "ct_mask.nii.gz";
   run_or_throw(colonflat, {"run", real_ct.string(), "--to", "segment", "-o", seg.string()}, dir, "segment.log",
                "segmenting the real CT");
-  cf::write_mask(cf::bench::grown_mask(cf::read_binary_mask(seg / "lumen_mask.nrrd").GetPointer(), 1).GetPointer(), mask);
+  cf::write_mask(cf::bench::grown_mask(cf::read_binary_mask(seg / "lumen_mask.nrrd").GetPointer(), grow).GetPointer(), mask);
   return mask;
 }
 
@@ -205,7 +208,7 @@ int main(int argc, char** argv) {
   cli.app().add_option("--real", real, "folder of the real data (ctc_prone_a.nrrd, ctc_lumen_mask_a.nii.gz)")
       ->capture_default_str();
   cli.app().add_option("--work", work, "folder for the painted CTs (kept, reused) and the runs' outputs");
-  cli.app().add_option("--cases", cases, "comma-separated: real, thin, long, grown (default all)");
+  cli.app().add_option("--cases", cases, "comma-separated: real, thin, long, grown, sliced (default all)");
   cli.app().add_option("--threads-list", threads_list, "comma-separated thread counts (default 2)");
   cli.app().add_option("--pad-slices", pad, "empty 1.25 mm slices added to the mask for the long case (default 90)")
       ->check(CLI::Range(0, 2000));
@@ -219,13 +222,18 @@ int main(int argc, char** argv) {
     const fs::path real_ct = fs::path(real) / "ctc_prone_a.nrrd";
     if (selected(cases, "real")) list.push_back({"real", real_ct.string(), ""});
     const std::vector<std::string> thin_slices = {"--position", "supine", "--seed", "14", "--slice-spacing", "0.5"};
+    const std::vector<std::string> sliced_paint = {"--position",      "supine", "--seed",       "5",
+                                                   "--slice-spacing", "1.25",   "--deep-pools", "--pressed-bowel"};
     if (selected(cases, "thin")) list.push_back({"thin", painted_ct(bin, mask, thin_slices, work, "thin", fresh), ""});
     if (selected(cases, "long"))
       list.push_back({"long", painted_ct(bin, mask, thin_slices, work, "long", fresh,
                                          [&](const fs::path& dir) { return padded_real_mask(mask, pad, dir); }), ""});
     if (selected(cases, "grown"))
       list.push_back({"grown", painted_ct(bin, {}, {"--position", "prone", "--seed", "14"}, work, "grown", fresh,
-                                          [&](const fs::path& dir) { return grown_ct_mask(bin, real_ct, dir); }), ""});
+                                          [&](const fs::path& dir) { return real_ct_mask(bin, real_ct, 1, dir); }), ""});
+    if (selected(cases, "sliced"))
+      list.push_back({"sliced", painted_ct(bin, {}, sliced_paint, work, "sliced", fresh,
+                                           [&](const fs::path& dir) { return real_ct_mask(bin, real_ct, 0, dir); }), ""});
     for (Case& c : list) c.size = volume_size(c.ct);
     std::printf("run_bench: colonflat run, load %.2f at the start\n", cf::bench::load_average());
     print_header();
@@ -237,7 +245,8 @@ int main(int argc, char** argv) {
       for (int n : threads) ok = bench_case(bin, c, n, work) && ok;
     std::printf("cases: real = %s; thin = the CT painted around %s at 0.5 mm slices; long = the same mask with %d "
                 "empty slices after its last, painted at 0.5 mm; grown = the real CT's own lumen grown by one voxel, "
-                "painted prone at its slices\n",
+                "painted prone at its slices; sliced = the real CT's own lumen at 1.25 mm slices (every slice the nearest "
+                "of the 1 mm ones), painted supine with deep pools and pressed bowel\n",
                 real_ct.c_str(), mask.c_str(), pad);
     return ok ? 0 : 1;
   });
