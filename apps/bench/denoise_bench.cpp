@@ -15,7 +15,9 @@
 //           - the real prone CT ../shared/real/ctc_prone_a.nrrd, segmented and reconstructed with
 //             the defaults (as `colonflat run` does: reconstruct also gets the CT);
 //           - its lumen mask reconstructed from the mask alone, raw, with the defaults, grown
-//             and shrunk by one voxel (the rows of the real mask, for a second real colon);
+//             and shrunk by one voxel (the rows of the real mask, for a second real colon), and at
+//             1.25 mm slices (a mask with thinner slices only: a thick-slice scan of the same colon,
+//             where walls between touching loops that lay in a dropped slice are gone);
 //           - the real GCA large-intestine surfaces (../shared/real/*.vtk);
 //           - generated colon-like surfaces at 0.42 mm voxels (bench_meshes.h): limbs touching
 //             over 60, 120 and 180 mm, no contact;
@@ -45,6 +47,7 @@
 #include "colonflat/core/run_stats.h"
 #include "colonflat/core/threads.h"
 #include "colonflat/denoise/denoise.h"
+#include "colonflat/phantom/mask_phantom.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include "colonflat/segment/segment.h"
 #include "colonflat/volume/volume_io.h"
@@ -129,7 +132,7 @@ void built(const std::string& name, const std::function<Mesh()>& build) {
 
 // The rows of one real lumen mask: its raw staircase (no sub-voxel surface, no smoothing or
 // fairing: far more handles), reconstruct's defaults, and the defaults on the mask grown and shrunk
-// by one voxel (mask_variants.h).
+// by one voxel and, when its slices are thinner, at kThickSliceMm slices (mask_variants.h).
 void mask_cases(const std::string& name, const MaskImage* mask) {
   built(name + " raw", [&] {
     ReconstructOptions raw;
@@ -142,6 +145,10 @@ void mask_cases(const std::string& name, const MaskImage* mask) {
   for (int grow : {1, -1})
     built(name + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
           [&] { return reconstruct_surface(bench::grown_mask(mask, grow).GetPointer(), ReconstructOptions{}); });
+  if (mask->GetSpacing()[2] < bench::kThickSliceMm)
+    built(name + " 1.25 mm slices", [&] {
+      return reconstruct_surface(resample_mask_slices(mask, bench::kThickSliceMm).GetPointer(), ReconstructOptions{});
+    });
 }
 
 void real_cases() {

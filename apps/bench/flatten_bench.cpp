@@ -16,7 +16,9 @@
 //                            coverage, area ratio p05/p95, qc mean/p95, flipped, time, peak memory;
 //                            DIR3 gets colon.png per case. --raw-masks: each mask also as its raw
 //                            staircase; --grown-masks: each mask also grown and shrunk by one voxel
-//                            (mask_variants.h: the same anatomy with thinner / thicker walls).
+//                            (mask_variants.h: the same anatomy with thinner / thicker walls);
+//                            --sliced-masks: each mask with thinner slices also at 1.25 mm slices
+//                            (a thick-slice scan: walls between touching loops drop out).
 #include <benchmark/benchmark.h>
 
 #include "bench_cli.h"
@@ -50,6 +52,7 @@
 #include "colonflat/flatten/flatten.h"
 #include "colonflat/flatten/synthetic_colon.h"
 #include "colonflat/testdata/synthetic.h"
+#include "colonflat/phantom/mask_phantom.h"
 #include "colonflat/phantom/phantom.h"
 #include "colonflat/reconstruct/reconstruct.h"
 #include <vtkImageData.h>
@@ -146,19 +149,24 @@ void phantom_table(int first, int last, const std::string& size, const std::stri
 // The denoised surface of a real case, computed once and cached; `raw`: a lumen mask reconstructed
 // as its binary staircase (no sub-voxel surface, smoothing or fairing: far more handles).
 // A real case denoised (cached in `cache`): a surface as it is, a mask reconstructed first (`raw`:
-// as its binary staircase; `grow` != 0: the mask grown (> 0) or shrunk (< 0) by that many voxels).
+// as its binary staircase; `grow` != 0: the mask grown (> 0) or shrunk (< 0) by that many voxels;
+// `sliced`: the mask at kThickSliceMm slices).
 std::filesystem::path denoised_real(const std::filesystem::path& in, const std::filesystem::path& cache, bool raw,
-                                    int grow = 0) {
+                                    int grow = 0, bool sliced = false) {
   std::filesystem::create_directories(cache);
   std::string stem = in.filename().string();
   stem = stem.substr(0, stem.find('.')) + (raw ? "_raw" : "") +
-         (grow > 0 ? "_grown" + std::to_string(grow) : grow < 0 ? "_shrunk" + std::to_string(-grow) : "");
+         (grow > 0 ? "_grown" + std::to_string(grow) : grow < 0 ? "_shrunk" + std::to_string(-grow) : "") +
+         (sliced ? "_sliced" : "");
   const auto den = cache / (stem + "_denoised.vtp");
   if (std::filesystem::exists(den)) return den;
   std::filesystem::path source = in;
-  if (grow != 0) {
+  if (grow != 0 || sliced) {
     source = cache / (stem + "_mask.nii.gz");
-    cf::write_mask(cf::bench::grown_mask(cf::read_mask(in).GetPointer(), grow).GetPointer(), source);
+    const cf::MaskImage::Pointer mask = cf::read_mask(in);
+    cf::write_mask(sliced ? cf::resample_mask_slices(mask, cf::bench::kThickSliceMm).GetPointer()
+                          : cf::bench::grown_mask(mask, grow).GetPointer(),
+                   source);
   }
   auto run = [](std::unique_ptr<cf::Stage> (*make)(), const std::vector<std::string>& args) {
     std::ostringstream o, e;
@@ -275,7 +283,7 @@ void stress_row(const std::string& name, const cf::Mesh& mesh, int threads, cons
 struct StressOptions {
   std::string real, cache, map, out;
   std::vector<std::string> surfaces;
-  bool generated = false, raw_masks = false, grown_masks = false;
+  bool generated = false, raw_masks = false, grown_masks = false, sliced_masks = false;
   std::vector<int> thread_counts{1, 2};
 };
 
@@ -301,6 +309,9 @@ void stress_table(const StressOptions& so) {
         if (mask && so.grown_masks)
           cases.push_back({in.filename().string() + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
                            [in, grow, &so] { return cf::load_mesh(denoised_real(in, so.cache, false, grow)).mesh; }});
+      if (mask && so.sliced_masks && cf::read_mask(in)->GetSpacing()[2] < cf::bench::kThickSliceMm)
+        cases.push_back({in.filename().string() + " 1.25 mm slices",
+                         [in, &so] { return cf::load_mesh(denoised_real(in, so.cache, false, 0, true)).mesh; }});
     }
   }
   for (const std::string& f : so.surfaces)
@@ -352,6 +363,8 @@ int main(int argc, char** argv) {
   app.add_flag("--generated", so.generated, "stress set: the generated colon-like surfaces");
   app.add_flag("--raw-masks", so.raw_masks, "stress set: also each --real mask reconstructed as its raw staircase");
   app.add_flag("--grown-masks", so.grown_masks, "stress set: also each --real mask grown and shrunk by one voxel");
+  app.add_flag("--sliced-masks", so.sliced_masks,
+               "stress set: also each --real mask with thinner slices at 1.25 mm slices (each the nearest of its own)");
   app.add_option("--thread-counts", threads, "stress set: thread counts, one row each (e.g. 1,2)");
   app.add_option("--cache", so.cache, "cache of denoised real and generated surfaces");
   app.add_option("--map", so.map, "flatten map")->check(CLI::IsMember({"area-balanced", "conformal"}));
