@@ -146,7 +146,7 @@ void mask_cases(const std::string& name, const MaskImage* mask) {
     built(name + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
           [&] { return reconstruct_surface(bench::grown_mask(mask, grow).GetPointer(), ReconstructOptions{}); });
   if (mask->GetSpacing()[2] < bench::kThickSliceMm)
-    built(name + " 1.25 mm slices", [&] {
+    built(name + " " + bench::thick_slice_text() + " mm slices", [&] {
       return reconstruct_surface(resample_mask_slices(mask, bench::kThickSliceMm).GetPointer(), ReconstructOptions{});
     });
 }

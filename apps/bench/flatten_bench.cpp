@@ -310,7 +310,7 @@ void stress_table(const StressOptions& so) {
           cases.push_back({in.filename().string() + (grow > 0 ? " grown 1 vx" : " shrunk 1 vx"),
                            [in, grow, &so] { return cf::load_mesh(denoised_real(in, so.cache, false, grow)).mesh; }});
       if (mask && so.sliced_masks && cf::read_mask(in)->GetSpacing()[2] < cf::bench::kThickSliceMm)
-        cases.push_back({in.filename().string() + " 1.25 mm slices",
+        cases.push_back({in.filename().string() + " " + cf::bench::thick_slice_text() + " mm slices",
                          [in, &so] { return cf::load_mesh(denoised_real(in, so.cache, false, 0, true)).mesh; }});
     }
   }

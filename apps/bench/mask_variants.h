@@ -3,6 +3,9 @@
 // thinner or thicker, as another segmentation of the same scan could give it. Growing the lumen
 // closes the thin walls between touching colon loops (more and longer handles, pockets behind
 // long contacts); shrinking it opens thin necks and strands (fewer handles).
+#include <cstdio>
+#include <string>
+
 #include "colonflat/volume/volume_io.h"
 
 namespace cf::bench {
@@ -13,6 +16,13 @@ namespace cf::bench {
 // mask: genus 93 at its 1 mm slices, 170 at 1.25 mm; painted at 1.25 mm and run end to end: 224);
 // a common slice spacing of CT colonography.
 constexpr double kThickSliceMm = 1.25;
+
+// kThickSliceMm as text ("1.25"), for command lines and row names.
+inline std::string thick_slice_text() {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", kThickSliceMm);
+  return text;
+}
 
 // `mask` (lumen 1, else 0) dilated (voxels > 0) or eroded (voxels < 0) by ITK's binary
 // morphology with a ball of |voxels| voxels along every axis (BinaryBallStructuringElement).

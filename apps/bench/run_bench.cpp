@@ -222,8 +222,8 @@ int main(int argc, char** argv) {
     const fs::path real_ct = fs::path(real) / "ctc_prone_a.nrrd";
     if (selected(cases, "real")) list.push_back({"real", real_ct.string(), ""});
     const std::vector<std::string> thin_slices = {"--position", "supine", "--seed", "14", "--slice-spacing", "0.5"};
-    const std::vector<std::string> sliced_paint = {"--position",      "supine", "--seed",       "5",
-                                                   "--slice-spacing", "1.25",   "--deep-pools", "--pressed-bowel"};
+    const std::vector<std::string> sliced_paint = {"--position",      "supine", "--seed", "5", "--slice-spacing",
+                                                   cf::bench::thick_slice_text(), "--deep-pools", "--pressed-bowel"};
     if (selected(cases, "thin")) list.push_back({"thin", painted_ct(bin, mask, thin_slices, work, "thin", fresh), ""});
     if (selected(cases, "long"))
       list.push_back({"long", painted_ct(bin, mask, thin_slices, work, "long", fresh,
