@@ -2,6 +2,8 @@
 // its own index, resampled to thicker and thinner slices.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "colonflat/core/error.h"
